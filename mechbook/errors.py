@@ -1,0 +1,36 @@
+"""Errors that point a user at the exact place in a problem file that is wrong."""
+
+from __future__ import annotations
+
+
+class MechbookError(Exception):
+    """Base class for every error mechbook raises on purpose."""
+
+
+class ExpressionError(MechbookError):
+    """An expression string was rejected by the safe parser."""
+
+    def __init__(self, message: str, text: str | None = None):
+        self.text = text
+        super().__init__(message)
+
+
+class SpecError(MechbookError):
+    """A problem or answer file is malformed; carries file, line and what is wrong."""
+
+    def __init__(self, message: str, file: str | None = None, line: int | None = None):
+        self.file = file
+        self.line = line
+        self.bare = message
+        where = file or "<input>"
+        if line is not None:
+            where += f":{line}"
+        super().__init__(f"{where}: {message}")
+
+
+class UnsupportedError(MechbookError):
+    """The engine cannot compute this yet; names the capability that is missing."""
+
+    def __init__(self, capability: str):
+        self.capability = capability
+        super().__init__(f"unsupported: {capability}")

@@ -1,0 +1,242 @@
+"""Equilibria, linearization and small oscillations.
+
+The equations of motion E(q, q̇, q̈, t) = 0 are expanded to first order about a point q* with
+q̇ = q̈ = 0, counting parameters declared `small` (a driving amplitude, say) as first-order too:
+    M·δq̈ + C·δq̇ + K·δq = F(t),    δq = q − q*.
+C holds gyroscopic (antisymmetric) and damping (symmetric) terms. With C = 0 the normal
+frequencies are the roots of det(K − ω²M) = 0 and numerically `scipy.linalg.eigh(K, M)`; with
+gyroscopic terms they are the roots of det(K − ω²M + iωC) = 0 and numerically the imaginary
+parts of the state-space eigenvalues.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import sympy as sp
+
+from .errors import UnsupportedError
+from .lagrange import Dynamics
+from .timeout import Timeout, time_limit, try_simplify
+
+EPS = sp.Symbol("epsilon_order", positive=True)
+ZERO_TOL = 1e-9
+
+
+@dataclass
+class LinearSystem:
+    """M·δq̈ + C·δq̇ + K·δq = F(t) about `point`."""
+
+    dyn: Dynamics
+    point: dict
+    M: sp.Matrix
+    C: sp.Matrix
+    K: sp.Matrix
+    F: sp.Matrix
+
+    @property
+    def q(self):
+        return self.dyn.q
+
+    def displacement(self) -> sp.Matrix:
+        return sp.Matrix([q - self.point.get(q, 0) for q in self.q])
+
+    def equations(self) -> list[sp.Expr]:
+        """Linear equations (each = 0) in the original coordinate symbols."""
+        dq = self.displacement()
+        lhs = self.M * sp.Matrix(self.dyn.qdd) + self.C * sp.Matrix(self.dyn.qd) + self.K * dq
+        return [sp.expand(e) for e in lhs - self.F]
+
+    @property
+    def gyroscopic(self) -> bool:
+        return any(c != 0 for c in self.C)
+
+    # ---- symbolic frequencies ------------------------------------------------------------
+    @cached_property
+    def squared_frequencies(self) -> list[sp.Expr]:
+        """Roots w = ω² of det(K − w M) = 0 with multiplicity (no gyroscopic terms)."""
+        if self.gyroscopic:
+            raise UnsupportedError("ω² roots of a gyroscopic system (use `frequencies`)")
+        w = sp.Symbol("w")
+        poly = sp.Poly(sp.factor((self.K - w * self.M).det()), w)
+        try:
+            with time_limit(30):
+                roots = sp.roots(poly, w)
+        except Timeout:
+            roots = {}
+        if sum(roots.values()) != poly.degree():
+            raise UnsupportedError("closed-form roots of the secular equation")
+        out = []
+        for r, mult in roots.items():
+            out += [try_simplify(r, 5)] * mult
+        return out
+
+    @cached_property
+    def frequencies(self) -> list[sp.Expr]:
+        """Symbolic normal angular frequencies ω ≥ 0 (with multiplicity)."""
+        if not self.gyroscopic:
+            return [try_simplify(sp.sqrt(r), 5) for r in self.squared_frequencies]
+        om = sp.Symbol("omega_root", positive=True)
+        det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
+        n = len(self.q)
+        try:
+            with time_limit(30):
+                roots = sp.roots(sp.Poly(det, om), om)
+        except Timeout:
+            roots = {}
+        # keep the n roots that are real and non-negative at the default parameters
+        values = self.dyn.sys.numeric_values()
+        keep = []
+        for r, mult in roots.items():
+            v = complex(r.evalf(subs=values))
+            if abs(v.imag) < 1e-9 * (1 + abs(v)) and v.real >= -1e-12:
+                keep += [try_simplify(r, 5)] * mult
+        if len(keep) != n:
+            raise UnsupportedError("closed-form frequencies of a gyroscopic system")
+        return keep
+
+    # ---- numeric -------------------------------------------------------------------------
+    def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        def num(A):
+            return np.array(A.evalf(30, subs=values).tolist(), dtype=complex).real.astype(float)
+
+        return num(self.M), num(self.C), num(self.K)
+
+    def numeric_modes(self, values: dict) -> tuple[np.ndarray, np.ndarray]:
+        """(ω², modes as columns) by the generalized symmetric eigensolver, M-normalized."""
+        M, C, K = self.matrices(values)
+        if np.any(C):
+            raise UnsupportedError("real normal modes of a gyroscopic or damped system")
+        w2, vecs = scipy.linalg.eigh(K, M)
+        return w2, vecs
+
+    def numeric_frequencies(self, values: dict) -> np.ndarray:
+        """Normal angular frequencies at `values` (NaN marks an unstable, imaginary one)."""
+        M, C, K = self.matrices(values)
+        n = M.shape[0]
+        if not np.any(C):
+            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+            scale = max(1.0, float(np.max(np.abs(w2))))
+            w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
+            return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
+        Minv = np.linalg.inv(M)
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+        lam = np.linalg.eigvals(A)
+        lam = lam[np.argsort(-lam.imag)]
+        return np.sort(np.abs(lam.imag[:n]))
+
+    def numeric_stability(self, values: dict) -> str:
+        """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
+        M, C, K = self.matrices(values)
+        n = M.shape[0]
+        if not np.any(C):
+            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+            scale = max(1.0, float(np.max(np.abs(w2))))
+            if np.any(w2 < -ZERO_TOL * scale):
+                return "unstable"
+            return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+        re = np.linalg.eigvals(A).real
+        scale = max(1.0, float(np.max(np.abs(np.linalg.eigvals(A)))))
+        if np.any(re > 1e-8 * scale):
+            return "unstable"
+        return "stable"
+
+    @cached_property
+    def stability_condition(self) -> sp.Basic:
+        """Sufficient and (without gyroscopic terms) necessary condition: K positive definite."""
+        if self.gyroscopic:
+            raise UnsupportedError("symbolic stability condition with gyroscopic terms")
+        K = self.K
+        minors = [try_simplify(K[:k, :k].det(), 5) for k in range(1, K.rows + 1)]
+        return sp.And(*[mi > 0 for mi in minors])
+
+
+class Equilibria:
+    """Static equilibria of a system (autonomous equations, q̇ = 0) and linearization."""
+
+    def __init__(self, dyn: Dynamics):
+        self.dyn = dyn
+        self.sys = dyn.sys
+
+    @cached_property
+    def conditions(self) -> list[sp.Expr]:
+        """E_i(q, 0, 0) with small parameters switched off: zero at an equilibrium."""
+        if self.sys.constraints:
+            raise UnsupportedError("equilibria of a system with multiplier constraints")
+        zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
+        zero.update({s: 0 for s in self.sys.small_params})
+        conds = [try_simplify(e.subs(zero), 5) for e in self.dyn.residuals]
+        if any(c.has(self.sys.t) for c in conds):
+            raise UnsupportedError("static equilibria of a non-autonomous system")
+        return conds
+
+    @cached_property
+    def symbolic(self) -> list[dict]:
+        """Equilibria SymPy can find in closed form (possibly incomplete for trig equations)."""
+        try:
+            with time_limit(30):
+                sols = sp.solve(self.conditions, self.dyn.q, dict=True)
+        except (Timeout, NotImplementedError):
+            return []
+        return [s for s in sols if len(s) == len(self.dyn.q)
+                and all(v.is_real is not False for v in s.values())]
+
+    def numeric(self, values: dict, search: dict | None = None, starts: int = 7) -> list[np.ndarray]:
+        """Equilibria at `values` by root finding from a grid of starting points."""
+        q = self.dyn.q
+        conds = [c.subs(values) for c in self.conditions]
+        F = sp.Matrix(conds)
+        J = F.jacobian(q)
+        f_num = sp.lambdify([q], list(F), modules="numpy")
+        j_num = sp.lambdify([q], J.tolist(), modules="numpy")
+        ranges = [search.get(v, (-np.pi, np.pi)) if search else (-np.pi, np.pi) for v in q]
+        grids = [np.linspace(lo, hi, starts) for lo, hi in ranges]
+        found: list[np.ndarray] = []
+        mesh = np.array(np.meshgrid(*grids, indexing="ij")).reshape(len(q), -1).T
+        if len(mesh) > 2000:
+            mesh = mesh[np.random.default_rng(0).choice(len(mesh), 2000, replace=False)]
+        for x0 in mesh:
+            sol = scipy.optimize.root(lambda x: np.asarray(f_num(x), float), x0,
+                                      jac=lambda x: np.asarray(j_num(x), float))
+            if sol.success and np.max(np.abs(f_num(sol.x))) < 1e-10:
+                if not any(np.allclose(sol.x, f, atol=1e-7) for f in found):
+                    found.append(sol.x)
+        return found
+
+    def residual(self, point: dict) -> list[sp.Expr]:
+        return [c.subs(point) for c in self.conditions]
+
+    def linearize(self, point: dict) -> LinearSystem:
+        """First-order expansion of the equations of motion about `point` (q̇ = 0)."""
+        dyn = self.dyn
+        sub = {}
+        for q in dyn.q:
+            sub[q] = point.get(q, sp.S.Zero) + EPS * q
+        sub.update({v: EPS * v for v in dyn.qd + dyn.qdd})
+        sub.update({s: EPS * s for s in self.sys.small_params})
+        lin = []
+        zeroth = []
+        for e in dyn.residuals:
+            e_sub = e.subs(sub, simultaneous=True)
+            zeroth.append(try_simplify(e_sub.subs(EPS, 0), 5))
+            lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
+        if any(z != 0 for z in zeroth):
+            raise UnsupportedError("linearization about a point that is not an equilibrium")
+        n = len(dyn.q)
+        M = sp.Matrix(n, n, lambda i, j: try_simplify(sp.diff(lin[i], dyn.qdd[j]), 5))
+        C = sp.Matrix(n, n, lambda i, j: try_simplify(sp.diff(lin[i], dyn.qd[j]), 5))
+        K = sp.Matrix(n, n, lambda i, j: try_simplify(sp.diff(lin[i], dyn.q[j]), 5))
+        rest = sp.Matrix([lin[i] - sum((M[i, j] * dyn.qdd[j] + C[i, j] * dyn.qd[j]
+                                        + K[i, j] * dyn.q[j]) for j in range(n))
+                          for i in range(n)])
+        F = (-rest).applyfunc(lambda x: try_simplify(sp.expand(x), 5))
+        bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
+        if bad:
+            raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
+        return LinearSystem(dyn, dict(point), M, C, K, F)
