@@ -1,0 +1,86 @@
+"""One problem's derived results, computed lazily and cached per system and per point.
+
+The checker and the CLI both ask this object for what they need; nothing is derived that is
+not asked for ("the engine computes only what the problem asks for").
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .errors import UnsupportedError
+from .lagrange import Dynamics
+from .linear import Equilibria, LinearSystem
+from .problem import Problem
+from .system import System
+
+
+class Analysis:
+    def __init__(self, problem: Problem, simplify: bool = True):
+        self.problem = problem
+        self.simplify = simplify
+        self._dyn: dict[str, Dynamics] = {}
+        self._eq: dict[str, Equilibria] = {}
+        self._lin: dict[tuple, LinearSystem] = {}
+
+    def system(self, name: str | None = None) -> System:
+        return self.problem.system(name)
+
+    def dynamics(self, name: str | None = None) -> Dynamics:
+        sys = self.system(name)
+        if sys.name not in self._dyn:
+            self._dyn[sys.name] = Dynamics(sys, self.simplify)
+        return self._dyn[sys.name]
+
+    def equilibria(self, name: str | None = None) -> Equilibria:
+        sys = self.system(name)
+        if sys.name not in self._eq:
+            self._eq[sys.name] = Equilibria(self.dynamics(name))
+        return self._eq[sys.name]
+
+    def linear(self, name: str | None, point: dict) -> LinearSystem:
+        sys = self.system(name)
+        key = (sys.name, tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())))
+        if key not in self._lin:
+            self._lin[key] = self.equilibria(name).linearize(point)
+        return self._lin[key]
+
+    def stable_equilibria(self, name: str | None = None) -> list[dict]:
+        """Closed-form equilibria that are stable at the default parameter values."""
+        eq = self.equilibria(name)
+        values = self.problem.values()
+        out = []
+        for point in eq.symbolic:
+            try:
+                ok = self.linear(name, point).numeric_stability(values) == "stable"
+            except (UnsupportedError, TypeError, ValueError):
+                continue
+            if ok:
+                out.append(point)
+        return out
+
+    def default_point(self, name: str | None = None) -> dict:
+        """The equilibrium to expand about when a question names none: the stable one,
+        or the origin when the system is already linear with no static equilibrium issue."""
+        try:
+            stable = self.stable_equilibria(name)
+        except UnsupportedError:
+            stable = []
+        distinct = []
+        values = self.problem.values()
+        for pt in stable:
+            num = tuple(complex(sp.N(v.subs(values))) for v in pt.values())
+            if not any(max(abs(a - b) for a, b in zip(num, d, strict=True)) < 1e-9
+                       for d in distinct):
+                distinct.append(num)
+        if len(distinct) == 1:
+            return stable[0]
+        sys = self.system(name)
+        origin = {q: sp.S.Zero for q in sys.q}
+        if len(distinct) == 0:
+            # a system with a zero-frequency mode (a free translation) has no isolated
+            # equilibrium; the origin is one if the conditions vanish there
+            if all(sp.simplify(c.subs(origin)) == 0 for c in self.equilibria(name).conditions):
+                return origin
+        raise UnsupportedError("choosing the equilibrium: the answer must name `about:` "
+                               f"({len(distinct)} stable equilibria found)")

@@ -1,0 +1,93 @@
+"""Answer keys: the book's answers, part by part, kept apart from the problem files.
+
+An answer key names, for each part, the quantity it checks and the book's value, in the
+problem's own symbols plus any symbols of its own (`symbols:`, e.g. integration constants or
+the names of normal coordinates) and abbreviations (`abbreviations: {omega0: sqrt(g/l)}`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+
+from .errors import ExpressionError
+from .expr import parse, parse_equation
+from .schema import validate
+from .yamlio import Document, load
+
+
+@dataclass
+class Part:
+    key: "AnswerKey"
+    index: int
+    data: dict
+
+    @property
+    def name(self) -> str:
+        return self.data["part"]
+
+    @property
+    def quantity(self) -> str:
+        return self.data["quantity"]
+
+    @property
+    def system(self) -> str | None:
+        return self.data.get("system")
+
+    @property
+    def path(self) -> tuple:
+        return ("parts", self.index)
+
+    def error(self, sub: tuple, message: str):
+        return self.key.doc.error(self.path + sub, message)
+
+    def names(self, system) -> dict[str, sp.Basic]:
+        names = dict(system.names)
+        names.update(self.key.symbols)
+        for abbr, text in (self.key.doc.data.get("abbreviations") or {}).items():
+            if abbr in names:
+                raise self.key.doc.error(("abbreviations", abbr), f"{abbr!r} is already a name")
+            try:
+                names[abbr] = parse(text, names)
+            except ExpressionError as exc:
+                raise self.key.doc.error(("abbreviations", abbr), str(exc)) from None
+        return names
+
+    def parse(self, text, sub: tuple, names: dict, equation: bool = False,
+              relation: bool = False) -> sp.Basic:
+        try:
+            if equation:
+                return parse_equation(text, names)
+            return parse(text, names, relation)
+        except ExpressionError as exc:
+            raise self.error(sub, str(exc)) from None
+
+
+class AnswerKey:
+    def __init__(self, doc: Document):
+        self.doc = doc
+        self.file = doc.file
+        data = doc.data
+        self.problem_id: str = data["problem"]
+        self.symbols: dict[str, sp.Symbol] = {}
+        self.symbol_values: dict[sp.Symbol, float] = {}
+        for name, spec in (data.get("symbols") or {}).items():
+            spec = spec or {}
+            positive = spec.get("positive", True)
+            sym = sp.Symbol(name, positive=True) if positive else sp.Symbol(name, real=True)
+            self.symbols[name] = sym
+            self.symbol_values[sym] = float(spec.get("value", 1.0))
+        self.parts = [Part(self, i, p) for i, p in enumerate(data["parts"])]
+        seen = set()
+        for p in self.parts:
+            if p.name in seen:
+                raise p.error(("part",), f"part {p.name!r} appears twice")
+            seen.add(p.name)
+
+
+def load_answers(path: str | Path) -> AnswerKey:
+    doc = load(path)
+    validate(doc, "answers")
+    return AnswerKey(doc)

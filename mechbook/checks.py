@@ -1,0 +1,612 @@
+"""One check per kind of answer: how a book's value is compared with the engine's result.
+
+Every check takes the part's context and a value (the book's, or an erratum's corrected one)
+and returns a Verdict. Checks never look at other answers and never feed a book value into
+the engine: the engine's side is derived from the problem file alone.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from .analysis import Analysis
+from .answers import Part
+from .compare import Sampler, Verdict, equal, match_multiset, value, vanishes
+from .errors import UnsupportedError
+from .linear import LinearSystem
+
+CHECKS: dict[str, Callable[[Context, object], Verdict]] = {}
+
+
+def check(name: str):
+    def register(fn):
+        CHECKS[name] = fn
+        return fn
+
+    return register
+
+
+@dataclass
+class Context:
+    analysis: Analysis
+    part: Part
+
+    def __post_init__(self):
+        self.system = self.analysis.system(self.part.system)
+        self.names = self.part.names(self.system)
+        for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
+            self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
+        for k, v in (self.part.data.get("define") or {}).items():  # e.g. alpha = theta - pi
+            if k in self.names:
+                raise self.part.error(("define", k), f"{k!r} is already a name")
+            f = self.parse(v, ("define", k))
+            self.names[k] = f
+            self.names[k + "dot"] = self.system.dt(f)
+            self.names[k + "ddot"] = self.system.dt(self.system.dt(f))
+        conds = [self.parse(c, ("assume", i), relation=True)
+                 for i, c in enumerate(self.part.data.get("assume", []))]
+        base = dict(self.analysis.problem.values())
+        base.update(self.part.key.symbol_values)
+        self.sampler = Sampler(base, conds)
+
+    @property
+    def dyn(self):
+        return self.analysis.dynamics(self.part.system)
+
+    def parse(self, text, sub, equation=False, relation=False):
+        return self.part.parse(text, sub, self.names, equation, relation)
+
+    def point(self) -> dict:
+        about = self.part.data.get("about")
+        if about is None:
+            return self.analysis.default_point(self.part.system)
+        point = {}
+        for k, v in about.items():
+            if k not in self.system.coord_names:
+                raise self.part.error(("about", k), f"{k!r} is not a coordinate")
+            point[self.system.q[self.system.coord_names.index(k)]] = self.parse(v, ("about", k))
+        return point
+
+    def linear(self) -> LinearSystem:
+        return self.analysis.linear(self.part.system, self.point())
+
+    def as_list(self, val, sub) -> list:
+        if isinstance(val, list):
+            return val
+        raise self.part.error(sub, "expected a list")
+
+    def as_map(self, val, sub) -> dict:
+        if isinstance(val, dict):
+            return val
+        raise self.part.error(sub, "expected a mapping")
+
+
+def _all(verdicts: list[Verdict]) -> Verdict:
+    for v in verdicts:
+        if not v.ok:
+            return v
+    methods = {v.method.split("(")[0] for v in verdicts}
+    method = "symbolic" if methods == {"symbolic"} else ("numeric" if "numeric" in methods else
+                                                          ",".join(sorted(methods)))
+    return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail))
+
+
+def _strip_const(text):
+    if isinstance(text, str):
+        for tail in ("= constant", "= const", "=constant", "=const"):
+            if text.rstrip().endswith(tail):
+                return text.rstrip()[: -len(tail)]
+    return text
+
+
+def _linear_accelerations(lin: LinearSystem) -> dict:
+    n = len(lin.q)
+    rhs = lin.F - lin.C * sp.Matrix(lin.dyn.qd) - lin.K * lin.displacement()
+    sol = lin.M.LUsolve(rhs)
+    return {lin.dyn.qdd[i]: sol[i] for i in range(n)}
+
+
+# ---- Lagrangian and equations of motion ----------------------------------------------------
+@check("lagrangian")
+def check_lagrangian(ctx: Context, val) -> Verdict:
+    """Equal up to a total time derivative: the difference has vanishing Lagrange expressions."""
+    book = ctx.parse(val, ("book",))
+    diff = book - ctx.system.lagrangian
+    sys = ctx.system
+    exprs = [sys.dt(sp.diff(diff, qd)) - sp.diff(diff, q) for q, qd in zip(sys.q, sys.qd,
+                                                                           strict=True)]
+    return _all([vanishes(e, ctx.sampler) for e in exprs])
+
+
+@check("eom")
+def check_eom(ctx: Context, val) -> Verdict:
+    """Each book equation holds once the engine's accelerations are substituted
+    (the linearized ones when `about` is given)."""
+    eqs = [ctx.parse(v, ("book", i), equation=True)
+           for i, v in enumerate(ctx.as_list(val, ("book",)))]
+    if "about" in ctx.part.data:
+        acc = _linear_accelerations(ctx.linear())
+    else:
+        acc = dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True))
+    out = []
+    for i, e in enumerate(eqs):
+        if not (e.free_symbols & set(ctx.dyn.qdd)):
+            raise ctx.part.error(("book", i), "an equation of motion must contain an "
+                                 "acceleration; a first integral is a 'conserved' part")
+        out.append(vanishes(e.subs(acc), ctx.sampler))
+    return _all(out)
+
+
+@check("conserved")
+def check_conserved(ctx: Context, val) -> Verdict:
+    """d/dt of each book expression vanishes along the motion ('= const' may be written)."""
+    vals = val if isinstance(val, list) else [val]
+    out = []
+    if "about" in ctx.part.data:
+        acc = _linear_accelerations(ctx.linear())
+    else:
+        acc = dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True))
+    for i, v in enumerate(vals):
+        sub = ("book", i) if isinstance(val, list) else ("book",)
+        e = ctx.parse(_strip_const(v), sub)
+        if not (e.free_symbols & set(ctx.dyn.q + ctx.dyn.qd)):
+            raise ctx.part.error(sub, "a conserved quantity must depend on the motion")
+        out.append(vanishes(ctx.system.dt(e).subs(acc), ctx.sampler))
+    return _all(out)
+
+
+# ---- equilibria and stability --------------------------------------------------------------
+def _engine_points(ctx: Context) -> list[dict]:
+    return ctx.analysis.equilibria(ctx.part.system).symbolic
+
+
+@check("equilibrium")
+def check_equilibrium(ctx: Context, val) -> Verdict:
+    """`at:` the point satisfies the equilibrium conditions; `where:` some engine equilibrium
+    satisfies the book's equations. `stable:` also checks the stability there."""
+    val = ctx.as_map(val, ("book",))
+    eq = ctx.analysis.equilibria(ctx.part.system)
+    if "at" in val:
+        at = ctx.as_map(val["at"], ("book", "at"))
+        point = {ctx.system.q[ctx.system.coord_names.index(k)]: ctx.parse(v, ("book", "at", k))
+                 for k, v in at.items() if k in ctx.system.coord_names}
+        if len(point) != len(ctx.system.q):
+            raise ctx.part.error(("book", "at"), "give every coordinate of the point")
+        verdicts = [vanishes(r, ctx.sampler) for r in eq.residual(point)]
+        candidates = [point]
+    elif "where" in val:
+        where = [ctx.parse(w, ("book", "where", i), equation=True)
+                 for i, w in enumerate(ctx.as_list(val["where"], ("book", "where")))]
+        candidates = []
+        for pt in _engine_points(ctx):
+            if all(vanishes(w.subs(pt), ctx.sampler, symbolic=False).ok for w in where):
+                candidates.append(pt)
+        if not candidates:
+            return Verdict(False, "numeric", "no equilibrium found by the engine satisfies "
+                           f"{val['where']}; engine found {_engine_points(ctx)}")
+        verdicts = [Verdict(True, "symbolic", f"engine equilibrium {candidates[0]}")]
+    else:
+        raise ctx.part.error(("book",), "an equilibrium answer gives 'at:' or 'where:'")
+    if "stable" in ctx.part.data:
+        want = ctx.part.data["stable"]
+        for pt in candidates:
+            lin = ctx.analysis.linear(ctx.part.system, pt)
+            for _ in range(4):
+                got = lin.numeric_stability(ctx.sampler.draw())
+                if (got == "stable") != want:
+                    return Verdict(False, "numeric", f"engine finds the equilibrium {got}")
+    return _all(verdicts)
+
+
+@check("stability_condition")
+def check_stability_condition(ctx: Context, val) -> Verdict:
+    """The book's condition holds exactly where the engine finds the point stable, over
+    parameter points drawn widely on both sides of the boundary."""
+    cond = ctx.parse(val, ("book",), relation=True)
+    lin = ctx.linear()
+    wide = Sampler(ctx.sampler.base, ctx.sampler.conditions, spread=2.0)
+    seen = {True: 0, False: 0}
+    n = 0
+    for _ in range(400):
+        pt = wide.draw()
+        got = lin.numeric_stability(pt)
+        if got == "marginal":
+            continue
+        claim = bool(cond.subs(pt))
+        if claim != (got == "stable"):
+            return Verdict(False, f"numeric({n + 1} points)",
+                           f"book says {'stable' if claim else 'unstable'}, engine finds {got} "
+                           f"at {{{', '.join(f'{k}={float(v):.4g}' for k, v in pt.items())}}}")
+        seen[claim] += 1
+        n += 1
+        if n >= 60 and min(seen.values()) >= 10:
+            break
+    if min(seen.values()) == 0:
+        return Verdict(False, "numeric", "sampling never crossed the stability boundary; "
+                       "the check cannot discriminate (widen parameters)")
+    return Verdict(True, f"numeric({n} points: {seen[True]} stable, {seen[False]} unstable)")
+
+
+# ---- frequencies and modes -----------------------------------------------------------------
+def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:
+    return [ctx.parse(v, ("book", i)) for i, v in enumerate(ctx.as_list(val, ("book",)))]
+
+
+def _numbers(exprs, pt) -> list[float]:
+    out = []
+    for e in exprs:
+        z = value(e, pt)
+        out.append(z.real if abs(z.imag) <= 1e-12 * max(1, abs(z)) else float("nan"))
+    return out
+
+
+@check("frequencies")
+def check_frequencies(ctx: Context, val) -> Verdict:
+    """Multiset of normal angular frequencies (numeric eigh at random points; symbolic where
+    SymPy can); `partial: true` allows the book to list a subset; `limit:` compares an
+    asymptotic formula."""
+    book = _book_frequencies(ctx, val)
+    lin = ctx.linear()
+    partial = bool(ctx.part.data.get("partial"))
+    if "limit" in ctx.part.data:
+        return _check_limit(ctx, book, lin)
+    n = 0
+    for _ in range(6):
+        pt = ctx.sampler.draw()
+        ok, why = match_multiset(_numbers(book, pt), list(lin.numeric_frequencies(pt)), partial)
+        n += 1
+        if not ok:
+            return Verdict(False, f"numeric({n} points)", why)
+    return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or
+                   f"numeric({n} points, eigensolver)")
+
+
+def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
+    try:
+        engine = list(lin.frequencies)
+    except UnsupportedError:
+        return None
+    pt = ctx.sampler.draw()
+    eng_vals = _numbers(engine, pt)
+    used = set()
+    for b in book:
+        bv = _numbers([b], pt)[0]
+        idx = [i for i in range(len(engine)) if i not in used
+               and abs(eng_vals[i] - bv) <= 1e-8 * max(1, abs(bv))]
+        if not idx or not vanishes(b**2 - engine[idx[0]] ** 2, ctx.sampler).method == "symbolic":
+            return None
+        used.add(idx[0])
+    return "symbolic"
+
+
+def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
+    spec = ctx.part.data["limit"]
+    name = spec["parameter"]
+    if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
+        raise ctx.part.error(("limit", "parameter"), f"unknown parameter {name!r}")
+    sym = ctx.names[name]
+    order = spec.get("order", 0)
+    to_zero = str(spec["to"]) == "0"
+    base = ctx.sampler.default()
+    errors = []
+    for eps in (1e-3, 1e-4, 1e-5):
+        pt = dict(base)
+        pt[sym] = base[sym] * eps if to_zero else base[sym] / eps
+        eng = list(lin.numeric_frequencies(pt))
+        worst = 0.0
+        for b in _numbers(book, pt):
+            nearest = min(eng, key=lambda e, b=b: abs(e - b))
+            worst = max(worst, abs(nearest - b) / max(abs(b), 1e-300))
+        errors.append(worst)
+    ratios = [errors[i + 1] / errors[i] if errors[i] > 1e-14 else 0.0 for i in range(2)]
+    needed = 0.5 * 10.0 ** (-order)
+    ok = errors[-1] < 1e-3 and all(r <= needed for r in ratios)
+    detail = (f"relative error {errors[0]:.2g}, {errors[1]:.2g}, {errors[2]:.2g} as "
+              f"{name} -> {spec['to']} by decades (needs decrease faster than x{needed:g})")
+    return Verdict(ok, "numeric(asymptotic)", detail)
+
+
+@check("period")
+def check_period(ctx: Context, val) -> Verdict:
+    """2π/ω for one of the engine's nonzero frequencies."""
+    period = ctx.parse(val, ("book",))
+    lin = ctx.linear()
+    for _ in range(6):
+        pt = ctx.sampler.draw()
+        p = _numbers([period], pt)[0]
+        freqs = [w for w in lin.numeric_frequencies(pt) if w > 0]
+        if not any(abs(2 * np.pi / w - p) <= 1e-8 * p for w in freqs):
+            return Verdict(False, "numeric", f"period {p:.10g} vs engine "
+                           f"{[2 * np.pi / w for w in freqs]}")
+    try:
+        if any(vanishes(period - 2 * sp.pi / w, ctx.sampler).method == "symbolic"
+               for w in lin.frequencies if w != 0):
+            return Verdict(True, "symbolic")
+    except UnsupportedError:
+        pass
+    return Verdict(True, "numeric(6 points)")
+
+
+def _mode_residual(lin: LinearSystem, freq: sp.Expr, shape: sp.Matrix, pt: dict) -> float:
+    M, C, K = lin.matrices(pt)
+    w = _numbers([freq], pt)[0]
+    u = np.array(_numbers(list(shape), pt))
+    r = (K - w**2 * M) @ u
+    scale = (np.abs(K) + w**2 * np.abs(M)) @ np.abs(u)
+    return float(np.max(np.abs(r) / np.maximum(scale, 1e-300))) if np.any(u) else np.inf
+
+
+@check("normal_modes")
+def check_normal_modes(ctx: Context, val) -> Verdict:
+    """Each (frequency, shape) satisfies (K − ω²M)·u = 0: shape up to scale and sign, and any
+    vector of a degenerate eigenspace is accepted."""
+    lin = ctx.linear()
+    modes = ctx.as_list(val, ("book",))
+    for _ in range(5):
+        pt = ctx.sampler.draw()
+        for i, mode in enumerate(modes):
+            mode = ctx.as_map(mode, ("book", i))
+            freq = ctx.parse(mode["frequency"], ("book", i, "frequency"))
+            shape = _shape(ctx, mode.get("shape"), ("book", i, "shape"))
+            if abs(_numbers([freq], pt)[0]) not in _near(lin.numeric_frequencies(pt),
+                                                         _numbers([freq], pt)[0]):
+                return Verdict(False, "numeric", f"mode {i}: frequency not an engine frequency")
+            res = _mode_residual(lin, freq, shape, pt)
+            if res > 1e-8:
+                return Verdict(False, "numeric", f"mode {i}: (K - w^2 M) u relative residual "
+                               f"{res:.3g}")
+    return Verdict(True, "numeric(5 points)")
+
+
+def _near(values, x, rtol=1e-8):
+    return [x] if any(abs(v - x) <= rtol * max(1, abs(x)) for v in values) else []
+
+
+def _shape(ctx: Context, shape, sub) -> sp.Matrix:
+    shape = ctx.as_map(shape, sub)
+    unknown = set(shape) - set(ctx.system.coord_names)
+    if unknown:
+        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate")
+    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0
+                      for c in ctx.system.coord_names])
+
+
+@check("normal_coordinates")
+def check_normal_coordinates(ctx: Context, val) -> Verdict:
+    """A linear form c·q is a normal coordinate iff u = M⁻¹c is a mode: (K − ω²M)u = 0."""
+    lin = ctx.linear()
+    items = ctx.as_list(val, ("book",))
+    rows = []
+    for _ in range(5):
+        pt = ctx.sampler.draw()
+        M, C, K = lin.matrices(pt)
+        rows = []
+        for i, item in enumerate(items):
+            item = ctx.as_map(item, ("book", i))
+            form = ctx.parse(item["coordinate"], ("book", i, "coordinate"))
+            c = sp.Matrix([sp.diff(form, q) for q in ctx.system.q])
+            if any(s in ctx.system.q for x in c for s in x.free_symbols):
+                raise ctx.part.error(("book", i, "coordinate"), "a normal coordinate is linear "
+                                     "in the coordinates")
+            cv = np.array(_numbers(list(c), pt))
+            rows.append(cv)
+            u = np.linalg.solve(M, cv)
+            w2 = float(u @ K @ u / (u @ M @ u))
+            r = (K - w2 * M) @ u
+            scale = (np.abs(K) + abs(w2) * np.abs(M)) @ np.abs(u)
+            if np.max(np.abs(r) / np.maximum(scale, 1e-300)) > 1e-8:
+                return Verdict(False, "numeric", f"{item['coordinate']} is not a normal "
+                               "coordinate (M^-1 c is not a mode)")
+            if "frequency" in item:
+                w = _numbers([ctx.parse(item["frequency"], ("book", i, "frequency"))], pt)[0]
+                if abs(np.sqrt(max(w2, 0)) - w) > 1e-8 * max(1, w):
+                    return Verdict(False, "numeric", f"{item['coordinate']}: frequency "
+                                   f"{w:.10g}, engine {np.sqrt(max(w2, 0)):.10g}")
+        if len(rows) == len(ctx.system.q) and np.linalg.matrix_rank(np.array(rows)) < len(rows):
+            return Verdict(False, "numeric", "the normal coordinates are not independent")
+    return Verdict(True, "numeric(5 points)")
+
+
+@check("mode_count")
+def check_mode_count(ctx: Context, val) -> Verdict:
+    n = len(ctx.system.q)
+    ok = isinstance(val, int) and val == n
+    return Verdict(ok, "exact", f"book {val}, engine {n} degrees of freedom")
+
+
+@check("mode_node")
+def check_mode_node(ctx: Context, val) -> Verdict:
+    """A point whose position (linear in the small displacements) stays put in the mode of a
+    given frequency: ∇position · u = 0. The book's value fixes the point's parameter."""
+    book = ctx.as_map(val, ("book",))
+    lin = ctx.linear()
+    subs = {ctx.names[k]: ctx.parse(v, ("book", k)) for k, v in book.items()}
+    position = ctx.parse(ctx.part.data["position"], ("position",)).subs(subs)
+    freq = ctx.parse(ctx.part.data["frequency"], ("frequency",))
+    point = lin.point
+    grad = [sp.diff(position, q).subs(point) for q in ctx.system.q]
+    for _ in range(5):
+        pt = ctx.sampler.draw()
+        w2, vecs = lin.numeric_modes(pt)
+        w = _numbers([freq], pt)[0]
+        idx = [i for i, x in enumerate(w2) if abs(np.sqrt(max(x, 0)) - w) <= 1e-8 * max(1, w)]
+        if not idx:
+            return Verdict(False, "numeric", "frequency is not an engine frequency")
+        g = np.array(_numbers(grad, pt))
+        for i in idx:
+            u = vecs[:, i]
+            if abs(g @ u) > 1e-9 * (np.abs(g) @ np.abs(u)):
+                return Verdict(False, "numeric", f"the point moves in that mode ({g @ u:.3g})")
+    return Verdict(True, "numeric(5 points)")
+
+
+# ---- driven and initial-value motion -------------------------------------------------------
+def _time_functions(ctx: Context, val, sub) -> dict[sp.Symbol, sp.Expr]:
+    """Book's {coordinate or defined name: f(t)} turned into coordinates where possible."""
+    val = ctx.as_map(val, sub)
+    define = ctx.part.data.get("define") or {}
+    funcs = {}
+    for name, text in val.items():
+        if name not in ctx.system.coord_names and name not in define:
+            raise ctx.part.error(sub + (name,), f"{name!r} is neither a coordinate nor defined")
+        funcs[name] = ctx.parse(text, sub + (name,))
+    return funcs
+
+
+@check("steady_state")
+def check_steady_state(ctx: Context, val) -> Verdict:
+    """The book's particular solution satisfies the linearized driven equations (each
+    equation whose coordinates the book gives must vanish)."""
+    lin = ctx.linear()
+    funcs = _time_functions(ctx, val, ("book",))
+    return _residual_of_motion(ctx, lin, funcs)
+
+
+def _coordinates_from(ctx: Context, funcs: dict) -> dict[sp.Symbol, sp.Expr]:
+    """Coordinates as functions of t from the book's functions (and `define:` forms)."""
+    define = ctx.part.data.get("define") or {}
+    sys = ctx.system
+    direct = {sys.q[sys.coord_names.index(k)]: v for k, v in funcs.items()
+              if k in sys.coord_names}
+    defined = {k: v for k, v in funcs.items() if k in define}
+    if not defined:
+        return direct
+    unknowns = [q for q in sys.q if q not in direct]
+    eqs = [ctx.parse(define[k], ("define", k)).subs(direct) - v for k, v in defined.items()]
+    sol = sp.solve(eqs, unknowns, dict=True)
+    if len(sol) != 1:
+        raise ctx.part.error(("define",), "the defined coordinates do not determine the motion")
+    direct.update(sol[0])
+    return direct
+
+
+def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict:
+    coords = _coordinates_from(ctx, funcs)
+    t = ctx.system.t
+    subs = {}
+    for q, qd, qdd in zip(lin.dyn.q, lin.dyn.qd, lin.dyn.qdd, strict=True):
+        if q in coords:
+            f = coords[q]
+            subs.update({q: f, qd: sp.diff(f, t), qdd: sp.diff(f, t, 2)})
+    checked = []
+    for e in lin.equations():
+        r = e.subs(subs)
+        if r.free_symbols & set(lin.dyn.q + lin.dyn.qd + lin.dyn.qdd):
+            continue
+        checked.append(vanishes(r, ctx.sampler))
+    if not checked:
+        raise UnsupportedError("checking a motion that leaves every equation with unknown "
+                               "coordinates (give the initial conditions instead)")
+    return _all(checked)
+
+
+@check("motion")
+def check_motion(ctx: Context, val) -> Verdict:
+    """With `initial:`, compare with the modal solution of the linearized initial-value
+    problem at several times; without, the book's general solution must satisfy the
+    linearized equations for any values of its constants."""
+    lin = ctx.linear()
+    funcs = _time_functions(ctx, val, ("book",))
+    if "initial" not in ctx.part.data:
+        return _residual_of_motion(ctx, lin, funcs)
+    if lin.gyroscopic or any(f != 0 for f in lin.F):
+        raise UnsupportedError("initial-value solution of a driven or gyroscopic system")
+    init = ctx.as_map(ctx.part.data["initial"], ("initial",))
+    sys = ctx.system
+    define = ctx.part.data.get("define") or {}
+    forms = {k: ctx.parse(v, ("define", k)) for k, v in define.items()}
+    t = sys.t
+    for _ in range(4):
+        pt = ctx.sampler.draw()
+        q0 = np.zeros(len(sys.q))
+        v0 = np.zeros(len(sys.q))
+        for k, text in init.items():
+            x = _numbers([ctx.parse(text, ("initial", k))], pt)[0]
+            if k in sys.coord_names:
+                q0[sys.coord_names.index(k)] = x
+            elif k.endswith("dot") and k[:-3] in sys.coord_names:
+                v0[sys.coord_names.index(k[:-3])] = x
+            else:
+                raise ctx.part.error(("initial", k), "initial values are given for coordinates "
+                                     "(x) and their velocities (xdot)")
+        eq0 = np.array(_numbers([lin.point.get(q, 0) for q in sys.q], pt))
+        w2, U = lin.numeric_modes(pt)
+        Mn = lin.matrices(pt)[0]
+        a = U.T @ Mn @ (q0 - eq0)
+        b = U.T @ Mn @ v0
+        for tv in (0.37, 1.3, 2.9, 7.1):
+            eta = np.empty(len(w2))
+            for k, x in enumerate(w2):
+                if abs(x) < 1e-10 * max(1.0, np.max(np.abs(w2))):
+                    eta[k] = a[k] + b[k] * tv
+                elif x > 0:
+                    w = np.sqrt(x)
+                    eta[k] = a[k] * np.cos(w * tv) + b[k] * np.sin(w * tv) / w
+                else:
+                    raise UnsupportedError("motion about an unstable equilibrium")
+            q = eq0 + U @ eta
+            env = dict(pt)
+            env[t] = sp.Float(tv, 30)
+            env.update({sq: sp.Float(x, 30) for sq, x in zip(sys.q, q, strict=True)})
+            for name, f in funcs.items():
+                expected = (q[sys.coord_names.index(name)] if name in sys.coord_names
+                            else _numbers([forms[name]], env)[0])
+                got = _numbers([f], env)[0]
+                scale = max(np.max(np.abs(q)), np.max(np.abs(q0)), 1e-300)
+                if not abs(got - expected) <= 1e-8 * max(abs(expected), scale):
+                    return Verdict(False, "numeric", f"{name}(t={tv}) = {got:.10g}, "
+                                   f"engine {expected:.10g}")
+    return Verdict(True, "numeric(4 points x 4 times, modal solution)")
+
+
+# ---- named expressions ---------------------------------------------------------------------
+@check("expression")
+def check_expression(ctx: Context, val) -> Verdict:
+    """An engine quantity named by `of:`; potentials compare up to an additive constant."""
+    of = ctx.part.data.get("of")
+    if of is None:
+        raise ctx.part.error(("of",), "an 'expression' part names what it is with 'of:'")
+    dyn = ctx.dyn
+    if of == "momenta":
+        items = ctx.as_map(val, ("book",))
+        out = []
+        for k, v in items.items():
+            if k not in ctx.system.coord_names:
+                raise ctx.part.error(("book", k), "momenta are keyed by coordinate")
+            out.append(equal(ctx.parse(v, ("book", k)),
+                             dyn.momenta[ctx.system.coord_names.index(k)], ctx.sampler))
+        return _all(out)
+    book = ctx.parse(val, ("book",), equation=False)
+    if of in ("potential", "quadratic_potential"):
+        if of == "potential":
+            engine = ctx.system.potential
+        else:
+            lin = ctx.linear()
+            dq = lin.displacement()
+            engine = (dq.T * lin.K * dq)[0, 0] / 2
+        # up to a constant: gradients agree
+        return _all([vanishes(sp.diff(book - engine, q), ctx.sampler) for q in ctx.system.q])
+    if of == "quadratic_kinetic":
+        lin = ctx.linear()
+        qd = sp.Matrix(dyn.qd)
+        return equal(book, (qd.T * lin.M * qd)[0, 0] / 2, ctx.sampler)
+    if of == "kinetic":
+        return equal(book, ctx.system.kinetic, ctx.sampler)
+    if of == "energy_function":
+        return equal(book, dyn.energy_function, ctx.sampler)
+    return equal(book, dyn.hamiltonian, ctx.sampler)
+
+
+@check("force")
+def check_force(ctx: Context, val) -> Verdict:
+    raise UnsupportedError("constraint forces along a trajectory (Lagrange multipliers "
+                           "combined with a first integral)")
+
+
+@check("proof")
+def check_proof(ctx: Context, val) -> Verdict:
+    raise UnsupportedError("a proof in words")
