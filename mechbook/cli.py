@@ -1,0 +1,194 @@
+"""The `mechbook` command line: list, solve, check, validate, show."""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from pathlib import Path
+
+import click
+
+from . import __version__
+from .analysis import Analysis
+from .catalog import all_ids, answer_path, problem_path, root
+from .derive import derive
+from .errors import MechbookError
+from .problem import load_problem
+from .run import ProblemRun, run_many
+from .store import DEFAULT_PATH, read, write
+from .validate import validate_file
+
+STATUS_ORDER = ("pass", "erratum", "unsupported", "fail", "error")
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="mechbook")
+@click.option("--root", "root_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=None,
+              help="Tree holding problems/ and answers/ (default: nearest parent, or "
+                   "$MECHBOOK_ROOT).")
+@click.pass_context
+def main(ctx: click.Context, root_dir: Path | None) -> None:
+    """mechbook: textbook mechanics problems as Lagrangian systems, checked against the book."""
+    ctx.ensure_object(dict)
+    ctx.obj["root_opt"] = root_dir
+
+
+def _resolve_root(ctx: click.Context) -> Path:
+    opt = ctx.obj.get("root_opt")
+    try:
+        return Path(opt) if opt else root()
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
+
+
+@main.command("list")
+@click.pass_context
+def list_cmd(ctx: click.Context) -> None:
+    """List every problem with its title and number of answer parts."""
+    base = _resolve_root(ctx)
+    for pid in all_ids(base):
+        try:
+            p = load_problem(problem_path(pid, base))
+            title = p.title
+        except MechbookError as exc:
+            title = f"INVALID: {exc}"
+        apath = answer_path(pid, base)
+        parts = "no answer key"
+        if apath.exists():
+            from .answers import load_answers
+            try:
+                parts = f"{len(load_answers(apath).parts)} parts"
+            except MechbookError:
+                parts = "INVALID answer key"
+        click.echo(f"{pid:<22} {parts:<16} {title}")
+
+
+@main.command()
+@click.argument("problem_id")
+@click.option("--system", default=None, help="Which system of a multi-system problem.")
+@click.option("--no-simplify", is_flag=True, help="Skip SymPy simplification (faster).")
+@click.pass_context
+def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: bool) -> None:
+    """Derive and print a problem's results (what its `compute:` asks for)."""
+    base = _resolve_root(ctx)
+    try:
+        problem = load_problem(problem_path(problem_id, base))
+        analysis = Analysis(problem, simplify=not no_simplify)
+        names = [system] if system else list(problem.systems)
+        click.echo(f"{problem.id}: {problem.title}  [{problem.source}]")
+        for name in names:
+            res = derive(analysis, name)
+            if len(problem.systems) > 1:
+                click.echo(f"\n== system {name}")
+            for key, text in res.text.items():
+                click.echo(f"{key}:\n    {text}")
+            for key, arr in res.arrays.items():
+                click.echo(f"{key} (numeric, default parameters):\n    {arr.tolist()}")
+            for key, text in res.notes.items():
+                click.echo(f"{key}: {text}")
+    except (MechbookError, KeyError) as exc:
+        raise click.ClickException(str(exc)) from None
+
+
+def _progress(i: int, n: int, run: ProblemRun) -> None:
+    counts = Counter(o.status for o in run.outcomes)
+    summary = run.error or ", ".join(f"{counts[s]} {s}" for s in STATUS_ORDER if counts[s])
+    click.echo(f"[{i}/{n}] {run.pid} ({run.seconds:.1f} s): {summary}", err=True)
+
+
+@main.command()
+@click.argument("problem_ids", nargs=-1)
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 file to write results to.")
+@click.option("--no-store", is_flag=True, help="Do not write results.")
+@click.option("-v", "--verbose", is_flag=True, help="Show the method and detail of every part.")
+@click.pass_context
+def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
+          verbose: bool) -> None:
+    """Check problems against their answer keys (all by default); exit 1 on any fail."""
+    base = _resolve_root(ctx)
+    ids = list(problem_ids) or all_ids(base)
+    if not ids:
+        raise click.ClickException(f"no problems under {base / 'problems'}")
+    runs = run_many(ids, base, progress=_progress)
+    _table(runs, verbose)
+    records = [r.record for r in runs if r.record is not None]
+    if records and not no_store:
+        path = write(records, store_path if store_path.is_absolute() else base / store_path)
+        click.echo(f"results written to {path}")
+    bad = sum(1 for r in runs if r.error) + sum(1 for r in runs for o in r.outcomes
+                                                if o.status in ("fail", "error"))
+    if bad:
+        click.echo(f"{bad} failure(s)", err=True)
+        sys.exit(1)
+
+
+def _table(runs: list[ProblemRun], verbose: bool) -> None:
+    total: Counter = Counter()
+    click.echo(f"{'problem':<16} {'part':<16} {'quantity':<20} {'outcome':<12} method / detail")
+    click.echo("-" * 100)
+    for run in runs:
+        if run.error:
+            click.echo(f"{run.pid:<16} {'-':<16} {'-':<20} {'ERROR':<12} {run.error}")
+            total["error"] += 1
+            continue
+        for o in run.outcomes:
+            total[o.status] += 1
+            info = o.method
+            if o.status in ("fail", "error", "unsupported", "erratum") or verbose:
+                info = f"{o.method} {o.detail}".strip()
+            click.echo(f"{run.pid:<16} {o.part:<16} {o.quantity:<20} {o.status:<12} "
+                       f"{info[:160] if not verbose else info}")
+    click.echo("-" * 100)
+    parts = sum(total.values())
+    click.echo(f"{len(runs)} problems, {parts} parts: " +
+               ", ".join(f"{total[s]} {s}" for s in STATUS_ORDER if total[s]))
+
+
+@main.command()
+@click.argument("files", nargs=-1, required=True,
+                type=click.Path(exists=True, dir_okay=False, path_type=Path))
+def validate(files: tuple[Path, ...]) -> None:
+    """Validate problem or answer files (schema and every expression); nothing runs."""
+    bad = 0
+    for f in files:
+        try:
+            click.echo(validate_file(f))
+        except MechbookError as exc:
+            click.echo(f"invalid: {exc}", err=True)
+            bad += 1
+    if bad:
+        sys.exit(1)
+
+
+@main.command()
+@click.argument("problem_id")
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 file to read.")
+@click.pass_context
+def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
+    """Print a problem's stored results and checks, read back from the HDF5 store."""
+    base = _resolve_root(ctx)
+    path = store_path if store_path.is_absolute() else base / store_path
+    try:
+        rec = read(problem_id, path)
+    except (FileNotFoundError, KeyError) as exc:
+        raise click.ClickException(str(exc).strip("'\"")) from None
+    a = rec["attrs"]
+    click.echo(f"{problem_id}: {a.get('title')}  [{a.get('source')}]")
+    click.echo(f"stored {a.get('date')} by mechbook {a.get('mechbook')} (SymPy {a.get('sympy')}, "
+               f"NumPy {a.get('numpy')}); {a.get('duration_s', 0):.1f} s; problem sha256 "
+               f"{str(a.get('problem_sha256'))[:12]}")
+    for sname, entry in rec["systems"].items():
+        click.echo(f"\n== system {sname}")
+        for key, text in entry["symbolic"].items():
+            click.echo(f"{key}: {text}")
+        for key, arr in entry["numeric"].items():
+            click.echo(f"{key} (numeric): {arr.tolist()}")
+        for key, text in entry["notes"].items():
+            click.echo(f"{key}: {text}")
+    click.echo("\n== checks")
+    for c in rec["checks"]:
+        click.echo(f"{c['part']:<16} {c['quantity']:<20} {c['status']:<12} {c['method']} "
+                   f"{c['detail']}".rstrip())

@@ -1,0 +1,112 @@
+"""What `mechbook solve` shows and the store keeps: the results a problem's `compute:` asks for.
+
+Each result is either text (a SymPy expression printed in the parser's own syntax, so it can
+be read back) or a NumPy array evaluated at the problem's default parameter values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from .analysis import Analysis
+from .errors import UnsupportedError
+
+DEFAULT_COMPUTE = ["lagrangian", "eom", "momenta", "cyclic", "energy", "equilibria",
+                   "small_oscillations"]
+
+
+@dataclass
+class Results:
+    system: str
+    text: dict[str, str] = field(default_factory=dict)
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    notes: dict[str, str] = field(default_factory=dict)
+
+
+def show(expr) -> str:
+    if isinstance(expr, (list, tuple)):
+        return "[" + ", ".join(show(e) for e in expr) + "]"
+    if isinstance(expr, dict):
+        return "{" + ", ".join(f"{k}: {show(v)}" for k, v in expr.items()) + "}"
+    return sp.sstr(expr)
+
+
+def derive(analysis: Analysis, system: str | None = None,
+           compute: list[str] | None = None) -> Results:
+    sys = analysis.system(system)
+    wanted = compute or sys.spec.get("compute") or DEFAULT_COMPUTE
+    res = Results(sys.name)
+    dyn = analysis.dynamics(sys.name)
+    values = analysis.problem.values()
+
+    def attempt(key, fn):
+        try:
+            fn()
+        except UnsupportedError as exc:
+            res.notes[key] = f"unsupported: {exc.capability}"
+
+    if "lagrangian" in wanted:
+        res.text["lagrangian"] = show(sp.simplify(sys.lagrangian))
+        res.text["kinetic"] = show(sp.simplify(sys.kinetic))
+        res.text["potential"] = show(sp.simplify(sys.potential))
+    if "eom" in wanted:
+        def eom():
+            res.text["mass_matrix"] = show(dyn.mass_matrix.tolist())
+            res.text["forcing"] = show(list(dyn.forcing))
+            res.text["accelerations"] = show({a: s for a, s in dyn.solved.items()})
+        attempt("eom", eom)
+    if "momenta" in wanted:
+        res.text["momenta"] = show(dict(zip(sys.q, dyn.momenta, strict=True)))
+    if "cyclic" in wanted:
+        res.text["cyclic"] = show(dyn.cyclic)
+    if "energy" in wanted:
+        res.text["energy_function"] = show(dyn.energy_function)
+        res.text["energy_conserved"] = str(dyn.energy_conserved)
+    if "hamiltonian" in wanted:
+        def ham():
+            res.text["hamiltonian"] = show(dyn.hamiltonian)
+            qdot, pdot = dyn.hamilton_equations
+            res.text["hamilton_qdot"] = show(qdot)
+            res.text["hamilton_pdot"] = show(pdot)
+        attempt("hamiltonian", ham)
+    if "equilibria" in wanted or "small_oscillations" in wanted:
+        def equilibria():
+            eq = analysis.equilibria(sys.name)
+            points = eq.symbolic
+            res.text["equilibria"] = show(points)
+            for i, point in enumerate(points):
+                lin = analysis.linear(sys.name, point)
+                tag = f"equilibrium_{i}"
+                res.text[f"{tag}/point"] = show(point)
+                try:
+                    res.text[f"{tag}/stability"] = lin.numeric_stability(values)
+                    if not lin.gyroscopic:
+                        res.text[f"{tag}/stable_if"] = show(lin.stability_condition)
+                except (TypeError, ValueError):
+                    res.notes[f"{tag}/stability"] = "does not evaluate at the default values"
+                    continue
+                if "small_oscillations" in wanted:
+                    _oscillations(res, lin, tag, values)
+        attempt("equilibria", equilibria)
+    return res
+
+
+def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
+    res.text[f"{tag}/M"] = show(lin.M.tolist())
+    res.text[f"{tag}/K"] = show(lin.K.tolist())
+    if lin.gyroscopic:
+        res.text[f"{tag}/C"] = show(lin.C.tolist())
+    try:
+        res.text[f"{tag}/frequencies"] = show(lin.frequencies)
+    except UnsupportedError as exc:
+        res.notes[f"{tag}/frequencies"] = f"unsupported: {exc.capability}"
+    M, C, K = lin.matrices(values)
+    res.arrays[f"{tag}/M"] = M
+    res.arrays[f"{tag}/K"] = K
+    res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
+    if not lin.gyroscopic:
+        w2, modes = lin.numeric_modes(values)
+        res.arrays[f"{tag}/modes"] = modes

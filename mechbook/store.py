@@ -1,0 +1,142 @@
+"""The HDF5 store: every run's results, checks and provenance, written atomically.
+
+Layout (one group per problem, replaced whole on each run of that problem):
+    /problems/<id>                 attrs: title, source, problem_sha256, mechbook, sympy,
+                                          numpy, h5py, date, duration_s
+    /problems/<id>/systems/<s>/symbolic/<key>   UTF-8 string datasets
+    /problems/<id>/systems/<s>/numeric/<key>    float arrays (default parameter values)
+    /problems/<id>/systems/<s>/notes/<key>      why a result is missing
+    /problems/<id>/checks/<part>   attrs: quantity, cite, status, method, detail, seconds
+
+A run copies the current file, edits the copy and renames it over the original, so an
+interrupted run leaves the previous file whole and readable.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Iterable
+from datetime import UTC, datetime
+from pathlib import Path
+
+import h5py
+import numpy as np
+import sympy as sp
+
+from . import __version__
+from .checker import Outcome
+from .derive import Results
+from .problem import Problem
+
+DEFAULT_PATH = Path("results/mechbook.h5")
+FORMAT = 1
+_STR = h5py.string_dtype("utf-8")
+
+
+class ProblemRecord:
+    """Everything one run learned about one problem."""
+
+    def __init__(self, problem: Problem, results: Iterable[Results],
+                 outcomes: Iterable[Outcome], duration: float):
+        self.problem = problem
+        self.results = list(results)
+        self.outcomes = list(outcomes)
+        self.duration = duration
+
+
+def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> Path:
+    """Add or replace the given problems in the store, atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        if path.exists():
+            shutil.copyfile(path, tmp)
+            mode = "a"
+        else:
+            mode = "w"
+        with h5py.File(tmp, mode) as f:
+            f.attrs["format"] = FORMAT
+            root = f.require_group("problems")
+            for rec in records:
+                _write_problem(root, rec)
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
+    pid = rec.problem.id
+    if pid in root:
+        del root[pid]
+    g = root.create_group(pid, track_order=True)
+    g.attrs.update({
+        "title": rec.problem.title, "source": rec.problem.source,
+        "problem_sha256": rec.problem.sha256, "mechbook": __version__,
+        "sympy": sp.__version__, "numpy": np.__version__, "h5py": h5py.__version__,
+        "date": datetime.now(UTC).isoformat(timespec="seconds"),
+        "duration_s": float(rec.duration),
+    })
+    for res in rec.results:
+        s = g.require_group("systems").create_group(res.system, track_order=True)
+        for key, text in res.text.items():
+            s.create_dataset(f"symbolic/{key}", data=text, dtype=_STR)
+        for key, arr in res.arrays.items():
+            s.create_dataset(f"numeric/{key}", data=np.asarray(arr, dtype=float))
+        for key, text in res.notes.items():
+            s.create_dataset(f"notes/{key}", data=text, dtype=_STR)
+    checks = g.create_group("checks")
+    for i, o in enumerate(rec.outcomes):
+        c = checks.create_group(o.part)
+        c.attrs.update({"index": i, "quantity": o.quantity, "cite": o.cite, "status": o.status,
+                        "method": o.method, "detail": o.detail, "seconds": float(o.seconds)})
+
+
+def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
+    """One problem's record as plain Python data (raises KeyError if absent)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
+    with h5py.File(path, "r") as f:
+        if "problems" not in f or pid not in f["problems"]:
+            raise KeyError(f"{pid} is not in {path}; run `mechbook check {pid}`")
+        g = f["problems"][pid]
+        out = {"attrs": {k: _plain(v) for k, v in g.attrs.items()}, "systems": {}, "checks": []}
+        for sname, s in g.get("systems", {}).items():
+            entry = {"symbolic": {}, "numeric": {}, "notes": {}}
+            for kind in entry:
+                if kind in s:
+                    s[kind].visititems(lambda name, obj, kind=kind, entry=entry:
+                                       _collect(entry[kind], name, obj))
+            out["systems"][sname] = entry
+        for part, c in g["checks"].items():
+            out["checks"].append({"part": part, **{k: _plain(v) for k, v in c.attrs.items()}})
+        out["checks"].sort(key=lambda c: c.get("index", 0))
+    return out
+
+
+def problems(path: str | Path = DEFAULT_PATH) -> list[str]:
+    with h5py.File(path, "r") as f:
+        return sorted(f.get("problems", {}).keys())
+
+
+def _collect(target: dict, name: str, obj) -> None:
+    if isinstance(obj, h5py.Dataset):
+        data = obj[()]
+        target[name] = data.decode() if isinstance(data, bytes) else (
+            np.array(data) if obj.dtype.kind == "f" else _plain(data))
+
+
+def _plain(v):
+    if isinstance(v, bytes):
+        return v.decode()
+    if isinstance(v, np.generic):
+        return v.item()
+    return v

@@ -1,0 +1,58 @@
+"""`mechbook validate`: a file is checked against its schema and every expression parsed,
+without deriving anything."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .analysis import Analysis
+from .answers import load_answers
+from .catalog import problem_path, root
+from .checks import Context
+from .errors import MechbookError
+from .problem import load_problem
+from .yamlio import load
+
+
+def validate_file(path: str | Path) -> str:
+    """Validate a problem or an answer file; return a one-line summary or raise SpecError."""
+    path = Path(path)
+    doc = load(path)
+    if isinstance(doc.data, dict) and "parts" in doc.data:
+        return _validate_answers(path)
+    problem = load_problem(path)
+    for name in problem.systems:
+        problem.system(name)
+    return f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s))"
+
+
+def _validate_answers(path: Path) -> str:
+    key = load_answers(path)
+    try:
+        base = root(path.parent)
+    except MechbookError:
+        base = path.resolve().parents[2]
+    problem = load_problem(problem_path(key.problem_id, base))
+    analysis = Analysis(problem)
+    for part in key.parts:
+        ctx = Context(analysis, part)
+        for field in ("book", "about", "initial"):
+            if field in part.data:
+                _walk(ctx, part.data[field], (field,))
+        if "erratum" in part.data:
+            _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"))
+    return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
+
+
+def _walk(ctx: Context, value, sub: tuple) -> None:
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _walk(ctx, v, sub + (k,))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            _walk(ctx, v, sub + (i,))
+    elif isinstance(value, str):
+        if "<" in value or ">" in value:
+            ctx.parse(value, sub, relation=True)
+        else:
+            ctx.parse(value, sub, equation=True)
