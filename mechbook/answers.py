@@ -20,7 +20,7 @@ from .yamlio import Document, load
 
 @dataclass
 class Part:
-    key: "AnswerKey"
+    key: AnswerKey
     index: int
     data: dict
 

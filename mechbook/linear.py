@@ -187,7 +187,8 @@ class Equilibria:
         return [s for s in sols if len(s) == len(self.dyn.q)
                 and all(v.is_real is not False for v in s.values())]
 
-    def numeric(self, values: dict, search: dict | None = None, starts: int = 7) -> list[np.ndarray]:
+    def numeric(self, values: dict, search: dict | None = None,
+                starts: int = 7) -> list[np.ndarray]:
         """Equilibria at `values` by root finding from a grid of starting points."""
         q = self.dyn.q
         conds = [c.subs(values) for c in self.conditions]

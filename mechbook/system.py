@@ -11,7 +11,7 @@ from __future__ import annotations
 import sympy as sp
 
 from .bodies import body_kinetic, shape_inertia
-from .problem import RESERVED, T, Problem, SystemSpec
+from .problem import RESERVED, Problem, SystemSpec, T
 
 
 class System:
