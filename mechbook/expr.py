@@ -30,7 +30,7 @@ FUNCTIONS: dict[str, object] = {
     "sign": sp.sign, "cbrt": sp.cbrt,
 }
 ARITY = {"atan2": (2, 2), "log": (1, 2)}
-CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi, "E": sp.E, "I": sp.I}
+CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
 
 _BINOPS = {
     ast.Add: lambda a, b: a + b,
@@ -40,7 +40,7 @@ _BINOPS = {
     ast.Pow: None,  # handled separately (size check)
 }
 _COMPARE = {ast.Lt: sp.StrictLessThan, ast.LtE: sp.LessThan,
-            ast.Gt: sp.StrictGreaterThan, ast.GtE: sp.GreaterThan}
+            ast.Gt: sp.StrictGreaterThan, ast.GtE: sp.GreaterThan, ast.NotEq: sp.Ne}
 
 
 def _depth(text: str) -> int:

@@ -174,6 +174,9 @@ class Equilibria:
         conds = [try_simplify(e.subs(zero), 5) for e in self.dyn.residuals]
         if any(c.has(self.sys.t) for c in conds):
             raise UnsupportedError("static equilibria of a non-autonomous system")
+        free = {s for syms in self.sys.free_driven for s in syms}
+        if any(c.free_symbols & free for c in conds):
+            raise UnsupportedError("static equilibria with an arbitrary driven coordinate")
         return conds
 
     @cached_property
@@ -209,6 +212,19 @@ class Equilibria:
                 if not any(np.allclose(sol.x, f, atol=1e-7) for f in found):
                     found.append(sol.x)
         return found
+
+    def quadratic_lagrangian(self, point: dict) -> sp.Expr:
+        """L expanded to second order in δq, q̇ and small parameters about `point`
+        (constant term dropped), written in the original coordinates."""
+        dyn = self.dyn
+        sub = {q: point.get(q, sp.S.Zero) + EPS * q for q in dyn.q}
+        sub.update({v: EPS * v for v in dyn.qd})
+        sub.update({s: EPS * s for s in self.sys.small_params})
+        lag = dyn.L.subs(sub, simultaneous=True)
+        first = sp.diff(lag, EPS)
+        out = first.subs(EPS, 0) + sp.diff(first, EPS).subs(EPS, 0) / 2
+        back = {q: q - point.get(q, sp.S.Zero) for q in dyn.q}
+        return sp.expand(out.subs(back, simultaneous=True))
 
     def residual(self, point: dict) -> list[sp.Expr]:
         return [c.subs(point) for c in self.conditions]

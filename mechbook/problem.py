@@ -60,6 +60,7 @@ class Problem:
     systems: dict[str, SystemSpec]
     sha256: str
     description: str = ""
+    conditions: list = field(default_factory=list)
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -131,5 +132,10 @@ def load_problem(path: str | Path) -> Problem:
     if not data["id"].endswith(expected):
         raise doc.error(("id",), f"id {data['id']!r} does not match the file name {expected!r}")
     sha = hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    return Problem(data["id"], data["title"], data["source"], str(path), doc, params, systems,
-                   sha, data.get("description", ""))
+    problem = Problem(data["id"], data["title"], data["source"], str(path), doc, params, systems,
+                      sha, data.get("description", ""))
+    problem.conditions = [problem.parse(c, ("conditions", i), relation=True)
+                          for i, c in enumerate(data.get("conditions", []))]
+    if not all(bool(c.subs(problem.values())) for c in problem.conditions):
+        raise doc.error(("conditions",), "the default parameter values violate the conditions")
+    return problem

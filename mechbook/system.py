@@ -11,6 +11,7 @@ from __future__ import annotations
 import sympy as sp
 
 from .bodies import body_kinetic, shape_inertia
+from .errors import UnsupportedError
 from .problem import RESERVED, Problem, SystemSpec, T
 
 
@@ -52,9 +53,16 @@ class System:
                 names[sym.name] = sym
         names["t"] = T
         self.driven: dict[str, sp.Expr] = {}
+        self.free_driven: list[tuple[sp.Symbol, sp.Symbol, sp.Symbol]] = []
         for name, text in (self.spec.get("driven") or {}).items():
             if name in taken or name + "dot" in taken or name + "ddot" in taken:
                 raise self._error(("driven", name), f"name {name!r} is already taken")
+            if isinstance(text, dict):  # {free: true}: an arbitrary prescribed function of t
+                syms = tuple(sp.Symbol(name + s, real=True) for s in ("", "dot", "ddot"))
+                self.free_driven.append(syms)
+                names.update({s.name: s for s in syms})
+                taken |= {s.name for s in syms}
+                continue
             expr = self._parse_with(text, ("driven", name), names)
             if any(s in expr.free_symbols for s in self.q + self.qd + self.qdd):
                 raise self._error(("driven", name), "a driven coordinate is a function of t and "
@@ -218,6 +226,10 @@ class System:
         out = sp.diff(expr, T)
         for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True):
             out += sp.diff(expr, q) * qd + sp.diff(expr, qd) * qdd
+        for y, yd, ydd in self.free_driven:
+            if expr.has(ydd):
+                raise UnsupportedError("third derivative of a free driven coordinate")
+            out += sp.diff(expr, y) * yd + sp.diff(expr, yd) * ydd
         return out
 
     def point(self, mapping: dict, sub: tuple) -> dict[sp.Symbol, sp.Expr]:
