@@ -77,9 +77,25 @@ def derive(analysis: Analysis, system: str | None = None,
             eq = analysis.equilibria(sys.name)
             points = eq.symbolic
             res.text["equilibria"] = show(points)
+            if not points:
+                search = (sys.spec.get("equilibria") or {}).get("search")
+                found = eq.numeric(values, _ranges(sys, search))
+                res.notes["equilibria"] = "no closed form found; numeric equilibria at the " \
+                    "default parameters stored as numeric/equilibria"
+                if found:
+                    res.arrays["equilibria"] = np.array(found)
+                    points = [{q: _snap(x) for q, x in zip(sys.q, f, strict=True)}
+                              for f in found]
             for i, point in enumerate(points):
-                lin = analysis.linear(sys.name, point)
                 tag = f"equilibrium_{i}"
+                if any(v.has(sp.Float) for v in point.values()):
+                    res.notes[tag] = f"{show(point)}: numeric point, not linearized symbolically"
+                    continue
+                try:
+                    lin = analysis.linear(sys.name, point)
+                except UnsupportedError as exc:
+                    res.notes[tag] = f"{show(point)}: unsupported: {exc.capability}"
+                    continue
                 res.text[f"{tag}/point"] = show(point)
                 try:
                     res.text[f"{tag}/stability"] = lin.numeric_stability(values)
@@ -92,6 +108,20 @@ def derive(analysis: Analysis, system: str | None = None,
                     _oscillations(res, lin, tag, values)
         attempt("equilibria", equilibria)
     return res
+
+
+def _snap(x: float) -> sp.Expr:
+    """A numerically found coordinate: k*pi/12 exactly if it is that to 1e-10, else a Float."""
+    k = round(x * 12 / np.pi)
+    return k * sp.pi / 12 if abs(x - k * np.pi / 12) < 1e-10 else sp.Float(x)
+
+
+def _ranges(sys, search: dict | None) -> dict | None:
+    if not search:
+        return None
+    vals = sys.problem.values()
+    return {sys.q[sys.coord_names.index(k)]: tuple(float(sys._parse(x, ("equilibria", "search",
+            k, i)).subs(vals)) for i, x in enumerate(v)) for k, v in search.items()}
 
 
 def _oscillations(res: Results, lin, tag: str, values: dict) -> None:

@@ -183,7 +183,7 @@ class Equilibria:
     def symbolic(self) -> list[dict]:
         """Equilibria SymPy can find in closed form (possibly incomplete for trig equations)."""
         try:
-            with time_limit(30):
+            with time_limit(10):
                 sols = sp.solve(self.conditions, self.dyn.q, dict=True)
         except (Timeout, NotImplementedError):
             return []
@@ -208,7 +208,7 @@ class Equilibria:
         for x0 in mesh:
             sol = scipy.optimize.root(lambda x: np.asarray(f_num(x), float), x0,
                                       jac=lambda x: np.asarray(j_num(x), float))
-            if sol.success and np.max(np.abs(f_num(sol.x))) < 1e-10:
+            if np.all(np.isfinite(sol.x)) and np.max(np.abs(f_num(sol.x))) < 1e-10:
                 if not any(np.allclose(sol.x, f, atol=1e-7) for f in found):
                     found.append(sol.x)
         return found
@@ -243,17 +243,27 @@ class Equilibria:
             e_sub = e.subs(sub, simultaneous=True)
             zeroth.append(try_simplify(e_sub.subs(EPS, 0), 5))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
-        if any(z != 0 for z in zeroth):
+        if any(z != 0 and not _numerically_zero(z, self.sys.numeric_values()) for z in zeroth):
             raise UnsupportedError("linearization about a point that is not an equilibrium")
         n = len(dyn.q)
-        M = sp.Matrix(n, n, lambda i, j: try_simplify(sp.diff(lin[i], dyn.qdd[j]), 5))
-        C = sp.Matrix(n, n, lambda i, j: try_simplify(sp.diff(lin[i], dyn.qd[j]), 5))
-        K = sp.Matrix(n, n, lambda i, j: try_simplify(sp.diff(lin[i], dyn.q[j]), 5))
-        rest = sp.Matrix([lin[i] - sum((M[i, j] * dyn.qdd[j] + C[i, j] * dyn.qd[j]
-                                        + K[i, j] * dyn.q[j]) for j in range(n))
+        raw = {name: sp.Matrix(n, n, lambda i, j, v=v: sp.diff(lin[i], v[j]))
+               for name, v in (("M", dyn.qdd), ("C", dyn.qd), ("K", dyn.q))}
+        rest = sp.Matrix([lin[i] - sum((raw["M"][i, j] * dyn.qdd[j] + raw["C"][i, j] * dyn.qd[j]
+                                        + raw["K"][i, j] * dyn.q[j]) for j in range(n))
                           for i in range(n)])
+        M, C, K = (raw[k].applyfunc(lambda x: try_simplify(x, 5)) for k in ("M", "C", "K"))
         F = (-rest).applyfunc(lambda x: try_simplify(sp.expand(x), 5))
         bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
         return LinearSystem(dyn, dict(point), M, C, K, F)
+
+
+def _numerically_zero(expr: sp.Expr, values: dict) -> bool:
+    """A residual left by a numerically found point (floats), zero to rounding."""
+    if not expr.has(sp.Float):
+        return False
+    try:
+        return abs(complex(sp.N(expr.subs(values)))) < 1e-9
+    except (TypeError, ValueError):
+        return False

@@ -8,16 +8,17 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 
-class Timeout(Exception):
-    """The guarded computation ran past its limit."""
+class Timeout(BaseException):
+    """The guarded computation ran past its limit (a BaseException, so that SymPy's own
+    `except Exception` clauses cannot swallow it)."""
 
 
 @contextmanager
 def time_limit(seconds: float) -> Iterator[None]:
     """Raise Timeout inside the block after `seconds` (main thread, POSIX; else no limit)."""
     if seconds <= 0 or threading.current_thread() is not threading.main_thread() \
-            or not hasattr(signal, "setitimer"):
-        yield
+            or not hasattr(signal, "setitimer") or signal.getitimer(signal.ITIMER_REAL)[0] > 0:
+        yield  # no timer here, or an outer limit is already running and governs
         return
 
     def _raise(signum, frame):
