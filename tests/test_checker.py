@@ -1,0 +1,587 @@
+"""The checker: the book's answers pass, and wrong answers do not.
+
+The mutation test takes every answer file in the tree (globbed at collection time, so new
+problems are covered without editing this file), and for every part the checker passes (or
+reports as an erratum) it derives wrong versions of the book's value and requires the checker
+to fail each one. A mutant is skipped only when it is provably the same statement (SymPy
+proves the two texts mean the same), never because the checker happened to accept it.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+import sympy as sp
+from ruamel.yaml import YAML
+
+from mechbook.analysis import Analysis
+from mechbook.answers import AnswerKey, Part, load_answers
+from mechbook.catalog import problem_path
+from mechbook.checker import check_problem
+from mechbook.checks import Context
+from mechbook.errors import UnsupportedError
+from mechbook.problem import load_problem
+
+ROOT = Path(__file__).resolve().parents[1]
+ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
+MAX_MUTANTS_PER_SLOT = 5
+VERBOSE = bool(os.environ.get("MECHBOOK_MUTANTS_VERBOSE"))
+
+
+def plain(data):
+    """Plain Python data (ruamel's round-trip scalars are subclasses of int/float)."""
+    if isinstance(data, dict):
+        return {str(k): plain(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [plain(v) for v in data]
+    if isinstance(data, bool) or data is None:
+        return data
+    if isinstance(data, int):
+        return int(data)
+    if isinstance(data, float):
+        return float(data)
+    return str(data)
+
+
+def dump(data: dict, path: Path) -> Path:
+    yaml = YAML(typ="safe", pure=True)
+    yaml.default_flow_style = False
+    with open(path, "w", encoding="utf-8") as fh:
+        yaml.dump(plain(data), fh)
+    return path
+
+
+def load_real(answer_file: Path) -> tuple[AnswerKey, Analysis]:
+    key = load_answers(answer_file)
+    problem = load_problem(problem_path(key.problem_id, ROOT))
+    return key, Analysis(problem)
+
+
+# ---- (a) the worked example passes ----------------------------------------------------------
+def test_lim_2031_passes():
+    key, analysis = load_real(ROOT / "answers" / "lim" / "2031.yaml")
+    outcomes = check_problem(analysis, key)
+    assert outcomes, "no parts"
+    bad = [(o.part, o.status, o.detail) for o in outcomes if o.status != "pass"]
+    assert not bad
+    assert {o.part for o in outcomes} >= {"a-lagrangian", "a-eom", "b", "c", "c-frequency"}
+
+
+def test_answer_key_for_another_problem_is_rejected(tmp_path):
+    key, analysis = load_real(ROOT / "answers" / "lim" / "2031.yaml")
+    data = copy.deepcopy(key.doc.data)
+    data["problem"] = "lim-9999"
+    other = load_answers(dump(data, tmp_path / "key.yaml"))
+    with pytest.raises(Exception, match="lim-9999"):
+        check_problem(analysis, other)
+
+
+# ---- text surgery ---------------------------------------------------------------------------
+OPERAND_END = re.compile(r"[A-Za-z0-9_.)\]]")
+
+
+def _binary_ops(s: str) -> list[int]:
+    """Positions of top-level binary + and - in an expression text."""
+    out, depth = [], 0
+    for i, ch in enumerate(s):
+        if ch in "([":
+            depth += 1
+        elif ch in ")]":
+            depth -= 1
+        elif ch in "+-" and depth == 0:
+            before = s[:i].rstrip()
+            if not before or not OPERAND_END.match(before[-1]):
+                continue  # unary
+            if before[-1] in "eE" and len(before) >= 2 and before[-2].isdigit() \
+                    and re.search(r"(^|[^A-Za-z_])[0-9.]+[eE]$", before):
+                continue  # exponent of a float literal such as 1e-3
+            out.append(i)
+    return out
+
+
+def flip_first_sign(s: str) -> str | None:
+    ops = _binary_ops(s)
+    if not ops:
+        return None
+    i = ops[0]
+    return s[:i] + ("-" if s[i] == "+" else "+") + s[i + 1:]
+
+
+def double_first_term(s: str) -> str | None:
+    ops = _binary_ops(s)
+    if not ops:
+        return None
+    return f"2*({s[:ops[0]].strip()}) {s[ops[0]:]}"
+
+
+def split_equation(s: str) -> tuple[str, str] | None:
+    idx = [i for i, ch in enumerate(s) if ch == "="
+           and (i == 0 or s[i - 1] not in "<>=!") and (i + 1 >= len(s) or s[i + 1] != "=")]
+    if len(idx) != 1:
+        return None
+    return s[:idx[0]].strip(), s[idx[0] + 1:].strip()
+
+
+def swap_names(s: str, names: list[str]) -> Iterator[tuple[str, str]]:
+    present = [n for n in names if re.search(rf"\b{re.escape(n)}\b", s)]
+    pairs = [(a, b) for i, a in enumerate(present) for b in present[i + 1:]]
+    for a, b in pairs[:2]:
+        pattern = re.compile(rf"\b({re.escape(a)}|{re.escape(b)})\b")
+        yield f"swap {a}<->{b}", pattern.sub(lambda m, a=a, b=b: b if m.group() == a else a, s)
+
+
+def flip_relation(s: str) -> str | None:
+    m = re.search(r"<=|>=|<|>", s)
+    if not m:
+        return None
+    opposite = {"<=": ">=", ">=": "<=", "<": ">", ">": "<"}[m.group()]
+    return s[:m.start()] + opposite + s[m.end():]
+
+
+# ---- where the book's value can be changed, and how -----------------------------------------
+@dataclass
+class Slot:
+    path: tuple  # inside the part's data
+    kind: str
+
+
+def get(data, path):
+    for p in path:
+        data = data[p]
+    return data
+
+
+def put(data, path, value):
+    get(data, path[:-1])[path[-1]] = value
+
+
+def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
+    q = part.quantity
+    root = ("erratum", "corrected") if "erratum" in part.data else ("book",)
+    val = get(part.data, root)
+    if q == "lagrangian":
+        yield Slot(root, "lagrangian")
+    elif q == "eom":
+        for i in range(len(val)):
+            yield Slot(root + (i,), "equation")
+    elif q == "conserved":
+        if isinstance(val, list):
+            for i in range(len(val)):
+                yield Slot(root + (i,), "conserved")
+        else:
+            yield Slot(root, "conserved")
+    elif q == "equilibrium":
+        if "at" in val:
+            conds = analysis.equilibria(part.system).conditions
+            live = set().union(*(c.free_symbols for c in conds))
+            for k in val["at"]:
+                if ctx.system.q[ctx.system.coord_names.index(k)] in live:
+                    yield Slot(root + ("at", k), "point")
+        for i in range(len(val.get("where", []))):
+            yield Slot(root + ("where", i), "equation")
+        if "stable" in part.data:
+            yield Slot(("stable",), "flag")
+    elif q == "stability_condition":
+        yield Slot(root, "relation")
+    elif q == "frequencies":
+        for i in range(len(val)):
+            yield Slot(root + (i,), "value")
+    elif q == "period":
+        yield Slot(root, "value")
+    elif q == "normal_modes":
+        for i, mode in enumerate(val):
+            yield Slot(root + (i, "frequency"), "value")
+            if len(mode.get("shape", {})) > 1 and not degenerate(ctx, mode["frequency"]):
+                for c in mode["shape"]:
+                    yield Slot(root + (i, "shape", c), "component")
+    elif q == "normal_coordinates":
+        for i, item in enumerate(val):
+            if not degenerate(ctx, item.get("frequency")):
+                yield Slot(root + (i, "coordinate"), "form")
+            if "frequency" in item:
+                yield Slot(root + (i, "frequency"), "value")
+    elif q == "steady_state":
+        for k in val:
+            yield Slot(root + (k,), "function")
+    elif q == "motion":
+        kind = "function" if "initial" in part.data else "general_function"
+        for k in val:
+            yield Slot(root + (k,), kind)
+    elif q == "mode_count":
+        yield Slot(root, "count")
+    elif q == "mode_node":
+        for k in val:
+            yield Slot(root + (k,), "value")
+    elif q == "expression":
+        of = part.data.get("of")
+        if of == "momenta":
+            for k in val:
+                yield Slot(root + (k,), "value")
+        elif of in ("potential", "quadratic_potential"):
+            yield Slot(root, "potential")
+        else:
+            yield Slot(root, "value")
+
+
+def degenerate(ctx: Context, freq) -> bool:
+    """Is `freq` a repeated engine frequency at the default parameters (then any vector of
+    its eigenspace is a correct mode, and changing one component may not be wrong)?"""
+    values = ctx.sampler.default()
+    engine = ctx.linear().numeric_frequencies(values)
+    if freq is None:  # no frequency given: is any engine frequency repeated?
+        return any(sum(abs(e - w) <= 1e-6 * max(1.0, abs(w)) for e in engine) > 1
+                   for w in engine)
+    w = complex(sp.N(ctx.parse(freq, ("frequency",)).subs(values))).real
+    return sum(abs(e - w) <= 1e-6 * max(1.0, abs(w)) for e in engine) > 1
+
+
+def expression_mutants(s: str, names: list[str]) -> Iterator[tuple[str, str]]:
+    yield "negate", f"-({s})"
+    yield "double", f"2*({s})"
+    flipped = flip_first_sign(s)
+    if flipped:
+        yield "flip sign of a term", flipped
+    doubled = double_first_term(s)
+    if doubled:
+        yield "double a term", doubled
+    yield from swap_names(s, names)
+    yield "add one", f"({s}) + 1"
+
+
+def equation_mutants(s: str, names: list[str], coordinate: str) -> Iterator[tuple[str, str]]:
+    sides = split_equation(s)
+    if sides is None:
+        lhs, rhs = s, "0"
+    else:
+        lhs, rhs = sides
+    for side, build in ((lhs, lambda x: f"{x} = {rhs}"), (rhs, lambda x: f"{lhs} = {x}")):
+        flipped = flip_first_sign(side)
+        if flipped:
+            yield "flip sign of a term", build(flipped)
+            break
+    for side, build in ((lhs, lambda x: f"{x} = {rhs}"), (rhs, lambda x: f"{lhs} = {x}")):
+        doubled = double_first_term(side)
+        if doubled:
+            yield "double a term", build(doubled)
+            break
+    if rhs.strip() != "0":
+        yield "double right side", f"{lhs} = 2*({rhs})"
+        yield "negate right side", f"{lhs} = -({rhs})"
+    yield "add a term", f"{lhs} + {coordinate} = {rhs}"
+    yield from swap_names(s, names)
+
+
+def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tuple[str, object]]:
+    if slot.kind == "count":
+        yield "plus one", value + 1
+        yield "minus one", value - 1
+        return
+    if slot.kind == "flag":
+        yield "flip stable", not value
+        return
+    s = str(value)
+    if slot.kind in ("lagrangian", "value", "potential"):
+        yield from expression_mutants(s, names)
+    elif slot.kind == "point":
+        yield "negate", f"-({s})"
+        yield "double", f"2*({s})"
+        yield "shift", f"({s}) + 1/3"
+    elif slot.kind == "component":
+        yield "double", f"2*({s})"
+        yield "add one", f"({s}) + 1"
+    elif slot.kind == "equation":
+        yield from equation_mutants(s, names, coordinate)
+    elif slot.kind == "conserved":
+        body = re.sub(r"=\s*const(ant)?\s*$", "", s).strip()
+        yield "times (2 + coordinate)", f"({body})*(2 + {coordinate})"
+        doubled = double_first_term(body)
+        if doubled:
+            yield "double a term", doubled
+        yield from swap_names(body, names)
+    elif slot.kind == "relation":
+        flipped = flip_relation(s)
+        if flipped:
+            yield "flip comparison", flipped
+        yield from swap_names(s, names)
+    elif slot.kind == "form":
+        doubled = double_first_term(s)
+        if doubled:
+            yield "double a term", doubled
+        yield "add a coordinate", f"{s} + {coordinate}"
+        yield from swap_names(s, names)
+    elif slot.kind == "function":
+        yield "double", f"2*({s})"
+        yield "negate", f"-({s})"
+        yield "add t**2", f"({s}) + t**2"
+        yield from swap_names(s, names)
+    elif slot.kind == "general_function":  # a general solution: any multiple is one too
+        yield "add t**2", f"({s}) + t**2"
+    else:  # pragma: no cover
+        raise AssertionError(slot.kind)
+
+
+# ---- when is a mutant provably the same statement? ------------------------------------------
+def _zero(expr) -> bool:
+    try:
+        return sp.simplify(expr) == 0
+    except Exception:
+        return False
+
+
+def _free_of(expr, symbols) -> bool:
+    expr = sp.simplify(expr)
+    return expr.is_finite is not False and expr != 0 and not (expr.free_symbols & symbols)
+
+
+def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
+    if str(old) == str(new):
+        return True
+    if slot.kind in ("count", "flag", "relation"):
+        return False
+    sys = ctx.system
+    motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}
+    sub = slot.path
+    if slot.kind == "equation":
+        a = ctx.parse(old, sub, equation=True)
+        b = ctx.parse(new, sub, equation=True)
+        return _zero(a - b) or (a != 0 and _free_of(b / a, motion))
+    if slot.kind == "conserved":
+        a = ctx.parse(re.sub(r"=\s*const(ant)?\s*$", "", str(old)), sub)
+        b = ctx.parse(new, sub)
+        return _free_of(b - a, motion) or _zero(a - b) or (a != 0 and _free_of(b / a, motion))
+    if slot.kind == "form":
+        a, b = ctx.parse(old, sub), ctx.parse(new, sub)
+        return a != 0 and _free_of(b / a, motion)
+    if slot.kind == "component":
+        mode_path, comp = slot.path[:-1], slot.path[-1]
+        shape = get(part_data, mode_path)
+        names = sys.coord_names
+        u = [ctx.parse(shape.get(c, 0), sub) for c in names]
+        v = [ctx.parse(new if c == comp else shape.get(c, 0), sub) for c in names]
+        return all(_zero(u[i] * v[j] - u[j] * v[i])
+                   for i in range(len(u)) for j in range(i + 1, len(u)))
+    a, b = ctx.parse(old, sub), ctx.parse(new, sub)
+    if slot.kind == "lagrangian":
+        d = b - a
+        return all(_zero(sys.dt(sp.diff(d, qd)) - sp.diff(d, q))
+                   for q, qd in zip(sys.q, sys.qd, strict=True))
+    if slot.kind == "potential":
+        return all(_zero(sp.diff(b - a, q)) for q in sys.q)
+    return _zero(b - a)
+
+
+# ---- (b) the mutation test ------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def analyses() -> dict:
+    return {}
+
+
+def _analysis_for(analyses: dict, pid: str) -> Analysis:
+    if pid not in analyses:
+        analyses[pid] = Analysis(load_problem(problem_path(pid, ROOT)))
+    return analyses[pid]
+
+
+# Known checker bugs (see the strict xfail tests below). A mutant that survives only through
+# one of them makes the mutation test xfail instead of fail, so it still catches anything new.
+NAN_BUG = "frequencies: a book value that is not real at the sample points (NaN) is accepted"
+UNSUPPORTED_BUG = ("equilibrium: a wrong `at:` point with `stable:` is reported unsupported "
+                   "(linearizing about a non-equilibrium) instead of fail")
+
+
+def _nonreal_somewhere(ctx: Context, text, sub) -> bool:
+    expr = ctx.parse(text, sub)
+    for _ in range(12):
+        z = complex(sp.N(expr.subs(ctx.sampler.draw()), 20))
+        if abs(z.imag) > 1e-12 * max(1.0, abs(z)):
+            return True
+    return False
+
+
+def known_bug(ctx: Context, part: Part, slot: Slot, new, status: str, detail: str) -> str | None:
+    if (part.quantity == "frequencies" and status == "pass"
+            and _nonreal_somewhere(ctx, new, slot.path)):
+        return NAN_BUG
+    if (part.quantity == "equilibrium" and status == "unsupported" and "stable" in part.data
+            and "not an equilibrium" in detail):
+        return UNSUPPORTED_BUG
+    return None
+
+
+@pytest.mark.parametrize("answer_file", ANSWER_FILES,
+                         ids=[f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES])
+def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict):
+    key = load_answers(answer_file)
+    analysis = _analysis_for(analyses, key.problem_id)
+    originals = check_problem(analysis, key)
+    names = sorted(analysis.problem.parameters) + sorted(
+        key.doc.data.get("abbreviations") or {})
+    survivors: list[str] = []
+    bugs: set[str] = set()
+    tried = 0
+    checked_parts = 0
+    for part, outcome in zip(key.parts, originals, strict=True):
+        if "unsupported" in part.data or outcome.status not in ("pass", "erratum"):
+            continue
+        erratum = "erratum" in part.data
+        try:
+            ctx = Context(analysis, part)
+            part_slots = list(slots(part, ctx, analysis))
+        except UnsupportedError:
+            continue
+        checked_parts += 1
+        coordinate = ctx.system.coord_names[0]
+        for slot in part_slots:
+            old = get(part.data, slot.path)
+            count = 0
+            for label, new in mutants(slot, old, names, coordinate):
+                if count >= MAX_MUTANTS_PER_SLOT:
+                    break
+                if "limit" in part.data and label == "add one" and str(old) != "0":
+                    continue  # a lower-order term does not change an asymptotic formula
+                if same_meaning(ctx, slot, part.data, old, new):
+                    continue
+                count += 1
+                tried += 1
+                data = copy.deepcopy(part.data)
+                put(data, slot.path, new)
+                doc = copy.deepcopy(key.doc.data)
+                doc["parts"] = [data]
+                mutant_key = load_answers(dump(doc, tmp_path / f"mutant{tried}.yaml"))
+                got = check_problem(analysis, mutant_key)[0]
+                if VERBOSE:
+                    print(f"{part.name} {slot.path} {label}: {new!r} -> {got.status}")
+                ok = got.status != "erratum" if erratum else got.status == "fail"
+                if not ok:
+                    where = "/".join(str(p) for p in slot.path)
+                    bug = known_bug(ctx, part, slot, new, got.status, got.detail)
+                    if bug:
+                        bugs.add(bug)
+                        continue
+                    survivors.append(f"{part.name} [{part.quantity}] {where}: {label}: "
+                                     f"{old!r} -> {new!r}: {got.status} {got.method} "
+                                     f"{got.detail[:200]}")
+    if checked_parts:
+        assert tried > 0, "no mutant was generated for any checked part"
+    assert not survivors, (f"{len(survivors)} of {tried} mutants were not failed:\n  "
+                           + "\n  ".join(survivors))
+    if bugs:
+        pytest.xfail("mutants survive only through known checker bugs: " + "; ".join(sorted(bugs)))
+
+
+@pytest.mark.xfail(strict=True, reason=NAN_BUG)
+def test_nonreal_book_frequency_fails(tmp_path, hoop_analysis):
+    """At the default values (b=0.5, omega=6) 1 - g**2/(omega**2*b**4) < 0: the book's
+    frequency is imaginary, match_multiset compares NaN (always False) and passes it."""
+    key = load_answers(ROOT / "answers" / "lim" / "2031.yaml")
+    doc = copy.deepcopy(key.doc.data)
+    part = next(p for p in doc["parts"] if p["quantity"] == "frequencies")
+    part["book"] = ["b*sqrt(1 - g**2/(omega**2*b**4))"]
+    doc["parts"] = [part]
+    out = check_problem(hoop_analysis, load_answers(dump(doc, tmp_path / "nan.yaml")))[0]
+    assert out.status == "fail"
+
+
+def test_match_multiset_nan_documented():
+    from mechbook.compare import match_multiset
+    assert match_multiset([1.0], [2.0])[0] is False
+    assert match_multiset([1.0, 2.0], [2.0, 1.0])[0] is True
+
+
+@pytest.mark.xfail(strict=True, reason="compare.match_multiset accepts NaN book values")
+def test_match_multiset_rejects_nan():
+    from mechbook.compare import match_multiset
+    assert match_multiset([float("nan")], [5.0])[0] is False
+
+
+@pytest.mark.xfail(strict=True, reason=UNSUPPORTED_BUG)
+def test_wrong_equilibrium_point_with_stable_fails(tmp_path, hoop_analysis):
+    """Bead on the hoop: theta = pi/2 is not an equilibrium. With `stable: true` the check
+    linearizes there before looking at its own failed residual, so the part comes out
+    'unsupported' instead of 'fail'."""
+    key = load_answers(ROOT / "answers" / "lim" / "2031.yaml")
+    doc = copy.deepcopy(key.doc.data)
+    doc["parts"] = [{"part": "wrong", "cite": "test", "quantity": "equilibrium",
+                     "book": {"at": {"theta": "pi/2"}}, "stable": True}]
+    out = check_problem(hoop_analysis, load_answers(dump(doc, tmp_path / "eq.yaml")))[0]
+    assert out.status == "fail", (out.status, out.detail)
+
+
+def test_wrong_equilibrium_point_without_stable_fails(tmp_path, hoop_analysis):
+    key = load_answers(ROOT / "answers" / "lim" / "2031.yaml")
+    doc = copy.deepcopy(key.doc.data)
+    doc["parts"] = [{"part": "wrong", "cite": "test", "quantity": "equilibrium",
+                     "book": {"at": {"theta": "pi/2"}}},
+                    {"part": "right", "cite": "test", "quantity": "equilibrium",
+                     "book": {"at": {"theta": "pi"}}}]
+    out = check_problem(hoop_analysis, load_answers(dump(doc, tmp_path / "eq.yaml")))
+    assert [o.status for o in out] == ["fail", "pass"]
+
+
+# ---- (c) errata -----------------------------------------------------------------------------
+def _erratum_key(tmp_path: Path, book: str, corrected: str) -> AnswerKey:
+    key = load_answers(ROOT / "answers" / "lim" / "2031.yaml")
+    doc = copy.deepcopy(key.doc.data)
+    doc["parts"] = [{
+        "part": "c-frequency",
+        "cite": "a test erratum",
+        "quantity": "frequencies",
+        "assume": ["omega > Omega"],
+        "about": {"theta": "acos(-g/(b*omega**2))"},
+        "book": [book],
+        "erratum": {"corrected": [corrected],
+                    "derivation": "the test says so, at some length, for the schema"},
+    }]
+    return load_answers(dump(doc, tmp_path / "erratum.yaml"))
+
+
+RIGHT = "omega*sqrt(1 - g**2/(b**2*omega**4))"
+WRONG = "omega*sqrt(1 + g**2/(b**2*omega**4))"
+
+
+@pytest.fixture(scope="module")
+def hoop_analysis() -> Analysis:
+    return Analysis(load_problem(ROOT / "problems" / "lim" / "2031.yaml"))
+
+
+def test_erratum_whose_book_value_agrees_is_a_fail(tmp_path, hoop_analysis):
+    out = check_problem(hoop_analysis, _erratum_key(tmp_path, RIGHT, RIGHT))[0]
+    assert out.status == "fail"
+    assert "agrees" in out.detail
+
+
+def test_erratum_with_wrong_book_and_right_correction(tmp_path, hoop_analysis):
+    out = check_problem(hoop_analysis, _erratum_key(tmp_path, WRONG, RIGHT))[0]
+    assert out.status == "erratum"
+
+
+def test_erratum_whose_correction_is_wrong_too_is_a_fail(tmp_path, hoop_analysis):
+    out = check_problem(hoop_analysis, _erratum_key(tmp_path, WRONG, f"2*{RIGHT}"))[0]
+    assert out.status == "fail"
+    assert "corrected value fails" in out.detail
+
+
+def test_unsupported_part_is_never_a_pass(tmp_path, hoop_analysis):
+    key = load_answers(ROOT / "answers" / "lim" / "2031.yaml")
+    doc = copy.deepcopy(key.doc.data)
+    doc["parts"] = [dict(doc["parts"][0], unsupported="not done yet, for the test")]
+    out = check_problem(hoop_analysis, load_answers(dump(doc, tmp_path / "u.yaml")))[0]
+    assert out.status == "unsupported"
+
+
+def test_text_surgery_helpers():
+    assert flip_first_sign("a + b - c") == "a - b - c"
+    assert flip_first_sign("-a - b") == "-a + b"
+    assert flip_first_sign("x**-2 + 1e-3") == "x**-2 - 1e-3"
+    assert flip_first_sign("(a + b)*c") is None
+    assert double_first_term("a*b + c") == "2*(a*b) + c"
+    assert split_equation("a = b") == ("a", "b")
+    assert split_equation("a <= b") is None
+    assert flip_relation("omega < Omega") == "omega > Omega"
+    assert list(swap_names("m*b + b2", ["b", "m"])) == [("swap b<->m", "b*m + b2")]
