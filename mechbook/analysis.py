@@ -12,6 +12,7 @@ from .errors import UnsupportedError
 from .lagrange import Dynamics
 from .linear import Equilibria, LinearSystem
 from .problem import Problem
+from .routh import ReducedSystem
 from .system import System
 
 
@@ -43,6 +44,18 @@ class Analysis:
         key = (sys.name, tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())))
         if key not in self._lin:
             self._lin[key] = self.equilibria(name).linearize(point)
+        return self._lin[key]
+
+    def steady_linear(self, name: str | None, rates: dict, point: dict) -> LinearSystem:
+        """Linearization about a steady motion: cyclic coordinates turning at `rates`, the
+        others at `point`, by Routh's reduction (momenta of the cyclic coordinates fixed)."""
+        sys = self.system(name)
+        key = (sys.name, "steady",
+               tuple(sorted((str(k), sp.srepr(v)) for k, v in {**rates, **point}.items())))
+        if key not in self._lin:
+            reduced = ReducedSystem(sys, rates, point)
+            dyn = Dynamics(reduced, self.simplify)
+            self._lin[key] = Equilibria(dyn).linearize(point)
         return self._lin[key]
 
     def stable_equilibria(self, name: str | None = None) -> list[dict]:

@@ -73,6 +73,17 @@ class Context:
         return point
 
     def linear(self) -> LinearSystem:
+        if "steady" in self.part.data:
+            if "about" not in self.part.data:
+                raise self.part.error(("steady",), "a steady motion needs `about:` for the "
+                                      "coordinates that stay put")
+            rates = {}
+            for k, v in self.part.data["steady"].items():
+                if k not in self.system.coord_names:
+                    raise self.part.error(("steady", k), f"{k!r} is not a coordinate")
+                rates[self.system.q[self.system.coord_names.index(k)]] = \
+                    self.parse(v, ("steady", k))
+            return self.analysis.steady_linear(self.part.system, rates, self.point())
         return self.analysis.linear(self.part.system, self.point())
 
     def as_list(self, val, sub) -> list:

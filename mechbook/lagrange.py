@@ -105,7 +105,8 @@ class Dynamics:
         cons = [f for _, f in self.sys.constraints]
         out = {}
         for q, p, force in zip(self.q, self.momenta, self.sys.forces, strict=True):
-            if sp.diff(self.L, q) == 0 and force == 0 and all(sp.diff(c, q) == 0 for c in cons):
+            if (force == 0 and all(sp.diff(c, q) == 0 for c in cons)
+                    and try_simplify(sp.diff(self.L, q)) == 0):
                 out[q] = p
         return out
 

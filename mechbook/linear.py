@@ -243,7 +243,7 @@ class Equilibria:
             e_sub = e.subs(sub, simultaneous=True)
             zeroth.append(try_simplify(e_sub.subs(EPS, 0), 5))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
-        if any(z != 0 and not _numerically_zero(z, self.sys.numeric_values()) for z in zeroth):
+        if any(not _is_zero(z, self.sys.numeric_values()) for z in zeroth):
             raise UnsupportedError("linearization about a point that is not an equilibrium")
         n = len(dyn.q)
         raw = {name: sp.Matrix(n, n, lambda i, j, v=v: sp.diff(lin[i], v[j]))
@@ -257,6 +257,32 @@ class Equilibria:
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
         return LinearSystem(dyn, dict(point), M, C, K, F)
+
+
+def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:
+    """Zero symbolically, or (when SymPy cannot tell) to 25 digits at random points around
+    the default values; a residual left by a numerically found point is zero to 1e-9."""
+    if expr == 0:
+        return True
+    if _numerically_zero(expr, values):
+        return True
+    rng = np.random.default_rng(7)
+    for _ in range(points):
+        env = {}
+        for sym in expr.free_symbols:
+            base = values.get(sym, 1.0)
+            factor = float(np.exp(rng.uniform(-0.3, 0.3)))
+            env[sym] = sp.Float(base * factor if sym.is_positive or sym not in values
+                                else base + rng.uniform(-0.3, 0.3), 40)
+        try:
+            v = complex(sp.N(expr.subs(env), 40))
+            scale = sum(abs(complex(sp.N(t.subs(env), 40)))
+                        for t in sp.Add.make_args(sp.expand(expr)))
+        except (TypeError, ValueError, ZeroDivisionError):
+            return False
+        if not abs(v) <= 1e-25 * max(scale, 1e-300):
+            return False
+    return True
 
 
 def _numerically_zero(expr: sp.Expr, values: dict) -> bool:
