@@ -20,10 +20,10 @@ import scipy.optimize
 import sympy as sp
 
 from .errors import UnsupportedError
+from .expansion import EPS, expand_lagrangian
 from .lagrange import Dynamics
 from .timeout import Timeout, time_limit, try_simplify
 
-EPS = sp.Symbol("epsilon_order", positive=True)
 ZERO_TOL = 1e-9
 
 
@@ -214,17 +214,9 @@ class Equilibria:
         return found
 
     def quadratic_lagrangian(self, point: dict) -> sp.Expr:
-        """L expanded to second order in δq, q̇ and small parameters about `point`
-        (constant term dropped), written in the original coordinates."""
+        """L expanded to second order about `point` (see mechbook.expansion)."""
         dyn = self.dyn
-        sub = {q: point.get(q, sp.S.Zero) + EPS * q for q in dyn.q}
-        sub.update({v: EPS * v for v in dyn.qd})
-        sub.update({s: EPS * s for s in self.sys.small_params})
-        lag = dyn.L.subs(sub, simultaneous=True)
-        first = sp.diff(lag, EPS)
-        out = first.subs(EPS, 0) + sp.diff(first, EPS).subs(EPS, 0) / 2
-        back = {q: q - point.get(q, sp.S.Zero) for q in dyn.q}
-        return sp.expand(out.subs(back, simultaneous=True))
+        return expand_lagrangian(dyn.L, dyn.q, dyn.qd, point, self.sys.small_params, 2)
 
     def residual(self, point: dict) -> list[sp.Expr]:
         return [c.subs(point) for c in self.conditions]

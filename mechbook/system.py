@@ -12,6 +12,7 @@ import sympy as sp
 
 from .bodies import body_kinetic, shape_inertia
 from .errors import UnsupportedError
+from .expansion import expand_lagrangian
 from .problem import RESERVED, Problem, SystemSpec, T
 
 
@@ -108,6 +109,11 @@ class System:
             lag -= self._parse(s["velocity_potential"], ("velocity_potential",))
         if lag == 0:
             raise self._error(("coordinates",), "the system has no kinetic or potential energy")
+        if "approximation" in s:  # the approximation the problem makes, e.g. small angles
+            approx = s["approximation"]
+            point = self.point(approx["about"], ("approximation", "about"))
+            lag = expand_lagrangian(lag, self.q, self.qd, point, self.small_params,
+                                    approx.get("order", 2))
         self.lagrangian = lag
         self.forces = self._forces()
         self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))

@@ -1,0 +1,28 @@
+"""Taylor expansion of a Lagrangian about a point, counting small quantities by order.
+
+Displacements from the point, velocities and parameters declared `small` are all first
+order; the expansion keeps terms up to the requested order (the constant term is dropped,
+as it does not affect the motion).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+EPS = sp.Symbol("epsilon_order", positive=True)
+
+
+def expand_lagrangian(lag: sp.Expr, q: list, qd: list, point: dict, small: list,
+                      order: int = 2) -> sp.Expr:
+    """L to `order` in (q − point, q̇, small parameters), in the original coordinates."""
+    sub = {c: point.get(c, sp.S.Zero) + EPS * c for c in q}
+    sub.update({v: EPS * v for v in qd})
+    sub.update({s: EPS * s for s in small})
+    scaled = lag.subs(sub, simultaneous=True)
+    out = sp.S.Zero
+    term = scaled
+    for k in range(1, order + 1):
+        term = sp.diff(term, EPS)
+        out += term.subs(EPS, 0) / sp.factorial(k)
+    back = {c: c - point.get(c, sp.S.Zero) for c in q}
+    return sp.expand(out.subs(back, simultaneous=True))
