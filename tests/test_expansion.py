@@ -44,6 +44,6 @@ def test_expansion_about_a_shifted_point(tmp_path):
     sys = problem.system()
     m, l, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
     theta = sys.q[0]
-    # about the top, V = -m g l cos(theta) expands to + m g l (theta - pi)**2 / 2 (+ const)
+    # about the top, V = -m g l cos(theta) expands to - m g l (theta - pi)**2 / 2 (+ const)
     dv = sp.diff(-sys.lagrangian.subs(sys.qd[0], 0), theta)
-    assert sp.simplify(dv - m * g * l * (theta - sp.pi)) == 0
+    assert sp.simplify(dv + m * g * l * (theta - sp.pi)) == 0
