@@ -29,6 +29,7 @@ class Outcome:
     method: str = ""
     detail: str = ""
     seconds: float = 0.0
+    origin: str = "book"  # 'derived': no printed answer; the value is an independent derivation
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -36,7 +37,8 @@ class Outcome:
 
 def check_part(analysis: Analysis, part: Part) -> Outcome:
     start = time.perf_counter()
-    out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], "error")
+    out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], "error",
+                  origin=part.data.get("origin", "book"))
     try:
         if "unsupported" in part.data:
             out.status, out.detail = "unsupported", part.data["unsupported"]

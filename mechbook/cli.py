@@ -138,7 +138,8 @@ def _table(runs: list[ProblemRun], verbose: bool) -> None:
             info = o.method
             if o.status in ("fail", "error", "unsupported", "erratum") or verbose:
                 info = f"{o.method} {o.detail}".strip()
-            click.echo(f"{run.pid:<16} {o.part:<16} {o.quantity:<20} {o.status:<12} "
+            label = o.part if o.origin == "book" else f"{o.part} (derived)"
+            click.echo(f"{run.pid:<16} {label:<16} {o.quantity:<20} {o.status:<12} "
                        f"{info[:160] if not verbose else info}")
     click.echo("-" * 100)
     parts = sum(total.values())
