@@ -95,8 +95,9 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     checks = g.create_group("checks")
     for i, o in enumerate(rec.outcomes):
         c = checks.create_group(o.part)
-        c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity, "cite": o.cite, "status": o.status,
-                        "method": o.method, "detail": o.detail, "seconds": float(o.seconds)})
+        c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
+                        "cite": o.cite, "status": o.status, "method": o.method,
+                        "detail": o.detail, "seconds": float(o.seconds)})
 
 
 def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
