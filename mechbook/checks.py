@@ -623,6 +623,31 @@ def check_expression(ctx: Context, val) -> Verdict:
     return equal(book, dyn.hamiltonian, ctx.sampler)
 
 
+@check("constraint_force")
+def check_constraint_force(ctx: Context, val) -> Verdict:
+    """The generalized force λ·∂f/∂q that constraint `constraint` exerts on `coordinate`, as
+    a function of the state; `at:` fixes coordinates and velocities the constraint pins
+    (e.g. {r: l, rdot: 0} for a string of length l)."""
+    dyn = ctx.dyn
+    names = [n for n, _ in ctx.system.constraints]
+    cname = ctx.part.data.get("constraint")
+    if cname not in names:
+        raise ctx.part.error(("constraint",), f"no constraint {cname!r} (have {names})")
+    coord = ctx.part.data.get("coordinate")
+    if coord not in ctx.system.coord_names:
+        raise ctx.part.error(("coordinate",), f"{coord!r} is not a coordinate")
+    f = ctx.system.constraints[names.index(cname)][1]
+    q = ctx.system.q[ctx.system.coord_names.index(coord)]
+    engine = dyn.solved[dyn.multipliers[names.index(cname)]] * sp.diff(f, q)
+    book = ctx.parse(val, ("book",))
+    at = {}
+    for k, v in (ctx.part.data.get("at") or {}).items():
+        if k not in ctx.names or not isinstance(ctx.names[k], sp.Symbol):
+            raise ctx.part.error(("at", k), f"{k!r} is not a coordinate or velocity")
+        at[ctx.names[k]] = ctx.parse(v, ("at", k))
+    return equal(book.subs(at), engine.subs(at), ctx.sampler)
+
+
 @check("force")
 def check_force(ctx: Context, val) -> Verdict:
     raise UnsupportedError("constraint forces along a trajectory (Lagrange multipliers "

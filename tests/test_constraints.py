@@ -1,0 +1,48 @@
+"""Lagrange multipliers against Newton's law: a pendulum whose string length is a constraint.
+
+Newton, radially: m (r̈ − r θ̇²) = −T + m g cos θ with r = l fixed, so the string tension is
+T = m g cos θ + m l θ̇², pulling inward. With the residual convention
+E_i = d/dt ∂L/∂q̇_i − ∂L/∂q_i − λ ∂f/∂q_i and f = r − l, the generalized constraint force on
+r is λ = −T.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mechbook.analysis import Analysis
+from mechbook.answers import load_answers
+from mechbook.checker import check_problem
+from mechbook.problem import load_problem
+
+DATA = Path(__file__).parent / "data"
+
+
+def _run(tmp_path, book: str | None = None):
+    problem = load_problem(DATA / "problems/lim/2097.yaml")
+    text = (DATA / "answers/lim/2097.yaml").read_text()
+    if book is not None:
+        text = text.replace('"-(m*g*cos(theta) + m*l*thetadot**2)"', book)
+    path = tmp_path / "2097.yaml"
+    path.write_text(text)
+    return check_problem(Analysis(problem), load_answers(path))[0]
+
+
+def test_tension_matches_newton(tmp_path):
+    assert _run(tmp_path).status == "pass"
+
+
+def test_wrong_sign_or_term_fails(tmp_path):
+    assert _run(tmp_path, '"m*g*cos(theta) + m*l*thetadot**2"').status == "fail"
+    assert _run(tmp_path, '"-(m*g*cos(theta) + 2*m*l*thetadot**2)"').status == "fail"
+    assert _run(tmp_path, '"-(m*g*sin(theta) + m*l*thetadot**2)"').status == "fail"
+
+
+def test_multiplier_at_rest_at_the_bottom_is_minus_weight():
+    problem = load_problem(DATA / "problems/lim/2097.yaml")
+    dyn = Analysis(problem).dynamics()
+    sys = problem.system()
+    r, theta = sys.q
+    lam = dyn.solved[dyn.multipliers[0]]
+    values = {**problem.values(), r: 2.0, theta: 0.0, sys.qd[0]: 0.0, sys.qd[1]: 0.0}
+    assert abs(float(lam.subs(values)) + 9.81) < 1e-12
