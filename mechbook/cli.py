@@ -94,6 +94,8 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
 def _progress(i: int, n: int, run: ProblemRun) -> None:
     counts = Counter(o.status for o in run.outcomes)
     summary = run.error or ", ".join(f"{counts[s]} {s}" for s in STATUS_ORDER if counts[s])
+    if run.cached:
+        summary += " (cached: problem, answers and engine unchanged)"
     click.echo(f"[{i}/{n}] {run.pid} ({run.seconds:.1f} s): {summary}", err=True)
 
 
@@ -103,19 +105,24 @@ def _progress(i: int, n: int, run: ProblemRun) -> None:
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to write results to.")
 @click.option("--no-store", is_flag=True, help="Do not write results.")
 @click.option("-v", "--verbose", is_flag=True, help="Show the method and detail of every part.")
+@click.option("--fresh", is_flag=True,
+              help="Recompute everything; by default a problem whose problem file, answer key "
+                   "and engine are unchanged since the stored run reuses the stored outcomes.")
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
-          verbose: bool) -> None:
+          verbose: bool, fresh: bool) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail."""
     base = _resolve_root(ctx)
     ids = list(problem_ids) or all_ids(base)
     if not ids:
         raise click.ClickException(f"no problems under {base / 'problems'}")
-    runs = run_many(ids, base, progress=_progress)
+    store_file = store_path if store_path.is_absolute() else base / store_path
+    cache = None if (fresh or no_store) else store_file
+    runs = run_many(ids, base, progress=_progress, cache=cache)
     _table(runs, verbose)
     records = [r.record for r in runs if r.record is not None]
     if records and not no_store:
-        path = write(records, store_path if store_path.is_absolute() else base / store_path)
+        path = write(records, store_file)
         click.echo(f"results written to {path}")
     bad = sum(1 for r in runs if r.error) + sum(1 for r in runs for o in r.outcomes
                                                 if o.status in ("fail", "error"))

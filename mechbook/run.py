@@ -13,8 +13,9 @@ from .catalog import answer_path, problem_path
 from .checker import Outcome, check_problem
 from .derive import Results, derive
 from .errors import MechbookError, UnsupportedError
+from .fingerprint import file_sha256
 from .problem import load_problem
-from .store import ProblemRecord
+from .store import ProblemRecord, cached_outcomes
 
 
 @dataclass
@@ -25,9 +26,12 @@ class ProblemRun:
     error: str | None = None
     seconds: float = 0.0
     record: ProblemRecord | None = None
+    cached: bool = False
 
 
-def run_problem(pid: str, base: Path, simplify: bool = True) -> ProblemRun:
+def run_problem(pid: str, base: Path, simplify: bool = True,
+                cache: Path | None = None) -> ProblemRun:
+    """Check one problem; with `cache`, reuse stored outcomes whose content hashes match."""
     start = time.perf_counter()
     run = ProblemRun(pid)
     try:
@@ -36,6 +40,13 @@ def run_problem(pid: str, base: Path, simplify: bool = True) -> ProblemRun:
         if not apath.exists():
             raise MechbookError(f"{apath}: no answer key for {pid}")
         key = load_answers(apath)
+        answers_sha = file_sha256(apath)
+        if cache is not None:
+            stored = cached_outcomes(pid, problem.sha256, answers_sha, cache)
+            if stored is not None:
+                run.outcomes, run.cached = stored, True
+                run.seconds = time.perf_counter() - start
+                return run
         analysis = Analysis(problem, simplify)
         run.outcomes = check_problem(analysis, key)
         for name in problem.systems:
@@ -46,7 +57,7 @@ def run_problem(pid: str, base: Path, simplify: bool = True) -> ProblemRun:
                 res.notes["derive"] = f"unsupported: {exc.capability}"
                 run.results.append(res)
         run.seconds = time.perf_counter() - start
-        run.record = ProblemRecord(problem, run.results, run.outcomes, run.seconds)
+        run.record = ProblemRecord(problem, run.results, run.outcomes, run.seconds, answers_sha)
     except MechbookError as exc:
         run.error = str(exc)
         run.seconds = time.perf_counter() - start
@@ -54,10 +65,11 @@ def run_problem(pid: str, base: Path, simplify: bool = True) -> ProblemRun:
 
 
 def run_many(ids: list[str], base: Path, simplify: bool = True,
-             progress: Callable[[int, int, ProblemRun], None] | None = None) -> list[ProblemRun]:
+             progress: Callable[[int, int, ProblemRun], None] | None = None,
+             cache: Path | None = None) -> list[ProblemRun]:
     runs = []
     for i, pid in enumerate(ids, 1):
-        run = run_problem(pid, base, simplify)
+        run = run_problem(pid, base, simplify, cache)
         runs.append(run)
         if progress:
             progress(i, len(ids), run)

@@ -1,7 +1,8 @@
 """The HDF5 store: every run's results, checks and provenance, written atomically.
 
 Layout (one group per problem, replaced whole on each run of that problem):
-    /problems/<id>                 attrs: title, source, problem_sha256, mechbook, sympy,
+    /problems/<id>                 attrs: title, source, problem_sha256, answers_sha256,
+                                          engine_sha256 (the warm-run cache key), mechbook, sympy,
                                           numpy, h5py, date, duration_s
     /problems/<id>/systems/<s>/symbolic/<key>   UTF-8 string datasets
     /problems/<id>/systems/<s>/numeric/<key>    float arrays (default parameter values)
@@ -28,6 +29,7 @@ import sympy as sp
 from . import __version__
 from .checker import Outcome
 from .derive import Results
+from .fingerprint import engine_sha256
 from .problem import Problem
 
 DEFAULT_PATH = Path("results/mechbook.h5")
@@ -39,8 +41,9 @@ class ProblemRecord:
     """Everything one run learned about one problem."""
 
     def __init__(self, problem: Problem, results: Iterable[Results],
-                 outcomes: Iterable[Outcome], duration: float):
+                 outcomes: Iterable[Outcome], duration: float, answers_sha256: str = ""):
         self.problem = problem
+        self.answers_sha256 = answers_sha256
         self.results = list(results)
         self.outcomes = list(outcomes)
         self.duration = duration
@@ -79,7 +82,8 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     g = root.create_group(pid, track_order=True)
     g.attrs.update({
         "title": rec.problem.title, "source": rec.problem.source,
-        "problem_sha256": rec.problem.sha256, "mechbook": __version__,
+        "problem_sha256": rec.problem.sha256, "answers_sha256": rec.answers_sha256,
+        "engine_sha256": engine_sha256(), "mechbook": __version__,
         "sympy": sp.__version__, "numpy": np.__version__, "h5py": h5py.__version__,
         "date": datetime.now(UTC).isoformat(timespec="seconds"),
         "duration_s": float(rec.duration),
@@ -121,6 +125,25 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
             out["checks"].append({"part": part, **{k: _plain(v) for k, v in c.attrs.items()}})
         out["checks"].sort(key=lambda c: c.get("index", 0))
     return out
+
+
+def cached_outcomes(pid: str, problem_sha: str, answers_sha: str,
+                    path: str | Path = DEFAULT_PATH) -> list[Outcome] | None:
+    """The stored outcomes of `pid` if problem file, answer key and engine are unchanged."""
+    path = Path(path)
+    if not path.exists():
+        return None
+    try:
+        rec = read(pid, path)
+    except (KeyError, OSError):
+        return None
+    a = rec["attrs"]
+    if (a.get("problem_sha256"), a.get("answers_sha256"), a.get("engine_sha256")) != \
+            (problem_sha, answers_sha, engine_sha256()):
+        return None
+    fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin")
+    return [Outcome(pid, c["part"], **{k: c[k] for k in fields if k in c})
+            for c in rec["checks"]]
 
 
 def problems(path: str | Path = DEFAULT_PATH) -> list[str]:

@@ -1,0 +1,22 @@
+"""Content hashes that decide whether a stored result is still valid (the warm-run cache)."""
+
+from __future__ import annotations
+
+import hashlib
+from functools import cache
+from pathlib import Path
+
+
+@cache
+def engine_sha256() -> str:
+    """Hash of the engine's own source and schemas: any change invalidates every result."""
+    here = Path(__file__).parent
+    h = hashlib.sha256()
+    for path in sorted([*here.rglob("*.py"), *here.rglob("*.json")]):
+        h.update(str(path.relative_to(here)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def file_sha256(path: str | Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()

@@ -1,0 +1,38 @@
+"""Warm runs: stored outcomes are reused only while problem, answer key and engine are unchanged."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from click.testing import CliRunner
+
+from mechbook.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _tree(tmp_path: Path) -> Path:
+    for sub in ("problems/lim", "answers/lim"):
+        (tmp_path / sub).mkdir(parents=True)
+        shutil.copy(ROOT / sub / "2031.yaml", tmp_path / sub / "2031.yaml")
+    return tmp_path
+
+
+def test_second_run_is_cached_and_a_changed_key_is_not(tmp_path):
+    tree = _tree(tmp_path)
+    runner = CliRunner()
+    args = ["--root", str(tree), "check", "lim-2031"]
+    first = runner.invoke(main, args)
+    assert first.exit_code == 0, first.output
+    assert "cached" not in first.output
+    second = runner.invoke(main, args)
+    assert second.exit_code == 0
+    assert "cached" in second.output and "6 pass" in second.output
+    key = tree / "answers/lim/2031.yaml"
+    key.write_text(key.read_text().replace('book: "omega < Omega"', 'book: "omega > Omega"'))
+    third = runner.invoke(main, args)
+    assert "cached" not in third.output
+    assert third.exit_code == 1 and "fail" in third.output
+    fresh = runner.invoke(main, [*args, "--fresh"])
+    assert "cached" not in fresh.output
