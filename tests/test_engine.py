@@ -302,10 +302,8 @@ def test_polar_equations(tmp_path):
     assert not zero(dyn.on_shell(an.system().dt(dyn.momenta[0])))
 
 
-@pytest.mark.xfail(strict=True, reason="Dynamics.cyclic tests sp.diff(L, q) == 0 structurally on "
-                                       "the unsimplified Lagrangian; L built from particle "
-                                       "positions holds phi until simplified, so phi is missed")
 def test_polar_phi_is_cyclic(tmp_path):
+    """phi is cyclic although L built from the particle position holds phi until simplified."""
     an = analysis(tmp_path, POLAR, "2003")
     m, r, phi, phid = syms(an, "m", "r", "phi", "phidot")
     cyclic = an.dynamics().cyclic
