@@ -207,6 +207,9 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
         verdicts = [Verdict(True, "symbolic", f"engine equilibrium {candidates[0]}")]
     else:
         raise ctx.part.error(("book",), "an equilibrium answer gives 'at:' or 'where:'")
+    verdict = _all(verdicts)
+    if not verdict.ok:
+        return verdict
     if "stable" in ctx.part.data:
         want = ctx.part.data["stable"]
         for pt in candidates:

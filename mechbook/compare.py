@@ -159,8 +159,10 @@ def _fmt(point: dict) -> str:
 def match_multiset(book: Sequence[float], engine: Sequence[float], partial: bool = False,
                    rtol: float = 1e-8) -> tuple[bool, str]:
     """Compare two lists of numbers as multisets (book ⊆ engine if partial)."""
+    if any(not np.isfinite(x) for x in book):
+        return False, f"book value(s) not real and finite here: {_list(list(book))}"
     b = sorted(book)
-    e = sorted(engine)
+    e = sorted(x for x in engine if np.isfinite(x))
     if not partial and len(b) != len(e):
         return False, f"book has {len(b)} values, engine {len(e)}: {_list(b)} vs {_list(e)}"
     scale = max([abs(x) for x in b + e] + [1e-300])

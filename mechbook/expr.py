@@ -9,6 +9,7 @@ names; anything else is rejected with a message that says what and where.
 from __future__ import annotations
 
 import ast
+import math
 from collections.abc import Mapping
 
 import sympy as sp
@@ -17,7 +18,9 @@ from .errors import ExpressionError
 
 MAX_LENGTH = 20_000  # characters in one expression
 MAX_NODES = 5_000  # AST nodes in one expression
-MAX_DEPTH = 60  # nesting of brackets / operators
+MAX_DEPTH = 60  # nesting of brackets
+MAX_AST_DEPTH = 400  # nesting of the parsed tree (a flat sum of n terms is n deep)
+MAX_DIGITS = 1000  # largest number of digits a numeric power may produce
 MAX_EXPONENT = 64  # largest |numeric exponent| accepted
 MAX_INTEGER = 10**30  # largest integer literal accepted
 
@@ -57,6 +60,7 @@ def _depth(text: str) -> int:
 class _Builder:
     def __init__(self, text: str, names: Mapping[str, sp.Basic], allow_relations: bool):
         self.text = text
+        self.source = text.strip()
         self.names = names
         self.allow_relations = allow_relations
         self.nodes = 0
@@ -70,8 +74,8 @@ class _Builder:
         self.nodes += 1
         if self.nodes > MAX_NODES:
             raise self.fail(None, f"expression too large (more than {MAX_NODES} nodes)")
-        if depth > MAX_DEPTH:
-            raise self.fail(node, f"expression nested too deeply (more than {MAX_DEPTH})")
+        if depth > MAX_AST_DEPTH:
+            raise self.fail(node, f"expression nested too deeply (more than {MAX_AST_DEPTH})")
         method = getattr(self, "_" + type(node).__name__, None)
         if method is None:
             raise self.fail(node, f"{type(node).__name__} is not allowed")
@@ -88,8 +92,15 @@ class _Builder:
             if abs(value) > MAX_INTEGER:
                 raise self.fail(node, "integer literal too large")
             return sp.Integer(value)
-        # decimal literals are read exactly (0.5 -> 1/2) so symbolic checks stay exact
-        return sp.Rational(repr(value))
+        # decimal literals are read exactly from their source text (0.5 -> 1/2, all digits
+        # kept) so symbolic checks stay exact
+        literal = ast.get_source_segment(self.source, node) or repr(value)
+        if not math.isfinite(value) or (value != 0 and not 1e-30 <= abs(value) <= MAX_INTEGER):
+            raise self.fail(node, f"number {literal} out of range")
+        try:
+            return sp.Rational(literal.replace("_", ""))
+        except (TypeError, ValueError):
+            raise self.fail(node, f"cannot read number {literal}") from None
 
     def _Name(self, node: ast.Name, depth: int) -> sp.Basic:
         name = node.id
@@ -120,7 +131,14 @@ class _Builder:
         if op is ast.Pow:
             if right.is_Number and abs(right) > MAX_EXPONENT:
                 raise self.fail(node, f"exponent {right} too large (at most {MAX_EXPONENT})")
-            return left**right
+            if left.is_Number and right.is_Number and left != 0 and \
+                    float(abs(right)) * math.log10(max(float(abs(left)), 2.0)) > MAX_DIGITS:
+                raise self.fail(node, f"power too large (more than {MAX_DIGITS} digits)")
+            result = left**right
+            exponent = result.exp if isinstance(result, sp.Pow) else sp.S.One
+            if exponent.is_Number and abs(exponent) > MAX_EXPONENT**2:
+                raise self.fail(node, "power too large (a tower of exponents)")
+            return result
         return _BINOPS[op](left, right)
 
     def _Call(self, node: ast.Call, depth: int) -> sp.Basic:

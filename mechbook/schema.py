@@ -27,6 +27,13 @@ def validate(doc: Document, name: str) -> None:
     best = jsonschema.exceptions.best_match(errors)
     # best_match descends into oneOf branches; report the leaf that is most specific
     path = tuple(best.absolute_path)
+    if best.validator == "additionalProperties" and isinstance(best.instance, dict):
+        extra = sorted(set(best.instance) - set(best.schema.get("properties", {})))
+        if extra:  # point at the offending key's own line
+            line = doc.line(path + (extra[0],))
+            err = doc.error(path, _message(best))
+            err.line = line
+            raise type(err)(err.bare, doc.file, line)
     raise doc.error(path, _message(best))
 
 

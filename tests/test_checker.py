@@ -412,32 +412,6 @@ def _analysis_for(analyses: dict, pid: str) -> Analysis:
     return analyses[pid]
 
 
-# Known checker bugs (see the strict xfail tests below). A mutant that survives only through
-# one of them makes the mutation test xfail instead of fail, so it still catches anything new.
-NAN_BUG = "frequencies: a book value that is not real at the sample points (NaN) is accepted"
-UNSUPPORTED_BUG = ("equilibrium: a wrong `at:` point with `stable:` is reported unsupported "
-                   "(linearizing about a non-equilibrium) instead of fail")
-
-
-def _nonreal_somewhere(ctx: Context, text, sub) -> bool:
-    expr = ctx.parse(text, sub)
-    for _ in range(12):
-        z = complex(sp.N(expr.subs(ctx.sampler.draw()), 20))
-        if abs(z.imag) > 1e-12 * max(1.0, abs(z)):
-            return True
-    return False
-
-
-def known_bug(ctx: Context, part: Part, slot: Slot, new, status: str, detail: str) -> str | None:
-    if (part.quantity == "frequencies" and status == "pass"
-            and _nonreal_somewhere(ctx, new, slot.path)):
-        return NAN_BUG
-    if (part.quantity == "equilibrium" and status == "unsupported" and "stable" in part.data
-            and "not an equilibrium" in detail):
-        return UNSUPPORTED_BUG
-    return None
-
-
 @pytest.mark.parametrize("answer_file", ANSWER_FILES,
                          ids=[f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES])
 def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict):
@@ -447,7 +421,6 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict)
     names = sorted(analysis.problem.parameters) + sorted(
         key.doc.data.get("abbreviations") or {})
     survivors: list[str] = []
-    bugs: set[str] = set()
     tried = 0
     checked_parts = 0
     for part, outcome in zip(key.parts, originals, strict=True):
@@ -484,10 +457,6 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict)
                 ok = got.status != "erratum" if erratum else got.status == "fail"
                 if not ok:
                     where = "/".join(str(p) for p in slot.path)
-                    bug = known_bug(ctx, part, slot, new, got.status, got.detail)
-                    if bug:
-                        bugs.add(bug)
-                        continue
                     survivors.append(f"{part.name} [{part.quantity}] {where}: {label}: "
                                      f"{old!r} -> {new!r}: {got.status} {got.method} "
                                      f"{got.detail[:200]}")
@@ -495,8 +464,6 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict)
         assert tried > 0, "no mutant was generated for any checked part"
     assert not survivors, (f"{len(survivors)} of {tried} mutants were not failed:\n  "
                            + "\n  ".join(survivors))
-    if bugs:
-        pytest.xfail("mutants survive only through known checker bugs: " + "; ".join(sorted(bugs)))
 
 
 def test_nonreal_book_frequency_fails(tmp_path, hoop_analysis):

@@ -29,12 +29,12 @@ def test_small_angle_lagrangian_is_quadratic(tmp_path):
     path.write_text(PENDULUM)
     problem = load_problem(path)
     sys = problem.system()
-    m, l, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
+    m, ln, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
     theta, thetadot = sys.q[0], sys.qd[0]
-    expected = m * l**2 * thetadot**2 / 2 - m * g * l * theta**2 / 2
+    expected = m * ln**2 * thetadot**2 / 2 - m * g * ln * theta**2 / 2
     assert sp.simplify(sys.lagrangian - expected) == 0
     dyn = Analysis(problem).dynamics()
-    assert sp.simplify(dyn.accelerations[0] + g * theta / l) == 0
+    assert sp.simplify(dyn.accelerations[0] + g * theta / ln) == 0
 
 
 def test_expansion_about_a_shifted_point(tmp_path):
@@ -42,8 +42,8 @@ def test_expansion_about_a_shifted_point(tmp_path):
     path.write_text(PENDULUM.replace("about: {theta: 0}", "about: {theta: pi}"))
     problem = load_problem(path)
     sys = problem.system()
-    m, l, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
+    m, ln, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
     theta = sys.q[0]
     # about the top, V = -m g l cos(theta) expands to - m g l (theta - pi)**2 / 2 (+ const)
     dv = sp.diff(-sys.lagrangian.subs(sys.qd[0], 0), theta)
-    assert sp.simplify(dv + m * g * l * (theta - sp.pi)) == 0
+    assert sp.simplify(dv + m * g * ln * (theta - sp.pi)) == 0
