@@ -297,20 +297,47 @@ def test_overflowing_float_literal():
     _rejected("m*1e400")
 
 
-def test_power_tower_is_bounded():
-    code = textwrap.dedent("""
+TOWER_BUG = ("the power-size limits look at a bare number or a bare Pow only: a numeric "
+             "coefficient times a symbol, (2*x)**64, becomes a Mul and each further **64 "
+             "multiplies the coefficient's digits by 64 unchecked")
+
+
+def _tower_rejected_quickly(text: str, seconds: float = 5) -> None:
+    code = textwrap.dedent(f"""
         import resource
         resource.setrlimit(resource.RLIMIT_AS, (1_500_000_000, 1_500_000_000))
+        import sympy as sp
         from mechbook.expr import parse
         from mechbook.errors import ExpressionError
         try:
-            parse('(((((2**64)**64)**64)**64)**64)**64', {})
+            parse({text!r}, {{'x': sp.Symbol('x')}})
         except ExpressionError:
             print('rejected')
     """)
     try:
         proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                              timeout=5, env={**os.environ, "PYTHONHASHSEED": "0"})
+                              timeout=seconds, env={**os.environ, "PYTHONHASHSEED": "0"})
     except subprocess.TimeoutExpired:
-        pytest.fail("parsing a power tower ran past 5 s")
+        pytest.fail(f"parsing {text!r} ran past {seconds} s")
     assert "rejected" in proc.stdout, proc.stderr[-500:]
+
+
+def test_power_tower_is_bounded():
+    _tower_rejected_quickly("(((((2**64)**64)**64)**64)**64)**64")
+
+
+@pytest.mark.parametrize("text", ["((x**64)**64)**64", "((2**64)**64)**64",
+                                  "((2**0.5*2**64)**64)**64"])
+def test_small_power_towers_rejected(text):
+    _rejected(text, "too large")
+
+
+@pytest.mark.xfail(strict=True, reason=TOWER_BUG)
+def test_power_tower_with_symbol_factor_is_bounded():
+    _tower_rejected_quickly("((((((2*x)**64)**64)**64)**64)**64)**64")
+
+
+@pytest.mark.xfail(strict=True, reason=TOWER_BUG)
+def test_power_tower_with_symbol_factor_digit_limit():
+    # the coefficient 2**262144 has 78,914 digits, far over MAX_DIGITS
+    _rejected("(((2*x)**64)**64)**64", "too large")

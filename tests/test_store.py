@@ -227,3 +227,21 @@ def test_cli_show_missing(tmp_path):
     result = runner.invoke(main, ["--root", str(ROOT), "show", "lim-2032", "--store", str(path)])
     assert result.exit_code != 0
     assert "lim-2032 is not in" in result.output
+
+
+@pytest.mark.xfail(strict=True, reason="write() renames a tempfile.mkstemp file over the store, "
+                                       "so the store always ends up mode 0600, ignoring the umask "
+                                       "and the previous file's mode")
+def test_store_file_mode_follows_umask_and_is_kept(tmp_path):
+    import os
+    import stat
+
+    old = os.umask(0o022)
+    try:
+        path = store.write([make_record(tmp_path)], tmp_path / "s.h5")
+        assert stat.S_IMODE(path.stat().st_mode) == 0o644
+        path.chmod(0o640)
+        store.write([make_record(tmp_path, "2032")], path)
+        assert stat.S_IMODE(path.stat().st_mode) == 0o640
+    finally:
+        os.umask(old)
