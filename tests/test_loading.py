@@ -266,3 +266,41 @@ def test_overflowing_literal_in_file_is_a_spec_error(tmp_path):
     result = CliRunner().invoke(main, ["validate", str(path)])
     assert result.exit_code == 1
     assert isinstance(result.exception, SystemExit)
+
+
+HOSTILE_KEY = """\
+problem: lim-2031
+source: a hostile answer key
+parts:
+  - part: a
+    cite: test
+    quantity: lagrangian
+    book: "__import__('os').system('touch {target}')"
+  - part: b
+    cite: test
+    quantity: eom
+    book:
+      - "thetaddot = 0"
+      - "theta.__class__ = 0"
+"""
+
+
+def test_hostile_answer_key_rejected(tmp_path, no_pwned):
+    root = Path(__file__).resolve().parents[1]
+    marker = tmp_path / "pwned"
+    (tmp_path / "problems" / "lim").mkdir(parents=True)
+    (tmp_path / "answers" / "lim").mkdir(parents=True)
+    (tmp_path / "problems" / "lim" / "2031.yaml").write_text(
+        (root / "problems" / "lim" / "2031.yaml").read_text())
+    key = tmp_path / "answers" / "lim" / "2031.yaml"
+    key.write_text(HOSTILE_KEY.replace("{target}", str(marker)))
+    result = CliRunner().invoke(main, ["validate", str(key)])
+    assert result.exit_code == 1
+    assert f"{key}:{line_of(key, 'book: ')}" in result.output
+    result = CliRunner().invoke(main, ["--root", str(tmp_path), "check", "lim-2031",
+                                       "--no-store"])
+    assert result.exit_code == 1
+    rows = {ln.split()[1]: ln for ln in result.output.splitlines() if ln.startswith("lim-2031 ")}
+    assert " error " in rows["a"] and f"{key}:{line_of(key, 'book: ')}" in rows["a"]
+    assert " error " in rows["b"] and f"{key}:{line_of(key, '__class__')}" in rows["b"]
+    assert not marker.exists()
