@@ -135,9 +135,13 @@ class _Builder:
                     float(abs(right)) * math.log10(max(float(abs(left)), 2.0)) > MAX_DIGITS:
                 raise self.fail(node, f"power too large (more than {MAX_DIGITS} digits)")
             result = left**right
-            exponent = result.exp if isinstance(result, sp.Pow) else sp.S.One
-            if exponent.is_Number and abs(exponent) > MAX_EXPONENT**2:
-                raise self.fail(node, "power too large (a tower of exponents)")
+            for power in [result, *result.atoms(sp.Pow)]:
+                if isinstance(power, sp.Pow) and power.exp.is_Number \
+                        and abs(power.exp) > MAX_EXPONENT**2:
+                    raise self.fail(node, "power too large (a tower of exponents)")
+            for number in result.atoms(sp.Rational):
+                if max(abs(number.p), number.q) > 10**MAX_DIGITS:
+                    raise self.fail(node, f"power too large (more than {MAX_DIGITS} digits)")
             return result
         return _BINOPS[op](left, right)
 

@@ -55,6 +55,14 @@ def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> 
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
     os.close(fd)
+    # mkstemp makes the file 0600; keep the old file's mode, or follow the umask
+    if path.exists():
+        mode = path.stat().st_mode & 0o777
+    else:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    os.chmod(tmp, mode)
     try:
         if path.exists():
             shutil.copyfile(path, tmp)

@@ -229,9 +229,6 @@ def test_cli_show_missing(tmp_path):
     assert "lim-2032 is not in" in result.output
 
 
-@pytest.mark.xfail(strict=True, reason="write() renames a tempfile.mkstemp file over the store, "
-                                       "so the store always ends up mode 0600, ignoring the umask "
-                                       "and the previous file's mode")
 def test_store_file_mode_follows_umask_and_is_kept(tmp_path):
     import os
     import stat
