@@ -115,19 +115,72 @@ class LinearSystem:
         return w2, vecs
 
     def numeric_frequencies(self, values: dict) -> np.ndarray:
-        """Normal angular frequencies at `values` (NaN marks an unstable, imaginary one)."""
+        """Normal angular frequencies at `values` (NaN marks an unstable, imaginary one).
+
+        `scipy.linalg.eigh(K, M)` in double precision, after a diagonal scaling that makes
+        M's diagonal one; when the problem is ill-conditioned there (cond(M) or the spread
+        of the eigenvalues beyond 1e6, or gyroscopic terms spanning many decades) the
+        eigenvalues are recomputed with 50-digit mpmath arithmetic (bench/extremes.py).
+        """
         M, C, K = self.matrices(values)
         n = M.shape[0]
         if not np.any(C):
-            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
-            scale = max(1.0, float(np.max(np.abs(w2))))
+            d = 1.0 / np.sqrt(np.abs(np.diag(M)))
+            Ms, Ks = M * np.outer(d, d), K * np.outer(d, d)
+            w2 = scipy.linalg.eigh(Ks, Ms, eigvals_only=True)
+            if _ill_conditioned(Ms, w2):
+                w2 = self._precise_squared(values)
+            scale = max(1e-300, float(np.max(np.abs(w2))))
             w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
             return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
         lam = np.linalg.eigvals(A)
+        mags = np.abs(lam[np.abs(lam) > 0])
+        if np.linalg.cond(M) > 1e6 or (len(mags) and mags.max() > 1e6 * mags.min()):
+            lam = self._precise_state_eigenvalues(values)
         lam = lam[np.argsort(-lam.imag)]
         return np.sort(np.abs(lam.imag[:n]))
+
+    def _mp_matrices(self, values: dict, dps: int = 50):
+        import mpmath
+
+        def conv(A):
+            return mpmath.matrix([[mpmath.mpf(str(sp.re(sp.N(x, dps)))) for x in row]
+                                  for row in A.evalf(dps, subs=values).tolist()])
+
+        return conv(self.M), conv(self.C), conv(self.K)
+
+    def _precise_squared(self, values: dict, dps: int = 50) -> np.ndarray:
+        """ω² by Cholesky reduction and a symmetric eigensolver in mpmath."""
+        import mpmath
+
+        with mpmath.workdps(dps):
+            M, _, K = self._mp_matrices(values, dps)
+            L = mpmath.cholesky(M)
+            Linv = mpmath.inverse(L)
+            A = Linv * K * Linv.T
+            A = (A + A.T) / 2
+            w2 = mpmath.eigsy(A, eigvals_only=True)
+            return np.sort(np.array([float(x) for x in w2]))
+
+    def _precise_state_eigenvalues(self, values: dict, dps: int = 50) -> np.ndarray:
+        """Eigenvalues of the first-order (state-space) form in mpmath."""
+        import mpmath
+
+        with mpmath.workdps(dps):
+            M, C, K = self._mp_matrices(values, dps)
+            n = M.rows
+            Minv = mpmath.inverse(M)
+            A = mpmath.zeros(2 * n, 2 * n)
+            MK, MC = -Minv * K, -Minv * C
+            for i in range(n):
+                A[i, n + i] = 1
+                for j in range(n):
+                    A[n + i, j] = MK[i, j]
+                    A[n + i, n + j] = MC[i, j]
+            lam = mpmath.eig(A, left=False, right=False)
+            return np.array([complex(x) for x in lam])
 
     def numeric_stability(self, values: dict) -> str:
         """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
@@ -155,6 +208,12 @@ class LinearSystem:
         K = self.K
         minors = [try_simplify(K[:k, :k].det(), 5) for k in range(1, K.rows + 1)]
         return sp.And(*[mi > 0 for mi in minors])
+
+
+def _ill_conditioned(M: np.ndarray, w2: np.ndarray) -> bool:
+    nonzero = np.abs(w2[np.abs(w2) > 0])
+    spread = nonzero.max() / nonzero.min() if len(nonzero) else 1.0
+    return bool(np.linalg.cond(M) > 1e6 or spread > 1e6)
 
 
 class Equilibria:
