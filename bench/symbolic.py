@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import sympy as sp
+from sympy.core.cache import clear_cache
 from sympy.physics.mechanics import LagrangesMethod, dynamicsymbols, msubs
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,6 +37,7 @@ from mechbook.problem import load_problem  # noqa: E402
 def timed(fn, repeat: int) -> tuple[float, object]:
     times, out = [], None
     for _ in range(repeat):
+        clear_cache()  # SymPy memoizes; every timing starts cold so the ratio is fair
         start = time.perf_counter()
         out = fn()
         times.append(time.perf_counter() - start)
@@ -105,6 +107,7 @@ def main() -> None:
             t_simp, mf_simp = timed(lambda s=system: ours(s, True), args.repeat)
             t_lm, mf_lm = timed(lambda s=system: theirs(s), args.repeat)
             analysis = Analysis(problem)
+            clear_cache()
             start = time.perf_counter()
             try:
                 point = analysis.default_point(name)
