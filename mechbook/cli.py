@@ -1,4 +1,4 @@
-"""The `mechbook` command line: list, solve, check, validate, show."""
+"""The `mechbook` command line: list, solve, check, validate, show, simulate."""
 
 from __future__ import annotations
 
@@ -200,3 +200,85 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     for c in rec["checks"]:
         click.echo(f"{c['part']:<16} {c['quantity']:<20} {c['status']:<12} {c['method']} "
                    f"{c['detail']}".rstrip())
+
+
+@main.command()
+@click.argument("problem_id")
+@click.option("--system", default=None, help="Which system of a multi-system problem.")
+@click.option("--method", default="DOP853", show_default=True,
+              type=click.Choice(["RK45", "DOP853", "Radau", "LSODA", "RK4", "leapfrog",
+                                 "yoshida4", "midpoint"]),
+              help="SciPy's solve_ivp methods; RK4 (fixed step); symplectic leapfrog "
+                   "(Störmer–Verlet) and yoshida4 (Forest–Ruth) for separable Hamiltonians, "
+                   "midpoint (implicit, symplectic) for any conservative system.")
+@click.option("--rtol", type=float, default=None, help="Relative tolerance (SciPy methods; "
+              "default 1e-8).")
+@click.option("--atol", type=float, default=None, help="Absolute tolerance (SciPy methods; "
+              "default 1e-10).")
+@click.option("--max-step", type=float, default=None, help="Largest step (SciPy methods).")
+@click.option("--step", type=float, default=None,
+              help="Step size of the fixed-step methods (default: the span / 10000).")
+@click.option("--t-end", type=float, default=10.0, show_default=True, help="End time.")
+@click.option("--points", type=int, default=2001, show_default=True,
+              help="Samples recorded (SciPy methods; fixed-step methods record every step "
+                   "up to 200001 samples).")
+@click.option("--init", "init", multiple=True, metavar="NAME=VALUE",
+              help="Initial value of a coordinate (theta=0.1) or velocity (thetadot=0); "
+                   "overrides the problem's `initial:`. Repeat for several.")
+@click.option("--backend", type=click.Choice(["llvm", "symengine", "sympy"]), default=None,
+              help="How the equations are compiled (default: llvm; see docs/numerics.md).")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write coordinates against time and the phase portrait here.")
+@click.option("--name", default=None, help="Name of the stored run (default SYSTEM-METHOD).")
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 file to store the run in.")
+@click.option("--no-store", is_flag=True, help="Do not store the run.")
+@click.pass_context
+def simulate(ctx: click.Context, problem_id: str, system: str | None, method: str,
+             rtol: float | None, atol: float | None, max_step: float | None,
+             step: float | None, t_end: float, points: int, init: tuple[str, ...],
+             backend: str | None, plot_path: Path | None, name: str | None,
+             store_path: Path, no_store: bool) -> None:
+    """Integrate a problem's full nonlinear equations of motion; report the drift of every
+    conserved quantity the engine found; store the trajectory (and plot it)."""
+    from .simulate import DEFAULT_BACKEND
+    from .simulate.core import parse_assignments
+    from .simulate.core import simulate as run_simulation
+    from .store import write_simulation
+
+    base = _resolve_root(ctx)
+    try:
+        problem = load_problem(problem_path(problem_id, base))
+        analysis = Analysis(problem)
+        sim = run_simulation(analysis, system, init=parse_assignments(init),
+                             t_span=(0.0, t_end), method=method, points=points,
+                             backend=backend or DEFAULT_BACKEND, rtol=rtol, atol=atol,
+                             max_step=max_step, step=step)
+    except (MechbookError, KeyError) as exc:
+        raise click.ClickException(str(exc).strip("'\"")) from None
+    traj = sim.trajectory
+    click.echo(f"{problem.id} [{sim.system}]: {problem.title}")
+    click.echo("initial: " + ", ".join(f"{k}={v:.6g}" for k, v in sim.initial.items())
+               + f"  ({sim.initial_source})")
+    click.echo("method: " + ", ".join(f"{k}={v}" for k, v in traj.settings.items())
+               + f"; {traj.nfev} evaluations, {len(traj.t)} samples, {sim.seconds:.2f} s "
+               f"(RHS: {sim.model.backend}, generated in {sim.model.generation_seconds:.3f} s)")
+    for note in sim.notes:
+        click.echo(f"note: {note}")
+    if sim.drifts:
+        for d in sim.drifts:
+            click.echo("drift of " + d.summary())
+    else:
+        click.echo("no conserved quantity found by the engine: nothing to monitor")
+    if not no_store:
+        path = store_path if store_path.is_absolute() else base / store_path
+        run_name = name or f"{sim.system}-{method}"
+        write_simulation(problem.id, run_name, sim.arrays(), sim.settings(),
+                         {f"monitors/{d.name}": d.attrs() for d in sim.drifts}, path)
+        click.echo(f"stored as /problems/{problem.id}/simulations/{run_name} in {path}")
+    if plot_path is not None:
+        from .simulate.plot import plot_simulation
+
+        click.echo(f"plot written to {plot_simulation(sim, plot_path)}")
+    if not traj.success:
+        sys.exit(1)

@@ -8,17 +8,27 @@ Layout (one group per problem, replaced whole on each run of that problem):
     /problems/<id>/systems/<s>/numeric/<key>    float arrays (default parameter values)
     /problems/<id>/systems/<s>/notes/<key>      why a result is missing
     /problems/<id>/checks/<part>   attrs: quantity, cite, status, method, detail, seconds
+    /problems/<id>/crosschecks/<n> attrs: name, kind, system, status, error, detail, parts,
+                                          seconds, modes (JSON); see mechbook/crosscheck.py
+    /problems/<id>/simulations/<name>   attrs: the method's settings, initial conditions,
+                                        parameters, RHS backend, drift of each monitor;
+                                        datasets t, q (n×N), qdot (n×N), monitors/<quantity>
+                                        (with attrs initial, max_abs_drift, relative_drift,
+                                        final_drift, drift_rate)
 
 A run copies the current file, edits the copy and renames it over the original, so an
-interrupted run leaves the previous file whole and readable.
+interrupted run leaves the previous file whole and readable. Rewriting a problem's checks
+keeps its stored simulations; storing a simulation replaces only that simulation.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -41,16 +51,28 @@ class ProblemRecord:
     """Everything one run learned about one problem."""
 
     def __init__(self, problem: Problem, results: Iterable[Results],
-                 outcomes: Iterable[Outcome], duration: float, answers_sha256: str = ""):
+                 outcomes: Iterable[Outcome], duration: float, answers_sha256: str = "",
+                 crosschecks: Iterable[dict] = ()):
         self.problem = problem
         self.answers_sha256 = answers_sha256
         self.results = list(results)
         self.outcomes = list(outcomes)
         self.duration = duration
+        self.crosschecks = list(crosschecks)  # CrossCheck.as_dict() of mechbook.crosscheck
 
 
 def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> Path:
     """Add or replace the given problems in the store, atomically."""
+    with _atomic_edit(path) as f:
+        root = f.require_group("problems")
+        for rec in records:
+            _write_problem(root, rec)
+    return Path(path)
+
+
+@contextmanager
+def _atomic_edit(path: str | Path) -> Iterator[h5py.File]:
+    """An open copy of the store (or a new file) that replaces `path` only on success."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
@@ -71,23 +93,25 @@ def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> 
             mode = "w"
         with h5py.File(tmp, mode) as f:
             f.attrs["format"] = FORMAT
-            root = f.require_group("problems")
-            for rec in records:
-                _write_problem(root, rec)
+            yield f
         with open(tmp, "rb") as fh:
             os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
 
 
 def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     pid = rec.problem.id
+    kept = f"_simulations_of_{pid}"
     if pid in root:
+        if "simulations" in root[pid]:  # a check run keeps the problem's simulations
+            root.move(f"{pid}/simulations", kept)
         del root[pid]
     g = root.create_group(pid, track_order=True)
+    if kept in root:
+        root.move(kept, f"{pid}/simulations")
     g.attrs.update({
         "title": rec.problem.title, "source": rec.problem.source,
         "problem_sha256": rec.problem.sha256, "answers_sha256": rec.answers_sha256,
@@ -110,6 +134,12 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
         c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
                         "cite": o.cite, "status": o.status, "method": o.method,
                         "detail": o.detail, "seconds": float(o.seconds)})
+    if rec.crosschecks:
+        cross = g.create_group("crosschecks", track_order=True)
+        for i, x in enumerate(rec.crosschecks):
+            c = cross.create_group(str(i))
+            c.attrs.update({k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
+                            for k, v in x.items()})
 
 
 def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
@@ -129,10 +159,75 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
                     s[kind].visititems(lambda name, obj, kind=kind, entry=entry:
                                        _collect(entry[kind], name, obj))
             out["systems"][sname] = entry
-        for part, c in g["checks"].items():
+        for part, c in g.get("checks", {}).items():
             out["checks"].append({"part": part, **{k: _plain(v) for k, v in c.attrs.items()}})
         out["checks"].sort(key=lambda c: c.get("index", 0))
+        out["crosschecks"] = _crosschecks(g)
+        out["simulations"] = sorted(g.get("simulations", {}).keys())
     return out
+
+
+def _crosschecks(g: h5py.Group) -> list[dict]:
+    out = []
+    for key, c in g.get("crosschecks", {}).items():
+        entry = {k: _plain(v) for k, v in c.attrs.items()}
+        for k in ("parts", "modes"):
+            if isinstance(entry.get(k), str):
+                entry[k] = json.loads(entry[k])
+        out.append((int(key), entry))
+    return [e for _, e in sorted(out, key=lambda x: x[0])]
+
+
+def cached_crosschecks(pid: str, path: str | Path = DEFAULT_PATH) -> list[dict]:
+    """The stored cross-checks of `pid` (used with `cached_outcomes` on a warm run)."""
+    try:
+        return read(pid, path).get("crosschecks", [])
+    except (KeyError, OSError):
+        return []
+
+
+def write_simulation(pid: str, name: str, arrays: dict[str, np.ndarray], attrs: dict,
+                     array_attrs: dict[str, dict] | None = None,
+                     path: str | Path = DEFAULT_PATH) -> Path:
+    """Store one simulation at /problems/<pid>/simulations/<name>, replacing only it,
+    atomically (the rest of the file, checks included, is kept as it was)."""
+    if not name or "/" in name or name.startswith("."):
+        raise ValueError(f"invalid simulation name {name!r}")
+    with _atomic_edit(path) as f:
+        sims = f.require_group("problems").require_group(pid).require_group("simulations")
+        if name in sims:
+            del sims[name]
+        s = sims.create_group(name, track_order=True)
+        s.attrs.update({k: _attr(v) for k, v in attrs.items()})
+        for key, arr in arrays.items():
+            d = s.create_dataset(key, data=np.asarray(arr, dtype=float), compression="gzip")
+            for k, v in ((array_attrs or {}).get(key) or {}).items():
+                d.attrs[k] = _attr(v)
+    return Path(path)
+
+
+def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dict:
+    """{"attrs": {...}, "arrays": {key: array}, "array_attrs": {key: {...}}} of one run."""
+    with h5py.File(path, "r") as f:
+        s = f["problems"][pid]["simulations"][name]
+        out = {"attrs": {k: _plain(v) for k, v in s.attrs.items()}, "arrays": {},
+               "array_attrs": {}}
+
+        def visit(key, obj):
+            if isinstance(obj, h5py.Dataset):
+                out["arrays"][key] = np.array(obj[()])
+                out["array_attrs"][key] = {k: _plain(v) for k, v in obj.attrs.items()}
+
+        s.visititems(visit)
+    return out
+
+
+def _attr(v):
+    if v is None:
+        return ""
+    if isinstance(v, (bool, int, float, str, np.generic)):
+        return v
+    return json.dumps(v)
 
 
 def cached_outcomes(pid: str, problem_sha: str, answers_sha: str,
