@@ -108,17 +108,24 @@ def _progress(i: int, n: int, run: ProblemRun) -> None:
 @click.option("--fresh", is_flag=True,
               help="Recompute everything; by default a problem whose problem file, answer key "
                    "and engine are unchanged since the stored run reuses the stored outcomes.")
+@click.option("--no-crosscheck", is_flag=True,
+              help="Skip the independent cross-checks (simulated frequencies, Newton's law).")
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
-          verbose: bool, fresh: bool) -> None:
-    """Check problems against their answer keys (all by default); exit 1 on any fail."""
+          verbose: bool, fresh: bool, no_crosscheck: bool) -> None:
+    """Check problems against their answer keys (all by default); exit 1 on any fail.
+
+    The cross-check column is independent of the book: each frequency part's linear
+    system is confirmed by simulating the nonlinear equations along every mode, and each
+    system's Lagrange equations against Newton's law (docs/numerics.md); a cross-check
+    fail also exits 1."""
     base = _resolve_root(ctx)
     ids = list(problem_ids) or all_ids(base)
     if not ids:
         raise click.ClickException(f"no problems under {base / 'problems'}")
     store_file = store_path if store_path.is_absolute() else base / store_path
     cache = None if (fresh or no_store) else store_file
-    runs = run_many(ids, base, progress=_progress, cache=cache)
+    runs = run_many(ids, base, progress=_progress, cache=cache, crosscheck=not no_crosscheck)
     _table(runs, verbose)
     records = [r.record for r in runs if r.record is not None]
     if records and not no_store:
@@ -126,6 +133,7 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
         click.echo(f"results written to {path}")
     bad = sum(1 for r in runs if r.error) + sum(1 for r in runs for o in r.outcomes
                                                 if o.status in ("fail", "error"))
+    bad += sum(1 for r in runs for x in r.crosschecks if x.failed)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
         sys.exit(1)
@@ -133,25 +141,49 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
 
 def _table(runs: list[ProblemRun], verbose: bool) -> None:
     total: Counter = Counter()
-    click.echo(f"{'problem':<16} {'part':<16} {'quantity':<20} {'outcome':<12} method / detail")
-    click.echo("-" * 100)
+    crossed: Counter = Counter()
+    click.echo(f"{'problem':<16} {'part':<16} {'quantity':<20} {'outcome':<12} "
+               f"{'cross-check':<12} method / detail")
+    click.echo("-" * 112)
     for run in runs:
         if run.error:
-            click.echo(f"{run.pid:<16} {'-':<16} {'-':<20} {'ERROR':<12} {run.error}")
+            click.echo(f"{run.pid:<16} {'-':<16} {'-':<20} {'ERROR':<12} {'-':<12} {run.error}")
             total["error"] += 1
             continue
+        by_part: dict[str, list] = {}
+        for x in run.crosschecks:
+            crossed[x.status] += 1
+            for p in x.parts:
+                by_part.setdefault(p, []).append(x)
         for o in run.outcomes:
             total[o.status] += 1
             info = o.method
             if o.status in ("fail", "error", "unsupported", "erratum") or verbose:
                 info = f"{o.method} {o.detail}".strip()
             label = o.part if o.origin == "book" else f"{o.part} (derived)"
-            click.echo(f"{run.pid:<16} {label:<16} {o.quantity:<20} {o.status:<12} "
+            cell = ",".join(x.cell() for x in by_part.get(o.part, [])) or "-"
+            click.echo(f"{run.pid:<16} {label:<16} {o.quantity:<20} {o.status:<12} {cell:<12} "
                        f"{info[:160] if not verbose else info}")
-    click.echo("-" * 100)
+        for x in run.crosschecks:  # cross-checks no answer part refers to
+            if x.parts:
+                continue
+            quantity = "eom (Newton)" if x.kind == "newton" else "frequencies"
+            info = f"{x.name}: {x.detail}"
+            click.echo(f"{run.pid:<16} {'(cross-check)':<16} {quantity:<20} {'-':<12} "
+                       f"{x.cell():<12} {info[:160] if not verbose else info}")
+    click.echo("-" * 112)
     parts = sum(total.values())
     click.echo(f"{len(runs)} problems, {parts} parts: " +
                ", ".join(f"{total[s]} {s}" for s in STATUS_ORDER if total[s]))
+    if crossed:
+        click.echo(f"cross-checks: {sum(crossed.values())}: " +
+                   ", ".join(f"{crossed[s]} {s}" for s in ("pass", "n.a.", "fail", "error")
+                             if crossed[s]))
+    shown = [(r.pid, x) for r in runs for x in r.crosschecks if verbose or x.failed]
+    if shown:
+        click.echo("\ncross-check details:" if verbose else "\nfailed cross-checks:")
+        for pid, x in shown:
+            click.echo(f"{pid:<16} {x.name} [{x.cell()}; {x.seconds:.2f} s] {x.detail}")
 
 
 @main.command()
@@ -200,6 +232,14 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     for c in rec["checks"]:
         click.echo(f"{c['part']:<16} {c['quantity']:<20} {c['status']:<12} {c['method']} "
                    f"{c['detail']}".rstrip())
+    if rec.get("crosschecks"):
+        click.echo("\n== cross-checks")
+        for x in rec["crosschecks"]:
+            parts = ", ".join(x.get("parts") or []) or "-"
+            click.echo(f"{x['name']} [{x['status']}, error {x.get('error', float('nan')):.1e}; "
+                       f"parts: {parts}] {x.get('detail', '')}")
+    for name in rec.get("simulations", []):
+        click.echo(f"simulation stored: /problems/{problem_id}/simulations/{name}")
 
 
 @main.command()

@@ -11,11 +11,12 @@ from .analysis import Analysis
 from .answers import load_answers
 from .catalog import answer_path, problem_path
 from .checker import Outcome, check_problem
+from .crosscheck import CrossCheck, crosscheck_problem
 from .derive import Results, derive
 from .errors import MechbookError, UnsupportedError
 from .fingerprint import file_sha256
 from .problem import load_problem
-from .store import ProblemRecord, cached_outcomes
+from .store import ProblemRecord, cached_crosschecks, cached_outcomes
 
 
 @dataclass
@@ -27,11 +28,13 @@ class ProblemRun:
     seconds: float = 0.0
     record: ProblemRecord | None = None
     cached: bool = False
+    crosschecks: list[CrossCheck] = field(default_factory=list)
 
 
 def run_problem(pid: str, base: Path, simplify: bool = True,
-                cache: Path | None = None) -> ProblemRun:
-    """Check one problem; with `cache`, reuse stored outcomes whose content hashes match."""
+                cache: Path | None = None, crosscheck: bool = True) -> ProblemRun:
+    """Check one problem; with `cache`, reuse stored outcomes whose content hashes match.
+    With `crosscheck`, also run the independent cross-checks (mechbook/crosscheck.py)."""
     start = time.perf_counter()
     run = ProblemRun(pid)
     try:
@@ -43,8 +46,10 @@ def run_problem(pid: str, base: Path, simplify: bool = True,
         answers_sha = file_sha256(apath)
         if cache is not None:
             stored = cached_outcomes(pid, problem.sha256, answers_sha, cache)
-            if stored is not None:
+            crossed = cached_crosschecks(pid, cache) if crosscheck else []
+            if stored is not None and (crossed or not crosscheck):
                 run.outcomes, run.cached = stored, True
+                run.crosschecks = [CrossCheck.from_dict(d) for d in crossed]
                 run.seconds = time.perf_counter() - start
                 return run
         analysis = Analysis(problem, simplify)
@@ -56,8 +61,11 @@ def run_problem(pid: str, base: Path, simplify: bool = True,
                 res = Results(name)
                 res.notes["derive"] = f"unsupported: {exc.capability}"
                 run.results.append(res)
+        if crosscheck:
+            run.crosschecks = crosscheck_problem(analysis, key)
         run.seconds = time.perf_counter() - start
-        run.record = ProblemRecord(problem, run.results, run.outcomes, run.seconds, answers_sha)
+        run.record = ProblemRecord(problem, run.results, run.outcomes, run.seconds, answers_sha,
+                                   [c.as_dict() for c in run.crosschecks])
     except MechbookError as exc:
         run.error = str(exc)
         run.seconds = time.perf_counter() - start
@@ -66,10 +74,10 @@ def run_problem(pid: str, base: Path, simplify: bool = True,
 
 def run_many(ids: list[str], base: Path, simplify: bool = True,
              progress: Callable[[int, int, ProblemRun], None] | None = None,
-             cache: Path | None = None) -> list[ProblemRun]:
+             cache: Path | None = None, crosscheck: bool = True) -> list[ProblemRun]:
     runs = []
     for i, pid in enumerate(ids, 1):
-        run = run_problem(pid, base, simplify, cache)
+        run = run_problem(pid, base, simplify, cache, crosscheck)
         runs.append(run)
         if progress:
             progress(i, len(ids), run)
