@@ -117,6 +117,9 @@ def _setup(analysis: Analysis, lin, values: dict, models: dict) -> _Setup:
     sys_lin = lin.dyn.sys
     steady = hasattr(sys_lin, "base")
     base = sys_lin.base if steady else sys_lin
+    if any(m.has(base.t) for m in (lin.M, lin.C, lin.K)):
+        raise UnsupportedError("frequency cross-check: the linearized equations have "
+                               "time-dependent coefficients (not autonomous)")
     vals = _float_values(values)
     for s in base.small_params:
         vals[s] = 0.0
@@ -275,8 +278,9 @@ def frequency_crosscheck(analysis: Analysis, lin, values: dict, name: str,
         _frequency_crosscheck(analysis, lin, values, out, models if models is not None else {})
     except UnsupportedError as exc:
         out.status, out.detail = "n.a.", exc.capability
-    except (MechbookError, np.linalg.LinAlgError, ValueError, ZeroDivisionError) as exc:
-        out.status, out.detail = "error", str(exc)
+    except (MechbookError, np.linalg.LinAlgError, ValueError, TypeError,
+            ZeroDivisionError) as exc:
+        out.status, out.detail = "error", f"{type(exc).__name__}: {exc}"
     out.seconds = time.perf_counter() - start
     return out
 

@@ -1,0 +1,173 @@
+"""Cross-checks: frequencies measured from nonlinear simulations, Lagrange against Newton.
+Each check must be able to fail: tampered engines are caught."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+from click.testing import CliRunner
+
+import mechbook.run as run_mod
+from mechbook.analysis import Analysis
+from mechbook.answers import load_answers
+from mechbook.cli import main
+from mechbook.crosscheck import (
+    REL_TOL,
+    CrossCheck,
+    crosscheck_problem,
+    frequency_crosscheck,
+    newton_crosscheck,
+)
+from mechbook.problem import load_problem
+
+ROOT = Path(__file__).resolve().parents[1]
+
+OSCILLATOR = """\
+id: lim-9201
+source: test
+title: mass on a spring
+parameters:
+  m: {value: 1.7}
+  k: {value: 5.3}
+coordinates:
+  x: {}
+particles:
+  mass: {mass: m, position: [x]}
+springs:
+  - {k: k, between: [mass, [0]]}
+"""
+
+DRIVEN = """\
+id: lim-9202
+source: test
+title: pendulum with a prescribed vibrating support
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  g: {}
+  a: {value: 0.1}
+  w: {value: 7.0}
+coordinates:
+  theta: {}
+particles:
+  bob: {mass: m, position: [l*sin(theta), a*cos(w*t) - l*cos(theta)]}
+gravity: {}
+"""
+
+
+def load(tmp_path: Path, text: str, num: str) -> Analysis:
+    d = tmp_path / "problems" / "lim"
+    d.mkdir(parents=True, exist_ok=True)
+    (d / f"{num}.yaml").write_text(text)
+    return Analysis(load_problem(d / f"{num}.yaml"))
+
+
+def real(pid: str) -> tuple[Analysis, object]:
+    book, num = pid.split("-", 1)
+    an = Analysis(load_problem(ROOT / "problems" / book / f"{num}.yaml"))
+    return an, load_answers(ROOT / "answers" / book / f"{num}.yaml")
+
+
+def test_harmonic_oscillator_frequency_to_1e8(tmp_path):
+    an = load(tmp_path, OSCILLATOR, "9201")
+    lin = an.linear(None, {an.system().q[0]: sp.S.Zero})
+    x = frequency_crosscheck(an, lin, an.problem.values(), "osc")
+    assert x.status == "pass", x.detail
+    (mode,) = x.modes
+    exact = np.sqrt(5.3 / 1.7)
+    assert abs(mode["measured"] - exact) / exact < 1e-8
+    assert x.error < 1e-8
+
+
+def test_pendulum_nonlinear_shift_controlled():
+    """A pendulum's frequency falls with amplitude as ω(1 − A²/16): the amplitude is chosen
+    small enough that the measured frequency agrees to far better than REL_TOL."""
+    an, key = real("lim-2035")
+    checks = crosscheck_problem(an, key)
+    (modes,) = [c for c in checks if c.kind == "frequencies"]
+    assert modes.status == "pass"
+    for m in modes.modes:
+        assert m["relative_error"] < REL_TOL and m["shift"] < 1e-5
+        assert m["extrapolated_error"] < 1e-8
+    assert set(modes.parts) == {"modes", "point"}
+
+
+def test_tampered_linear_system_fails(tmp_path):
+    an = load(tmp_path, OSCILLATOR, "9201")
+    lin = an.linear(None, {an.system().q[0]: sp.S.Zero})
+    wrong = dataclasses.replace(lin, K=lin.K * sp.Rational(1001, 1000))
+    x = frequency_crosscheck(an, wrong, an.problem.values(), "osc")
+    assert x.status == "fail" and x.error > REL_TOL
+
+
+def test_point_that_is_not_an_equilibrium_fails(tmp_path):
+    an = load(tmp_path, OSCILLATOR, "9201")
+    lin = an.linear(None, {an.system().q[0]: sp.S.Zero})
+    moved = dataclasses.replace(lin, point={an.system().q[0]: sp.Rational(1, 10)})
+    x = frequency_crosscheck(an, moved, an.problem.values(), "osc")
+    assert x.status == "fail" and "not an equilibrium" in x.detail
+
+
+@pytest.mark.parametrize("pid", ["lim-2037", "lim-2040", "lim-2038", "symon-09-20"])
+def test_gyroscopic_steady_and_zero_modes(pid):
+    """Gyroscopic (magnetic) terms, a steady motion by Routh reduction, and a free
+    translation (zero mode, which must stay put) are all handled."""
+    an, key = real(pid)
+    checks = [c for c in crosscheck_problem(an, key) if c.kind == "frequencies"]
+    assert checks and all(c.status == "pass" for c in checks), [c.detail for c in checks]
+    if pid == "lim-2038":
+        assert any(m["kind"] == "zero" and m["status"] == "pass" for m in checks[0].modes)
+
+
+def test_non_autonomous_is_not_applicable(tmp_path):
+    an = load(tmp_path, DRIVEN, "9202")
+    an.problem.parameters["a"].small = False
+    lin = an.linear(None, {an.system().q[0]: sp.S.Zero})
+    x = frequency_crosscheck(an, lin, an.problem.values(), "driven")
+    assert x.status == "n.a." and "autonomous" in x.detail
+
+
+def test_newton_passes_and_catches_a_wrong_lagrangian(tmp_path):
+    an, _ = real("lim-2039")  # rigid body with Euler terms, springs by length
+    assert newton_crosscheck(an).status == "pass"
+    an, _ = real("lim-2042")  # planar body, particle, extra potential
+    assert newton_crosscheck(an, "spring").status == "pass"
+    an = load(tmp_path, OSCILLATOR, "9201")
+    sys = an.system()
+    sys.lagrangian = sys.lagrangian.subs(sp.Symbol("k", positive=True, real=True), 2)
+    x = newton_crosscheck(an)
+    assert x.status == "fail" and x.error > 1e-3
+
+
+def test_newton_not_applicable_without_positions():
+    an, _ = real("lim-2032")
+    assert newton_crosscheck(an, "free").status == "n.a."
+
+
+def test_crosscheck_roundtrip_dict():
+    x = CrossCheck("n", "newton", "main", "pass", 1e-16, "d", ["a"], 0.1, [{"mode": 0}])
+    assert CrossCheck.from_dict(x.as_dict()) == x
+    assert x.cell() == "pass 1e-16" and not x.failed
+
+
+def test_check_table_has_the_column_and_a_crosscheck_fail_exits_1(monkeypatch):
+    runner = CliRunner()
+    res = runner.invoke(main, ["--root", str(ROOT), "check", "lim-2031", "--no-store"])
+    assert res.exit_code == 0, res.output
+    header = next(x for x in res.output.splitlines() if x.startswith("problem "))
+    assert "cross-check" in header
+    line = next(x for x in res.output.splitlines() if "c-frequency" in x)
+    assert line.split()[4] == "pass" and float(line.split()[5]) < REL_TOL
+
+    def failing(analysis, key):
+        return [CrossCheck("newton:main", "newton", "main", "fail", 0.5, "tampered",
+                           ["a-eom"])]
+
+    monkeypatch.setattr(run_mod, "crosscheck_problem", failing)
+    res = runner.invoke(main, ["--root", str(ROOT), "check", "lim-2031", "--no-store"])
+    assert res.exit_code == 1
+    assert "fail 5e-01" in res.output and "failed cross-checks" in res.output

@@ -1,0 +1,163 @@
+"""Integrators: symplectic ones keep the energy error bounded, explicit Runge–Kutta lets it
+grow; orders of convergence; applicability."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mechbook.analysis import Analysis
+from mechbook.problem import load_problem
+from mechbook.simulate.integrators import IntegratorError, integrate
+from mechbook.simulate.monitors import conserved_quantities, drifts
+from mechbook.simulate.rhs import build_model, structure
+
+PENDULUM = """\
+id: lim-9101
+source: test
+title: simple pendulum
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  g: {value: 1.0}
+coordinates:
+  theta: {}
+particles:
+  bob: {mass: m, position: [l*sin(theta), -l*cos(theta)]}
+gravity: {}
+"""
+
+DOUBLE = """\
+id: lim-9102
+source: test
+title: double pendulum (non-separable)
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  g: {value: 1.0}
+coordinates:
+  a: {}
+  b: {}
+particles:
+  p1: {mass: m, position: [l*sin(a), -l*cos(a)]}
+  p2: {mass: m, position: [l*sin(a) + l*sin(b), -l*cos(a) - l*cos(b)]}
+gravity: {}
+"""
+
+OSCILLATOR = """\
+id: lim-9103
+source: test
+title: harmonic oscillator
+parameters:
+  m: {value: 1.5}
+  k: {value: 6.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*x**2/2
+"""
+
+
+def model_of(tmp_path: Path, text: str, num: str):
+    d = tmp_path / "problems" / "lim"
+    d.mkdir(parents=True, exist_ok=True)
+    (d / f"{num}.yaml").write_text(text)
+    problem = load_problem(d / f"{num}.yaml")
+    an = Analysis(problem)
+    sys, dyn = problem.system(), an.dynamics()
+    return build_model(sys, dyn, problem.values(), conserved_quantities(sys, dyn))
+
+
+@pytest.fixture(scope="module")
+def pendulum(tmp_path_factory):
+    return model_of(tmp_path_factory.mktemp("pend"), PENDULUM, "9101")
+
+
+def energy_error(model, traj) -> np.ndarray:
+    (d,) = drifts(model, traj)
+    assert d.name == "energy_function"
+    return d.values - d.initial
+
+
+def test_symplectic_energy_bounded_over_10000_periods_rk_grows(pendulum):
+    """Leapfrog: the energy error oscillates with the same bound at the start and the end of
+    10^4 periods; classical RK4 with the same step drifts secularly."""
+    period = 2 * np.pi  # small-oscillation period; the swing (θ0 = 1) is 12 % longer
+    span = (0.0, 1e4 * period)
+    h = period / 20
+    leap = integrate(pendulum, span, [1.0], [0.0], "leapfrog", step=h, max_points=20001)
+    rk = integrate(pendulum, span, [1.0], [0.0], "RK4", step=h, max_points=20001)
+    assert leap.success and rk.success
+    e_leap, e_rk = energy_error(pendulum, leap), energy_error(pendulum, rk)
+    tenth = len(e_leap) // 10
+    first, last = np.abs(e_leap[:tenth]).max(), np.abs(e_leap[-tenth:]).max()
+    assert first < 0.02  # |h| = 0.54 at θ0 = 1; error O(h²)
+    assert last < 1.05 * first  # bounded: no secular growth
+    rk_first, rk_last = np.abs(e_rk[:tenth]).max(), np.abs(e_rk[-tenth:]).max()
+    assert rk_last > 3 * rk_first  # grows with time
+    assert rk_last > 10 * last
+    slope_rk = np.polyfit(rk.t, e_rk, 1)[0]
+    slope_leap = np.polyfit(leap.t, e_leap, 1)[0]
+    assert abs(slope_rk) > 1e3 * abs(slope_leap)
+
+
+def test_adaptive_explicit_rk_also_drifts(pendulum):
+    """SciPy's RK45 at a loose tolerance loses energy steadily over 1000 periods."""
+    span = (0.0, 1e3 * 2 * np.pi)
+    traj = integrate(pendulum, span, [1.0], [0.0], "RK45", rtol=1e-5, atol=1e-8,
+                     t_eval=np.linspace(*span, 2001))
+    e = energy_error(pendulum, traj)
+    assert abs(e[-1]) > 5 * np.abs(e[:200]).max()
+
+
+@pytest.mark.parametrize("method, order", [("leapfrog", 2), ("yoshida4", 4), ("RK4", 4),
+                                           ("midpoint", 2)])
+def test_order_of_convergence(pendulum, method, order):
+    ref = integrate(pendulum, (0, 5.0), [1.0], [0.0], "DOP853", rtol=1e-13, atol=1e-14)
+    errors = []
+    for h in (0.05, 0.025):
+        traj = integrate(pendulum, (0, 5.0), [1.0], [0.0], method, step=h)
+        errors.append(abs(traj.q[0, -1] - ref.q[0, -1]))
+    rate = np.log2(errors[0] / errors[1])
+    assert abs(rate - order) < 0.3, (method, errors, rate)
+
+
+def test_implicit_midpoint_non_separable_energy_bounded(tmp_path):
+    model = model_of(tmp_path, DOUBLE, "9102")
+    st = structure(model, (0.0, np.array([0.5, -0.3]), np.zeros(2)))
+    assert st.canonical and not st.separable
+    with pytest.raises(IntegratorError, match="separable"):
+        integrate(model, (0, 1), [0.5, -0.3], [0, 0], "leapfrog", step=0.01)
+    traj = integrate(model, (0, 400.0), [0.5, -0.3], [0.0, 0.0], "midpoint", step=0.1)
+    e = energy_error(model, traj)
+    tenth = len(e) // 10
+    assert np.abs(e).max() < 5e-3
+    assert np.abs(e[-tenth:]).max() < 1.5 * np.abs(e[:tenth]).max() + 1e-12
+
+
+def test_midpoint_keeps_quadratic_energy_exactly(tmp_path):
+    model = model_of(tmp_path, OSCILLATOR, "9103")
+    traj = integrate(model, (0, 200.0), [0.3], [0.1], "midpoint", step=0.2)
+    e = energy_error(model, traj)
+    assert np.abs(e).max() < 1e-13
+
+
+def test_trajectory_shapes_and_settings(pendulum):
+    traj = integrate(pendulum, (0, 2.0), [0.2], [0.0], "DOP853", rtol=1e-9, atol=1e-11,
+                     t_eval=np.linspace(0, 2, 11))
+    assert traj.q.shape == (1, 11) and traj.qd.shape == (1, 11) and traj.y.shape == (2, 11)
+    assert traj.settings["rtol"] == 1e-9 and traj.settings["method"] == "DOP853"
+    fixed = integrate(pendulum, (0, 2.0), [0.2], [0.0], "yoshida4", step=0.01)
+    assert fixed.settings["steps"] == 200 and fixed.settings["order"] == 4
+    assert fixed.t[-1] == pytest.approx(2.0)
+    with pytest.raises(IntegratorError, match="unknown method"):
+        integrate(pendulum, (0, 1), [0.1], [0.0], "Euler")
+
+
+@pytest.mark.parametrize("method", ["RK45", "DOP853", "Radau", "LSODA"])
+def test_scipy_methods_agree(pendulum, method):
+    traj = integrate(pendulum, (0, 3.0), [0.4], [0.0], method, rtol=1e-10, atol=1e-12)
+    ref = integrate(pendulum, (0, 3.0), [0.4], [0.0], "yoshida4", step=1e-3)
+    assert traj.q[0, -1] == pytest.approx(ref.q[0, -1], abs=1e-7)

@@ -1,0 +1,166 @@
+"""`mechbook simulate`: compiled right-hand sides, initial conditions, monitors, the store
+and the plot."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import mechbook.store as store
+from mechbook.analysis import Analysis
+from mechbook.cli import main
+from mechbook.errors import MechbookError
+from mechbook.problem import load_problem
+from mechbook.simulate import simulate
+from mechbook.simulate.monitors import conserved_quantities
+from mechbook.simulate.rhs import BACKENDS, build_model, structure
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def problem(pid: str):
+    book, num = pid.split("-", 1)
+    return load_problem(ROOT / "problems" / book / f"{num}.yaml")
+
+
+@pytest.mark.parametrize("pid, system", [("lim-2036", None), ("lim-2042", "spring"),
+                                         ("lim-2037", None), ("symon-09-20", None)])
+def test_backends_agree_with_the_symbolic_accelerations(pid, system):
+    p = problem(pid)
+    an = Analysis(p)
+    sys, dyn = p.system(system), an.dynamics(system)
+    n = len(sys.q)
+    rng = np.random.default_rng(3)
+    q = rng.uniform(0.1, 0.4, n)
+    v = rng.uniform(-1, 1, n)
+    env = {**p.values(), **dict(zip(sys.q, q, strict=True)), **dict(zip(sys.qd, v, strict=True)),
+           sys.t: 0.3}
+    exact = np.array([float(a.subs(env)) for a in dyn.accelerations])
+    for backend in BACKENDS:
+        model = build_model(sys, dyn, p.values(), backend=backend)
+        assert model.backend == backend
+        got = model.accelerations(0.3, q, v)
+        assert np.allclose(got, exact, rtol=1e-10, atol=1e-12), backend
+
+
+def test_structure_classifies_separable_canonical_gyroscopic():
+    for pid, system, separable in (("lim-2031", None, True), ("lim-2036", None, False),
+                                   ("lim-2037", None, False)):
+        p = problem(pid)
+        an = Analysis(p)
+        model = build_model(p.system(system), an.dynamics(system), p.values())
+        st = structure(model, (0.0, np.full(model.n, 0.3), np.zeros(model.n)))
+        assert st.canonical and st.separable == separable, (pid, st)
+    p = problem("lim-2037")
+    model = build_model(p.system(), Analysis(p).dynamics(), p.values())
+    assert "linear in the velocities" in structure(model).reason
+
+
+def test_monitors_energy_and_cyclic_momentum():
+    p = problem("lim-2040")
+    an = Analysis(p)
+    names = list(conserved_quantities(p.system(), an.dynamics()))
+    assert names == ["energy_function", "p_theta"]
+    sim = simulate(an, init={"r": "0.3", "thetadot": "4", "rdot": "0.2"}, t_span=(0, 5),
+                   method="DOP853", rtol=1e-11, atol=1e-12)
+    assert sim.trajectory.success
+    assert {d.name for d in sim.drifts} == {"energy_function", "p_theta"}
+    assert all(d.relative < 1e-8 for d in sim.drifts)
+
+
+def test_initial_conditions_from_file_and_command_line(tmp_path):
+    src = (ROOT / "problems/lim/2031.yaml").read_text()
+    (tmp_path / "problems/lim").mkdir(parents=True)
+    path = tmp_path / "problems/lim/2031.yaml"
+    path.write_text(src + "initial: {theta: pi/2, thetadot: 0.5}\n")
+    an = Analysis(load_problem(path))
+    sim = simulate(an, t_span=(0, 0.1))
+    assert sim.initial["theta"] == pytest.approx(np.pi / 2)
+    assert sim.initial["thetadot"] == 0.5
+    assert sim.initial_source == "problem file `initial:`"
+    sim = simulate(an, init={"thetadot": "omega/4"}, t_span=(0, 0.1))
+    assert sim.initial["thetadot"] == pytest.approx(1.5) and "command line" in sim.initial_source
+    with pytest.raises(MechbookError, match="not a coordinate"):
+        simulate(an, init={"phi": "1"})
+    with pytest.raises(MechbookError):
+        simulate(an, init={"theta": "__import__('os')"})
+
+
+def test_fallback_start_near_a_stable_equilibrium():
+    an = Analysis(problem("lim-2031"))
+    sim = simulate(an, t_span=(0, 0.5))
+    assert sim.initial_source == "fallback"
+    assert any("no initial conditions" in n for n in sim.notes)
+
+
+def test_cli_simulate_done_criterion(tmp_path):
+    """`mechbook simulate lim-2031 --method DOP853 --rtol 1e-10 --plot out.png` plots,
+    stores the trajectory and prints the energy-function drift."""
+    out, h5 = tmp_path / "out.png", tmp_path / "m.h5"
+    res = CliRunner().invoke(main, ["--root", str(ROOT), "simulate", "lim-2031", "--method",
+                                    "DOP853", "--rtol", "1e-10", "--plot", str(out),
+                                    "--store", str(h5)])
+    assert res.exit_code == 0, res.output
+    assert "drift of energy_function" in res.output
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rec = store.read_simulation("lim-2031", "main-DOP853", h5)
+    assert rec["attrs"]["method"] == "DOP853" and rec["attrs"]["setting_rtol"] == 1e-10
+    assert rec["arrays"]["q"].shape == (1, 2001) and rec["arrays"]["t"][-1] == 10.0
+    e = rec["array_attrs"]["monitors/energy_function"]
+    assert e["relative_drift"] < 1e-8
+    assert rec["attrs"]["rhs_backend"] == "llvm"
+
+
+def test_cli_symplectic_method_refused_when_not_separable(tmp_path):
+    res = CliRunner().invoke(main, ["--root", str(ROOT), "simulate", "lim-2036", "--method",
+                                    "leapfrog", "--init", "theta1=0.2", "--no-store"])
+    assert res.exit_code != 0 and "separable" in res.output
+    res = CliRunner().invoke(main, ["--root", str(ROOT), "simulate", "lim-2036", "--method",
+                                    "midpoint", "--init", "theta1=0.2", "--t-end", "2",
+                                    "--step", "0.01", "--no-store"])
+    assert res.exit_code == 0, res.output
+    assert "drift of energy_function" in res.output
+
+
+def test_check_run_keeps_simulations_and_simulation_keeps_checks(tmp_path):
+    h5 = tmp_path / "m.h5"
+    for p in ("problems/lim/2031.yaml", "answers/lim/2031.yaml"):
+        (tmp_path / p).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / p, tmp_path / p)
+    runner = CliRunner()
+    res = runner.invoke(main, ["--root", str(tmp_path), "simulate", "lim-2031", "--t-end", "1",
+                               "--store", str(h5), "--name", "first"])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(main, ["--root", str(tmp_path), "check", "lim-2031", "--store", str(h5)])
+    assert res.exit_code == 0, res.output
+    rec = store.read("lim-2031", h5)
+    assert rec["simulations"] == ["first"] and rec["checks"] and rec["crosschecks"]
+    res = runner.invoke(main, ["--root", str(tmp_path), "simulate", "lim-2031", "--t-end", "1",
+                               "--store", str(h5), "--name", "second", "--method", "yoshida4"])
+    assert res.exit_code == 0, res.output
+    rec = store.read("lim-2031", h5)
+    assert rec["simulations"] == ["first", "second"] and rec["checks"]
+    with h5py.File(h5) as f:
+        assert f["problems/lim-2031/simulations/second"].attrs["method"] == "yoshida4"
+    res = runner.invoke(main, ["--root", str(tmp_path), "show", "lim-2031", "--store", str(h5)])
+    assert "simulations/second" in res.output and "cross-checks" in res.output
+
+
+def test_interrupted_simulation_write_keeps_previous_file(tmp_path, monkeypatch):
+    h5 = tmp_path / "m.h5"
+    store.write_simulation("lim-1", "a", {"t": np.arange(3.0)}, {"method": "RK4"}, path=h5)
+    before = h5.read_bytes()
+
+    def broken(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(store.os, "replace", broken)
+    with pytest.raises(KeyboardInterrupt):
+        store.write_simulation("lim-1", "b", {"t": np.arange(4.0)}, {}, path=h5)
+    assert h5.read_bytes() == before
+    assert not list(tmp_path.glob("*.tmp"))
