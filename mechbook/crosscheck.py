@@ -573,7 +573,11 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
     out: list[CrossCheck] = []
     newton: dict[str, CrossCheck] = {}
     for name in problem.systems:
-        newton[name] = newton_crosscheck(analysis, name)
+        try:
+            newton[name] = newton_crosscheck(analysis, name)
+        except Exception as exc:  # a fault here must not hide the other checks
+            newton[name] = CrossCheck(f"newton:{name}", "newton", name, "error",
+                                      detail=_fault(exc))
     only = next(iter(problem.systems)) if len(problem.systems) == 1 else None
     freq: dict[tuple, CrossCheck] = {}
     models: dict = {}
@@ -596,10 +600,10 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
                                    detail=f"no linear system: {exc.capability}")
             freq[tag].parts.append(part.name)
             continue
-        except (MechbookError, ValueError, KeyError) as exc:
+        except Exception as exc:  # noqa: BLE001 - the part's own check reports it too
             tag = (sname, "error", part.name)
             freq[tag] = CrossCheck(f"modes:{sname}", "frequencies", sname or "", "error",
-                                   detail=str(exc))
+                                   detail=_fault(exc))
             freq[tag].parts.append(part.name)
             continue
         label = _point_label(lin)
@@ -609,7 +613,13 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
                                            models)
         freq[tag].parts.append(part.name)
     for name in problem.systems:  # the engine's own stable equilibria
-        for lin, label in _engine_linear_systems(analysis, name):
+        try:
+            engine_systems = _engine_linear_systems(analysis, name)
+        except Exception as exc:  # noqa: BLE001 - reported, never hidden
+            freq[(name, "engine-error")] = CrossCheck(f"modes:{name}", "frequencies", name,
+                                                      "error", detail=_fault(exc))
+            continue
+        for lin, label in engine_systems:
             values = dict(problem.values())
             tag = (name, *_numeric_key(lin, values, params))
             if tag not in freq:
@@ -619,13 +629,15 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
     return out
 
 
+def _fault(exc: BaseException) -> str:
+    return f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-1).strip()}]"
+
+
 def _guarded_frequency(analysis, lin, values, name, models) -> CrossCheck:
     try:
         return frequency_crosscheck(analysis, lin, values, name, models)
     except Exception as exc:  # a fault here must not hide the other checks
-        return CrossCheck(name, "frequencies", "", "error",
-                          detail=f"{type(exc).__name__}: {exc} "
-                                 f"[{traceback.format_exc(limit=-1).strip()}]")
+        return CrossCheck(name, "frequencies", "", "error", detail=_fault(exc))
 
 
 def _engine_linear_systems(analysis: Analysis, name: str) -> list[tuple]:
