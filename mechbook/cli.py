@@ -164,13 +164,6 @@ def _table(runs: list[ProblemRun], verbose: bool) -> None:
             cell = ",".join(x.cell() for x in by_part.get(o.part, [])) or "-"
             click.echo(f"{run.pid:<16} {label:<16} {o.quantity:<20} {o.status:<12} {cell:<12} "
                        f"{info[:160] if not verbose else info}")
-        for x in run.crosschecks:  # cross-checks no answer part refers to
-            if x.parts:
-                continue
-            quantity = "eom (Newton)" if x.kind == "newton" else "frequencies"
-            info = f"{x.name}: {x.detail}"
-            click.echo(f"{run.pid:<16} {'(cross-check)':<16} {quantity:<20} {'-':<12} "
-                       f"{x.cell():<12} {info[:160] if not verbose else info}")
     click.echo("-" * 112)
     parts = sum(total.values())
     click.echo(f"{len(runs)} problems, {parts} parts: " +
@@ -179,11 +172,17 @@ def _table(runs: list[ProblemRun], verbose: bool) -> None:
         click.echo(f"cross-checks: {sum(crossed.values())}: " +
                    ", ".join(f"{crossed[s]} {s}" for s in ("pass", "n.a.", "fail", "error")
                              if crossed[s]))
+    loose = [(r.pid, x) for r in runs for x in r.crosschecks if not x.parts]
+    if loose:  # the engine's own equilibria, systems no answer part refers to
+        click.echo("\ncross-checks no answer part refers to:")
+        for pid, x in loose:
+            info = f"{x.name}: {x.detail}"
+            click.echo(f"  {pid:<16} {x.cell():<12} {info[:160] if not verbose else info}")
     shown = [(r.pid, x) for r in runs for x in r.crosschecks if verbose or x.failed]
     if shown:
         click.echo("\ncross-check details:" if verbose else "\nfailed cross-checks:")
         for pid, x in shown:
-            click.echo(f"{pid:<16} {x.name} [{x.cell()}; {x.seconds:.2f} s] {x.detail}")
+            click.echo(f"  {pid:<16} {x.name} [{x.cell()}; {x.seconds:.2f} s] {x.detail}")
 
 
 @main.command()
