@@ -7,7 +7,7 @@ the names of normal coordinates) and abbreviations (`abbreviations: {omega0: sqr
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import sympy as sp
@@ -23,6 +23,7 @@ class Part:
     key: AnswerKey
     index: int
     data: dict
+    _unavailable: dict = field(default_factory=dict, repr=False)  # abbreviation -> why
 
     @property
     def name(self) -> str:
@@ -52,7 +53,10 @@ class Part:
             try:
                 names[abbr] = parse(text, names)
             except ExpressionError as exc:
-                raise self.key.doc.error(("abbreviations", abbr), str(exc)) from None
+                # An abbreviation may belong to another of the problem's systems (it names
+                # that system's coordinates): it is simply not available in this one, and a
+                # part that uses it here is told why.
+                self._unavailable[abbr] = str(exc)
         return names
 
     def parse(self, text, sub: tuple, names: dict, equation: bool = False,
@@ -62,7 +66,11 @@ class Part:
                 return parse_equation(text, names)
             return parse(text, names, relation)
         except ExpressionError as exc:
-            raise self.error(sub, str(exc)) from None
+            message = str(exc)
+            for abbr, why in self._unavailable.items():
+                if f"unknown name {abbr!r}" in message:
+                    message += f" (abbreviation {abbr!r} does not parse here: {why})"
+            raise self.error(sub, message) from None
 
 
 class AnswerKey:

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 from .analysis import Analysis
 from .answers import AnswerKey, Part
 from .checks import CHECKS, Context
-from .errors import MechbookError, SpecError, UnsupportedError
+from .errors import MechbookError, NotEquilibriumError, SpecError, UnsupportedError
 
 STATUSES = ("pass", "fail", "erratum", "unsupported", "error")
 
@@ -62,6 +62,8 @@ def check_part(analysis: Analysis, part: Part) -> Outcome:
             out.method, out.detail = verdict.method, verdict.detail
     except UnsupportedError as exc:
         out.status, out.detail = "unsupported", exc.capability
+    except NotEquilibriumError as exc:  # the answer's point or steady rate is wrong
+        out.status, out.detail = "fail", str(exc)
     except SpecError as exc:
         out.status, out.detail = "error", str(exc)
     except MechbookError as exc:

@@ -15,7 +15,7 @@ import sympy as sp
 
 from .analysis import Analysis
 from .answers import Part
-from .compare import Sampler, Verdict, equal, match_multiset, value, vanishes
+from .compare import Sampler, Verdict, all_vanish, combine, equal, match_multiset, value, vanishes
 from .errors import UnsupportedError
 from .linear import LinearSystem
 
@@ -36,7 +36,11 @@ class Context:
     part: Part
 
     def __post_init__(self):
-        self.system = self.analysis.system(self.part.system)
+        try:
+            self.system = self.analysis.system(self.part.system)
+        except KeyError as exc:  # no `system:` in a multi-system problem, or a wrong one
+            raise self.part.error(("system",) if self.part.system else (),
+                                  str(exc.args[0]) + "; name it with `system:`") from None
         self.names = self.part.names(self.system)
         for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
             self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
@@ -97,14 +101,7 @@ class Context:
         raise self.part.error(sub, "expected a mapping")
 
 
-def _all(verdicts: list[Verdict]) -> Verdict:
-    for v in verdicts:
-        if not v.ok:
-            return v
-    methods = {v.method.split("(")[0] for v in verdicts}
-    method = "symbolic" if methods == {"symbolic"} else ("numeric" if "numeric" in methods else
-                                                          ",".join(sorted(methods)))
-    return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail))
+_all = combine
 
 
 def _strip_const(text):
@@ -135,7 +132,7 @@ def check_lagrangian(ctx: Context, val) -> Verdict:
     sys = ctx.system
     exprs = [sys.dt(sp.diff(diff, qd)) - sp.diff(diff, q) for q, qd in zip(sys.q, sys.qd,
                                                                            strict=True)]
-    return _all([vanishes(e, ctx.sampler) for e in exprs])
+    return all_vanish(exprs, ctx.sampler)
 
 
 @check("eom")
@@ -153,8 +150,8 @@ def check_eom(ctx: Context, val) -> Verdict:
         if not (e.free_symbols & set(ctx.dyn.qdd)):
             raise ctx.part.error(("book", i), "an equation of motion must contain an "
                                  "acceleration; a first integral is a 'conserved' part")
-        out.append(vanishes(e.subs(acc), ctx.sampler))
-    return _all(out)
+        out.append(e.subs(acc))
+    return all_vanish(out, ctx.sampler)
 
 
 @check("conserved")
@@ -171,8 +168,8 @@ def check_conserved(ctx: Context, val) -> Verdict:
         e = ctx.parse(_strip_const(v), sub)
         if not (e.free_symbols & set(ctx.dyn.q + ctx.dyn.qd)):
             raise ctx.part.error(sub, "a conserved quantity must depend on the motion")
-        out.append(vanishes(ctx.system.dt(e).subs(acc), ctx.sampler))
-    return _all(out)
+        out.append(ctx.system.dt(e).subs(acc))
+    return all_vanish(out, ctx.sampler)
 
 
 # ---- equilibria and stability --------------------------------------------------------------
@@ -192,7 +189,7 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
                  for k, v in at.items() if k in ctx.system.coord_names}
         if len(point) != len(ctx.system.q):
             raise ctx.part.error(("book", "at"), "give every coordinate of the point")
-        verdicts = [vanishes(r, ctx.sampler) for r in eq.residual(point)]
+        verdicts = [all_vanish(eq.residual(point), ctx.sampler)]
         candidates = [point]
     elif "where" in val:
         where = [ctx.parse(w, ("book", "where", i), equation=True)
@@ -522,11 +519,11 @@ def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict
         r = e.subs(subs)
         if r.free_symbols & set(lin.dyn.q + lin.dyn.qd + lin.dyn.qdd):
             continue
-        checked.append(vanishes(r, ctx.sampler))
+        checked.append(r)
     if not checked:
         raise UnsupportedError("checking a motion that leaves every equation with unknown "
                                "coordinates (give the initial conditions instead)")
-    return _all(checked)
+    return all_vanish(checked, ctx.sampler)
 
 
 @check("motion")
@@ -591,19 +588,22 @@ def check_motion(ctx: Context, val) -> Verdict:
 # ---- named expressions ---------------------------------------------------------------------
 @check("expression")
 def check_expression(ctx: Context, val) -> Verdict:
-    """An engine quantity named by `of:`; potentials compare up to an additive constant."""
+    """An engine quantity named by `of:`; potentials compare up to an additive constant.
+    At a state (`at:` coordinates and velocities, or a steady motion named by `steady:` and
+    `about:`) the quantity's value there is compared instead, the constant included."""
     of = ctx.part.data.get("of")
     if of is None:
         raise ctx.part.error(("of",), "an 'expression' part names what it is with 'of:'")
     dyn = ctx.dyn
+    state = _state(ctx)
     if of == "momenta":
         items = ctx.as_map(val, ("book",))
         out = []
         for k, v in items.items():
             if k not in ctx.system.coord_names:
                 raise ctx.part.error(("book", k), "momenta are keyed by coordinate")
-            out.append(equal(ctx.parse(v, ("book", k)),
-                             dyn.momenta[ctx.system.coord_names.index(k)], ctx.sampler))
+            engine = dyn.momenta[ctx.system.coord_names.index(k)]
+            out.append(equal(ctx.parse(v, ("book", k)), _at(ctx, engine, state), ctx.sampler))
         return _all(out)
     book = ctx.parse(val, ("book",), equation=False)
     if of in ("potential", "quadratic_potential"):
@@ -613,17 +613,59 @@ def check_expression(ctx: Context, val) -> Verdict:
             lin = ctx.linear()
             dq = lin.displacement()
             engine = (dq.T * lin.K * dq)[0, 0] / 2
+        if state is not None:
+            return equal(book, _at(ctx, engine, state), ctx.sampler)
         # up to a constant: gradients agree
-        return _all([vanishes(sp.diff(book - engine, q), ctx.sampler) for q in ctx.system.q])
+        return all_vanish([sp.diff(book - engine, q) for q in ctx.system.q], ctx.sampler)
     if of == "quadratic_kinetic":
         lin = ctx.linear()
         qd = sp.Matrix(dyn.qd)
-        return equal(book, (qd.T * lin.M * qd)[0, 0] / 2, ctx.sampler)
-    if of == "kinetic":
-        return equal(book, ctx.system.kinetic, ctx.sampler)
-    if of == "energy_function":
-        return equal(book, dyn.energy_function, ctx.sampler)
-    return equal(book, dyn.hamiltonian, ctx.sampler)
+        engine = (qd.T * lin.M * qd)[0, 0] / 2
+    elif of == "kinetic":
+        engine = ctx.system.kinetic
+    elif of == "energy_function":
+        engine = dyn.energy_function
+    else:
+        engine = dyn.hamiltonian
+    return equal(book, _at(ctx, engine, state), ctx.sampler)
+
+
+def _state(ctx: Context) -> dict | None:
+    """The state an `expression` part is evaluated at, or None (a function of the state).
+
+    `at:` gives coordinates and velocities (`<coordinate>dot`) outright. `steady:` with
+    `about:` names a steady motion (the other velocities zero), which is first confirmed to
+    be one: a wrong rate or radius is a fail."""
+    data = ctx.part.data
+    if "at" in data:
+        names = ctx.system.coord_names
+        symbols = dict(zip(names, ctx.system.q, strict=True))
+        symbols.update({n + "dot": v for n, v in zip(names, ctx.system.qd, strict=True)})
+        state = {}
+        for k, v in ctx.as_map(data["at"], ("at",)).items():
+            if k not in symbols:
+                raise ctx.part.error(("at", k), f"{k!r} is neither a coordinate nor a velocity")
+            state[symbols[k]] = ctx.parse(v, ("at", k))
+        return state
+    if "steady" in data and ctx.part.quantity == "expression":
+        ctx.linear()  # raises NotEquilibriumError unless this is a steady motion
+        state = {v: sp.S.Zero for v in ctx.system.qd}
+        state.update(ctx.point())
+        for k, v in data["steady"].items():
+            state[ctx.system.qd[ctx.system.coord_names.index(k)]] = ctx.parse(v, ("steady", k))
+        return state
+    return None
+
+
+def _at(ctx: Context, expr: sp.Basic, state: dict | None) -> sp.Basic:
+    if state is None:
+        return expr
+    out = expr.subs(state)
+    left = out.free_symbols & set(ctx.system.q + ctx.system.qd)
+    if left:
+        raise ctx.part.error(("at",), "the state leaves " + ", ".join(sorted(map(str, left)))
+                             + " unknown: give every coordinate and velocity it depends on")
+    return out
 
 
 @check("constraint_force")

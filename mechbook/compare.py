@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from .numeval import NotNumeric, evaluate
 from .timeout import Timeout, time_limit
 
 RTOL = 1e-10  # relative tolerance of a numeric comparison
@@ -67,11 +68,22 @@ class Sampler:
 
 def value(expr: sp.Basic, point: dict) -> complex:
     """expr at `point` as a complex number (NaN if it does not evaluate)."""
+    return value_and_scale(expr, point)[0]
+
+
+def value_and_scale(expr: sp.Basic, point: dict) -> tuple[complex, float]:
+    """expr at `point` and the magnitude of what cancelled on the way (NaN if no value)."""
     try:
-        v = sp.N(expr.subs(point), DIGITS)
-        return complex(v)
+        return evaluate(expr, point, DIGITS)
+    except NotNumeric:
+        pass
+    except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+        return complex(float("nan"), 0), float("nan")
+    try:  # a part the fast evaluator does not know: let SymPy evaluate the whole
+        v = complex(sp.N(expr.subs(point), DIGITS))
+        return v, abs(v)
     except (TypeError, ValueError, ZeroDivisionError):
-        return complex(float("nan"), 0)
+        return complex(float("nan"), 0), float("nan")
 
 
 def _free_variables(exprs: Iterable[sp.Basic], known: dict) -> set[sp.Symbol]:
@@ -97,16 +109,13 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool = True,
              seconds: float = 10.0) -> Verdict:
     """Is `expr` identically zero (under the sampler's assumptions)?"""
     variables = _free_variables([expr], sampler.base)
-    expanded = sp.expand(expr)
-    terms = sp.Add.make_args(expanded)
     worst = 0.0
     valid = 0
     for _ in range(POINTS * 3):
         if valid >= POINTS:
             break
         point = sampler.draw(variables)
-        v = value(expanded, point)
-        scale = sum(abs(value(t, point)) for t in terms)
+        v, scale = value_and_scale(expr, point)
         if not (np.isfinite(v.real) and np.isfinite(v.imag) and np.isfinite(scale)):
             continue
         valid += 1
@@ -120,6 +129,31 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool = True,
     if symbolic and _symbolic_zero(expr, seconds):
         return Verdict(True, "symbolic")
     return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+
+
+def all_vanish(exprs: Sequence[sp.Basic], sampler: Sampler, symbolic: bool = True,
+               seconds: float = 10.0) -> Verdict:
+    """Does every expression vanish? All are tested numerically before any symbolic proof is
+    tried, so a wrong one is reported at the cost of a few evaluations, not of simplify()."""
+    verdicts = [vanishes(e, sampler, symbolic=False) for e in exprs]
+    for v in verdicts:
+        if not v.ok:
+            return v
+    if symbolic:
+        verdicts = [Verdict(True, "symbolic") if _symbolic_zero(e, seconds) else v
+                    for e, v in zip(exprs, verdicts, strict=True)]
+    return combine(verdicts)
+
+
+def combine(verdicts: Sequence[Verdict]) -> Verdict:
+    """One verdict for several: the first failure, else a pass named by how it was decided."""
+    for v in verdicts:
+        if not v.ok:
+            return v
+    methods = {v.method.split("(")[0] for v in verdicts}
+    method = "symbolic" if methods == {"symbolic"} else ("numeric" if "numeric" in methods else
+                                                          ",".join(sorted(methods)))
+    return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail))
 
 
 def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool = True) -> Verdict:

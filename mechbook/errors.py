@@ -34,3 +34,8 @@ class UnsupportedError(MechbookError):
     def __init__(self, capability: str):
         self.capability = capability
         super().__init__(f"unsupported: {capability}")
+
+
+class NotEquilibriumError(MechbookError):
+    """A point (or steady motion) named by an answer does not satisfy the equations of motion:
+    the answer is wrong, which is a fail, not a missing capability."""

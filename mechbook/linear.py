@@ -19,7 +19,7 @@ import scipy.linalg
 import scipy.optimize
 import sympy as sp
 
-from .errors import UnsupportedError
+from .errors import NotEquilibriumError, UnsupportedError
 from .expansion import EPS, expand_lagrangian
 from .lagrange import Dynamics
 from .timeout import Timeout, time_limit, try_simplify
@@ -294,8 +294,11 @@ class Equilibria:
             e_sub = e.subs(sub, simultaneous=True)
             zeroth.append(try_simplify(e_sub.subs(EPS, 0), 5))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
-        if any(not _is_zero(z, self.sys.numeric_values()) for z in zeroth):
-            raise UnsupportedError("linearization about a point that is not an equilibrium")
+        bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
+        if bad:
+            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
+                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
+                                      "is left there")
         n = len(dyn.q)
         raw = {name: sp.Matrix(n, n, lambda i, j, v=v: sp.diff(lin[i], v[j]))
                for name, v in (("M", dyn.qdd), ("C", dyn.qd), ("K", dyn.q))}
@@ -344,3 +347,7 @@ def _numerically_zero(expr: sp.Expr, values: dict) -> bool:
         return abs(complex(sp.N(expr.subs(values)))) < 1e-9
     except (TypeError, ValueError):
         return False
+
+
+def _show(point: dict) -> str:
+    return "{" + ", ".join(f"{k} = {sp.sstr(v)}" for k, v in point.items()) + "}"

@@ -8,7 +8,7 @@ from pathlib import Path
 from .analysis import Analysis
 from .answers import load_answers
 from .catalog import problem_path, root
-from .checks import Context
+from .checks import Context, _strip_const
 from .errors import MechbookError
 from .problem import load_problem
 from .yamlio import load
@@ -52,6 +52,7 @@ def _walk(ctx: Context, value, sub: tuple) -> None:
         for i, v in enumerate(value):
             _walk(ctx, v, sub + (i,))
     elif isinstance(value, str):
+        value = _strip_const(value)  # a first integral may be written "... = constant"
         if "<" in value or ">" in value:
             ctx.parse(value, sub, relation=True)
         else:

@@ -10,7 +10,9 @@ proves the two texts mean the same), never because the checker happened to accep
 from __future__ import annotations
 
 import copy
+import math
 import os
+import random
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -27,10 +29,12 @@ from mechbook.checker import check_problem
 from mechbook.checks import Context
 from mechbook.errors import UnsupportedError
 from mechbook.problem import load_problem
+from mechbook.timeout import Timeout, time_limit
 
 ROOT = Path(__file__).resolve().parents[1]
 ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
 MAX_MUTANTS_PER_SLOT = 5
+SIMPLIFY_SECONDS = 20  # proving a mutant equivalent; unproved mutants are checked
 VERBOSE = bool(os.environ.get("MECHBOOK_MUTANTS_VERBOSE"))
 
 
@@ -50,7 +54,8 @@ def plain(data):
 
 
 def dump(data: dict, path: Path) -> Path:
-    yaml = YAML(typ="safe", pure=True)
+    """Write plain data, keeping the order of keys (an abbreviation may use an earlier one)."""
+    yaml = YAML(typ="rt")
     yaml.default_flow_style = False
     with open(path, "w", encoding="utf-8") as fh:
         yaml.dump(plain(data), fh)
@@ -351,15 +356,42 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
 
 
 # ---- when is a mutant provably the same statement? ------------------------------------------
+def _numerically_nonzero(expr) -> bool:
+    """True when expr is certainly not identically zero: it evaluates (30 digits) to a
+    clearly nonzero number at a random point. Cheap, and it settles most mutants at once."""
+    symbols = sorted(expr.free_symbols, key=str)
+    rng = random.Random(1234)
+    for _ in range(3):
+        point = {s: sp.Float(rng.uniform(0.3, 1.7), 30) for s in symbols}
+        try:
+            v = complex(sp.N(expr.subs(point), 30))
+        except (TypeError, ValueError, ZeroDivisionError):
+            continue
+        if math.isfinite(abs(v)) and abs(v) > 1e-15:
+            return True
+    return False
+
+
 def _zero(expr) -> bool:
+    """expr simplifies to zero (proved by SymPy within a time limit; unproved means no)."""
+    if _numerically_nonzero(expr):
+        return False
     try:
-        return sp.simplify(expr) == 0
-    except Exception:
+        with time_limit(SIMPLIFY_SECONDS):
+            return sp.simplify(expr) == 0
+    except (Timeout, Exception):
         return False
 
 
 def _free_of(expr, symbols) -> bool:
-    expr = sp.simplify(expr)
+    """expr is provably a nonzero constant as far as `symbols` go."""
+    if any(_numerically_nonzero(sp.diff(expr, s)) for s in symbols & expr.free_symbols):
+        return False
+    try:
+        with time_limit(SIMPLIFY_SECONDS):
+            expr = sp.simplify(expr)
+    except (Timeout, Exception):
+        return False
     return expr.is_finite is not False and expr != 0 and not (expr.free_symbols & symbols)
 
 
@@ -510,6 +542,48 @@ def test_wrong_equilibrium_point_without_stable_fails(tmp_path, hoop_analysis):
                      "book": {"at": {"theta": "pi"}}}]
     out = check_problem(hoop_analysis, load_answers(dump(doc, tmp_path / "eq.yaml")))
     assert [o.status for o in out] == ["fail", "pass"]
+
+
+def _part_of(pid: str, name: str, **changes) -> dict:
+    key = load_answers(ROOT / "answers" / pid.split("-")[0] / f"{pid.split('-', 1)[1]}.yaml")
+    doc = copy.deepcopy(key.doc.data)
+    part = next(p for p in doc["parts"] if p["part"] == name)
+    part.update(changes)
+    doc["parts"] = [part]
+    return doc
+
+
+@pytest.fixture(scope="module")
+def vessel_analysis() -> Analysis:
+    return Analysis(load_problem(ROOT / "problems" / "lim" / "2040.yaml"))
+
+
+@pytest.mark.parametrize("name", ["a-energy", "b"])
+def test_wrong_steady_rate_is_a_fail(tmp_path, vessel_analysis, name):
+    """A steady motion the book names at a wrong rate is the book's error: a fail, never
+    'unsupported' (the engine can tell that it is not a steady motion)."""
+    right = check_problem(vessel_analysis, load_answers(
+        dump(_part_of("lim-2040", name), tmp_path / "right.yaml")))[0]
+    assert right.status == "pass", right.detail
+    wrong = check_problem(vessel_analysis, load_answers(dump(
+        _part_of("lim-2040", name, steady={"theta": "2*omega"}), tmp_path / "wrong.yaml")))[0]
+    assert wrong.status == "fail"
+    assert "not an equilibrium" in wrong.detail
+
+
+def test_value_at_a_state(tmp_path, vessel_analysis):
+    """`at:` evaluates a function of the state at given coordinates and velocities."""
+    doc = _part_of("lim-2040", "a-energy")
+    del doc["parts"][0]["steady"], doc["parts"][0]["about"]
+    doc["parts"][0]["at"] = {"r": "r0", "rdot": 0, "thetadot": "omega"}
+    out = check_problem(vessel_analysis, load_answers(dump(doc, tmp_path / "at.yaml")))[0]
+    assert out.status == "pass", out.detail
+    doc["parts"][0]["at"] = {"r": "r0", "rdot": 0, "thetadot": "2*omega"}
+    out = check_problem(vessel_analysis, load_answers(dump(doc, tmp_path / "at2.yaml")))[0]
+    assert out.status == "fail"
+    doc["parts"][0]["at"] = {"r": "r0"}
+    out = check_problem(vessel_analysis, load_answers(dump(doc, tmp_path / "at3.yaml")))[0]
+    assert out.status == "error" and "unknown" in out.detail
 
 
 # ---- (c) errata -----------------------------------------------------------------------------

@@ -174,3 +174,27 @@ def test_solve_unknown_problem():
     result = run("--root", str(ROOT), "solve", "lim-9999")
     assert result.exit_code != 0
     assert "Error" in result.output
+
+
+def test_every_committed_file_validates():
+    """Every problem and answer file in the tree passes `validate` (a first integral written
+    "... = constant" included)."""
+    files = sorted(map(str, (ROOT / "problems").glob("*/*.yaml"))) + \
+        sorted(map(str, (ROOT / "answers").glob("*/*.yaml")))
+    result = run("validate", *files)
+    assert result.exit_code == 0, result.output
+    assert result.output.count(" is valid") == len(files)
+
+
+def test_validate_names_a_missing_system(tmp_path):
+    """A part of a several-system problem that names no system is an error with its line."""
+    (tmp_path / "answers" / "lim").mkdir(parents=True)
+    (tmp_path / "problems" / "lim").mkdir(parents=True)
+    shutil.copy(ROOT / "problems" / "lim" / "2043.yaml", tmp_path / "problems" / "lim")
+    text = (ROOT / "answers" / "lim" / "2043.yaml").read_text()
+    bad = tmp_path / "answers" / "lim" / "2043.yaml"
+    bad.write_text(text.replace("    system: general\n", "", 1))
+    result = run("validate", str(bad))
+    assert result.exit_code == 1
+    assert "Traceback" not in result.output
+    assert "2043.yaml:" in result.output and "system" in result.output
