@@ -16,7 +16,7 @@ check: $(STAMP)  ## check every problem against the book's answer key
 	$(BIN)/mechbook check
 
 test: $(STAMP)   ## run the test suite
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
 
 lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench

@@ -626,8 +626,25 @@ def check_expression(ctx: Context, val) -> Verdict:
     elif of == "energy_function":
         engine = dyn.energy_function
     else:
-        engine = dyn.hamiltonian
+        return _check_hamiltonian(ctx, book, state)
     return equal(book, _at(ctx, engine, state), ctx.sampler)
+
+
+def _check_hamiltonian(ctx: Context, book: sp.Basic, state: dict | None) -> Verdict:
+    """H(q, p) is the Legendre transform of L exactly when, with p = ∂L/∂q̇ put in, it is the
+    energy function h(q, q̇) and ∂H/∂p gives back q̇. Checking it this way needs no
+    inversion of p(q̇), so Lagrangians not quadratic in the velocities (relativistic ones)
+    are covered as well as the rest."""
+    dyn = ctx.dyn
+    momenta = {ctx.names["p_" + c]: p
+               for c, p in zip(ctx.system.coord_names, dyn.momenta, strict=True)}
+    value = equal(_at(ctx, book.subs(momenta), state),
+                  _at(ctx, dyn.energy_function, state), ctx.sampler)
+    if not value.ok or state is not None:
+        return value
+    velocities = all_vanish([sp.diff(book, p).subs(momenta) - v
+                             for p, v in zip(momenta, dyn.qd, strict=True)], ctx.sampler)
+    return combine([value, velocities])
 
 
 def _state(ctx: Context) -> dict | None:
