@@ -588,6 +588,10 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
         sname = part.system or only
         if part.quantity in EQUATION_QUANTITIES and sname in newton:
             newton[sname].parts.append(part.name)
+        if part.quantity in ("conserved", "expression"):
+            x = _guarded_conserved(analysis, part, models)
+            if x is not None:
+                out.append(x)
         if part.quantity not in FREQUENCY_QUANTITIES:
             continue
         try:
@@ -627,6 +631,28 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
                                                models)
     out += list(newton.values()) + list(freq.values())
     return out
+
+
+def _guarded_conserved(analysis: Analysis, part, models: dict) -> CrossCheck | None:
+    """The simulation cross-check of a part's first integral (None: the part states none)."""
+    from .checks import Context
+    from .crosscheck_conserved import book_integrals, conserved_crosscheck
+
+    start = time.perf_counter()
+    x = CrossCheck(f"conserved:{part.name}", "conserved", part.system or "", "error",
+                   parts=[part.name])
+    try:
+        ctx = Context(analysis, part)
+        exprs = book_integrals(ctx)
+        if not exprs:
+            return None
+        x.status, x.error, x.detail = conserved_crosscheck(analysis, ctx, exprs, models)
+    except UnsupportedError as exc:
+        x.status, x.detail = "n.a.", exc.capability
+    except Exception as exc:  # noqa: BLE001 - reported, never hidden
+        x.detail = _fault(exc)
+    x.seconds = time.perf_counter() - start
+    return x
 
 
 def _fault(exc: BaseException) -> str:

@@ -171,3 +171,22 @@ def test_check_table_has_the_column_and_a_crosscheck_fail_exits_1(monkeypatch):
     res = runner.invoke(main, ["--root", str(ROOT), "check", "lim-2031", "--no-store"])
     assert res.exit_code == 1
     assert "fail 5e-01" in res.output and "failed cross-checks" in res.output
+
+
+def test_conserved_by_simulation_passes_a_true_integral_and_fails_a_false_one(tmp_path):
+    """The book's first integral is evaluated along an integrated trajectory: the angular
+    momentum about the axis stays put, a wrong power of r does not."""
+    from mechbook.answers import load_answers
+    from mechbook.crosscheck import crosscheck_problem
+
+    src = Path(__file__).resolve().parents[1]
+    analysis = Analysis(load_problem(src / "problems" / "lim" / "2040.yaml"))
+    text = (src / "answers" / "lim" / "2040.yaml").read_text()
+    results = {}
+    for label, book in (("right", "m*r**2*thetadot"), ("wrong", "m*r*thetadot")):
+        f = tmp_path / f"{label}.yaml"
+        f.write_text(text.replace('book: "m*r**2*thetadot"', f'book: "{book}"'))
+        xs = crosscheck_problem(analysis, load_answers(f))
+        results[label] = next(x for x in xs if x.name == "conserved:b-momentum")
+    assert results["right"].status == "pass", results["right"].detail
+    assert results["wrong"].status == "fail"
