@@ -234,6 +234,11 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
             yield Slot(root, "value")
     elif q == "constraint_force":
         yield Slot(root, "value")
+    elif q == "phase_area":
+        yield Slot(root, "value")
+    elif q == "phase_region":
+        for i in range(len(val)):
+            yield Slot(root + (i,), "inequality")
     else:  # a quantity this test does not know yet: walk the value's structure
         yield from walk(val, root)
 
@@ -338,6 +343,14 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
         if flipped:
             yield "flip comparison", flipped
         yield from swap_names(s, names)
+    elif slot.kind == "inequality":  # one condition of a region: its boundary moves
+        flipped = flip_relation(s)
+        if flipped:
+            yield "flip comparison", flipped
+        flipped = flip_first_sign(s)
+        if flipped:
+            yield "flip sign of a term", flipped
+        yield from swap_names(s, names)
     elif slot.kind == "form":
         doubled = double_first_term(s)
         if doubled:
@@ -403,6 +416,8 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     sys = ctx.system
     motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}
     sub = slot.path
+    if slot.kind == "inequality":  # the same condition once parsed (e.g. m*g and g*m)
+        return ctx.parse(old, sub, relation=True) == ctx.parse(new, sub, relation=True)
     if slot.kind == "equation":
         a = ctx.parse(old, sub, equation=True)
         b = ctx.parse(new, sub, equation=True)
