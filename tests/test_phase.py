@@ -256,3 +256,23 @@ def test_damped_region_is_found(tmp_path):
          "book": "4*a*b*exp(-gamma*t)"}])
     assert [o.status for o in outs] == ["pass", "pass"], [o.detail for o in outs]
 
+
+
+def test_two_degrees_of_freedom_region(tmp_path):
+    """A projectile in the plane: the 4-dimensional box is sheared in x and y and shifted
+    in p_y; a region check runs in n = 2, and the area check says it needs n = 1."""
+    body = ("parameters:\n  m: {value: 0.6}\n  g: {}\ncoordinates:\n  x: {}\n  y: {}\n"
+            "particles:\n  ball: {mass: m, position: [x, y]}\ngravity: {}\n")
+    an = analysis(tmp_path, body)
+    region = {"x": ["-a", "a"], "y": ["0", "a"], "p_x": ["-b", "b"], "p_y": ["b", "2*b"]}
+    right = ["-a < x - p_x*t/m < a", "0 < y - p_y*t/m - g*t**2/2 < a",
+             "-b < p_x < b", "b < p_y + m*g*t < 2*b"]
+    wrong = right[:1] + ["0 < y - p_y*t/m + g*t**2/2 < a"] + right[2:]
+    outs = run(tmp_path, an, [
+        {"part": "right", "quantity": "phase_region", "region": region, "time": "tau",
+         "book": right},
+        {"part": "wrong", "quantity": "phase_region", "region": region, "time": "tau",
+         "book": wrong},
+        {"part": "area", "quantity": "phase_area", "region": region, "time": "tau",
+         "book": "a"}])
+    assert [o.status for o in outs] == ["pass", "fail", "unsupported"], [o.detail for o in outs]
