@@ -41,9 +41,13 @@ class Sampler:
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
              tries: int = 2000) -> dict[sp.Symbol, sp.Float]:
-        """One point satisfying every condition (raises if none is found)."""
+        """One point satisfying every condition (raises if none is found). When the
+        conditions exclude the neighbourhood of the default values, the spread is widened
+        step by step (x4 each time), so an `assume:` far from the defaults still samples."""
         spread = self.spread if spread is None else spread
-        for _ in range(tries):
+        for attempt in range(tries):
+            if attempt and attempt % (tries // 5) == 0:
+                spread *= 4
             point = {}
             for sym, value in self.base.items():
                 if sym.is_positive:

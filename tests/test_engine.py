@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 
 from mechbook.analysis import Analysis
-from mechbook.errors import UnsupportedError
+from mechbook.errors import NotEquilibriumError, UnsupportedError
 from mechbook.problem import load_problem
 
 
@@ -456,5 +456,5 @@ def test_vertically_driven_support_is_parametric(tmp_path):
 def test_driven_amplitude_not_small_is_not_an_equilibrium(tmp_path):
     an = analysis(tmp_path, DRIVEN.format(small="false", position=HORIZONTAL), "2005")
     th = syms(an, "theta")
-    with pytest.raises(UnsupportedError):
+    with pytest.raises(NotEquilibriumError, match="not an equilibrium"):
         an.linear(None, {th: sp.S.Zero})

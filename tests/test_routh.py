@@ -7,7 +7,7 @@ import pytest
 import sympy as sp
 
 from mechbook.analysis import Analysis
-from mechbook.errors import UnsupportedError
+from mechbook.errors import NotEquilibriumError, UnsupportedError
 from mechbook.problem import load_problem
 
 CONE = """\
@@ -56,7 +56,7 @@ def test_wrong_radius_is_not_a_steady_motion(cone):
     sys = analysis.system()
     r, phi = sys.q
     omega = sp.Symbol("Omega", positive=True)
-    with pytest.raises(UnsupportedError, match="not an equilibrium"):
+    with pytest.raises(NotEquilibriumError, match="not an equilibrium"):
         analysis.steady_linear(None, {phi: omega}, {r: 2 * problem.parameters["g"].symbol})
 
 
