@@ -707,7 +707,52 @@ def check_constraint_force(ctx: Context, val) -> Verdict:
         if k not in ctx.names or not isinstance(ctx.names[k], sp.Symbol):
             raise ctx.part.error(("at", k), f"{k!r} is not a coordinate or velocity")
         at[ctx.names[k]] = ctx.parse(v, ("at", k))
-    return equal(book.subs(at), engine.subs(at), ctx.sampler)
+    engine = engine.subs(at)
+    if "released" in ctx.part.data:
+        engine = _on_energy_shell(ctx, engine, at)
+    return equal(book.subs(at), engine, ctx.sampler)
+
+
+def _on_energy_shell(ctx: Context, expr: sp.Basic, at: dict) -> sp.Basic:
+    """expr at the state `at:` reached by the motion that started from `released:` (the
+    velocities there zero unless given): the one velocity `at:` leaves open is fixed by the
+    conservation of the energy function h (autonomous L, time-independent constraints, no
+    other forces). h and expr must be even in that velocity, so its square is what counts."""
+    sys, dyn = ctx.system, ctx.dyn
+    if sys.lagrangian.has(sys.t) or any(f != 0 for f in sys.forces) or \
+            any(c.has(sys.t) for _, c in sys.constraints):
+        raise UnsupportedError("`released:` needs a conserved energy function (autonomous "
+                               "Lagrangian, fixed constraints, no other forces)")
+    names = sys.coord_names
+    start = {v: sp.S.Zero for v in sys.qd}
+    for k, v in ctx.as_map(ctx.part.data["released"], ("released",)).items():
+        if k in names:
+            start[sys.q[names.index(k)]] = ctx.parse(v, ("released", k))
+        elif k.endswith("dot") and k[:-3] in names:
+            start[sys.qd[names.index(k[:-3])]] = ctx.parse(v, ("released", k))
+        else:
+            raise ctx.part.error(("released", k), f"{k!r} is neither a coordinate nor a "
+                                 "velocity")
+    h = dyn.energy_function
+    h0 = h.subs(start)
+    if h0.free_symbols & set(sys.q + sys.qd):
+        raise ctx.part.error(("released",), "give every coordinate of the starting state")
+    h_at = h.subs(at)
+    open_ = sorted((h_at.free_symbols | expr.free_symbols) & set(sys.qd), key=str)
+    if len(open_) != 1 or h_at.free_symbols & set(sys.q):
+        raise ctx.part.error(("at",), "`at:` must fix every coordinate and all velocities "
+                             "but one, which the energy integral then fixes")
+    v = open_[0]
+    if sp.simplify(h_at - h_at.subs(v, -v)) != 0 or sp.simplify(expr - expr.subs(v, -v)) != 0:
+        raise UnsupportedError("the energy integral fixes only the square of the open "
+                               "velocity, and the quantity depends on its sign")
+    poly = sp.Poly(sp.expand(h_at), v)
+    if poly.degree() != 2:
+        raise UnsupportedError("energy function not quadratic in the open velocity")
+    a, c = poly.coeff_monomial(v**2), poly.coeff_monomial(1)
+    v2 = (h0 - c) / a
+    w = sp.Dummy("w", positive=True)  # w**2 stands for the velocity's square
+    return sp.expand(expr.subs(v, w)).subs(w**2, v2).subs(w, sp.sqrt(v2))
 
 
 # ---- phase-space flow (Liouville) ----------------------------------------------------------

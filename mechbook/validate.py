@@ -36,7 +36,7 @@ def _validate_answers(path: Path) -> str:
     analysis = Analysis(problem)
     for part in key.parts:
         ctx = Context(analysis, part)
-        for field in ("book", "about", "initial", "region", "time"):
+        for field in ("book", "about", "initial", "released", "region", "time"):
             if field in part.data:
                 _walk(ctx, part.data[field], (field,))
         if "erratum" in part.data:
