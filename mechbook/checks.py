@@ -300,6 +300,23 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
 
 
 def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
+    def error(pt) -> float:
+        eng = list(lin.numeric_frequencies(pt))
+        worst = 0.0
+        for b in _numbers(book, pt):  # one-to-one: each engine frequency matches once
+            if not eng:
+                return float("inf")
+            nearest = min(range(len(eng)), key=lambda i, b=b: abs(eng[i] - b))
+            worst = max(worst, abs(eng.pop(nearest) - b) / max(abs(b), 1e-300))
+        return worst
+
+    return _asymptotic(ctx, error)
+
+
+def _asymptotic(ctx: Context, error) -> Verdict:
+    """`limit: {parameter, to, order}`: the book's formula holds in a limit of the
+    parameters. The relative error `error(point)` must fall as the parameter goes to 0 or ∞
+    by decades, faster than 10^-order per decade (halved, for safety), and end below 1e-3."""
     spec = ctx.part.data["limit"]
     name = spec["parameter"]
     if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
@@ -312,15 +329,7 @@ def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
     for eps in (1e-3, 1e-4, 1e-5):
         pt = dict(base)
         pt[sym] = base[sym] * eps if to_zero else base[sym] / eps
-        eng = list(lin.numeric_frequencies(pt))
-        worst = 0.0
-        for b in _numbers(book, pt):  # one-to-one: each engine frequency matches once
-            if not eng:
-                worst = float("inf")
-                break
-            nearest = min(range(len(eng)), key=lambda i, b=b: abs(eng[i] - b))
-            worst = max(worst, abs(eng.pop(nearest) - b) / max(abs(b), 1e-300))
-        errors.append(worst)
+        errors.append(error(pt))
     ratios = [errors[i + 1] / errors[i] if errors[i] > 1e-14 else 0.0 for i in range(2)]
     needed = 0.5 * 10.0 ** (-order)
     ok = errors[-1] < 1e-3 and all(r <= needed for r in ratios)
@@ -370,6 +379,8 @@ def check_normal_modes(ctx: Context, val) -> Verdict:
     vector of a degenerate eigenspace is accepted."""
     lin = ctx.linear()
     modes = ctx.as_list(val, ("book",))
+    if "limit" in ctx.part.data:
+        return _modes_limit(ctx, modes, lin)
     for _ in range(5):
         pt = ctx.sampler.draw()
         for i, mode in enumerate(modes):
@@ -384,6 +395,40 @@ def check_normal_modes(ctx: Context, val) -> Verdict:
                 return Verdict(False, "numeric", f"mode {i}: (K - w^2 M) u relative residual "
                                f"{res:.3g}")
     return Verdict(True, "numeric(5 points)")
+
+
+def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
+    """Modes in a limit of the parameters: each book mode must approach one engine mode, in
+    frequency (relative error) and in shape (the sine of the angle between the shapes)."""
+    parsed = []
+    for i, mode in enumerate(modes):
+        mode = ctx.as_map(mode, ("book", i))
+        parsed.append((ctx.parse(mode["frequency"], ("book", i, "frequency")),
+                       _shape(ctx, mode.get("shape"), ("book", i, "shape"))))
+
+    def error(pt) -> float:
+        w2, vecs = lin.numeric_modes(pt)
+        free = list(range(len(w2)))
+        worst = 0.0
+        for freq, shape in parsed:
+            w = _numbers([freq], pt)[0]
+            u = np.array(_numbers(list(shape), pt))
+            if not free or not np.any(u):
+                return float("inf")
+            best = float("inf")
+            for j in free:
+                v = vecs[:, j]
+                cos = abs(u @ v) / (np.linalg.norm(u) * np.linalg.norm(v))
+                sin = float(np.sqrt(max(0.0, 1.0 - cos**2)))
+                dw = abs(np.sqrt(abs(w2[j])) - w) / max(abs(w), 1e-300)
+                best_j = max(sin, dw)
+                if best_j < best:
+                    best, pick = best_j, j
+            free.remove(pick)
+            worst = max(worst, best)
+        return worst
+
+    return _asymptotic(ctx, error)
 
 
 def _near(values, x, rtol=1e-8):
