@@ -238,6 +238,7 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
         b = [system.dt(system.dt(c)).xreplace(zero_acc) for c in cons]
         exprs += list(A) + b
         m = len(cons)
+    exprs = [sp.sympify(e) for e in exprs]  # a derivative of a plain 0 can be a Python int
     bad = set().union(*(e.free_symbols for e in exprs)) - set([t] + q + qd)
     if bad:
         raise UnsupportedError("simulation: symbols without a value: "
