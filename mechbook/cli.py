@@ -244,12 +244,19 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @main.command()
 @click.argument("problem_id")
 @click.option("--system", default=None, help="Which system of a multi-system problem.")
-@click.option("--method", default="DOP853", show_default=True,
+@click.option("--method", default=None,
               type=click.Choice(["RK45", "DOP853", "Radau", "LSODA", "RK4", "leapfrog",
                                  "yoshida4", "midpoint"]),
               help="SciPy's solve_ivp methods; RK4 (fixed step); symplectic leapfrog "
                    "(Störmer–Verlet) and yoshida4 (Forest–Ruth) for separable Hamiltonians, "
-                   "midpoint (implicit, symplectic) for any conservative system.")
+                   "midpoint (implicit, symplectic) for any conservative system. Default: "
+                   "DOP853, or Radau when the run is stiff.")
+@click.option("--accuracy", type=float, default=None,
+              help="Error wanted at the end (relative to each coordinate's and velocity's "
+                   "scale): chooses the method (unless given) and tolerance from the measured "
+                   "rule (docs/performance.md) and prints the error to expect.")
+@click.option("--param", "params", multiple=True, metavar="NAME=VALUE",
+              help="Override a parameter's default value (k=1e6). Repeat for several.")
 @click.option("--rtol", type=float, default=None, help="Relative tolerance (SciPy methods; "
               "default 1e-8).")
 @click.option("--atol", type=float, default=None, help="Absolute tolerance (SciPy methods; "
@@ -273,8 +280,9 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to store the run in.")
 @click.option("--no-store", is_flag=True, help="Do not store the run.")
 @click.pass_context
-def simulate(ctx: click.Context, problem_id: str, system: str | None, method: str,
-             rtol: float | None, atol: float | None, max_step: float | None,
+def simulate(ctx: click.Context, problem_id: str, system: str | None, method: str | None,
+             accuracy: float | None, params: tuple[str, ...], rtol: float | None,
+             atol: float | None, max_step: float | None,
              step: float | None, t_end: float, points: int, init: tuple[str, ...],
              backend: str | None, plot_path: Path | None, name: str | None,
              store_path: Path, no_store: bool) -> None:
@@ -291,7 +299,8 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
         analysis = Analysis(problem)
         sim = run_simulation(analysis, system, init=parse_assignments(init),
                              t_span=(0.0, t_end), method=method, points=points,
-                             backend=backend or DEFAULT_BACKEND, rtol=rtol, atol=atol,
+                             backend=backend or DEFAULT_BACKEND, accuracy=accuracy,
+                             parameters=parse_assignments(params), rtol=rtol, atol=atol,
                              max_step=max_step, step=step)
     except (MechbookError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
@@ -299,6 +308,8 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
     click.echo(f"{problem.id} [{sim.system}]: {problem.title}")
     click.echo("initial: " + ", ".join(f"{k}={v:.6g}" for k, v in sim.initial.items())
                + f"  ({sim.initial_source})")
+    if sim.choice:
+        click.echo(f"accuracy: {sim.choice}")
     click.echo("method: " + ", ".join(f"{k}={v}" for k, v in traj.settings.items())
                + f"; {traj.nfev} evaluations, {len(traj.t)} samples, {sim.seconds:.2f} s "
                f"(RHS: {sim.model.backend}, generated in {sim.model.generation_seconds:.3f} s)")
@@ -311,7 +322,7 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
         click.echo("no conserved quantity found by the engine: nothing to monitor")
     if not no_store:
         path = store_path if store_path.is_absolute() else base / store_path
-        run_name = name or f"{sim.system}-{method}"
+        run_name = name or f"{sim.system}-{traj.method}"
         write_simulation(problem.id, run_name, sim.arrays(), sim.settings(),
                          {f"monitors/{d.name}": d.attrs() for d in sim.drifts}, path)
         click.echo(f"stored as /problems/{problem.id}/simulations/{run_name} in {path}")
