@@ -18,6 +18,15 @@ check: $(STAMP)  ## check every problem against the book's answer key
 test: $(STAMP)   ## run the test suite
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
 
+bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -> results/ (~15 min)
+	mkdir -p results/bench
+	$(BIN)/python bench/work_precision.py --out results/bench.h5 --figdir results/bench \
+		> results/bench/work_precision.txt && cat results/bench/work_precision.txt
+	$(BIN)/python bench/symbolic.py --repeat 1 --csv results/bench/symbolic.csv \
+		> results/bench/symbolic.txt && cat results/bench/symbolic.txt
+	$(BIN)/python bench/extremes.py --csv results/bench/extremes.csv \
+		> results/bench/extremes.txt && cat results/bench/extremes.txt
+
 lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench
 
