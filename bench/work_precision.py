@@ -444,7 +444,8 @@ def recheck_rule(runs: pd.DataFrame, labels: list[str]) -> list[dict]:
             choice = accuracy.choose(target)
         except MechbookError:
             continue
-        sel = runs[(runs.method == choice.method) & np.isclose(runs.tol, choice.rtol)
+        sel = runs[(runs.method == choice.method)
+                   & np.isclose(runs.tol, choice.rtol, rtol=1e-6, atol=0)
                    & runs.problem.isin(labels)]
         worst = float(sel.error.max()) if len(sel) == len(labels) else math.inf
         rows.append({"target": target, "method": choice.method, "tol": choice.rtol,
