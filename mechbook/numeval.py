@@ -42,7 +42,13 @@ def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, fl
 
 
 def _number(v):
-    v = sp.sympify(v)
+    """A point's value (a SymPy number or a Python number; never text) as an mpmath number."""
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return mpmath.mpf(v)
+    if isinstance(v, complex):
+        return mpmath.mpc(v)
+    if not isinstance(v, sp.Basic):
+        raise NotNumeric(f"not a number: {type(v).__name__}")
     if isinstance(v, sp.Float):
         return mpmath.mpf(v._mpf_)
     if v.is_real:

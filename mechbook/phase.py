@@ -25,6 +25,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from .errors import UnsupportedError
+from .simulate.rhs import as_expr
 
 RTOL = 1e-12  # tolerance of the flow's integration
 
@@ -49,7 +50,7 @@ class PhaseFlow:
         mom = list(dyn.momenta)
         jac = [sp.diff(p, v) for p in mom for v in self.qd]
         state = {self.t, *self.q, *self.qd}
-        free = set().union(*(sp.sympify(e).free_symbols for e in mass + force + mom + jac))
+        free = set().union(*(as_expr(e).free_symbols for e in mass + force + mom + jac))
         self.params = sorted(free - state, key=lambda s: s.name)
         args = [self.t] + self.q + self.qd + self.params
         self._mf = sp.lambdify(args, mass + force, modules="numpy", cse=True)

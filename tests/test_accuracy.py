@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 from click.testing import CliRunner
+from systems import pendulum
 
 from mechbook.analysis import Analysis
 from mechbook.cli import main
@@ -20,20 +21,7 @@ from mechbook.problem import load_problem
 from mechbook.simulate import accuracy, simulate
 from mechbook.simulate.stiffness import IMPLICIT, STIFF_RATIO, assess
 
-PENDULUM = """\
-id: lim-9301
-source: test
-title: simple pendulum
-parameters:
-  m: {value: 0.7}
-  l: {value: 0.8}
-  g: {}
-coordinates:
-  theta: {}
-particles:
-  bob: {mass: m, position: [l*sin(theta), -l*cos(theta)]}
-gravity: {}
-"""
+PENDULUM = pendulum(m=0.7, l=0.8, header="id: lim-9301\nsource: test\ntitle: simple pendulum\n")
 
 TWO_MASSES = """\
 id: lim-9302

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from systems import pendulum
 
 from mechbook.analysis import Analysis
 from mechbook.problem import load_problem
@@ -14,20 +15,8 @@ from mechbook.simulate.integrators import IntegratorError, integrate
 from mechbook.simulate.monitors import conserved_quantities, drifts
 from mechbook.simulate.rhs import build_model, structure
 
-PENDULUM = """\
-id: lim-9101
-source: test
-title: simple pendulum
-parameters:
-  m: {value: 1.0}
-  l: {value: 1.0}
-  g: {value: 1.0}
-coordinates:
-  theta: {}
-particles:
-  bob: {mass: m, position: [l*sin(theta), -l*cos(theta)]}
-gravity: {}
-"""
+PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
+                    header="id: lim-9101\nsource: test\ntitle: simple pendulum\n")
 
 DOUBLE = """\
 id: lim-9102

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from systems import pendulum
 
 from mechbook.analysis import Analysis
 from mechbook.answers import load_answers
@@ -32,17 +33,7 @@ potential: k*x**2/2
 DAMPED = OSCILLATOR + "forces:\n  x: -m*gamma*xdot\n"
 DAMPED = DAMPED.replace("  k: {value: 2.3}\n", "  k: {value: 2.3}\n  gamma: {value: 0.4}\n")
 
-PENDULUM = """\
-parameters:
-  m: {value: 1.3}
-  l: {value: 0.7}
-  g: {}
-coordinates:
-  theta: {}
-particles:
-  bob: {mass: m, position: [l*sin(theta), -l*cos(theta)]}
-gravity: {}
-"""
+PENDULUM = pendulum(m=1.3, l=0.7)
 
 CYCLOTRON = """\
 parameters:

@@ -33,6 +33,18 @@ DEFAULT_BACKEND = "llvm"
 Compiled = Callable[[np.ndarray], np.ndarray]
 
 
+def as_expr(e) -> sp.Basic:
+    """An engine result as a SymPy object: plain numbers are wrapped, anything else (text
+    above all) is refused; nothing here is ever parsed."""
+    if isinstance(e, sp.Basic):
+        return e
+    if isinstance(e, int) and not isinstance(e, bool):
+        return sp.Integer(e)
+    if isinstance(e, float):
+        return sp.Float(e)
+    raise TypeError(f"not an engine expression: {type(e).__name__}")
+
+
 def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
                   backend: str = DEFAULT_BACKEND) -> tuple[Compiled, str]:
     """Compile `exprs` (a flat list) in `args` into f(vector) -> array, with cse.
@@ -41,7 +53,7 @@ def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
     translate an expression hands over to the next in BACKENDS)."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
-    exprs = [sp.sympify(e) for e in exprs]  # engine-built SymPy objects, never text
+    exprs = [as_expr(e) for e in exprs]
     order = list(BACKENDS[BACKENDS.index(backend):])
     last: Exception | None = None
     for name in order:
@@ -55,7 +67,8 @@ def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
 def _compile_symengine(args, exprs, backend: str) -> Compiled:
     import symengine as se
 
-    se_args = [se.sympify(a) for a in args]
+    # SymPy objects converted to SymEngine ones (as_expr has refused anything but those)
+    se_args = [se.sympify(as_expr(a)) for a in args]
     se_exprs = [se.sympify(e) for e in exprs]
     if not exprs:
         return lambda x: np.zeros(0)
@@ -238,7 +251,7 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
         b = [system.dt(system.dt(c)).xreplace(zero_acc) for c in cons]
         exprs += list(A) + b
         m = len(cons)
-    exprs = [sp.sympify(e) for e in exprs]  # a derivative of a plain 0 can be a Python int
+    exprs = [as_expr(e) for e in exprs]  # a derivative of a plain 0 can be a Python int
     bad = set().union(*(e.free_symbols for e in exprs)) - set([t] + q + qd)
     if bad:
         raise UnsupportedError("simulation: symbols without a value: "
