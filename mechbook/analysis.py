@@ -11,13 +11,14 @@ import sympy as sp
 from .errors import UnsupportedError
 from .lagrange import Dynamics
 from .linear import Equilibria, LinearSystem
+from .numeval import is_zero
 from .problem import Problem
 from .routh import ReducedSystem
 from .system import System
 
 
 class Analysis:
-    def __init__(self, problem: Problem, simplify: bool = True):
+    def __init__(self, problem: Problem, simplify: bool = False):
         self.problem = problem
         self.simplify = simplify
         self._dyn: dict[str, Dynamics] = {}
@@ -53,17 +54,19 @@ class Analysis:
         key = (sys.name, "steady",
                tuple(sorted((str(k), sp.srepr(v)) for k, v in {**rates, **point}.items())))
         if key not in self._lin:
-            reduced = ReducedSystem(sys, rates, point)
+            reduced = ReducedSystem(sys, rates, point, self.simplify)
             dyn = Dynamics(reduced, self.simplify)
             self._lin[key] = Equilibria(dyn).linearize(point)
         return self._lin[key]
 
-    def stable_equilibria(self, name: str | None = None) -> list[dict]:
-        """Closed-form equilibria that are stable at the default parameter values."""
+    def stable_equilibria(self, name: str | None = None,
+                          budget: float | None = None) -> list[dict]:
+        """Closed-form equilibria that are stable at the default parameter values (the
+        search given up after `budget` seconds when no part asked for it)."""
         eq = self.equilibria(name)
         values = self.problem.values()
         out = []
-        for point in eq.symbolic:
+        for point in eq.within(budget):
             try:
                 ok = self.linear(name, point).numeric_stability(values) == "stable"
             except (UnsupportedError, TypeError, ValueError):
@@ -72,11 +75,14 @@ class Analysis:
                 out.append(point)
         return out
 
+    DEFAULT_POINT_BUDGET = 5.0  # seconds to look for closed-form equilibria
+
     def default_point(self, name: str | None = None) -> dict:
-        """The equilibrium to expand about when a question names none: the stable one,
-        or the origin when the system is already linear with no static equilibrium issue."""
+        """The equilibrium to expand about when a question names none: the stable one
+        (among the closed-form equilibria SymPy finds within DEFAULT_POINT_BUDGET s), or
+        the origin when the system is already linear with no static equilibrium issue."""
         try:
-            stable = self.stable_equilibria(name)
+            stable = self.stable_equilibria(name, self.DEFAULT_POINT_BUDGET)
         except UnsupportedError:
             stable = []
         distinct = []
@@ -93,7 +99,7 @@ class Analysis:
         if len(distinct) == 0:
             # a system with a zero-frequency mode (a free translation) has no isolated
             # equilibrium; the origin is one if the conditions vanish there
-            if all(sp.simplify(c.subs(origin)) == 0 for c in self.equilibria(name).conditions):
+            if all(is_zero(c.subs(origin)) for c in self.equilibria(name).conditions):
                 return origin
         raise UnsupportedError("choosing the equilibrium: the answer must name `about:` "
                                f"({len(distinct)} stable equilibria found)")

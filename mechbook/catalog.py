@@ -7,6 +7,8 @@ from pathlib import Path
 
 from .errors import MechbookError
 
+DEFAULT_STORE = Path("results/mechbook.h5")  # relative to the tree's root
+
 
 def root(start: str | Path | None = None) -> Path:
     """The tree holding problems/ and answers/: $MECHBOOK_ROOT, or the nearest parent."""

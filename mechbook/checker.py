@@ -9,33 +9,16 @@ from __future__ import annotations
 
 import time
 import traceback
-from dataclasses import asdict, dataclass
 
 from .analysis import Analysis
 from .answers import AnswerKey, Part
 from .checks import CHECKS, Context
+from .compare import NUMERIC, ProofPolicy
 from .errors import MechbookError, NotEquilibriumError, SpecError, UnsupportedError
-
-STATUSES = ("pass", "fail", "erratum", "unsupported", "error")
-
-
-@dataclass
-class Outcome:
-    problem: str
-    part: str
-    quantity: str
-    cite: str
-    status: str
-    method: str = ""
-    detail: str = ""
-    seconds: float = 0.0
-    origin: str = "book"  # 'derived': no printed answer; the value is an independent derivation
-
-    def as_dict(self) -> dict:
-        return asdict(self)
+from .records import Outcome
 
 
-def check_part(analysis: Analysis, part: Part) -> Outcome:
+def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) -> Outcome:
     start = time.perf_counter()
     out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], "error",
                   origin=part.data.get("origin", "book"))
@@ -43,7 +26,7 @@ def check_part(analysis: Analysis, part: Part) -> Outcome:
         if "unsupported" in part.data:
             out.status, out.detail = "unsupported", part.data["unsupported"]
             return out
-        ctx = Context(analysis, part)
+        ctx = Context(analysis, part, policy)
         fn = CHECKS[part.quantity]
         verdict = fn(ctx, part.data.get("book"))
         if "erratum" in part.data:
@@ -76,8 +59,9 @@ def check_part(analysis: Analysis, part: Part) -> Outcome:
     return out
 
 
-def check_problem(analysis: Analysis, key: AnswerKey) -> list[Outcome]:
+def check_problem(analysis: Analysis, key: AnswerKey,
+                  policy: ProofPolicy = NUMERIC) -> list[Outcome]:
     if key.problem_id != analysis.problem.id:
         raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem file "
                             f"is {analysis.problem.id!r}")
-    return [check_part(analysis, part) for part in key.parts]
+    return [check_part(analysis, part, policy) for part in key.parts]

@@ -9,16 +9,14 @@ from pathlib import Path
 import click
 
 from . import __version__
-from .analysis import Analysis
-from .catalog import all_ids, answer_path, problem_path, root
-from .derive import derive
+from .batch import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from .catalog import DEFAULT_STORE, all_ids, answer_path, problem_path, root
 from .errors import MechbookError
-from .problem import load_problem
-from .run import ProblemRun, run_many
-from .store import DEFAULT_PATH, read, write
-from .validate import validate_file
 
+# The engine (SymPy, SciPy) is imported inside the commands that need it, so --help, list
+# and argument errors answer at once.
 STATUS_ORDER = ("pass", "erratum", "unsupported", "fail", "error")
+DEFAULT_PATH = DEFAULT_STORE
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -46,6 +44,8 @@ def _resolve_root(ctx: click.Context) -> Path:
 @click.pass_context
 def list_cmd(ctx: click.Context) -> None:
     """List every problem with its title and number of answer parts."""
+    from .problem import load_problem
+
     base = _resolve_root(ctx)
     for pid in all_ids(base):
         try:
@@ -70,7 +70,11 @@ def list_cmd(ctx: click.Context) -> None:
 @click.option("--no-simplify", is_flag=True, help="Skip SymPy simplification (faster).")
 @click.pass_context
 def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: bool) -> None:
-    """Derive and print a problem's results (what its `compute:` asks for)."""
+    """Derive and print a problem's results (what its `compute:` asks for), simplified."""
+    from .analysis import Analysis
+    from .derive import derive
+    from .problem import load_problem
+
     base = _resolve_root(ctx)
     try:
         problem = load_problem(problem_path(problem_id, base))
@@ -91,12 +95,40 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
         raise click.ClickException(str(exc)) from None
 
 
-def _progress(i: int, n: int, run: ProblemRun) -> None:
+class _Progress:
+    """Progress of a batch on stderr: a bar with ETA on a terminal, a plain line per
+    finished problem otherwise (CI logs)."""
+
+    def __init__(self, total: int, cached: int):
+        self.total, self.done = total, cached
+        self.bar = None
+        if sys.stderr.isatty() and total > cached:
+            self.bar = click.progressbar(length=total - cached, label="checking",
+                                         file=sys.stderr, show_eta=True, show_pos=True,
+                                         item_show_func=lambda pid: pid or "")
+            self.bar.__enter__()
+
+    def finished(self, run) -> None:
+        self.done += 1
+        if self.bar is not None:
+            self.bar.update(1, run.pid)
+            if run.error or any(o.status in ("fail", "error") for o in run.outcomes):
+                click.echo(f"\n{run.pid}: {_summary(run)}", err=True)
+        else:
+            click.echo(f"[{self.done}/{self.total}] {run.pid} ({run.seconds:.1f} s): "
+                       f"{_summary(run)}", err=True)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
+
+
+def _summary(run) -> str:
     counts = Counter(o.status for o in run.outcomes)
     summary = run.error or ", ".join(f"{counts[s]} {s}" for s in STATUS_ORDER if counts[s])
     if run.cached:
         summary += " (cached: problem, answers and engine unchanged)"
-    click.echo(f"[{i}/{n}] {run.pid} ({run.seconds:.1f} s): {summary}", err=True)
+    return summary
 
 
 @main.command()
@@ -110,36 +142,82 @@ def _progress(i: int, n: int, run: ProblemRun) -> None:
                    "and engine are unchanged since the stored run reuses the stored outcomes.")
 @click.option("--no-crosscheck", is_flag=True,
               help="Skip the independent cross-checks (simulated frequencies, Newton's law).")
+@click.option("-j", "--jobs", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Worker processes (0: one per core).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
+              default=DEFAULT_TIMEOUT, show_default=True,
+              help="Wall-clock seconds allowed per problem; a problem that takes longer is "
+                   "stopped and reported as an error with the stage it was in.")
+@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+              show_default=True, help="Resident memory (MB) allowed per problem (0: no bound).")
+@click.option("--prove", is_flag=True,
+              help="After a part passes numerically (30 digits at random admissible points), "
+                   "also try a symbolic proof with SymPy; the method column says which it got.")
+@click.option("--prove-seconds", type=click.FloatRange(min=0, min_open=True), default=10.0,
+              show_default=True, help="Time limit of each symbolic proof attempt.")
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
-          verbose: bool, fresh: bool, no_crosscheck: bool) -> None:
+          verbose: bool, fresh: bool, no_crosscheck: bool, jobs: int, timeout: float,
+          memory_mb: float, prove: bool, prove_seconds: float) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail.
 
-    The cross-check column is independent of the book: each frequency part's linear
-    system is confirmed by simulating the nonlinear equations along every mode, and each
-    system's Lagrange equations against Newton's law (docs/numerics.md); a cross-check
-    fail also exits 1."""
+    Problems run in parallel worker processes, the longest first; each finished problem is
+    written to the store at once, so an interrupted run keeps what it finished and the next
+    run resumes from there. The cross-check column is independent of the book: each
+    frequency part's linear system is confirmed by simulating the nonlinear equations along
+    every mode, and each system's Lagrange equations against Newton's law
+    (docs/numerics.md); a cross-check fail also exits 1."""
+    from .batch import Batch, BatchOptions
+    from .records import ProofPolicy
+    from .run import RunOptions, cached_runs
+    from .store import durations, write
+
     base = _resolve_root(ctx)
     ids = list(problem_ids) or all_ids(base)
     if not ids:
         raise click.ClickException(f"no problems under {base / 'problems'}")
+    for pid in ids:
+        try:
+            if not problem_path(pid, base).exists():
+                raise click.ClickException(f"no problem {pid} (no file "
+                                           f"{problem_path(pid, base)})")
+        except MechbookError as exc:
+            raise click.ClickException(str(exc)) from None
     store_file = store_path if store_path.is_absolute() else base / store_path
-    cache = None if (fresh or no_store) else store_file
-    runs = run_many(ids, base, progress=_progress, cache=cache, crosscheck=not no_crosscheck)
-    _table(runs, verbose)
-    records = [r.record for r in runs if r.record is not None]
-    if records and not no_store:
-        path = write(records, store_file)
-        click.echo(f"results written to {path}")
-    bad = sum(1 for r in runs if r.error) + sum(1 for r in runs for o in r.outcomes
-                                                if o.status in ("fail", "error"))
-    bad += sum(1 for r in runs for x in r.crosschecks if x.failed)
+    runs = {} if (fresh or no_store) else cached_runs(ids, base, store_file, not no_crosscheck)
+    progress = _Progress(len(ids), 0)
+    for pid in ids:
+        if pid in runs:
+            progress.finished(runs[pid])
+
+    def finished(run) -> None:
+        progress.finished(run)
+        if run.record is not None and not no_store:
+            write([run.record], store_file)
+
+    past = durations(store_file)
+    todo = sorted((pid for pid in ids if pid not in runs),
+                  key=lambda pid: -past.get(pid, float("inf")))
+    options = BatchOptions(jobs, timeout, memory_mb, run=RunOptions(
+        crosscheck=not no_crosscheck, policy=ProofPolicy(prove, prove_seconds)))
+    try:
+        for run in Batch(base, options, on_done=finished).run(todo):
+            runs[run.pid] = run
+    finally:
+        progress.close()
+    ordered = [runs[pid] for pid in ids]
+    _table(ordered, verbose)
+    if not no_store and any(r.record is not None for r in ordered):
+        click.echo(f"results written to {store_file}")
+    bad = sum(1 for r in ordered if r.error) + sum(1 for r in ordered for o in r.outcomes
+                                                   if o.status in ("fail", "error"))
+    bad += sum(1 for r in ordered for x in r.crosschecks if x.failed)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
         sys.exit(1)
 
 
-def _table(runs: list[ProblemRun], verbose: bool) -> None:
+def _table(runs: list, verbose: bool) -> None:
     total: Counter = Counter()
     crossed: Counter = Counter()
     click.echo(f"{'problem':<16} {'part':<16} {'quantity':<20} {'outcome':<12} "
@@ -190,6 +268,8 @@ def _table(runs: list[ProblemRun], verbose: bool) -> None:
                 type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def validate(files: tuple[Path, ...]) -> None:
     """Validate problem or answer files (schema and every expression); nothing runs."""
+    from .validate import validate_file
+
     bad = 0
     for f in files:
         try:
@@ -208,6 +288,8 @@ def validate(files: tuple[Path, ...]) -> None:
 @click.pass_context
 def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     """Print a problem's stored results and checks, read back from the HDF5 store."""
+    from .store import read
+
     base = _resolve_root(ctx)
     path = store_path if store_path.is_absolute() else base / store_path
     try:
@@ -288,6 +370,8 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
              store_path: Path, no_store: bool) -> None:
     """Integrate a problem's full nonlinear equations of motion; report the drift of every
     conserved quantity the engine found; store the trajectory (and plot it)."""
+    from .analysis import Analysis
+    from .problem import load_problem
     from .simulate import DEFAULT_BACKEND
     from .simulate.core import parse_assignments
     from .simulate.core import simulate as run_simulation

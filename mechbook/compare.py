@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .numeval import NotNumeric, evaluate
+from .numeval import NotNumeric, evaluate, holds
+from .records import NUMERIC, ProofPolicy
 from .timeout import Timeout, time_limit
 
 RTOL = 1e-10  # relative tolerance of a numeric comparison
@@ -33,11 +34,12 @@ class Sampler:
     """Random admissible values for symbols: parameters, answer symbols and free variables."""
 
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
-                 seed: int = 20261122, spread: float = 0.5):
+                 seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
         self.spread = spread
+        self.policy = policy  # carried with the sampler to every comparison it serves
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
              tries: int = 2000) -> dict[sp.Symbol, sp.Float]:
@@ -59,13 +61,13 @@ class Sampler:
                     point[v] = self.rng.uniform(0.1, 1.0) if v.is_positive \
                         else self.rng.uniform(-1.0, 1.0)
             point = {k: sp.Float(v, DIGITS) for k, v in point.items()}
-            if all(bool(c.subs(point)) for c in self.conditions):
+            if all(holds(c, point) for c in self.conditions):
                 return point
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
     def default(self) -> dict[sp.Symbol, sp.Float]:
         point = {k: sp.Float(v, DIGITS) for k, v in self.base.items()}
-        if all(bool(c.subs(point)) for c in self.conditions):
+        if all(holds(c, point) for c in self.conditions):
             return point
         return self.draw()
 
@@ -109,9 +111,9 @@ def _symbolic_zero(expr: sp.Basic, seconds: float) -> bool:
         return False
 
 
-def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool = True,
-             seconds: float = 10.0) -> Verdict:
-    """Is `expr` identically zero (under the sampler's assumptions)?"""
+def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
+    """Is `expr` identically zero (under the sampler's assumptions)? A symbolic proof is
+    attempted after the numeric pass when `symbolic` (default: the sampler's policy)."""
     variables = _free_variables([expr], sampler.base)
     worst = 0.0
     valid = 0
@@ -130,21 +132,26 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool = True,
                            f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
-    if symbolic and _symbolic_zero(expr, seconds):
+    if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
         return Verdict(True, "symbolic")
     return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
 
 
-def all_vanish(exprs: Sequence[sp.Basic], sampler: Sampler, symbolic: bool = True,
-               seconds: float = 10.0) -> Verdict:
+def _prove(sampler: Sampler, symbolic: bool | None) -> bool:
+    return sampler.policy.prove if symbolic is None else symbolic
+
+
+def all_vanish(exprs: Sequence[sp.Basic], sampler: Sampler,
+               symbolic: bool | None = None) -> Verdict:
     """Does every expression vanish? All are tested numerically before any symbolic proof is
     tried, so a wrong one is reported at the cost of a few evaluations, not of simplify()."""
     verdicts = [vanishes(e, sampler, symbolic=False) for e in exprs]
     for v in verdicts:
         if not v.ok:
             return v
-    if symbolic:
-        verdicts = [Verdict(True, "symbolic") if _symbolic_zero(e, seconds) else v
+    if _prove(sampler, symbolic):
+        verdicts = [Verdict(True, "symbolic") if _symbolic_zero(e, sampler.policy.seconds)
+                    else v
                     for e, v in zip(exprs, verdicts, strict=True)]
     return combine(verdicts)
 
@@ -160,7 +167,7 @@ def combine(verdicts: Sequence[Verdict]) -> Verdict:
     return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail))
 
 
-def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool = True) -> Verdict:
+def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
     """Do a and b agree identically?"""
     variables = _free_variables([a, b], sampler.base)
     worst = 0.0
@@ -180,7 +187,7 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool = True) -> 
                            f"{_num(va)} vs {_num(vb)} at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
-    if symbolic and _symbolic_zero(a - b, 10.0):
+    if _prove(sampler, symbolic) and _symbolic_zero(a - b, sampler.policy.seconds):
         return Verdict(True, "symbolic")
     return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
 

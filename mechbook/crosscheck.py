@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import time
 import traceback
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -46,6 +46,7 @@ from .analysis import Analysis
 from .answers import AnswerKey
 from .bodies import euler_body_rates, shape_inertia
 from .errors import MechbookError, UnsupportedError
+from .records import CrossCheck
 from .simulate.rhs import Model, build_model, compile_exprs
 
 REL_TOL = 1e-4  # required agreement of measured and linear frequencies
@@ -56,39 +57,7 @@ PERIODS = 4
 FREQUENCY_QUANTITIES = ("frequencies", "period", "normal_modes", "normal_coordinates",
                         "mode_node")
 EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force")
-
-
-@dataclass
-class CrossCheck:
-    """One cross-check and the answer parts it vouches for."""
-
-    name: str
-    kind: str  # "frequencies" or "newton"
-    system: str
-    status: str = "error"  # pass | fail | n.a. | error
-    error: float = float("nan")  # largest relative error measured
-    detail: str = ""
-    parts: list[str] = field(default_factory=list)
-    seconds: float = 0.0
-    modes: list[dict] = field(default_factory=list)
-
-    def as_dict(self) -> dict:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, data: dict) -> CrossCheck:
-        known = {k: data[k] for k in cls.__dataclass_fields__ if k in data}
-        return cls(**known)
-
-    @property
-    def failed(self) -> bool:
-        return self.status in ("fail", "error")
-
-    def cell(self) -> str:
-        """The table's cross-check column."""
-        if self.status in ("pass", "fail") and np.isfinite(self.error):
-            return f"{self.status} {self.error:.0e}"
-        return self.status
+LOOSE_BUDGET = 3.0  # seconds for the engine's own closed-form equilibria (no part asks)
 
 
 # ---- frequencies by simulation ---------------------------------------------------------------
@@ -564,15 +533,18 @@ def _point_label(lin) -> str:
     return "{" + pt + "}"
 
 
-def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list[CrossCheck]:
+def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
+                       stage=lambda text: None) -> list[CrossCheck]:
     """Every cross-check of a problem: Newton per system, frequencies per linear system the
-    answer key refers to and per stable equilibrium the engine derives."""
+    answer key refers to and per stable equilibrium the engine derives. `stage` is told
+    which check is running (a batch reports it if the problem runs out of time)."""
     from .checks import Context  # the answer parts' own reading of `about`/`steady`/`assume`
 
     problem = analysis.problem
     out: list[CrossCheck] = []
     newton: dict[str, CrossCheck] = {}
     for name in problem.systems:
+        stage(f"cross-check newton:{name}")
         try:
             newton[name] = newton_crosscheck(analysis, name)
         except Exception as exc:  # a fault here must not hide the other checks
@@ -589,6 +561,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
         if part.quantity in EQUATION_QUANTITIES and sname in newton:
             newton[sname].parts.append(part.name)
         if part.quantity in ("conserved", "expression"):
+            stage(f"cross-check conserved:{part.name}")
             x = _guarded_conserved(analysis, part, models)
             if x is not None:
                 out.append(x)
@@ -613,10 +586,12 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
         label = _point_label(lin)
         tag = (sname, *_numeric_key(lin, values, params))
         if tag not in freq:
+            stage(f"cross-check modes:{sname}@{label}")
             freq[tag] = _guarded_frequency(analysis, lin, values, f"modes:{sname}@{label}",
                                            models)
         freq[tag].parts.append(part.name)
     for name in problem.systems:  # the engine's own stable equilibria
+        stage(f"cross-check: the engine's own equilibria of {name}")
         try:
             engine_systems = _engine_linear_systems(analysis, name)
         except Exception as exc:  # noqa: BLE001 - reported, never hidden
@@ -627,6 +602,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None) -> list
             values = dict(problem.values())
             tag = (name, *_numeric_key(lin, values, params))
             if tag not in freq:
+                stage(f"cross-check modes:{name}@{label}")
                 freq[tag] = _guarded_frequency(analysis, lin, values, f"modes:{name}@{label}",
                                                models)
     out += list(newton.values()) + list(freq.values())
@@ -675,7 +651,7 @@ def _engine_linear_systems(analysis: Analysis, name: str) -> list[tuple]:
         return []
     out = []
     try:
-        points = analysis.equilibria(name).symbolic
+        points = analysis.equilibria(name).within(LOOSE_BUDGET)
     except UnsupportedError:
         return []
     values = analysis.problem.values()

@@ -23,6 +23,7 @@ from .simulate.rhs import build_model
 DRIFT_TOL = 1e-7  # largest relative change allowed along the run (DOP853 at rtol 1e-12)
 T_END = 3.0  # time units; long enough for the state to change, short enough to be cheap
 SAMPLES = 25
+SEARCH_SECONDS = 3.0  # for a stable equilibrium to start near (no part asked for one)
 
 
 def book_integrals(ctx) -> list[sp.Expr]:
@@ -58,7 +59,7 @@ def conserved_crosscheck(analysis, ctx, exprs: list[sp.Expr], models: dict):
     model = models[key]
     rng = np.random.default_rng(20261123)
     try:
-        q0, qd0, _ = initial_state(analysis, sys.name, {}, params)
+        q0, qd0, _ = initial_state(analysis, sys.name, {}, params, search=SEARCH_SECONDS)
     except MechbookError:  # no `initial:` and no stable equilibrium: a generic state
         q0, qd0 = rng.uniform(0.4, 1.2, len(sys.q)), np.zeros(len(sys.q))
     qd0 = qd0 + rng.uniform(-0.3, 0.3, len(qd0))  # moving, so the integral is exercised

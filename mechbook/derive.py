@@ -6,24 +6,15 @@ be read back) or a NumPy array evaluated at the problem's default parameter valu
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 import sympy as sp
 
 from .analysis import Analysis
 from .errors import UnsupportedError
+from .records import Results
 
 DEFAULT_COMPUTE = ["lagrangian", "eom", "momenta", "cyclic", "energy", "equilibria",
                    "small_oscillations"]
-
-
-@dataclass
-class Results:
-    system: str
-    text: dict[str, str] = field(default_factory=dict)
-    arrays: dict[str, np.ndarray] = field(default_factory=dict)
-    notes: dict[str, str] = field(default_factory=dict)
 
 
 def show(expr) -> str:
@@ -140,3 +131,49 @@ def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
     if not lin.gyroscopic:
         w2, modes = lin.numeric_modes(values)
         res.arrays[f"{tag}/modes"] = modes
+
+
+_DYNAMICS_TEXT = ("mass_matrix", "forcing", "momenta", "cyclic", "energy_function",
+                  "hamiltonian")
+
+
+def computed(analysis: Analysis) -> list[Results]:
+    """What a check run derived on its way, as text and default-value arrays, per system:
+    nothing is derived or simplified here (a check run stores what its parts needed)."""
+    problem = analysis.problem
+    values = problem.values()
+    out = []
+    for name in problem.systems:
+        sys = problem._cache.get(name)
+        if sys is None:  # no part touched this system
+            continue
+        res = Results(name)
+        res.text["lagrangian"] = show(sys.lagrangian)
+        dyn = analysis._dyn.get(name)
+        if dyn is not None:
+            for key in _DYNAMICS_TEXT:
+                if key in dyn.__dict__:  # a cached_property that was evaluated
+                    val = dyn.__dict__[key]
+                    if key == "momenta":
+                        val = dict(zip(sys.q, val, strict=True))
+                    res.text[key] = show(val.tolist() if hasattr(val, "tolist") else val)
+        eq = analysis._eq.get(name)
+        if eq is not None and eq._solved is not None:
+            res.text["equilibria"] = show(eq._solved)
+        linears = [lin for key, lin in analysis._lin.items() if key[0] == name]
+        for i, lin in enumerate(linears):
+            tag = f"linear_{i}"
+            res.text[f"{tag}/point"] = show(lin.point)
+            steady = getattr(lin.dyn.sys, "momenta", None)
+            if isinstance(steady, dict):
+                res.text[f"{tag}/steady_momenta"] = show(steady)
+            for m in ("M", "C", "K"):
+                res.text[f"{tag}/{m}"] = show(getattr(lin, m).tolist())
+            try:
+                M, C, K = lin.matrices(values)
+                res.arrays[f"{tag}/M"], res.arrays[f"{tag}/K"] = M, K
+                res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
+            except (TypeError, ValueError, UnsupportedError, np.linalg.LinAlgError) as exc:
+                res.notes[f"{tag}/numeric"] = f"not evaluated at the default values: {exc}"
+        out.append(res)
+    return out

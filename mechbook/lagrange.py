@@ -13,6 +13,7 @@ from functools import cached_property
 import sympy as sp
 
 from .errors import UnsupportedError
+from .numeval import is_zero
 from .system import System
 from .timeout import Timeout, time_limit, try_simplify
 
@@ -20,13 +21,15 @@ from .timeout import Timeout, time_limit, try_simplify
 class Dynamics:
     """Equations of motion, momenta, conserved quantities and the Hamiltonian of a system."""
 
-    def __init__(self, system: System, simplify: bool = True):
+    def __init__(self, system: System, simplify: bool = False):
         self.sys = system
         self.simplify = simplify
         self.q, self.qd, self.qdd = system.q, system.qd, system.qdd
         self.L = system.lagrangian
 
     def _simp(self, expr):
+        """Simplified for a human reader (`simplify=True`: `mechbook solve`); the checks
+        and cross-checks work on the raw expressions, which are equal and far cheaper."""
         return try_simplify(expr) if self.simplify else expr
 
     # ---- Lagrange ------------------------------------------------------------------------
@@ -106,7 +109,7 @@ class Dynamics:
         out = {}
         for q, p, force in zip(self.q, self.momenta, self.sys.forces, strict=True):
             if (force == 0 and all(sp.diff(c, q) == 0 for c in cons)
-                    and try_simplify(sp.diff(self.L, q)) == 0):
+                    and is_zero(sp.diff(self.L, q))):
                 out[q] = p
         return out
 
@@ -127,7 +130,8 @@ class Dynamics:
 
     @property
     def energy_conserved(self) -> bool:
-        return self.energy_power == 0
+        power = self.energy_power
+        return power is not sp.nan and is_zero(power)
 
     # ---- Hamilton ------------------------------------------------------------------------
     @cached_property

@@ -14,6 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
+import time
+
 import numpy as np
 import scipy.linalg
 import scipy.optimize
@@ -22,6 +24,7 @@ import sympy as sp
 from .errors import NotEquilibriumError, UnsupportedError
 from .expansion import EPS, expand_lagrangian
 from .lagrange import Dynamics
+from .numeval import NotNumeric, evaluate, is_zero, without_absent
 from .timeout import Timeout, time_limit, try_simplify
 
 ZERO_TOL = 1e-9
@@ -51,9 +54,15 @@ class LinearSystem:
         lhs = self.M * sp.Matrix(self.dyn.qdd) + self.C * sp.Matrix(self.dyn.qd) + self.K * dq
         return [sp.expand(e) for e in lhs - self.F]
 
-    @property
+    @cached_property
     def gyroscopic(self) -> bool:
-        return any(c != 0 for c in self.C)
+        """C ≠ 0 (velocity terms: gyroscopic or damping), decided numerically."""
+        return not all(is_zero(c) for c in self.C)
+
+    @cached_property
+    def driven(self) -> bool:
+        """F(t) ≠ 0 (a force that does not depend on the displacements)."""
+        return not all(is_zero(f) for f in self.F)
 
     # ---- symbolic frequencies ------------------------------------------------------------
     @cached_property
@@ -222,6 +231,8 @@ class Equilibria:
     def __init__(self, dyn: Dynamics):
         self.dyn = dyn
         self.sys = dyn.sys
+        self._solved: list[dict] | None = None
+        self._gave_up_at: float | None = None
 
     @cached_property
     def conditions(self) -> list[sp.Expr]:
@@ -230,7 +241,7 @@ class Equilibria:
             raise UnsupportedError("equilibria of a system with multiplier constraints")
         zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
         zero.update({s: 0 for s in self.sys.small_params})
-        conds = [try_simplify(e.subs(zero), 5) for e in self.dyn.residuals]
+        conds = [without_absent(e.subs(zero), [self.sys.t]) for e in self.dyn.residuals]
         if any(c.has(self.sys.t) for c in conds):
             raise UnsupportedError("static equilibria of a non-autonomous system")
         free = {s for syms in self.sys.free_driven for s in syms}
@@ -238,16 +249,50 @@ class Equilibria:
             raise UnsupportedError("static equilibria with an arbitrary driven coordinate")
         return conds
 
-    @cached_property
+    SIMPLIFY_SECONDS = 5.0  # per condition, before solving
+    SOLVE_SECONDS = 10.0
+
+    @property
     def symbolic(self) -> list[dict]:
-        """Equilibria SymPy can find in closed form (possibly incomplete for trig equations)."""
-        try:
-            with time_limit(10):
-                sols = sp.solve(self.conditions, self.dyn.q, dict=True)
-        except (Timeout, NotImplementedError):
+        """Equilibria SymPy can find in closed form (possibly incomplete for trig equations),
+        with the full time limits: what an answer part asks for."""
+        return self.within(None)
+
+    def within(self, budget: float | None) -> list[dict]:
+        """`symbolic`, but giving up (returning []) once `budget` seconds are spent on
+        simplifying and solving: for searches no part asked for (the loose cross-checks).
+        A result found once is kept; a search cut short is tried again with more time."""
+        if self._solved is not None:
+            return self._solved
+        if budget is not None and self._gave_up_at is not None and budget <= self._gave_up_at:
             return []
-        return [s for s in sols if len(s) == len(self.dyn.q)
-                and all(v.is_real is not False for v in s.values())]
+        deadline = None if budget is None else time.monotonic() + budget
+
+        def limit(cap: float) -> float:
+            return cap if deadline is None else min(cap, deadline - time.monotonic())
+
+        conds = []
+        for c in self.conditions:  # simplified first: solve finds more this way
+            seconds = limit(self.SIMPLIFY_SECONDS)
+            if seconds <= 0:
+                self._gave_up_at = budget
+                return []
+            conds.append(try_simplify(c, seconds))
+        try:
+            seconds = limit(self.SOLVE_SECONDS)
+            if seconds <= 0:
+                raise Timeout("no time left")
+            with time_limit(seconds):
+                sols = sp.solve(conds, self.dyn.q, dict=True)
+        except (Timeout, NotImplementedError):
+            if deadline is not None and time.monotonic() >= deadline - 1e-3:
+                self._gave_up_at = budget  # cut short by the budget: may retry with more
+                return []
+            self._solved = []
+            return []
+        self._solved = [s for s in sols if len(s) == len(self.dyn.q)
+                        and all(v.is_real is not False for v in s.values())]
+        return self._solved
 
     def numeric(self, values: dict, search: dict | None = None,
                 starts: int = 7) -> list[np.ndarray]:
@@ -292,7 +337,7 @@ class Equilibria:
         zeroth = []
         for e in dyn.residuals:
             e_sub = e.subs(sub, simultaneous=True)
-            zeroth.append(try_simplify(e_sub.subs(EPS, 0), 5))
+            zeroth.append(e_sub.subs(EPS, 0))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
         bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
         if bad:
@@ -305,8 +350,16 @@ class Equilibria:
         rest = sp.Matrix([lin[i] - sum((raw["M"][i, j] * dyn.qdd[j] + raw["C"][i, j] * dyn.qd[j]
                                         + raw["K"][i, j] * dyn.q[j]) for j in range(n))
                           for i in range(n)])
-        M, C, K = (raw[k].applyfunc(lambda x: try_simplify(x, 5)) for k in ("M", "C", "K"))
-        F = (-rest).applyfunc(lambda x: try_simplify(sp.expand(x), 5))
+        t = [self.sys.t]
+        state = t + dyn.q + dyn.qd + dyn.qdd  # F depends on t only, once terms cancel
+        if dyn.simplify:
+            def simp(x, absent=t):
+                return try_simplify(without_absent(x, absent), 5)
+        else:
+            def simp(x, absent=t):
+                return without_absent(x, absent)
+        M, C, K = (raw[k].applyfunc(simp) for k in ("M", "C", "K"))
+        F = (-rest).applyfunc(lambda x: simp(sp.expand(x), state))
         bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
@@ -329,10 +382,8 @@ def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:
             env[sym] = sp.Float(base * factor if sym.is_positive or sym not in values
                                 else base + rng.uniform(-0.3, 0.3), 40)
         try:
-            v = complex(sp.N(expr.subs(env), 40))
-            scale = sum(abs(complex(sp.N(t.subs(env), 40)))
-                        for t in sp.Add.make_args(sp.expand(expr)))
-        except (TypeError, ValueError, ZeroDivisionError):
+            v, scale = evaluate(expr, env, 40)
+        except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
             return False
         if not abs(v) <= 1e-25 * max(scale, 1e-300):
             return False
@@ -344,8 +395,8 @@ def _numerically_zero(expr: sp.Expr, values: dict) -> bool:
     if not expr.has(sp.Float):
         return False
     try:
-        return abs(complex(sp.N(expr.subs(values)))) < 1e-9
-    except (TypeError, ValueError):
+        return abs(evaluate(expr, {k: sp.Float(v, 30) for k, v in values.items()})[0]) < 1e-9
+    except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
         return False
 
 

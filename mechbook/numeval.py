@@ -130,3 +130,88 @@ def _node(e: sp.Basic, pt: dict, memo: dict):
     except (TypeError, ValueError) as exc:
         raise NotNumeric(f"cannot evaluate {e}") from exc
     return v, abs(v)
+
+
+def is_zero(expr: sp.Basic, points: int = 3, digits: int = 30, seed: int = 20261123) -> bool:
+    """Is `expr` identically zero? Decided at random points (every free symbol drawn in
+    (0.3, 1.3), so positive symbols stay positive), each value judged against its
+    cancellation scale; True only if it vanishes to 1e-20 relative at every point.
+
+    For the engine's structural questions (is this coordinate cyclic, is this matrix
+    zero) where `simplify` would cost seconds: an expression that is not identically zero
+    vanishes at a random point with probability zero. A point where it does not evaluate
+    (a singularity) is redrawn; if none evaluates, the answer is 'not known to be zero'."""
+    if expr == 0:
+        return True
+    if not isinstance(expr, sp.Basic):
+        return False
+    import random
+
+    rng = random.Random(seed)
+    symbols = sorted(expr.free_symbols, key=lambda s: s.name)
+    good = 0
+    for _ in range(points * 4):
+        if good >= points:
+            break
+        point = {s: sp.Float(rng.uniform(0.3, 1.3), digits) for s in symbols}
+        try:
+            v, m = evaluate(expr, point, digits)
+        except NotNumeric:
+            return False
+        except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+            continue
+        if not (abs(v) == abs(v) and m == m):  # NaN
+            continue
+        if abs(v) > 1e-20 * max(m, 1e-300):
+            return False
+        good += 1
+    return good >= points
+
+
+def without_absent(expr: sp.Basic, symbols) -> sp.Basic:
+    """expr with each of `symbols` it does not really depend on set to zero.
+
+    A kinetic energy built from Cartesian positions keeps an azimuth φ or the time in
+    cos²φ + sin²φ, and an unsimplified linearization keeps a coordinate in terms that
+    cancel; dropping it (a substitution, exact once ∂/∂φ vanishes identically, decided
+    numerically by `is_zero`) keeps cyclic coordinates, autonomous systems and linear
+    equations recognisable without simplify. A symbol is kept where dropping it would
+    land on a singularity."""
+    for s in symbols:
+        if expr.has(s) and is_zero(sp.diff(expr, s)):
+            dropped = expr.subs(s, 0)
+            if not dropped.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+                expr = dropped
+    return expr
+
+
+_RELATIONS = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
+              ">=": lambda a, b: a >= b, "!=": lambda a, b: a != b}
+
+
+def holds(cond: sp.Basic, point: dict, digits: int = 30) -> bool:
+    """Truth of a condition (relations joined by and/or/not) at `point`, by evaluating each
+    side in mpmath: SymPy's own evaluation of `cond.subs(point)` consults its assumption
+    system and costs milliseconds per relation, which sampling multiplies by thousands.
+    A side that does not evaluate to a real number makes the relation false."""
+    if cond is sp.true or cond is sp.false:
+        return bool(cond)
+    if isinstance(cond, sp.And):
+        return all(holds(a, point, digits) for a in cond.args)
+    if isinstance(cond, sp.Or):
+        return any(holds(a, point, digits) for a in cond.args)
+    if isinstance(cond, sp.Not):
+        return not holds(cond.args[0], point, digits)
+    if isinstance(cond, sp.core.relational.Relational) and cond.rel_op in _RELATIONS:
+        try:
+            a, _ = evaluate(cond.lhs, point, digits)
+            b, _ = evaluate(cond.rhs, point, digits)
+        except NotNumeric:
+            return bool(cond.subs(point))  # what the evaluator does not know: SymPy decides
+        except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+            return False
+        tiny = 10.0 ** (5 - digits)
+        if abs(a.imag) > tiny * max(1.0, abs(a)) or abs(b.imag) > tiny * max(1.0, abs(b)):
+            return False
+        return bool(_RELATIONS[cond.rel_op](a.real, b.real))
+    return bool(cond.subs(point))

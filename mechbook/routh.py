@@ -12,6 +12,7 @@ from __future__ import annotations
 import sympy as sp
 
 from .errors import UnsupportedError
+from .numeval import is_zero
 from .system import System
 from .timeout import Timeout, time_limit
 
@@ -22,7 +23,8 @@ class ReducedSystem:
     It offers the attributes of `System` that Dynamics and Equilibria use.
     """
 
-    def __init__(self, base: System, rates: dict[sp.Symbol, sp.Expr], point: dict):
+    def __init__(self, base: System, rates: dict[sp.Symbol, sp.Expr], point: dict,
+                 simplify: bool = False):
         self.base = base
         self.problem = base.problem
         self.t = base.t
@@ -33,7 +35,7 @@ class ReducedSystem:
         cyc = list(rates)
         idx = [base.q.index(c) for c in cyc]
         for i, c in zip(idx, cyc, strict=True):
-            if sp.simplify(sp.diff(base.lagrangian, c)) != 0 or base.forces[i] != 0:
+            if not is_zero(sp.diff(base.lagrangian, c)) or base.forces[i] != 0:
                 raise UnsupportedError(f"steady motion: {c} is not a cyclic coordinate")
         if base.constraints:
             raise UnsupportedError("steady motion of a system with multiplier constraints")
@@ -51,7 +53,8 @@ class ReducedSystem:
         at_steady = {v: 0 for v in self.qd}
         at_steady.update(point)
         at_steady.update({base.qd[i]: rates[c] for i, c in zip(idx, cyc, strict=True)})
-        p_values = [sp.simplify(p.subs(at_steady)) for p in momenta]
+        simp = sp.simplify if simplify else (lambda e: e)  # for a reader only
+        p_values = [simp(p.subs(at_steady)) for p in momenta]
         try:
             with time_limit(30):
                 sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
@@ -63,7 +66,7 @@ class ReducedSystem:
                                    "their momenta")
         rate_of = sol[0]
         routh = sum((pv * v for pv, v in zip(p_values, cyc_rates, strict=True)), sp.S.Zero)
-        self.lagrangian = sp.simplify((L - routh).subs(rate_of))
+        self.lagrangian = simp((L - routh).subs(rate_of))
         self.momenta = dict(zip(cyc, p_values, strict=True))
 
     def dt(self, expr):

@@ -1,84 +1,118 @@
-"""A check run over many problems: load, derive, check, store; with progress reporting."""
+"""Checking one problem: load, check its parts, cross-check, and return plain data.
+
+`run_problem` is what a batch worker runs (mechbook/batch.py); everything it returns is plain
+data (no SymPy objects), so it crosses process boundaries, and it reports the stage it is in
+through `stage`, so a problem stopped by the time limit says where it was.
+
+Nothing is derived that no part asks for: the checks pull what they need from a lazy
+`Analysis` (unsimplified: simplification is for a human reader, `mechbook solve`), and the
+store keeps what the run happened to derive, as text (`derive.computed`). Trouble in a stage
+no part asked for (the engine's own equilibria, loose cross-checks, the stored summary) is
+reported beside the parts and never takes them down.
+"""
 
 from __future__ import annotations
 
 import time
+import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .analysis import Analysis
-from .answers import load_answers
 from .catalog import answer_path, problem_path
-from .checker import Outcome, check_problem
-from .crosscheck import CrossCheck, crosscheck_problem
-from .derive import Results, derive
-from .errors import MechbookError, UnsupportedError
+from .errors import MechbookError
 from .fingerprint import file_sha256
-from .problem import load_problem
-from .store import ProblemRecord, cached_crosschecks, cached_outcomes
+from .records import NUMERIC, Outcome, ProofPolicy
+from .store import ProblemRecord, cached
+
+Stage = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    pass
 
 
 @dataclass
 class ProblemRun:
+    """The outcome of checking one problem, as plain data."""
+
     pid: str
     outcomes: list[Outcome] = field(default_factory=list)
-    results: list[Results] = field(default_factory=list)
     error: str | None = None
     seconds: float = 0.0
     record: ProblemRecord | None = None
     cached: bool = False
-    crosschecks: list[CrossCheck] = field(default_factory=list)
+    crosschecks: list = field(default_factory=list)  # CrossCheck
+    notes: list[str] = field(default_factory=list)  # trouble beside the parts
+    stage: str = ""  # the last stage reached (for a problem stopped from outside)
 
 
-def run_problem(pid: str, base: Path, simplify: bool = True,
-                cache: Path | None = None, crosscheck: bool = True) -> ProblemRun:
-    """Check one problem; with `cache`, reuse stored outcomes whose content hashes match.
-    With `crosscheck`, also run the independent cross-checks (mechbook/crosscheck.py)."""
+@dataclass(frozen=True)
+class RunOptions:
+    """How a batch checks its problems (the same for every problem of the batch)."""
+
+    crosscheck: bool = True
+    policy: ProofPolicy = NUMERIC
+
+
+def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
+                stage: Stage = _quiet) -> ProblemRun:
+    """Check one problem against its answer key (and cross-check it), from scratch."""
+    from .analysis import Analysis  # the engine: imported only where a problem is checked
+    from .answers import load_answers
+    from .checker import check_part
+    from .crosscheck import crosscheck_problem
+    from .derive import computed
+    from .problem import load_problem
+
     start = time.perf_counter()
     run = ProblemRun(pid)
     try:
+        stage("loading")
         problem = load_problem(problem_path(pid, base))
         apath = answer_path(pid, base)
         if not apath.exists():
             raise MechbookError(f"{apath}: no answer key for {pid}")
         key = load_answers(apath)
-        answers_sha = file_sha256(apath)
-        if cache is not None:
-            stored = cached_outcomes(pid, problem.sha256, answers_sha, cache)
-            crossed = cached_crosschecks(pid, cache) if crosscheck else []
-            if stored is not None and (crossed or not crosscheck):
-                run.outcomes, run.cached = stored, True
-                run.crosschecks = [CrossCheck.from_dict(d) for d in crossed]
-                run.seconds = time.perf_counter() - start
-                return run
-        analysis = Analysis(problem, simplify)
-        run.outcomes = check_problem(analysis, key)
-        for name in problem.systems:
-            try:
-                run.results.append(derive(analysis, name))
-            except UnsupportedError as exc:
-                res = Results(name)
-                res.notes["derive"] = f"unsupported: {exc.capability}"
-                run.results.append(res)
-        if crosscheck:
-            run.crosschecks = crosscheck_problem(analysis, key)
+        if key.problem_id != problem.id:
+            raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem "
+                                f"file is {problem.id!r}")
+        analysis = Analysis(problem)
+        for part in key.parts:
+            stage(f"part {part.name} ({part.quantity})")
+            run.outcomes.append(check_part(analysis, part, options.policy))
+        if options.crosscheck:
+            stage("cross-checks")
+            run.crosschecks = crosscheck_problem(analysis, key, stage)
+        stage("storing the derived results")
+        try:
+            results = computed(analysis)
+        except Exception as exc:  # noqa: BLE001 - the summary must not take down the parts
+            results = []
+            run.notes.append(f"derived results not stored: {type(exc).__name__}: {exc}")
         run.seconds = time.perf_counter() - start
-        run.record = ProblemRecord(problem, run.results, run.outcomes, run.seconds, answers_sha,
-                                   [c.as_dict() for c in run.crosschecks])
+        run.record = ProblemRecord.of(problem, results, run.outcomes, run.seconds,
+                                      file_sha256(apath),
+                                      [c.as_dict() for c in run.crosschecks])
     except MechbookError as exc:
         run.error = str(exc)
-        run.seconds = time.perf_counter() - start
+    except Exception as exc:  # noqa: BLE001 - one problem's fault must not end the batch
+        run.error = f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-2).strip()}]"
+    run.seconds = time.perf_counter() - start
     return run
 
 
-def run_many(ids: list[str], base: Path, simplify: bool = True,
-             progress: Callable[[int, int, ProblemRun], None] | None = None,
-             cache: Path | None = None, crosscheck: bool = True) -> list[ProblemRun]:
-    runs = []
-    for i, pid in enumerate(ids, 1):
-        run = run_problem(pid, base, simplify, cache, crosscheck)
-        runs.append(run)
-        if progress:
-            progress(i, len(ids), run)
-    return runs
+def cached_runs(ids: list[str], base: Path, store: Path,
+                crosscheck: bool = True) -> dict[str, ProblemRun]:
+    """The problems whose stored results are still valid (problem file, answer key and
+    engine unchanged): answered from the store without loading the engine."""
+    wanted = {}
+    for pid in ids:
+        ppath, apath = problem_path(pid, base), answer_path(pid, base)
+        if ppath.exists() and apath.exists():
+            wanted[pid] = (file_sha256(ppath), file_sha256(apath))
+    out = {}
+    for pid, hit in cached(wanted, store, crosscheck).items():
+        out[pid] = ProblemRun(pid, hit.outcomes, seconds=hit.duration, cached=True,
+                              crosschecks=hit.crosschecks)
+    return out

@@ -23,42 +23,56 @@ keeps its stored simulations; storing a simulation replaces only that simulation
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import shutil
 import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
+from importlib.metadata import version
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import h5py
 import numpy as np
-import sympy as sp
 
 from . import __version__
-from .checker import Outcome
-from .derive import Results
+from .catalog import DEFAULT_STORE
 from .fingerprint import engine_sha256
-from .problem import Problem
+from .records import CrossCheck, Outcome, Results
 
-DEFAULT_PATH = Path("results/mechbook.h5")
+if TYPE_CHECKING:
+    from .problem import Problem
+
+DEFAULT_PATH = DEFAULT_STORE
 FORMAT = 1
 _STR = h5py.string_dtype("utf-8")
 
 
+@dataclass
 class ProblemRecord:
-    """Everything one run learned about one problem."""
+    """Everything one run learned about one problem, as plain data (it crosses process
+    boundaries: a batch's workers send records to the parent, the store's only writer)."""
 
-    def __init__(self, problem: Problem, results: Iterable[Results],
-                 outcomes: Iterable[Outcome], duration: float, answers_sha256: str = "",
-                 crosschecks: Iterable[dict] = ()):
-        self.problem = problem
-        self.answers_sha256 = answers_sha256
-        self.results = list(results)
-        self.outcomes = list(outcomes)
-        self.duration = duration
-        self.crosschecks = list(crosschecks)  # CrossCheck.as_dict() of mechbook.crosscheck
+    problem_id: str
+    title: str
+    source: str
+    problem_sha256: str
+    results: list[Results] = field(default_factory=list)
+    outcomes: list[Outcome] = field(default_factory=list)
+    duration: float = 0.0
+    answers_sha256: str = ""
+    crosschecks: list[dict] = field(default_factory=list)  # CrossCheck.as_dict()
+
+    @classmethod
+    def of(cls, problem: Problem, results: Iterable[Results], outcomes: Iterable[Outcome],
+           duration: float, answers_sha256: str = "",
+           crosschecks: Iterable[dict] = ()) -> ProblemRecord:
+        return cls(problem.id, problem.title, problem.source, problem.sha256, list(results),
+                   list(outcomes), duration, answers_sha256, list(crosschecks))
 
 
 def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> Path:
@@ -71,10 +85,31 @@ def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> 
 
 
 @contextmanager
+def _locked(directory: Path) -> Iterator[None]:
+    """An exclusive lock on the store's directory for one read-modify-write: two processes
+    writing the same store (two `mechbook check` runs) take turns, so neither starts from a
+    copy the other is about to replace. Readers need no lock: the file is only ever
+    replaced by a rename, so they see the old file or the new one, never a torn one."""
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+@contextmanager
 def _atomic_edit(path: str | Path) -> Iterator[h5py.File]:
     """An open copy of the store (or a new file) that replaces `path` only on success."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    with _locked(path.parent):
+        with _edited_copy(path) as f:
+            yield f
+
+
+@contextmanager
+def _edited_copy(path: Path) -> Iterator[h5py.File]:
     fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
     os.close(fd)
     # mkstemp makes the file 0600; keep the old file's mode, or follow the umask
@@ -103,7 +138,7 @@ def _atomic_edit(path: str | Path) -> Iterator[h5py.File]:
 
 
 def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
-    pid = rec.problem.id
+    pid = rec.problem_id
     kept = f"_simulations_of_{pid}"
     if pid in root:
         if "simulations" in root[pid]:  # a check run keeps the problem's simulations
@@ -113,10 +148,10 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     if kept in root:
         root.move(kept, f"{pid}/simulations")
     g.attrs.update({
-        "title": rec.problem.title, "source": rec.problem.source,
-        "problem_sha256": rec.problem.sha256, "answers_sha256": rec.answers_sha256,
+        "title": rec.title, "source": rec.source,
+        "problem_sha256": rec.problem_sha256, "answers_sha256": rec.answers_sha256,
         "engine_sha256": engine_sha256(), "mechbook": __version__,
-        "sympy": sp.__version__, "numpy": np.__version__, "h5py": h5py.__version__,
+        "sympy": version("sympy"), "numpy": np.__version__, "h5py": h5py.__version__,
         "date": datetime.now(UTC).isoformat(timespec="seconds"),
         "duration_s": float(rec.duration),
     })
@@ -178,14 +213,6 @@ def _crosschecks(g: h5py.Group) -> list[dict]:
     return [e for _, e in sorted(out, key=lambda x: x[0])]
 
 
-def cached_crosschecks(pid: str, path: str | Path = DEFAULT_PATH) -> list[dict]:
-    """The stored cross-checks of `pid` (used with `cached_outcomes` on a warm run)."""
-    try:
-        return read(pid, path).get("crosschecks", [])
-    except (KeyError, OSError):
-        return []
-
-
 def write_simulation(pid: str, name: str, arrays: dict[str, np.ndarray], attrs: dict,
                      array_attrs: dict[str, dict] | None = None,
                      path: str | Path = DEFAULT_PATH) -> Path:
@@ -230,23 +257,67 @@ def _attr(v):
     return json.dumps(v)
 
 
-def cached_outcomes(pid: str, problem_sha: str, answers_sha: str,
-                    path: str | Path = DEFAULT_PATH) -> list[Outcome] | None:
-    """The stored outcomes of `pid` if problem file, answer key and engine are unchanged."""
+@dataclass
+class Cached:
+    """A problem's stored outcomes and cross-checks, still valid for this run."""
+
+    outcomes: list[Outcome]
+    crosschecks: list[CrossCheck]
+    duration: float
+
+
+def cached(wanted: dict[str, tuple[str, str]], path: str | Path = DEFAULT_PATH,
+           crosschecks: bool = True) -> dict[str, Cached]:
+    """The stored results of the problems in `wanted` ({id: (problem sha256, answers
+    sha256)}) whose problem file, answer key and engine are unchanged since they were
+    stored (and, with `crosschecks`, that were cross-checked). One read of the file."""
+    path = Path(path)
+    out: dict[str, Cached] = {}
+    if not path.exists():
+        return out
+    engine = engine_sha256()
+    try:
+        with h5py.File(path, "r") as f:
+            root = f.get("problems", {})
+            for pid, shas in wanted.items():
+                if pid not in root:
+                    continue
+                g = root[pid]
+                a = {k: _plain(v) for k, v in g.attrs.items()}
+                if (a.get("problem_sha256"), a.get("answers_sha256"),
+                        a.get("engine_sha256")) != (*shas, engine):
+                    continue
+                crossed = [CrossCheck.from_dict(d) for d in _crosschecks(g)]
+                if crosschecks and not crossed:
+                    continue
+                out[pid] = Cached(_outcomes(pid, g), crossed if crosschecks else [],
+                                  float(a.get("duration_s", 0.0)))
+    except OSError:
+        return {}
+    return out
+
+
+def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
+    """Each stored problem's last cold duration (seconds): a batch starts the longest first."""
     path = Path(path)
     if not path.exists():
-        return None
+        return {}
     try:
-        rec = read(pid, path)
-    except (KeyError, OSError):
-        return None
-    a = rec["attrs"]
-    if (a.get("problem_sha256"), a.get("answers_sha256"), a.get("engine_sha256")) != \
-            (problem_sha, answers_sha, engine_sha256()):
-        return None
+        with h5py.File(path, "r") as f:
+            return {pid: float(g.attrs.get("duration_s", 0.0))
+                    for pid, g in f.get("problems", {}).items()}
+    except OSError:
+        return {}
+
+
+def _outcomes(pid: str, g: h5py.Group) -> list[Outcome]:
     fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin")
-    return [Outcome(pid, c["part"], **{k: c[k] for k in fields if k in c})
-            for c in rec["checks"]]
+    rows = []
+    for part, c in g.get("checks", {}).items():
+        a = {k: _plain(v) for k, v in c.attrs.items()}
+        rows.append((a.get("index", 0), Outcome(pid, part, **{k: a[k] for k in fields
+                                                              if k in a})))
+    return [o for _, o in sorted(rows, key=lambda r: r[0])]
 
 
 def problems(path: str | Path = DEFAULT_PATH) -> list[str]:

@@ -13,6 +13,7 @@ import sympy as sp
 from .bodies import body_kinetic, shape_inertia
 from .errors import UnsupportedError
 from .expansion import expand_lagrangian
+from .numeval import without_absent
 from .problem import RESERVED, Problem, SystemSpec, T
 
 
@@ -97,8 +98,6 @@ class System:
         for name, b in (s.get("rigid_bodies") or {}).items():
             kinetic += self._rigid_body(name, b)
         potential += self._gravity() + self._springs()
-        self.kinetic = kinetic
-        self.potential = potential
         if "lagrangian" in s:
             lag = self._parse(s["lagrangian"], ("lagrangian",))
             if self.positions or s.get("rigid_bodies"):
@@ -114,7 +113,9 @@ class System:
             point = self.point(approx["about"], ("approximation", "about"))
             lag = expand_lagrangian(lag, self.q, self.qd, point, self.small_params,
                                     approx.get("order", 2))
-        self.lagrangian = lag
+        self.kinetic = without_absent(kinetic, [T, *self.q])
+        self.potential = without_absent(potential, [T, *self.q])
+        self.lagrangian = without_absent(lag, [T, *self.q])
         self.forces = self._forces()
         self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))
                             for i, c in enumerate(s.get("constraints") or [])]
@@ -249,3 +250,4 @@ class System:
 
     def numeric_values(self) -> dict[sp.Symbol, float]:
         return self.problem.values()
+

@@ -131,9 +131,12 @@ def test_check_exits_nonzero_on_fail(tmp_path):
 
 
 def test_check_unknown_problem(tmp_path):
-    result = run("--root", str(ROOT), "check", "lim-9999", "--no-store")
+    """An id with no problem file is refused before anything runs (a typo in a list of
+    ids must not cost a whole batch)."""
+    result = run("--root", str(ROOT), "check", "lim-2031", "lim-9999", "--no-store")
     assert result.exit_code == 1
-    assert "ERROR" in result.output
+    assert "no problem lim-9999" in result.output
+    assert "lim-2031 " not in result.output  # nothing was checked
 
 
 def test_validate_good_files():

@@ -55,7 +55,7 @@ def make_record(tmp_path: Path, num: str = "2031", tag: str = "first") -> store.
                 f"a detail {tag}", 0.5),
         Outcome(problem.id, "c", "proof", "cite c", "unsupported", "", "a proof in words", 0.0),
     ]
-    return store.ProblemRecord(problem, [res], outcomes, 1.25)
+    return store.ProblemRecord.of(problem, [res], outcomes, 1.25)
 
 
 def test_round_trip(tmp_path):
@@ -66,7 +66,7 @@ def test_round_trip(tmp_path):
     a = got["attrs"]
     assert a["title"] == "a test title 2031"
     assert a["source"] == "a test source 2031"
-    assert a["problem_sha256"] == rec.problem.sha256
+    assert a["problem_sha256"] == rec.problem_sha256
     assert a["sympy"] == sp.__version__
     assert a["duration_s"] == pytest.approx(1.25)
     assert "date" in a and "mechbook" in a
@@ -136,9 +136,9 @@ def test_interrupted_write_keeps_previous_file(tmp_path, monkeypatch, exc):
     calls = []
 
     def half_then_fail(root, rec):
-        calls.append(rec.problem.id)
+        calls.append(rec.problem_id)
         real(root, rec)  # the new problem is (partly) written into the copy ...
-        root[rec.problem.id].attrs["title"] = "half written"
+        root[rec.problem_id].attrs["title"] = "half written"
         raise exc  # ... and then the run dies
 
     monkeypatch.setattr(store, "_write_problem", half_then_fail)

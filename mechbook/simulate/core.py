@@ -124,8 +124,9 @@ def parse_assignments(items: list[str] | tuple[str, ...]) -> dict[str, str]:
 
 
 def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[str, str],
-                  values: dict) -> tuple[np.ndarray, np.ndarray, str]:
-    """(q0, q̇0, where they came from) from `initial:` and the command-line overrides."""
+                  values: dict, search: float | None = None) -> tuple[np.ndarray, np.ndarray, str]:
+    """(q0, q̇0, where they came from) from `initial:` and the command-line overrides, or
+    near a stable equilibrium found within `search` seconds (default FALLBACK_SEARCH)."""
     sys = analysis.system(system_name)
     given: dict[str, object] = dict(sys.spec.get("initial") or {})
     source = "problem file `initial:`" if given else ""
@@ -135,7 +136,8 @@ def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[s
     n = len(sys.q)
     q0, qd0 = np.zeros(n), np.zeros(n)
     if not given:
-        return (*_fallback(analysis, system_name, values), "fallback")
+        return (*_fallback(analysis, system_name, values, search or FALLBACK_SEARCH),
+                "fallback")
     known = {c: i for i, c in enumerate(sys.coord_names)}
     names = dict(sys.names)
     for key, text in given.items():
@@ -159,19 +161,19 @@ def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[s
     return q0, qd0, source
 
 
-def _fallback(analysis: Analysis, system_name: str | None,
-              values: dict) -> tuple[np.ndarray, np.ndarray]:
+def _fallback(analysis: Analysis, system_name: str | None, values: dict,
+              seconds: float = FALLBACK_SEARCH) -> tuple[np.ndarray, np.ndarray]:
     """Rest, FALLBACK_OFFSET away from the first stable equilibrium (none: an error)."""
     sys = analysis.system(system_name)
     try:
-        with hard_time_limit(FALLBACK_SEARCH):
-            stable = analysis.stable_equilibria(system_name)
+        with hard_time_limit(seconds):
+            stable = analysis.stable_equilibria(system_name, budget=seconds)
     except UnsupportedError:
         stable = []
     except Timeout:
         raise MechbookError(f"{analysis.problem.id}: no initial conditions (`initial:` in the "
                             "problem file, or --init q=value), and no stable equilibrium to "
-                            f"start near found within {FALLBACK_SEARCH:g} s") from None
+                            f"start near found within {seconds:g} s") from None
     if not stable:
         raise MechbookError(f"{analysis.problem.id}: no initial conditions (`initial:` in the "
                             "problem file, or --init q=value) and no stable equilibrium to "
