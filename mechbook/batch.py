@@ -39,6 +39,7 @@ class BatchOptions:
     memory_mb: float = DEFAULT_MEMORY_MB
     max_tasks: int = MAX_TASKS
     run: RunOptions = RunOptions()
+    serial: bool = False  # in the calling process, no limits (debugging)
 
     @property
     def workers(self) -> int:
@@ -56,9 +57,12 @@ def _worker(conn: Connection, base: Path, options: RunOptions) -> None:
             return
         if pid is None:
             return
-        run = run_problem(pid, base, options, stage=lambda text, pid=pid:
-                          conn.send(("stage", pid, text)))
-        conn.send(("done", pid, run))
+        try:
+            run = run_problem(pid, base, options, stage=lambda text, pid=pid:
+                              conn.send(("stage", pid, text)))
+            conn.send(("done", pid, run))
+        except (BrokenPipeError, ConnectionResetError, EOFError):
+            return  # the parent is gone (killed): nobody to report to
 
 
 @dataclass
@@ -124,6 +128,8 @@ class Batch:
 
     def run(self, ids: list[str]) -> list[ProblemRun]:
         """Check `ids` (in the order given: put the longest first); results in that order."""
+        if self.options.serial:
+            return self._serial(ids)
         todo = list(ids)
         done: dict[str, ProblemRun] = {}
         try:
@@ -136,6 +142,18 @@ class Batch:
                 self._retire(slot, kill=slot.pid is not None)
             self._slots = []
         return [done[pid] for pid in ids]
+
+    def _serial(self, ids: list[str]) -> list[ProblemRun]:
+        """In this process, one after another: no limits, but a debugger can follow."""
+        from .run import run_problem
+
+        out = []
+        for pid in ids:
+            self.on_start(pid)
+            run = run_problem(pid, self.base, self.options.run)
+            self.on_done(run)
+            out.append(run)
+        return out
 
     def _assign(self, todo: list[str]) -> None:
         for i, slot in enumerate(self._slots):

@@ -150,6 +150,9 @@ def _summary(run) -> str:
                    "stopped and reported as an error with the stage it was in.")
 @click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
               show_default=True, help="Resident memory (MB) allowed per problem (0: no bound).")
+@click.option("--serial", is_flag=True,
+              help="Check in this process, one problem after another, without time or memory "
+                   "limits (for a debugger).")
 @click.option("--prove", is_flag=True,
               help="After a part passes numerically (30 digits at random admissible points), "
                    "also try a symbolic proof with SymPy; the method column says which it got.")
@@ -158,7 +161,7 @@ def _summary(run) -> str:
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
           verbose: bool, fresh: bool, no_crosscheck: bool, jobs: int, timeout: float,
-          memory_mb: float, prove: bool, prove_seconds: float) -> None:
+          memory_mb: float, serial: bool, prove: bool, prove_seconds: float) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail.
 
     Problems run in parallel worker processes, the longest first; each finished problem is
@@ -198,7 +201,7 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     past = durations(store_file)
     todo = sorted((pid for pid in ids if pid not in runs),
                   key=lambda pid: -past.get(pid, float("inf")))
-    options = BatchOptions(jobs, timeout, memory_mb, run=RunOptions(
+    options = BatchOptions(jobs, timeout, memory_mb, serial=serial, run=RunOptions(
         crosscheck=not no_crosscheck, policy=ProofPolicy(prove, prove_seconds)))
     try:
         for run in Batch(base, options, on_done=finished).run(todo):

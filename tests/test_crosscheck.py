@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 from click.testing import CliRunner
 
-import mechbook.run as run_mod
+import mechbook.crosscheck as crosscheck_mod
 from mechbook.analysis import Analysis
 from mechbook.answers import load_answers
 from mechbook.cli import main
@@ -163,12 +163,13 @@ def test_check_table_has_the_column_and_a_crosscheck_fail_exits_1(monkeypatch):
     line = next(x for x in res.output.splitlines() if "c-frequency" in x)
     assert line.split()[4] == "pass" and float(line.split()[5]) < REL_TOL
 
-    def failing(analysis, key):
+    def failing(analysis, key, stage=None):
         return [CrossCheck("newton:main", "newton", "main", "fail", 0.5, "tampered",
                            ["a-eom"])]
 
-    monkeypatch.setattr(run_mod, "crosscheck_problem", failing)
-    res = runner.invoke(main, ["--root", str(ROOT), "check", "lim-2031", "--no-store"])
+    monkeypatch.setattr(crosscheck_mod, "crosscheck_problem", failing)
+    res = runner.invoke(main, ["--root", str(ROOT), "check", "lim-2031", "--no-store",
+                               "--serial"])
     assert res.exit_code == 1
     assert "fail 5e-01" in res.output and "failed cross-checks" in res.output
 
