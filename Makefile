@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test lint bench clean
+.PHONY: check test lint bench bench-check clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -12,7 +12,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
-check: $(STAMP)  ## check every problem against the book's answer key
+check: $(STAMP)  ## check every problem against the book's answer key (one worker per core)
 	$(BIN)/mechbook check
 
 test: $(STAMP)   ## run the test suite
@@ -26,6 +26,13 @@ bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -
 		> results/bench/symbolic.txt && cat results/bench/symbolic.txt
 	$(BIN)/python bench/extremes.py --csv results/bench/extremes.csv \
 		> results/bench/extremes.txt && cat results/bench/extremes.txt
+
+bench-check: $(STAMP)  ## cold/warm `mechbook check` before and after, side by side (~30 min)
+	mkdir -p results/bench
+	$(BIN)/python bench/check_time.py --tests --csv results/bench/check_time.csv \
+		--profile lim-2057 symon-09-07 lim-2034 lim-2042 symon-09-31 symon-09-01 \
+		          lim-2058 lim-2043 symon-09-02 lim-2055 \
+		--out results/bench/check_time.md
 
 lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench

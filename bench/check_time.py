@@ -83,8 +83,8 @@ pr.enable(); call(); pr.disable()
 st = pstats.Stats(pr)
 out = {{}}
 for (file, line, name), (cc, nc, tt, ct, callers) in st.stats.items():
-    out.setdefault(f"{{file.rsplit('/', 1)[-1]}}:{{name}}", 0.0)
-    out[f"{{file.rsplit('/', 1)[-1]}}:{{name}}"] = max(out[f"{{file.rsplit('/', 1)[-1]}}:{{name}}"], ct)
+    key = f"{{file.rsplit('/', 1)[-1]}}:{{name}}"
+    out[key] = max(out.get(key, 0.0), ct)
 total = max(ct for (_, _, _, ct, _) in st.stats.values())
 out["total"] = total
 print(json.dumps(out))

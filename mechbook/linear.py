@@ -11,10 +11,9 @@ parts of the state-space eigenvalues.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from functools import cached_property
-
-import time
 
 import numpy as np
 import scipy.linalg
