@@ -6,10 +6,10 @@ STAMP   = $(VENV)/.installed
 
 .PHONY: check test lint bench bench-check clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[dev]'
 	touch $(STAMP)
 
 check: $(STAMP)  ## check every problem against the book's answer key (one worker per core)

@@ -41,7 +41,7 @@ CROSS = re.compile(r"^cross-checks: (.*)$")
 def launcher(tree: Path) -> list[str]:
     """A command running the `mechbook` CLI of `tree` (imported from that tree first)."""
     code = (f"import sys; sys.path.insert(0, {str(tree)!r}); "
-            "from mechbook.cli import main; sys.argv[0] = 'mechbook'; main()")
+            "from mechbook.app.cli import main; sys.argv[0] = 'mechbook'; main()")
     return [sys.executable, "-c", code]
 
 
@@ -74,10 +74,10 @@ from pathlib import Path
 tree = Path({str(tree)!r})
 pr = cProfile.Profile()
 try:
-    from mechbook.run import run_problem, RunOptions
+    from mechbook.app.run import run_problem, RunOptions
     call = lambda: run_problem({pid!r}, tree)
 except ImportError:
-    from mechbook.run import run_problem
+    from mechbook.app.run import run_problem
     call = lambda: run_problem({pid!r}, tree)
 pr.enable(); call(); pr.disable()
 st = pstats.Stats(pr)

@@ -23,10 +23,10 @@ import sympy as sp
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.analysis import Analysis  # noqa: E402
-from mechbook.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError, UnsupportedError  # noqa: E402
-from mechbook.problem import load_problem  # noqa: E402
+from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.model.problem import load_problem  # noqa: E402
 
 
 def reference(freqs: list[sp.Expr], values: dict) -> np.ndarray:

@@ -42,12 +42,13 @@ from sympy.core.cache import clear_cache
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.analysis import Analysis  # noqa: E402
-from mechbook.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.core import compile as rhsmod  # noqa: E402
+
+from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError  # noqa: E402
-from mechbook.problem import load_problem  # noqa: E402
-from mechbook.simulate import rhs as rhsmod  # noqa: E402
-from mechbook.simulate.rhs import Model, timed_calls  # noqa: E402
+from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.model.problem import load_problem  # noqa: E402
+from mechbook.numerics.model import Model, timed_calls  # noqa: E402
 
 BACKENDS = ("sympy-math", "sympy-numpy", "symengine", "llvm", "gcc")
 SPAN = 5.0  # time units integrated

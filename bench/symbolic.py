@@ -27,11 +27,12 @@ from sympy.physics.mechanics import LagrangesMethod, dynamicsymbols, msubs
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.analysis import Analysis  # noqa: E402
-from mechbook.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.engine.analysis import Analysis  # noqa: E402
+from mechbook.engine.lagrange import Dynamics  # noqa: E402
 from mechbook.errors import MechbookError, UnsupportedError  # noqa: E402
-from mechbook.lagrange import Dynamics  # noqa: E402
-from mechbook.problem import load_problem  # noqa: E402
+from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.model.problem import load_problem  # noqa: E402
+from mechbook.model.system import system_of  # noqa: E402
 
 
 def timed(fn, repeat: int) -> tuple[float, object]:
@@ -100,7 +101,7 @@ def main() -> None:
             print(f"{pid}: skipped ({exc})", file=sys.stderr)
             continue
         for name in problem.systems:
-            system = problem.system(name)
+            system = system_of(problem, name)
             if system.constraints or system.free_driven or any(f != 0 for f in system.forces):
                 continue  # LagrangesMethod comparison needs the plain Lagrangian form
             t_raw, mf_raw = timed(lambda s=system: ours(s, False), args.repeat)

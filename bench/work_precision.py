@@ -59,17 +59,18 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.analysis import Analysis  # noqa: E402
-from mechbook.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.numerics import accuracy  # noqa: E402
+
+from mechbook.core.timeout import Timeout  # noqa: E402
+from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError, UnsupportedError  # noqa: E402
-from mechbook.problem import load_problem  # noqa: E402
-from mechbook.simulate import accuracy  # noqa: E402
-from mechbook.simulate.core import hard_time_limit, initial_state  # noqa: E402
-from mechbook.simulate.integrators import IntegratorError, integrate, make_integrator  # noqa: E402
-from mechbook.simulate.monitors import conserved_quantities, drifts  # noqa: E402
-from mechbook.simulate.rhs import build_model  # noqa: E402
-from mechbook.simulate.stiffness import IMPLICIT, assess, linear_rates  # noqa: E402
-from mechbook.timeout import Timeout  # noqa: E402
+from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
+from mechbook.model.problem import load_problem  # noqa: E402
+from mechbook.numerics.integrators import IntegratorError, integrate, make_integrator  # noqa: E402
+from mechbook.numerics.model import build_model  # noqa: E402
+from mechbook.numerics.monitors import conserved_quantities, drifts  # noqa: E402
+from mechbook.numerics.simulate import hard_time_limit, initial_state  # noqa: E402
+from mechbook.numerics.stiffness import IMPLICIT, assess, linear_rates  # noqa: E402
 
 SCIPY = ("RK45", "DOP853", "Radau", "LSODA")
 FIXED = ("RK4", "leapfrog", "yoshida4", "midpoint")
@@ -577,7 +578,7 @@ def mechbook_command() -> list[str]:
     exe = Path(sys.executable).parent / "mechbook"
     if exe.exists():
         return [str(exe)]
-    return [sys.executable, "-c", "from mechbook.cli import main; main()"]
+    return [sys.executable, "-c", "from mechbook.app.cli import main; main()"]
 
 
 def check_times(pids: list[str], quick: bool) -> list[dict]:

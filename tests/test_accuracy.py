@@ -14,12 +14,13 @@ import scipy.linalg
 from click.testing import CliRunner
 from systems import pendulum
 
-from mechbook.analysis import Analysis
-from mechbook.cli import main
+from mechbook.app.cli import main
+from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError
-from mechbook.problem import load_problem
-from mechbook.simulate import accuracy, simulate
-from mechbook.simulate.stiffness import IMPLICIT, STIFF_RATIO, assess
+from mechbook.model.problem import load_problem
+from mechbook.numerics import accuracy
+from mechbook.numerics.simulate import simulate
+from mechbook.numerics.stiffness import IMPLICIT, STIFF_RATIO, assess
 
 PENDULUM = pendulum(m=0.7, l=0.8, header="id: lim-9301\nsource: test\ntitle: simple pendulum\n")
 
@@ -192,9 +193,9 @@ def test_not_stiff_when_the_fast_mode_is_excited_or_the_springs_are_alike(two_ma
 
 
 def test_assess_directly(two_masses):
-    from mechbook.simulate.core import parameter_values
-    from mechbook.simulate.monitors import conserved_quantities
-    from mechbook.simulate.rhs import build_model
+    from mechbook.numerics.model import build_model
+    from mechbook.numerics.monitors import conserved_quantities
+    from mechbook.numerics.simulate import parameter_values
 
     system, dyn = two_masses.system(), two_masses.dynamics()
     values = parameter_values(two_masses, {"k2": "2e6"})
@@ -224,8 +225,8 @@ def test_hard_time_limit_outlasts_a_swallowed_timeout():
     Timeout as its own limit and goes on (lim-2057/planar searched for 130 s that way)."""
     import time
 
-    from mechbook.simulate.core import hard_time_limit
-    from mechbook.timeout import Timeout
+    from mechbook.core.timeout import Timeout
+    from mechbook.numerics.simulate import hard_time_limit
 
     start = time.perf_counter()
     with pytest.raises(Timeout):

@@ -16,10 +16,10 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
-from mechbook.cli import main
+from mechbook.app.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-MECHBOOK = Path(sys.executable).with_name("mechbook")
+MECHBOOK = [sys.executable, "-m", "mechbook"]  # this tree's mechbook, whatever is installed
 
 
 def tree(tmp_path: Path, ids: list[str]) -> Path:
@@ -84,8 +84,8 @@ def test_the_store_is_written_as_problems_finish_and_survives_sigkill(tmp_path):
     ids = ["lim-2028", "lim-2029", "lim-2031", "lim-2043"]  # the last takes several seconds
     base = tree(tmp_path, ids)
     store = base / "results" / "mechbook.h5"
-    proc = subprocess.Popen([str(MECHBOOK), "--root", str(base), "check", *ids, "-j", "1"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+    proc = subprocess.Popen([*MECHBOOK, "--root", str(base), "check", *ids, "-j", "1"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT,
                             start_new_session=True)
     try:
         deadline = time.monotonic() + 120
@@ -115,13 +115,13 @@ def test_the_store_is_written_as_problems_finish_and_survives_sigkill(tmp_path):
 
 def test_progress_bar_on_a_terminal_and_plain_lines_otherwise(tmp_path):
     base = tree(tmp_path, ["lim-2028", "lim-2031"])
-    plain = subprocess.run([str(MECHBOOK), "--root", str(base), "check", "--no-store"],
-                           capture_output=True, text=True, timeout=300)
+    plain = subprocess.run([*MECHBOOK, "--root", str(base), "check", "--no-store"],
+                           capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert plain.returncode == 0, plain.stderr
     assert "[1/2] lim-2028" in plain.stderr or "[1/2] lim-2031" in plain.stderr
     leader, follower = pty.openpty()
-    proc = subprocess.Popen([str(MECHBOOK), "--root", str(base), "check", "--no-store"],
-                            stdout=subprocess.DEVNULL, stderr=follower, close_fds=True)
+    proc = subprocess.Popen([*MECHBOOK, "--root", str(base), "check", "--no-store"],
+                            stdout=subprocess.DEVNULL, stderr=follower, close_fds=True, cwd=ROOT)
     os.close(follower)
     seen = b""
     while True:

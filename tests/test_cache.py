@@ -7,7 +7,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from mechbook.cli import main
+from mechbook.app.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 

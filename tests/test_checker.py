@@ -22,14 +22,14 @@ import pytest
 import sympy as sp
 from ruamel.yaml import YAML
 
-from mechbook.analysis import Analysis
-from mechbook.answers import AnswerKey, Part, load_answers
-from mechbook.catalog import problem_path
-from mechbook.checker import check_problem
-from mechbook.checks import Context
+from mechbook.core.timeout import Timeout, time_limit
+from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
-from mechbook.problem import load_problem
-from mechbook.timeout import Timeout, time_limit
+from mechbook.model.catalog import problem_path
+from mechbook.model.problem import load_problem
+from mechbook.verify.answers import AnswerKey, Part, load_answers
+from mechbook.verify.checker import check_problem
+from mechbook.verify.context import Context
 
 ROOT = Path(__file__).resolve().parents[1]
 ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
@@ -526,13 +526,13 @@ def test_nonreal_book_frequency_fails(tmp_path, hoop_analysis):
 
 
 def test_match_multiset_nan_documented():
-    from mechbook.compare import match_multiset
+    from mechbook.verify.compare import match_multiset
     assert match_multiset([1.0], [2.0])[0] is False
     assert match_multiset([1.0, 2.0], [2.0, 1.0])[0] is True
 
 
 def test_match_multiset_rejects_nan():
-    from mechbook.compare import match_multiset
+    from mechbook.verify.compare import match_multiset
     assert match_multiset([float("nan")], [5.0])[0] is False
 
 

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-import mechbook.store as store
+import mechbook.app.store as store
 from mechbook import __version__
-from mechbook.cli import main
+from mechbook.app.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMANDS = sorted(main.commands)

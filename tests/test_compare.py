@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from mechbook.compare import Sampler, all_vanish, vanishes
-from mechbook.numeval import evaluate
+from mechbook.core.numeval import evaluate
+from mechbook.verify.compare import Sampler, all_vanish, vanishes
 
 x, y = sp.symbols("x y", positive=True)
 z = sp.Symbol("z", real=True)

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mechbook.analysis import Analysis
-from mechbook.answers import load_answers
-from mechbook.checker import check_problem
-from mechbook.problem import load_problem
+from mechbook.engine.analysis import Analysis
+from mechbook.model.problem import load_problem
+from mechbook.model.system import system_of
+from mechbook.verify.answers import load_answers
+from mechbook.verify.checker import check_problem
 
 DATA = Path(__file__).parent / "data"
 
@@ -41,7 +42,7 @@ def test_wrong_sign_or_term_fails(tmp_path):
 def test_multiplier_at_rest_at_the_bottom_is_minus_weight():
     problem = load_problem(DATA / "problems/lim/2097.yaml")
     dyn = Analysis(problem).dynamics()
-    sys = problem.system()
+    sys = system_of(problem)
     r, theta = sys.q
     lam = dyn.solved[dyn.multipliers[0]]
     values = {**problem.values(), r: 2.0, theta: 0.0, sys.qd[0]: 0.0, sys.qd[1]: 0.0}

@@ -12,17 +12,14 @@ import sympy as sp
 from click.testing import CliRunner
 
 import mechbook.crosscheck as crosscheck_mod
-from mechbook.analysis import Analysis
-from mechbook.answers import load_answers
-from mechbook.cli import main
-from mechbook.crosscheck import (
-    REL_TOL,
-    CrossCheck,
-    crosscheck_problem,
-    frequency_crosscheck,
-    newton_crosscheck,
-)
-from mechbook.problem import load_problem
+from mechbook.app.cli import main
+from mechbook.crosscheck import crosscheck_problem
+from mechbook.crosscheck.frequencies import REL_TOL, frequency_crosscheck
+from mechbook.crosscheck.newton import newton_crosscheck
+from mechbook.engine.analysis import Analysis
+from mechbook.model.problem import load_problem
+from mechbook.records import CrossCheck
+from mechbook.verify.answers import load_answers
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -177,8 +174,7 @@ def test_check_table_has_the_column_and_a_crosscheck_fail_exits_1(monkeypatch):
 def test_conserved_by_simulation_passes_a_true_integral_and_fails_a_false_one(tmp_path):
     """The book's first integral is evaluated along an integrated trajectory: the angular
     momentum about the axis stays put, a wrong power of r does not."""
-    from mechbook.answers import load_answers
-    from mechbook.crosscheck import crosscheck_problem
+    from mechbook.verify.answers import load_answers
 
     src = Path(__file__).resolve().parents[1]
     analysis = Analysis(load_problem(src / "problems" / "lim" / "2040.yaml"))
@@ -191,3 +187,38 @@ def test_conserved_by_simulation_passes_a_true_integral_and_fails_a_false_one(tm
         results[label] = next(x for x in xs if x.name == "conserved:b-momentum")
     assert results["right"].status == "pass", results["right"].detail
     assert results["wrong"].status == "fail"
+
+
+def test_independent_kinematics_agree_with_the_engine_and_catch_a_wrong_one():
+    """The Newton check's own kinematics (ω from Rᵀ·dR/dt, inertia by integration over the
+    shape) agree with the engine's closed forms for every standard shape — and would
+    expose a wrong entry in the engine's table."""
+    from mechbook.crosscheck.kinematics import body_angular_velocity, inertia_of_shape
+    from mechbook.model.bodies import SHAPES, euler_body_rates, shape_inertia
+
+    phi, theta, psi = sp.symbols("phi theta psi", real=True)
+    rates = dict(zip((phi, theta, psi), sp.symbols("phid thetad psid", real=True),
+                     strict=True))
+
+    def dt(e):
+        return sum((sp.diff(e, q) * v for q, v in rates.items()), sp.S.Zero)
+
+    ours = body_angular_velocity([phi, theta, psi], dt)
+    theirs = euler_body_rates([phi, theta, psi], dt)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        pt = {s: rng.uniform(-2, 2) for s in [phi, theta, psi, *rates.values()]}
+        assert np.allclose([float(x.subs(pt)) for x in ours],
+                           [float(x.subs(pt)) for x in theirs], rtol=1e-12, atol=1e-12)
+    m, r, length, a, b, c = sp.symbols("m r L a b c", positive=True)
+    dims = {"point": {}, "rod": {"length": length}, "ring": {"radius": r},
+            "disk": {"radius": r}, "solid_cylinder": {"radius": r, "length": length},
+            "solid_sphere": {"radius": r}, "spherical_shell": {"radius": r},
+            "rectangular_plate": {"sides": [a, b]}, "block": {"sides": [a, b, c]}}
+    assert set(dims) == set(SHAPES)
+    for shape, d in dims.items():
+        diff = sp.simplify(inertia_of_shape(shape, m, d) - shape_inertia(shape, m, d))
+        assert diff == sp.zeros(3, 3), shape
+    wrong = shape_inertia("solid_sphere", m, dims["solid_sphere"]) * sp.Rational(5, 4)
+    assert sp.simplify(inertia_of_shape("solid_sphere", m, dims["solid_sphere"]) - wrong) \
+        != sp.zeros(3, 3)

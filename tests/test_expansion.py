@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import sympy as sp
 
-from mechbook.analysis import Analysis
-from mechbook.problem import load_problem
+from mechbook.engine.analysis import Analysis
+from mechbook.model.problem import load_problem
+from mechbook.model.system import system_of
 
 PENDULUM = """\
 id: lim-2098
@@ -28,7 +29,7 @@ def test_small_angle_lagrangian_is_quadratic(tmp_path):
     path = tmp_path / "2098.yaml"
     path.write_text(PENDULUM)
     problem = load_problem(path)
-    sys = problem.system()
+    sys = system_of(problem)
     m, ln, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
     theta, thetadot = sys.q[0], sys.qd[0]
     expected = m * ln**2 * thetadot**2 / 2 - m * g * ln * theta**2 / 2
@@ -41,7 +42,7 @@ def test_expansion_about_a_shifted_point(tmp_path):
     path = tmp_path / "2098.yaml"
     path.write_text(PENDULUM.replace("about: {theta: 0}", "about: {theta: pi}"))
     problem = load_problem(path)
-    sys = problem.system()
+    sys = system_of(problem)
     m, ln, g = (problem.parameters[n].symbol for n in ("m", "l", "g"))
     theta = sys.q[0]
     # about the top, V = -m g l cos(theta) expands to - m g l (theta - pi)**2 / 2 (+ const)

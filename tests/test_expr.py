@@ -12,7 +12,7 @@ import pytest
 import sympy as sp
 
 from mechbook.errors import ExpressionError
-from mechbook.expr import parse, parse_equation
+from mechbook.model.expr import parse, parse_equation
 
 x, y = sp.symbols("x y", real=True)
 m = sp.Symbol("m", positive=True)
@@ -234,7 +234,7 @@ def test_deep_nesting_is_rejected_not_crashing(text):
 def test_deep_nesting_in_fresh_interpreter():
     """Deep nesting must not crash (segfault / RecursionError escape) the interpreter."""
     code = textwrap.dedent("""
-        from mechbook.expr import parse
+        from mechbook.model.expr import parse
         from mechbook.errors import ExpressionError
         for text in ['(' * 5000 + 'x' + ')' * 5000, '-' * 19000 + 'x', 'x**' * 5000 + 'x',
                      '(' * 100000]:
@@ -305,7 +305,7 @@ def _tower_rejected_quickly(text: str, seconds: float = 5) -> None:
         import resource
         resource.setrlimit(resource.RLIMIT_AS, (1_500_000_000, 1_500_000_000))
         import sympy as sp
-        from mechbook.expr import parse
+        from mechbook.model.expr import parse
         from mechbook.errors import ExpressionError
         try:
             parse({text!r}, {{'x': sp.Symbol('x')}})

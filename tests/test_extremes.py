@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from mechbook.analysis import Analysis
-from mechbook.catalog import problem_path
-from mechbook.problem import load_problem
+from mechbook.engine.analysis import Analysis
+from mechbook.model.catalog import problem_path
+from mechbook.model.problem import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 from systems import pendulum
 
-from mechbook.analysis import Analysis
-from mechbook.problem import load_problem
-from mechbook.simulate.integrators import IntegratorError, integrate
-from mechbook.simulate.monitors import conserved_quantities, drifts
-from mechbook.simulate.rhs import build_model, structure
+from mechbook.engine.analysis import Analysis
+from mechbook.model.problem import load_problem
+from mechbook.model.system import system_of
+from mechbook.numerics.integrators import IntegratorError, integrate
+from mechbook.numerics.model import build_model, structure
+from mechbook.numerics.monitors import conserved_quantities, drifts
 
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9101\nsource: test\ntitle: simple pendulum\n")
@@ -55,7 +56,7 @@ def model_of(tmp_path: Path, text: str, num: str):
     (d / f"{num}.yaml").write_text(text)
     problem = load_problem(d / f"{num}.yaml")
     an = Analysis(problem)
-    sys, dyn = problem.system(), an.dynamics()
+    sys, dyn = system_of(problem), an.dynamics()
     return build_model(sys, dyn, problem.values(), conserved_quantities(sys, dyn))
 
 

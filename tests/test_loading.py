@@ -9,10 +9,11 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from mechbook.cli import main
+from mechbook.app.cli import main
 from mechbook.errors import SpecError
-from mechbook.problem import load_problem
-from mechbook.yamlio import loads
+from mechbook.model.problem import load_problem
+from mechbook.model.system import system_of
+from mechbook.model.yamlio import loads
 
 PWNED = Path("/tmp/pwned")
 
@@ -57,7 +58,7 @@ def test_good_file_loads(tmp_path):
     assert set(problem.parameters) == {"m", "l", "g"}
     assert problem.parameters["g"].value == pytest.approx(9.81)
     assert problem.parameters["m"].value == 1.5
-    assert problem.system().coord_names == ["theta"]
+    assert system_of(problem).coord_names == ["theta"]
 
 
 def test_duplicate_key_is_rejected_with_its_line(tmp_path):
@@ -180,7 +181,7 @@ def test_hostile_kinetic_rejected_by_loader(tmp_path, no_pwned, target):
     path = hostile_file(tmp_path, target_path)
     problem = load_problem(path)  # schema-valid: an expression is only a string here
     with pytest.raises(SpecError) as info:
-        problem.system()
+        system_of(problem)
     err = info.value
     assert err.file == str(path)
     assert err.line == line_of(path, "kinetic:")
@@ -228,7 +229,7 @@ def test_bad_expression_names_its_line(tmp_path, where, payload):
         needle = f'g: "{payload}"'
     path = write(tmp_path, text)
     with pytest.raises(SpecError) as info:
-        load_problem(path).system()
+        system_of(load_problem(path))
     err = info.value
     assert err.line == line_of(path, needle), str(err)
     assert err.file == str(path)
@@ -247,7 +248,7 @@ def test_coordinate_name_clash(tmp_path):
     text = PENDULUM.replace("  theta: {{}}\n", "  theta: {{}}\n  m: {{}}\n")
     path = write(tmp_path, text)
     with pytest.raises(SpecError, match="already taken") as info:
-        load_problem(path).system()
+        system_of(load_problem(path))
     assert info.value.line == line_of(path, "  m: {}")
 
 
@@ -261,7 +262,7 @@ def test_cli_validate_good_file(tmp_path):
 def test_overflowing_literal_in_file_is_a_spec_error(tmp_path):
     path = write(tmp_path, PENDULUM + 'potential: "m*1e400*theta"\n')
     with pytest.raises(SpecError) as info:
-        load_problem(path).system()
+        system_of(load_problem(path))
     assert info.value.line == line_of(path, "potential:")
     result = CliRunner().invoke(main, ["validate", str(path)])
     assert result.exit_code == 1

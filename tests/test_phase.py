@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from systems import pendulum
 
-from mechbook.analysis import Analysis
-from mechbook.answers import load_answers
-from mechbook.checker import check_problem
-from mechbook.phase import PhaseFlow, box_boundary, image_area, shoelace
-from mechbook.problem import load_problem
+from mechbook.engine.analysis import Analysis
+from mechbook.engine.phase import PhaseFlow, box_boundary, image_area, shoelace
+from mechbook.model.problem import load_problem
+from mechbook.verify.answers import load_answers
+from mechbook.verify.checker import check_problem
 
 ROOT = Path(__file__).resolve().parents[1]
 

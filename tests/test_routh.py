@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from mechbook.analysis import Analysis
+from mechbook.engine.analysis import Analysis
 from mechbook.errors import NotEquilibriumError, UnsupportedError
-from mechbook.problem import load_problem
+from mechbook.model.problem import load_problem
 
 CONE = """\
 id: lim-2099

@@ -11,14 +11,15 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-import mechbook.store as store
-from mechbook.analysis import Analysis
-from mechbook.cli import main
+import mechbook.app.store as store
+from mechbook.app.cli import main
+from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError
-from mechbook.problem import load_problem
-from mechbook.simulate import simulate
-from mechbook.simulate.monitors import conserved_quantities
-from mechbook.simulate.rhs import BACKENDS, build_model, structure
+from mechbook.model.problem import load_problem
+from mechbook.model.system import system_of
+from mechbook.numerics.model import BACKENDS, build_model, structure
+from mechbook.numerics.monitors import conserved_quantities
+from mechbook.numerics.simulate import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,7 +34,7 @@ def problem(pid: str):
 def test_backends_agree_with_the_symbolic_accelerations(pid, system):
     p = problem(pid)
     an = Analysis(p)
-    sys, dyn = p.system(system), an.dynamics(system)
+    sys, dyn = system_of(p, system), an.dynamics(system)
     n = len(sys.q)
     rng = np.random.default_rng(3)
     q = rng.uniform(0.1, 0.4, n)
@@ -53,18 +54,18 @@ def test_structure_classifies_separable_canonical_gyroscopic():
                                    ("lim-2037", None, False)):
         p = problem(pid)
         an = Analysis(p)
-        model = build_model(p.system(system), an.dynamics(system), p.values())
+        model = build_model(system_of(p, system), an.dynamics(system), p.values())
         st = structure(model, (0.0, np.full(model.n, 0.3), np.zeros(model.n)))
         assert st.canonical and st.separable == separable, (pid, st)
     p = problem("lim-2037")
-    model = build_model(p.system(), Analysis(p).dynamics(), p.values())
+    model = build_model(system_of(p), Analysis(p).dynamics(), p.values())
     assert "linear in the velocities" in structure(model).reason
 
 
 def test_monitors_energy_and_cyclic_momentum():
     p = problem("lim-2040")
     an = Analysis(p)
-    names = list(conserved_quantities(p.system(), an.dynamics()))
+    names = list(conserved_quantities(system_of(p), an.dynamics()))
     assert names == ["energy_function", "p_theta"]
     sim = simulate(an, init={"r": "0.3", "thetadot": "4", "rdot": "0.2"}, t_span=(0, 5),
                    method="DOP853", rtol=1e-11, atol=1e-12)

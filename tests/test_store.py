@@ -10,11 +10,10 @@ import pytest
 import sympy as sp
 from click.testing import CliRunner
 
-import mechbook.store as store
-from mechbook.checker import Outcome
-from mechbook.cli import main
-from mechbook.derive import Results
-from mechbook.problem import load_problem
+import mechbook.app.store as store
+from mechbook.app.cli import main
+from mechbook.model.problem import load_problem
+from mechbook.records import Outcome, Results
 
 ROOT = Path(__file__).resolve().parents[1]
 

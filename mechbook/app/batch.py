@@ -1,0 +1,216 @@
+"""A batch of problem checks on a pool of worker processes, with limits and no losses.
+
+The parent hands out problem ids (the longest first, by the durations stored from earlier
+runs) to `jobs` worker processes and receives plain data back (mechbook/run.py). Each problem
+has a wall-clock limit and a memory bound enforced from outside: a worker that exceeds
+either is killed, the problem is reported as an error naming the limit and the stage it was
+in (workers report their stage as they go), and a fresh worker takes its place; a worker is
+also replaced after `max_tasks` problems, so memory SymPy caches do not grow without bound.
+Results are handed to `on_done` as each problem finishes (the CLI stores them at once: the
+parent is the store's only writer), and returned in the order the ids were given.
+
+Why not concurrent.futures or pebble: a per-task kill with the task's last stage, a memory
+bound read from /proc, and stage messages streamed while a task runs are the point of this
+module, and neither offers all three; the loop below is the whole of it.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from multiprocessing.connection import Connection, wait
+from pathlib import Path
+
+from mechbook.app.run import ProblemRun, RunOptions
+
+DEFAULT_TIMEOUT = 600.0  # seconds per problem; the slowest takes well under a minute
+DEFAULT_MEMORY_MB = 8000  # resident memory per worker
+MAX_TASKS = 20  # problems per worker before it is replaced
+POLL = 0.25  # seconds between checks of the limits
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    jobs: int = 0  # 0: one per core
+    timeout: float = DEFAULT_TIMEOUT
+    memory_mb: float = DEFAULT_MEMORY_MB
+    max_tasks: int = MAX_TASKS
+    run: RunOptions = RunOptions()
+    serial: bool = False  # in the calling process, no limits (debugging)
+
+    @property
+    def workers(self) -> int:
+        return self.jobs if self.jobs > 0 else (os.cpu_count() or 1)
+
+
+def _worker(conn: Connection, base: Path, options: RunOptions) -> None:
+    """A worker's loop: receive an id, check it, send stages and then the result."""
+    from mechbook.app.run import run_problem
+
+    while True:
+        try:
+            pid = conn.recv()
+        except (EOFError, KeyboardInterrupt):
+            return
+        if pid is None:
+            return
+        try:
+            run = run_problem(pid, base, options, stage=lambda text, pid=pid:
+                              conn.send(("stage", pid, text)))
+            conn.send(("done", pid, run))
+        except (BrokenPipeError, ConnectionResetError, EOFError):
+            return  # the parent is gone (killed): nobody to report to
+
+
+@dataclass
+class _Slot:
+    process: mp.process.BaseProcess
+    conn: Connection
+    pid: str | None = None  # the problem it is working on
+    started: float = 0.0
+    stage: str = ""
+    tasks: int = 0
+
+
+def _context():
+    ctx = mp.get_context("forkserver")
+    # workers fork from a server that has imported the engine once
+    ctx.set_forkserver_preload(["mechbook.app.run", "mechbook.verify.checker",
+                               "mechbook.verify.quantities", "mechbook.crosscheck"])
+    return ctx
+
+
+def _rss_mb(os_pid: int) -> float:
+    """Resident memory of a process in MB (0 if it cannot be read)."""
+    try:
+        with open(f"/proc/{os_pid}/statm") as fh:
+            return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
+class Batch:
+    """Check many problems on worker processes; see the module docstring."""
+
+    def __init__(self, base: Path, options: BatchOptions = BatchOptions(),
+                 on_done: Callable[[ProblemRun], None] | None = None,
+                 on_start: Callable[[str], None] | None = None):
+        self.base = base
+        self.options = options
+        self.on_done = on_done or (lambda run: None)
+        self.on_start = on_start or (lambda pid: None)
+        self._ctx = _context()
+        self._slots: list[_Slot] = []
+
+    def _spawn(self) -> _Slot:
+        parent, child = self._ctx.Pipe()
+        proc = self._ctx.Process(target=_worker, args=(child, self.base, self.options.run),
+                                 daemon=True)
+        proc.start()
+        child.close()
+        return _Slot(proc, parent)
+
+    def _retire(self, slot: _Slot, kill: bool = False) -> None:
+        if kill:
+            slot.process.kill()
+        else:
+            try:
+                slot.conn.send(None)
+            except (OSError, BrokenPipeError):
+                slot.process.kill()
+        slot.process.join(timeout=5)
+        if slot.process.is_alive():
+            slot.process.kill()
+            slot.process.join()
+        slot.conn.close()
+
+    def run(self, ids: list[str]) -> list[ProblemRun]:
+        """Check `ids` (in the order given: put the longest first); results in that order."""
+        if self.options.serial:
+            return self._serial(ids)
+        todo = list(ids)
+        done: dict[str, ProblemRun] = {}
+        try:
+            self._slots = [self._spawn() for _ in range(min(self.options.workers, len(todo)))]
+            while len(done) < len(ids):
+                self._assign(todo)
+                self._collect(done)
+        finally:
+            for slot in self._slots:
+                self._retire(slot, kill=slot.pid is not None)
+            self._slots = []
+        return [done[pid] for pid in ids]
+
+    def _serial(self, ids: list[str]) -> list[ProblemRun]:
+        """In this process, one after another: no limits, but a debugger can follow."""
+        from mechbook.app.run import run_problem
+
+        out = []
+        for pid in ids:
+            self.on_start(pid)
+            run = run_problem(pid, self.base, self.options.run)
+            self.on_done(run)
+            out.append(run)
+        return out
+
+    def _assign(self, todo: list[str]) -> None:
+        for i, slot in enumerate(self._slots):
+            if slot.pid is not None or not todo:
+                continue
+            if slot.tasks >= self.options.max_tasks:
+                self._retire(slot)
+                slot = self._slots[i] = self._spawn()
+            slot.pid, slot.started, slot.stage = todo.pop(0), time.monotonic(), "starting"
+            slot.tasks += 1
+            slot.conn.send(slot.pid)
+            self.on_start(slot.pid)
+
+    def _collect(self, done: dict[str, ProblemRun]) -> None:
+        busy = [s for s in self._slots if s.pid is not None]
+        ready = wait([s.conn for s in busy] + [s.process.sentinel for s in busy], POLL)
+        for slot in busy:
+            if slot.conn in ready or slot.process.sentinel in ready:
+                self._read(slot, done)
+        now = time.monotonic()
+        for slot in self._slots:
+            if slot.pid is None:
+                continue
+            why = None
+            if now - slot.started > self.options.timeout:
+                why = f"exceeded the time limit of {self.options.timeout:g} s"
+            elif self.options.memory_mb and _rss_mb(slot.process.pid) > self.options.memory_mb:
+                why = f"exceeded the memory bound of {self.options.memory_mb:g} MB"
+            if why:
+                self._fail(slot, done, f"{why} while in stage: {slot.stage}")
+
+    def _read(self, slot: _Slot, done: dict[str, ProblemRun]) -> None:
+        try:
+            while slot.conn.poll():
+                kind, pid, payload = slot.conn.recv()
+                if kind == "stage":
+                    slot.stage = payload
+                elif kind == "done":
+                    slot.pid = None
+                    done[pid] = payload
+                    self.on_done(payload)
+                    return
+        except (EOFError, OSError):
+            pass
+        if slot.pid is not None and not slot.process.is_alive():
+            code = slot.process.exitcode
+            how = f"signal {-code}" if code is not None and code < 0 else f"exit code {code}"
+            self._fail(slot, done, f"the worker process died ({how}) while in stage: "
+                       f"{slot.stage}")
+
+    def _fail(self, slot: _Slot, done: dict[str, ProblemRun], why: str) -> None:
+        pid = slot.pid
+        run = ProblemRun(pid, error=why, seconds=time.monotonic() - slot.started,
+                         stage=slot.stage)
+        self._retire(slot, kill=True)
+        i = self._slots.index(slot)
+        self._slots[i] = self._spawn()
+        done[pid] = run
+        self.on_done(run)

@@ -1,0 +1,120 @@
+"""Checking one problem: load, check its parts, cross-check, and return plain data.
+
+`run_problem` is what a batch worker runs (mechbook/batch.py); everything it returns is plain
+data (no SymPy objects), so it crosses process boundaries, and it reports the stage it is in
+through `stage`, so a problem stopped by the time limit says where it was.
+
+Nothing is derived that no part asks for: the checks pull what they need from a lazy
+`Analysis` (unsimplified: simplification is for a human reader, `mechbook solve`), and the
+store keeps what the run happened to derive, as text (`derive.computed`). Trouble in a stage
+no part asked for (the engine's own equilibria, loose cross-checks, the stored summary) is
+reported beside the parts and never takes them down.
+"""
+
+from __future__ import annotations
+
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from mechbook.app.fingerprint import file_sha256
+from mechbook.app.store import ProblemRecord, cached
+from mechbook.errors import MechbookError
+from mechbook.model.catalog import answer_path, problem_path
+from mechbook.records import NUMERIC, Outcome, ProofPolicy
+
+Stage = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    pass
+
+
+@dataclass
+class ProblemRun:
+    """The outcome of checking one problem, as plain data."""
+
+    pid: str
+    outcomes: list[Outcome] = field(default_factory=list)
+    error: str | None = None
+    seconds: float = 0.0
+    record: ProblemRecord | None = None
+    cached: bool = False
+    crosschecks: list = field(default_factory=list)  # CrossCheck
+    notes: list[str] = field(default_factory=list)  # trouble beside the parts
+    stage: str = ""  # the last stage reached (for a problem stopped from outside)
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How a batch checks its problems (the same for every problem of the batch)."""
+
+    crosscheck: bool = True
+    policy: ProofPolicy = NUMERIC
+
+
+def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
+                stage: Stage = _quiet) -> ProblemRun:
+    """Check one problem against its answer key (and cross-check it), from scratch."""
+    from mechbook.crosscheck import crosscheck_problem
+    from mechbook.engine.analysis import (
+        Analysis,  # the engine: imported only where a problem is checked
+    )
+    from mechbook.engine.derive import computed
+    from mechbook.model.problem import load_problem
+    from mechbook.verify.answers import load_answers
+    from mechbook.verify.checker import check_part
+
+    start = time.perf_counter()
+    run = ProblemRun(pid)
+    try:
+        stage("loading")
+        problem = load_problem(problem_path(pid, base))
+        apath = answer_path(pid, base)
+        if not apath.exists():
+            raise MechbookError(f"{apath}: no answer key for {pid}")
+        key = load_answers(apath)
+        if key.problem_id != problem.id:
+            raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem "
+                                f"file is {problem.id!r}")
+        analysis = Analysis(problem)
+        for part in key.parts:
+            stage(f"part {part.name} ({part.quantity})")
+            run.outcomes.append(check_part(analysis, part, options.policy))
+        if options.crosscheck:
+            stage("cross-checks")
+            run.crosschecks = crosscheck_problem(analysis, key, stage)
+        stage("storing the derived results")
+        try:
+            results = computed(analysis)
+        except Exception as exc:  # noqa: BLE001 - the summary must not take down the parts
+            results = []
+            run.notes.append(f"derived results not stored: {type(exc).__name__}: {exc}")
+        run.seconds = time.perf_counter() - start
+        run.record = ProblemRecord.of(problem, results, run.outcomes, run.seconds,
+                                      file_sha256(apath),
+                                      [c.as_dict() for c in run.crosschecks])
+    except MechbookError as exc:
+        run.error = str(exc)
+    except Exception as exc:  # noqa: BLE001 - one problem's fault must not end the batch
+        run.error = f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-2).strip()}]"
+    run.seconds = time.perf_counter() - start
+    return run
+
+
+def cached_runs(ids: list[str], base: Path, store: Path,
+                crosscheck: bool = True) -> dict[str, ProblemRun]:
+    """The problems whose stored results are still valid (problem file, answer key and
+    engine unchanged): answered from the store without loading the engine."""
+    wanted = {}
+    for pid in ids:
+        ppath, apath = problem_path(pid, base), answer_path(pid, base)
+        if ppath.exists() and apath.exists():
+            wanted[pid] = (file_sha256(ppath), file_sha256(apath))
+    out = {}
+    for pid, hit in cached(wanted, store, crosscheck).items():
+        out[pid] = ProblemRun(pid, hit.outcomes, seconds=hit.duration, cached=True,
+                              crosschecks=hit.crosschecks)
+    return out

@@ -1,0 +1,154 @@
+"""The compile layer: SymPy expressions turned into fast numeric functions, once.
+
+Every numeric evaluation of engine expressions at many points goes through here: the
+simulation's right-hand side (mechbook.numerics.model), the phase-space flow, the numeric
+equilibrium search, the cross-checks and region checks. Two entries:
+
+    compile_exprs(args, exprs)  f(x) for one point x (a flat vector of the args' values)
+                                -> a flat array of the expressions' values
+    compile_batch(args, exprs)  f(X) for N points at once, X of shape (N, len(args))
+                                -> an array of shape (N, len(exprs)) (NaN where undefined)
+
+Backends (docs/numerics.md has the measurements that chose the default):
+    llvm      SymEngine's Lambdify, LLVM-compiled, with cse (the default)
+    symengine SymEngine's Lambdify, interpreted ("lambda" backend), with cse
+    sympy     SymPy's lambdify(cse=True) printing to `math` (one point) or NumPy (batches)
+A backend that cannot translate an expression hands over to the next. Nothing here parses
+text: the inputs are SymPy objects built by the safe parser or the engine (`as_expr`
+refuses anything else).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+import sympy as sp
+
+from mechbook.errors import UnsupportedError
+
+BACKENDS = ("llvm", "symengine", "sympy")
+DEFAULT_BACKEND = "llvm"
+
+Compiled = Callable[[np.ndarray], np.ndarray]
+
+
+def as_expr(e) -> sp.Basic:
+    """An engine result as a SymPy object: plain numbers are wrapped, anything else (text
+    above all) is refused; nothing here is ever parsed."""
+    if isinstance(e, sp.Basic):
+        return e
+    if isinstance(e, int) and not isinstance(e, bool):
+        return sp.Integer(e)
+    if isinstance(e, float):
+        return sp.Float(e)
+    raise TypeError(f"not an engine expression: {type(e).__name__}")
+
+
+def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
+                  backend: str = DEFAULT_BACKEND) -> tuple[Compiled, str]:
+    """Compile `exprs` (a flat list) in `args` into f(vector) -> array, with cse.
+
+    Returns the function and the backend that actually compiled it (a backend that cannot
+    translate an expression hands over to the next in BACKENDS)."""
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
+    exprs = [as_expr(e) for e in exprs]
+    order = list(BACKENDS[BACKENDS.index(backend):])
+    last: Exception | None = None
+    for name in order:
+        try:
+            return _COMPILERS[name](list(args), exprs), name
+        except Exception as exc:  # noqa: BLE001 - any failure hands over to the next backend
+            last = exc
+    raise UnsupportedError(f"compiling the equations of motion numerically ({last})")
+
+
+def _compile_symengine(args, exprs, backend: str) -> Compiled:
+    import symengine as se
+
+    # SymPy objects converted to SymEngine ones (as_expr has refused anything but those)
+    se_args = [se.sympify(as_expr(a)) for a in args]
+    se_exprs = [se.sympify(e) for e in exprs]
+    if not exprs:
+        return lambda x: np.zeros(0)
+    fn = se.Lambdify(se_args, se_exprs, real=True, cse=True, backend=backend)
+    probe = fn(np.full(len(args), 0.3))  # surface translation errors now, not mid-run
+    if np.asarray(probe).shape[-1:] != (len(exprs),) and len(exprs) != 1:
+        raise ValueError("unexpected output shape from Lambdify")
+
+    def call(x: np.ndarray) -> np.ndarray:
+        return np.asarray(fn(x), dtype=float).reshape(-1)
+
+    return call
+
+
+def _compile_sympy(args, exprs) -> Compiled:
+    if not exprs:
+        return lambda x: np.zeros(0)
+    try:
+        fn = sp.lambdify(args, exprs, modules="math", cse=True)
+        fn(*([0.3] * len(args)))
+    except (NameError, TypeError, ValueError, AttributeError, ZeroDivisionError):
+        fn = sp.lambdify(args, exprs, modules="numpy", cse=True)
+
+    nan = np.full(len(exprs), np.nan)
+
+    def call(x: np.ndarray) -> np.ndarray:
+        try:
+            return np.array(fn(*x), dtype=float).reshape(-1)
+        except (ValueError, ZeroDivisionError, OverflowError):  # math's domain errors
+            return nan.copy()
+
+    return call
+
+
+_COMPILERS: dict[str, Callable[[list, list], Compiled]] = {
+    "llvm": lambda a, e: _compile_symengine(a, e, "llvm"),
+    "symengine": lambda a, e: _compile_symengine(a, e, "lambda"),
+    "sympy": _compile_sympy,
+}
+
+
+
+
+def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
+                  backend: str = DEFAULT_BACKEND) -> Callable[[np.ndarray], np.ndarray]:
+    """Compile `exprs` in `args` into F(X) -> (N, len(exprs)) for X of shape (N, len(args)).
+
+    Points where an expression is undefined come out NaN (never an exception), so a batch
+    of sample points can be filtered afterwards."""
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
+    exprs = [as_expr(e) for e in exprs]
+    width = len(exprs)
+    if not width:
+        return lambda X: np.zeros((np.asarray(X).shape[0], 0))
+    last: Exception | None = None
+    for name in BACKENDS[BACKENDS.index(backend):]:
+        try:
+            if name == "sympy":
+                fn = sp.lambdify(list(args), exprs, modules="numpy", cse=True)
+
+                def batch(X, fn=fn):
+                    X = np.asarray(X, dtype=float)
+                    with np.errstate(all="ignore"):
+                        cols = fn(*X.T)
+                    return np.column_stack([np.broadcast_to(np.asarray(c, dtype=float),
+                                                            (X.shape[0],)) for c in cols])
+            else:
+                import symengine as se
+
+                fn = se.Lambdify([se.sympify(as_expr(a)) for a in args],
+                                 [se.sympify(e) for e in exprs], real=True, cse=True,
+                                 backend="llvm" if name == "llvm" else "lambda")
+                fn(np.full((2, len(args)), 0.3))  # translation errors now, not mid-run
+
+                def batch(X, fn=fn):
+                    X = np.asarray(X, dtype=float)
+                    with np.errstate(all="ignore"):
+                        return np.asarray(fn(X), dtype=float).reshape(X.shape[0], width)
+            return batch
+        except Exception as exc:  # noqa: BLE001 - any failure hands over to the next backend
+            last = exc
+    raise UnsupportedError(f"compiling expressions numerically ({last})")

@@ -1,0 +1,13 @@
+"""The engine: everything derived from a system, lazily and without simplification unless a
+reader asks (mechbook solve).
+
+    lagrange    Lagrange's and Hamilton's equations, momenta, conservation (Dynamics)
+    equilibria  static equilibria, and the linearization about a point
+    linear      the linear system about a point: frequencies, modes, stability
+    routh       Routh's reduction about a steady motion
+    phase       the phase-space flow in (q, p)
+    analysis    one problem's results, cached per system and point (what checks pull from)
+    derive      results as text for a reader, and the summary a check run stores
+
+May import: mechbook.model, mechbook.core, mechbook.errors, mechbook.records.
+"""

@@ -1,0 +1,106 @@
+"""One problem's derived results, computed lazily and cached per system and per point.
+
+The checker and the CLI both ask this object for what they need; nothing is derived that is
+not asked for ("the engine computes only what the problem asks for").
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from mechbook.core.numeval import is_zero
+from mechbook.engine.equilibria import Equilibria
+from mechbook.engine.lagrange import Dynamics
+from mechbook.engine.linear import LinearSystem
+from mechbook.engine.routh import ReducedSystem
+from mechbook.errors import UnsupportedError
+from mechbook.model.problem import Problem
+from mechbook.model.system import System, system_of
+
+
+class Analysis:
+    def __init__(self, problem: Problem, simplify: bool = False):
+        self.problem = problem
+        self.simplify = simplify
+        self._dyn: dict[str, Dynamics] = {}
+        self._eq: dict[str, Equilibria] = {}
+        self._lin: dict[tuple, LinearSystem] = {}
+
+    def system(self, name: str | None = None) -> System:
+        return system_of(self.problem, name)
+
+    def dynamics(self, name: str | None = None) -> Dynamics:
+        sys = self.system(name)
+        if sys.name not in self._dyn:
+            self._dyn[sys.name] = Dynamics(sys, self.simplify)
+        return self._dyn[sys.name]
+
+    def equilibria(self, name: str | None = None) -> Equilibria:
+        sys = self.system(name)
+        if sys.name not in self._eq:
+            self._eq[sys.name] = Equilibria(self.dynamics(name))
+        return self._eq[sys.name]
+
+    def linear(self, name: str | None, point: dict) -> LinearSystem:
+        sys = self.system(name)
+        key = (sys.name, tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())))
+        if key not in self._lin:
+            self._lin[key] = self.equilibria(name).linearize(point)
+        return self._lin[key]
+
+    def steady_linear(self, name: str | None, rates: dict, point: dict) -> LinearSystem:
+        """Linearization about a steady motion: cyclic coordinates turning at `rates`, the
+        others at `point`, by Routh's reduction (momenta of the cyclic coordinates fixed)."""
+        sys = self.system(name)
+        key = (sys.name, "steady",
+               tuple(sorted((str(k), sp.srepr(v)) for k, v in {**rates, **point}.items())))
+        if key not in self._lin:
+            reduced = ReducedSystem(sys, rates, point, self.simplify)
+            dyn = Dynamics(reduced, self.simplify)
+            self._lin[key] = Equilibria(dyn).linearize(point)
+        return self._lin[key]
+
+    def stable_equilibria(self, name: str | None = None,
+                          budget: float | None = None) -> list[dict]:
+        """Closed-form equilibria that are stable at the default parameter values (the
+        search given up after `budget` seconds when no part asked for it)."""
+        eq = self.equilibria(name)
+        values = self.problem.values()
+        out = []
+        for point in eq.within(budget):
+            try:
+                ok = self.linear(name, point).numeric_stability(values) == "stable"
+            except (UnsupportedError, TypeError, ValueError):
+                continue
+            if ok:
+                out.append(point)
+        return out
+
+    DEFAULT_POINT_BUDGET = 5.0  # seconds to look for closed-form equilibria
+
+    def default_point(self, name: str | None = None) -> dict:
+        """The equilibrium to expand about when a question names none: the stable one
+        (among the closed-form equilibria SymPy finds within DEFAULT_POINT_BUDGET s), or
+        the origin when the system is already linear with no static equilibrium issue."""
+        try:
+            stable = self.stable_equilibria(name, self.DEFAULT_POINT_BUDGET)
+        except UnsupportedError:
+            stable = []
+        distinct = []
+        values = self.problem.values()
+        for pt in stable:
+            num = tuple(complex(sp.N(v.subs(values))) for v in pt.values())
+            if not any(max(abs(a - b) for a, b in zip(num, d, strict=True)) < 1e-9
+                       for d in distinct):
+                distinct.append(num)
+        if len(distinct) == 1:
+            return stable[0]
+        sys = self.system(name)
+        origin = {q: sp.S.Zero for q in sys.q}
+        if len(distinct) == 0:
+            # a system with a zero-frequency mode (a free translation) has no isolated
+            # equilibrium; the origin is one if the conditions vanish there
+            if all(is_zero(c.subs(origin)) for c in self.equilibria(name).conditions):
+                return origin
+        raise UnsupportedError("choosing the equilibrium: the answer must name `about:` "
+                               f"({len(distinct)} stable equilibria found)")

@@ -1,0 +1,179 @@
+"""What `mechbook solve` shows and the store keeps: the results a problem's `compute:` asks for.
+
+Each result is either text (a SymPy expression printed in the parser's own syntax, so it can
+be read back) or a NumPy array evaluated at the problem's default parameter values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from mechbook.engine.analysis import Analysis
+from mechbook.errors import UnsupportedError
+from mechbook.records import Results
+
+DEFAULT_COMPUTE = ["lagrangian", "eom", "momenta", "cyclic", "energy", "equilibria",
+                   "small_oscillations"]
+
+
+def show(expr) -> str:
+    if isinstance(expr, (list, tuple)):
+        return "[" + ", ".join(show(e) for e in expr) + "]"
+    if isinstance(expr, dict):
+        return "{" + ", ".join(f"{k}: {show(v)}" for k, v in expr.items()) + "}"
+    return sp.sstr(expr)
+
+
+def derive(analysis: Analysis, system: str | None = None,
+           compute: list[str] | None = None) -> Results:
+    sys = analysis.system(system)
+    wanted = compute or sys.spec.get("compute") or DEFAULT_COMPUTE
+    res = Results(sys.name)
+    dyn = analysis.dynamics(sys.name)
+    values = analysis.problem.values()
+
+    def attempt(key, fn):
+        try:
+            fn()
+        except UnsupportedError as exc:
+            res.notes[key] = f"unsupported: {exc.capability}"
+
+    if "lagrangian" in wanted:
+        res.text["lagrangian"] = show(sp.simplify(sys.lagrangian))
+        res.text["kinetic"] = show(sp.simplify(sys.kinetic))
+        res.text["potential"] = show(sp.simplify(sys.potential))
+    if "eom" in wanted:
+        def eom():
+            res.text["mass_matrix"] = show(dyn.mass_matrix.tolist())
+            res.text["forcing"] = show(list(dyn.forcing))
+            res.text["accelerations"] = show({a: s for a, s in dyn.solved.items()})
+        attempt("eom", eom)
+    if "momenta" in wanted:
+        res.text["momenta"] = show(dict(zip(sys.q, dyn.momenta, strict=True)))
+    if "cyclic" in wanted:
+        res.text["cyclic"] = show(dyn.cyclic)
+    if "energy" in wanted:
+        res.text["energy_function"] = show(dyn.energy_function)
+        res.text["energy_conserved"] = str(dyn.energy_conserved)
+    if "hamiltonian" in wanted:
+        def ham():
+            res.text["hamiltonian"] = show(dyn.hamiltonian)
+            qdot, pdot = dyn.hamilton_equations
+            res.text["hamilton_qdot"] = show(qdot)
+            res.text["hamilton_pdot"] = show(pdot)
+        attempt("hamiltonian", ham)
+    if "equilibria" in wanted or "small_oscillations" in wanted:
+        def equilibria():
+            eq = analysis.equilibria(sys.name)
+            points = eq.symbolic
+            res.text["equilibria"] = show(points)
+            if not points:
+                search = (sys.spec.get("equilibria") or {}).get("search")
+                found = eq.numeric(values, _ranges(sys, search))
+                res.notes["equilibria"] = "no closed form found; numeric equilibria at the " \
+                    "default parameters stored as numeric/equilibria"
+                if found:
+                    res.arrays["equilibria"] = np.array(found)
+                    points = [{q: _snap(x) for q, x in zip(sys.q, f, strict=True)}
+                              for f in found]
+            for i, point in enumerate(points):
+                tag = f"equilibrium_{i}"
+                if any(v.has(sp.Float) for v in point.values()):
+                    res.notes[tag] = f"{show(point)}: numeric point, not linearized symbolically"
+                    continue
+                try:
+                    lin = analysis.linear(sys.name, point)
+                except UnsupportedError as exc:
+                    res.notes[tag] = f"{show(point)}: unsupported: {exc.capability}"
+                    continue
+                res.text[f"{tag}/point"] = show(point)
+                try:
+                    res.text[f"{tag}/stability"] = lin.numeric_stability(values)
+                    if not lin.gyroscopic:
+                        res.text[f"{tag}/stable_if"] = show(lin.stability_condition)
+                except (TypeError, ValueError):
+                    res.notes[f"{tag}/stability"] = "does not evaluate at the default values"
+                    continue
+                if "small_oscillations" in wanted:
+                    _oscillations(res, lin, tag, values)
+        attempt("equilibria", equilibria)
+    return res
+
+
+def _snap(x: float) -> sp.Expr:
+    """A numerically found coordinate: k*pi/12 exactly if it is that to 1e-10, else a Float."""
+    k = round(x * 12 / np.pi)
+    return k * sp.pi / 12 if abs(x - k * np.pi / 12) < 1e-10 else sp.Float(x)
+
+
+def _ranges(sys, search: dict | None) -> dict | None:
+    if not search:
+        return None
+    vals = sys.problem.values()
+    return {sys.q[sys.coord_names.index(k)]: tuple(float(sys._parse(x, ("equilibria", "search",
+            k, i)).subs(vals)) for i, x in enumerate(v)) for k, v in search.items()}
+
+
+def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
+    res.text[f"{tag}/M"] = show(lin.M.tolist())
+    res.text[f"{tag}/K"] = show(lin.K.tolist())
+    if lin.gyroscopic:
+        res.text[f"{tag}/C"] = show(lin.C.tolist())
+    try:
+        res.text[f"{tag}/frequencies"] = show(lin.frequencies)
+    except UnsupportedError as exc:
+        res.notes[f"{tag}/frequencies"] = f"unsupported: {exc.capability}"
+    M, C, K = lin.matrices(values)
+    res.arrays[f"{tag}/M"] = M
+    res.arrays[f"{tag}/K"] = K
+    res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
+    if not lin.gyroscopic:
+        w2, modes = lin.numeric_modes(values)
+        res.arrays[f"{tag}/modes"] = modes
+
+
+_DYNAMICS_TEXT = ("mass_matrix", "forcing", "momenta", "cyclic", "energy_function",
+                  "hamiltonian")
+
+
+def computed(analysis: Analysis) -> list[Results]:
+    """What a check run derived on its way, as text and default-value arrays, per system:
+    nothing is derived or simplified here (a check run stores what its parts needed)."""
+    problem = analysis.problem
+    values = problem.values()
+    out = []
+    for name in problem.systems:
+        sys = problem._cache.get(name)
+        if sys is None:  # no part touched this system
+            continue
+        res = Results(name)
+        res.text["lagrangian"] = show(sys.lagrangian)
+        dyn = analysis._dyn.get(name)
+        if dyn is not None:
+            for key in _DYNAMICS_TEXT:
+                if key in dyn.__dict__:  # a cached_property that was evaluated
+                    val = dyn.__dict__[key]
+                    if key == "momenta":
+                        val = dict(zip(sys.q, val, strict=True))
+                    res.text[key] = show(val.tolist() if hasattr(val, "tolist") else val)
+        eq = analysis._eq.get(name)
+        if eq is not None and eq._solved is not None:
+            res.text["equilibria"] = show(eq._solved)
+        linears = [lin for key, lin in analysis._lin.items() if key[0] == name]
+        for i, lin in enumerate(linears):
+            tag = f"linear_{i}"
+            res.text[f"{tag}/point"] = show(lin.point)
+            steady = getattr(lin.dyn.sys, "momenta", None)
+            if isinstance(steady, dict):
+                res.text[f"{tag}/steady_momenta"] = show(steady)
+            for m in ("M", "C", "K"):
+                res.text[f"{tag}/{m}"] = show(getattr(lin, m).tolist())
+            try:
+                M, C, K = lin.matrices(values)
+                res.arrays[f"{tag}/M"], res.arrays[f"{tag}/K"] = M, K
+                res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
+            except (TypeError, ValueError, UnsupportedError, np.linalg.LinAlgError) as exc:
+                res.notes[f"{tag}/numeric"] = f"not evaluated at the default values: {exc}"
+        out.append(res)
+    return out

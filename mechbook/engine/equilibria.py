@@ -1,0 +1,209 @@
+"""Static equilibria of a system, and the linearization about one (or a steady motion).
+
+The equations of motion E(q, q̇, q̈, t) = 0 at rest (q̇ = q̈ = 0, small parameters off) give
+the equilibrium conditions; SymPy's solve finds the closed-form equilibria (within time
+limits: a search no part asked for gets a budget) and a root finder the numeric ones.
+`linearize` expands E to first order about a point and returns the `LinearSystem`
+M·δq̈ + C·δq̇ + K·δq = F(t); a point that is not an equilibrium is refused
+(NotEquilibriumError: the answer that named it is wrong).
+"""
+
+from __future__ import annotations
+
+import time
+from functools import cached_property
+
+import numpy as np
+import scipy.optimize
+import sympy as sp
+
+from mechbook.core.compile import compile_exprs
+from mechbook.core.expansion import EPS, expand_lagrangian
+from mechbook.core.numeval import NotNumeric, evaluate, without_absent
+from mechbook.core.timeout import Timeout, time_limit, try_simplify
+from mechbook.engine.lagrange import Dynamics
+from mechbook.engine.linear import LinearSystem
+from mechbook.errors import NotEquilibriumError, UnsupportedError
+
+
+class Equilibria:
+    """Static equilibria of a system (autonomous equations, q̇ = 0) and linearization."""
+
+    def __init__(self, dyn: Dynamics):
+        self.dyn = dyn
+        self.sys = dyn.sys
+        self._solved: list[dict] | None = None
+        self._gave_up_at: float | None = None
+
+    @cached_property
+    def conditions(self) -> list[sp.Expr]:
+        """E_i(q, 0, 0) with small parameters switched off: zero at an equilibrium."""
+        if self.sys.constraints:
+            raise UnsupportedError("equilibria of a system with multiplier constraints")
+        zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
+        zero.update({s: 0 for s in self.sys.small_params})
+        conds = [without_absent(e.subs(zero), [self.sys.t]) for e in self.dyn.residuals]
+        if any(c.has(self.sys.t) for c in conds):
+            raise UnsupportedError("static equilibria of a non-autonomous system")
+        free = {s for syms in self.sys.free_driven for s in syms}
+        if any(c.free_symbols & free for c in conds):
+            raise UnsupportedError("static equilibria with an arbitrary driven coordinate")
+        return conds
+
+    SIMPLIFY_SECONDS = 5.0  # per condition, before solving
+    SOLVE_SECONDS = 10.0
+
+    @property
+    def symbolic(self) -> list[dict]:
+        """Equilibria SymPy can find in closed form (possibly incomplete for trig equations),
+        with the full time limits: what an answer part asks for."""
+        return self.within(None)
+
+    def within(self, budget: float | None) -> list[dict]:
+        """`symbolic`, but giving up (returning []) once `budget` seconds are spent on
+        simplifying and solving: for searches no part asked for (the loose cross-checks).
+        A result found once is kept; a search cut short is tried again with more time."""
+        if self._solved is not None:
+            return self._solved
+        if budget is not None and self._gave_up_at is not None and budget <= self._gave_up_at:
+            return []
+        deadline = None if budget is None else time.monotonic() + budget
+
+        def limit(cap: float) -> float:
+            return cap if deadline is None else min(cap, deadline - time.monotonic())
+
+        conds = []
+        for c in self.conditions:  # simplified first: solve finds more this way
+            seconds = limit(self.SIMPLIFY_SECONDS)
+            if seconds <= 0:
+                self._gave_up_at = budget
+                return []
+            conds.append(try_simplify(c, seconds))
+        try:
+            seconds = limit(self.SOLVE_SECONDS)
+            if seconds <= 0:
+                raise Timeout("no time left")
+            with time_limit(seconds):
+                sols = sp.solve(conds, self.dyn.q, dict=True)
+        except (Timeout, NotImplementedError):
+            if deadline is not None and time.monotonic() >= deadline - 1e-3:
+                self._gave_up_at = budget  # cut short by the budget: may retry with more
+                return []
+            self._solved = []
+            return []
+        self._solved = [s for s in sols if len(s) == len(self.dyn.q)
+                        and all(v.is_real is not False for v in s.values())]
+        return self._solved
+
+    def numeric(self, values: dict, search: dict | None = None,
+                starts: int = 7) -> list[np.ndarray]:
+        """Equilibria at `values` by root finding from a grid of starting points."""
+        q = self.dyn.q
+        conds = [c.subs(values) for c in self.conditions]
+        F = sp.Matrix(conds)
+        J = F.jacobian(q)
+        n = len(q)
+        f_num, _ = compile_exprs(q, list(F))
+        jac, _ = compile_exprs(q, list(J))
+
+        def j_num(x):
+            return jac(x).reshape(n, n)
+        ranges = [search.get(v, (-np.pi, np.pi)) if search else (-np.pi, np.pi) for v in q]
+        grids = [np.linspace(lo, hi, starts) for lo, hi in ranges]
+        found: list[np.ndarray] = []
+        mesh = np.array(np.meshgrid(*grids, indexing="ij")).reshape(len(q), -1).T
+        if len(mesh) > 2000:
+            mesh = mesh[np.random.default_rng(0).choice(len(mesh), 2000, replace=False)]
+        for x0 in mesh:
+            sol = scipy.optimize.root(lambda x: np.asarray(f_num(x), float), x0,
+                                      jac=lambda x: np.asarray(j_num(x), float))
+            if np.all(np.isfinite(sol.x)) and np.max(np.abs(f_num(sol.x))) < 1e-10:
+                if not any(np.allclose(sol.x, f, atol=1e-7) for f in found):
+                    found.append(sol.x)
+        return found
+
+    def quadratic_lagrangian(self, point: dict) -> sp.Expr:
+        """L expanded to second order about `point` (see mechbook.expansion)."""
+        dyn = self.dyn
+        return expand_lagrangian(dyn.L, dyn.q, dyn.qd, point, self.sys.small_params, 2)
+
+    def residual(self, point: dict) -> list[sp.Expr]:
+        return [c.subs(point) for c in self.conditions]
+
+    def linearize(self, point: dict) -> LinearSystem:
+        """First-order expansion of the equations of motion about `point` (q̇ = 0)."""
+        dyn = self.dyn
+        sub = {}
+        for q in dyn.q:
+            sub[q] = point.get(q, sp.S.Zero) + EPS * q
+        sub.update({v: EPS * v for v in dyn.qd + dyn.qdd})
+        sub.update({s: EPS * s for s in self.sys.small_params})
+        lin = []
+        zeroth = []
+        for e in dyn.residuals:
+            e_sub = e.subs(sub, simultaneous=True)
+            zeroth.append(e_sub.subs(EPS, 0))
+            lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
+        bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
+        if bad:
+            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
+                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
+                                      "is left there")
+        n = len(dyn.q)
+        raw = {name: sp.Matrix(n, n, lambda i, j, v=v: sp.diff(lin[i], v[j]))
+               for name, v in (("M", dyn.qdd), ("C", dyn.qd), ("K", dyn.q))}
+        rest = sp.Matrix([lin[i] - sum((raw["M"][i, j] * dyn.qdd[j] + raw["C"][i, j] * dyn.qd[j]
+                                        + raw["K"][i, j] * dyn.q[j]) for j in range(n))
+                          for i in range(n)])
+        t = [self.sys.t]
+        state = t + dyn.q + dyn.qd + dyn.qdd  # F depends on t only, once terms cancel
+        if dyn.simplify:
+            def simp(x, absent=t):
+                return try_simplify(without_absent(x, absent), 5)
+        else:
+            def simp(x, absent=t):
+                return without_absent(x, absent)
+        M, C, K = (raw[k].applyfunc(simp) for k in ("M", "C", "K"))
+        F = (-rest).applyfunc(lambda x: simp(sp.expand(x), state))
+        bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
+        if bad:
+            raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
+        return LinearSystem(dyn, dict(point), M, C, K, F)
+
+
+def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:
+    """Zero symbolically, or (when SymPy cannot tell) to 25 digits at random points around
+    the default values; a residual left by a numerically found point is zero to 1e-9."""
+    if expr == 0:
+        return True
+    if _numerically_zero(expr, values):
+        return True
+    rng = np.random.default_rng(7)
+    for _ in range(points):
+        env = {}
+        for sym in expr.free_symbols:
+            base = values.get(sym, 1.0)
+            factor = float(np.exp(rng.uniform(-0.3, 0.3)))
+            env[sym] = sp.Float(base * factor if sym.is_positive or sym not in values
+                                else base + rng.uniform(-0.3, 0.3), 40)
+        try:
+            v, scale = evaluate(expr, env, 40)
+        except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return False
+        if not abs(v) <= 1e-25 * max(scale, 1e-300):
+            return False
+    return True
+
+
+def _numerically_zero(expr: sp.Expr, values: dict) -> bool:
+    """A residual left by a numerically found point (floats), zero to rounding."""
+    if not expr.has(sp.Float):
+        return False
+    try:
+        return abs(evaluate(expr, {k: sp.Float(v, 30) for k, v in values.items()})[0]) < 1e-9
+    except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return False
+
+
+def _show(point: dict) -> str:
+    return "{" + ", ".join(f"{k} = {sp.sstr(v)}" for k, v in point.items()) + "}"

@@ -1,0 +1,166 @@
+"""Lagrange's and Hamilton's equations of a system, derived once and cached.
+
+Sign conventions (tested against Newton's law): the Euler–Lagrange residual of coordinate i is
+    E_i = d/dt(∂L/∂q̇_i) − ∂L/∂q_i − Q_i − Σ_j λ_j ∂f_j/∂q_i,
+and the equations of motion are E = 0, i.e. M(q,t)·q̈ = f(q,q̇,t) + Aᵀλ with A = ∂f/∂q.
+λ_j ∂f_j/∂q_i is the generalized force that constraint j exerts on coordinate i.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import sympy as sp
+
+from mechbook.core.numeval import is_zero
+from mechbook.core.timeout import Timeout, time_limit, try_simplify
+from mechbook.errors import UnsupportedError
+from mechbook.model.system import System
+
+
+class Dynamics:
+    """Equations of motion, momenta, conserved quantities and the Hamiltonian of a system."""
+
+    def __init__(self, system: System, simplify: bool = False):
+        self.sys = system
+        self.simplify = simplify
+        self.q, self.qd, self.qdd = system.q, system.qd, system.qdd
+        self.L = system.lagrangian
+
+    def _simp(self, expr):
+        """Simplified for a human reader (`simplify=True`: `mechbook solve`); the checks
+        and cross-checks work on the raw expressions, which are equal and far cheaper."""
+        return try_simplify(expr) if self.simplify else expr
+
+    # ---- Lagrange ------------------------------------------------------------------------
+    @cached_property
+    def momenta(self) -> list[sp.Expr]:
+        """Generalized momenta p_i = ∂L/∂q̇_i."""
+        return [self._simp(sp.diff(self.L, v)) for v in self.qd]
+
+    @cached_property
+    def residuals(self) -> list[sp.Expr]:
+        """E_i without constraint forces (see module docstring)."""
+        out = []
+        for q, qd, force in zip(self.q, self.qd, self.sys.forces, strict=True):
+            e = self.sys.dt(sp.diff(self.L, qd)) - sp.diff(self.L, q) - force
+            out.append(sp.expand(e))
+        return out
+
+    @cached_property
+    def mass_matrix(self) -> sp.Matrix:
+        """M_ij = ∂E_i/∂q̈_j."""
+        return sp.Matrix([[self._simp(sp.diff(e, a)) for a in self.qdd] for e in self.residuals])
+
+    @cached_property
+    def forcing(self) -> sp.Matrix:
+        """f in M·q̈ = f (everything but the accelerations, moved to the right)."""
+        zero = {a: 0 for a in self.qdd}
+        return sp.Matrix([self._simp(-e.subs(zero)) for e in self.residuals])
+
+    @cached_property
+    def constraint_jacobian(self) -> sp.Matrix:
+        cons = [f for _, f in self.sys.constraints]
+        return sp.Matrix([[sp.diff(f, q) for q in self.q] for f in cons]) if cons else sp.zeros(0,
+                                                                                              len(self.q))
+
+    @cached_property
+    def multipliers(self) -> list[sp.Symbol]:
+        return [sp.Symbol(f"lambda_{name}", real=True) for name, _ in self.sys.constraints]
+
+    @cached_property
+    def solved(self) -> dict:
+        """Accelerations (and multipliers) solved as functions of q, q̇, t."""
+        n = len(self.q)
+        M, f = self.mass_matrix, self.forcing
+        if not self.sys.constraints:
+            try:
+                with time_limit(60):
+                    sol = M.LUsolve(f)
+            except Timeout:
+                raise UnsupportedError("solving the mass matrix symbolically (too large)") from None
+            return {a: self._simp(s) for a, s in zip(self.qdd, sol, strict=True)}
+        A = self.constraint_jacobian
+        zero = {a: 0 for a in self.qdd}
+        b = sp.Matrix([self.sys.dt(self.sys.dt(fc)).subs(zero) for _, fc in self.sys.constraints])
+        m = A.rows
+        big = sp.zeros(n + m, n + m)
+        big[:n, :n] = M
+        big[:n, n:] = -A.T
+        big[n:, :n] = A
+        rhs = sp.Matrix.vstack(f, -b)
+        sol = big.LUsolve(rhs)
+        unknowns = list(self.qdd) + self.multipliers
+        return {u: self._simp(s) for u, s in zip(unknowns, sol, strict=True)}
+
+    @cached_property
+    def accelerations(self) -> list[sp.Expr]:
+        return [self.solved[a] for a in self.qdd]
+
+    def on_shell(self, expr: sp.Expr) -> sp.Expr:
+        """Replace accelerations in `expr` by their values from the equations of motion."""
+        return expr.subs({a: self.solved[a] for a in self.qdd})
+
+    # ---- conservation --------------------------------------------------------------------
+    @cached_property
+    def cyclic(self) -> dict[sp.Symbol, sp.Expr]:
+        """Ignorable coordinates (absent from L, no force, no constraint) and their momenta."""
+        cons = [f for _, f in self.sys.constraints]
+        out = {}
+        for q, p, force in zip(self.q, self.momenta, self.sys.forces, strict=True):
+            if (force == 0 and all(sp.diff(c, q) == 0 for c in cons)
+                    and is_zero(sp.diff(self.L, q))):
+                out[q] = p
+        return out
+
+    @cached_property
+    def energy_function(self) -> sp.Expr:
+        """h = Σ q̇ ∂L/∂q̇ − L."""
+        h = sum((v * p for v, p in zip(self.qd, self.momenta, strict=True)), sp.S.Zero) - self.L
+        return self._simp(h)
+
+    @cached_property
+    def energy_power(self) -> sp.Expr:
+        """dh/dt along the motion = −∂L/∂t + Σ Q_i q̇_i (zero means h is conserved)."""
+        power = -sp.diff(self.L, self.sys.t)
+        power += sum((f * v for f, v in zip(self.sys.forces, self.qd, strict=True)), sp.S.Zero)
+        if any(sp.diff(f, self.sys.t) != 0 for _, f in self.sys.constraints):
+            return sp.nan  # moving constraints do work; not decided here
+        return self._simp(power)
+
+    @property
+    def energy_conserved(self) -> bool:
+        power = self.energy_power
+        return power is not sp.nan and is_zero(power)
+
+    # ---- Hamilton ------------------------------------------------------------------------
+    @cached_property
+    def p(self) -> list[sp.Symbol]:
+        return [sp.Symbol("p_" + q.name, real=True) for q in self.q]
+
+    @cached_property
+    def velocities_of_momenta(self) -> dict[sp.Symbol, sp.Expr]:
+        """q̇(q, p, t) from p = ∂L/∂q̇ (linear when T is quadratic in the velocities)."""
+        eqs = [pi - mom for pi, mom in zip(self.p, self.momenta, strict=True)]
+        try:
+            with time_limit(60):
+                sol = sp.solve(eqs, self.qd, dict=True)
+        except Timeout:
+            sol = []
+        if len(sol) != 1:
+            raise UnsupportedError("Legendre transform: p = ∂L/∂q̇ not uniquely solvable for q̇")
+        return {v: self._simp(sol[0][v]) for v in self.qd}
+
+    @cached_property
+    def hamiltonian(self) -> sp.Expr:
+        """H(q, p, t) = h expressed in the momenta."""
+        return self._simp(self.energy_function.subs(self.velocities_of_momenta))
+
+    @cached_property
+    def hamilton_equations(self) -> tuple[list[sp.Expr], list[sp.Expr]]:
+        """(q̇ = ∂H/∂p, ṗ = −∂H/∂q + Q)."""
+        H = self.hamiltonian
+        qdot = [self._simp(sp.diff(H, pi)) for pi in self.p]
+        forces = [f.subs(self.velocities_of_momenta) for f in self.sys.forces]
+        pdot = [self._simp(-sp.diff(H, q) + f) for q, f in zip(self.q, forces, strict=True)]
+        return qdot, pdot

@@ -1,0 +1,222 @@
+"""Small oscillations: the linear system about an equilibrium or a steady motion.
+
+The equations of motion E(q, q̇, q̈, t) = 0 are expanded (mechbook.engine.equilibria) to first
+order about a point q* with
+q̇ = q̈ = 0, counting parameters declared `small` (a driving amplitude, say) as first-order too:
+    M·δq̈ + C·δq̇ + K·δq = F(t),    δq = q − q*.
+C holds gyroscopic (antisymmetric) and damping (symmetric) terms. With C = 0 the normal
+frequencies are the roots of det(K − ω²M) = 0 and numerically `scipy.linalg.eigh(K, M)`; with
+gyroscopic terms they are the roots of det(K − ω²M + iωC) = 0 and numerically the imaginary
+parts of the state-space eigenvalues.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg
+import sympy as sp
+
+from mechbook.core.numeval import is_zero
+from mechbook.core.timeout import Timeout, time_limit, try_simplify
+from mechbook.engine.lagrange import Dynamics
+from mechbook.errors import UnsupportedError
+
+ZERO_TOL = 1e-9
+
+
+@dataclass
+class LinearSystem:
+    """M·δq̈ + C·δq̇ + K·δq = F(t) about `point`."""
+
+    dyn: Dynamics
+    point: dict
+    M: sp.Matrix
+    C: sp.Matrix
+    K: sp.Matrix
+    F: sp.Matrix
+
+    @property
+    def q(self):
+        return self.dyn.q
+
+    def displacement(self) -> sp.Matrix:
+        return sp.Matrix([q - self.point.get(q, 0) for q in self.q])
+
+    def equations(self) -> list[sp.Expr]:
+        """Linear equations (each = 0) in the original coordinate symbols."""
+        dq = self.displacement()
+        lhs = self.M * sp.Matrix(self.dyn.qdd) + self.C * sp.Matrix(self.dyn.qd) + self.K * dq
+        return [sp.expand(e) for e in lhs - self.F]
+
+    @cached_property
+    def gyroscopic(self) -> bool:
+        """C ≠ 0 (velocity terms: gyroscopic or damping), decided numerically."""
+        return not all(is_zero(c) for c in self.C)
+
+    @cached_property
+    def driven(self) -> bool:
+        """F(t) ≠ 0 (a force that does not depend on the displacements)."""
+        return not all(is_zero(f) for f in self.F)
+
+    # ---- symbolic frequencies ------------------------------------------------------------
+    @cached_property
+    def squared_frequencies(self) -> list[sp.Expr]:
+        """Roots w = ω² of det(K − w M) = 0 with multiplicity (no gyroscopic terms)."""
+        if self.gyroscopic:
+            raise UnsupportedError("ω² roots of a gyroscopic system (use `frequencies`)")
+        w = sp.Symbol("w")
+        poly = sp.Poly(sp.factor((self.K - w * self.M).det()), w)
+        try:
+            with time_limit(30):
+                roots = sp.roots(poly, w)
+        except Timeout:
+            roots = {}
+        if sum(roots.values()) != poly.degree():
+            raise UnsupportedError("closed-form roots of the secular equation")
+        out = []
+        for r, mult in roots.items():
+            out += [try_simplify(r, 5)] * mult
+        return out
+
+    @cached_property
+    def frequencies(self) -> list[sp.Expr]:
+        """Symbolic normal angular frequencies ω ≥ 0 (with multiplicity)."""
+        if not self.gyroscopic:
+            return [try_simplify(sp.sqrt(r), 5) for r in self.squared_frequencies]
+        om = sp.Symbol("omega_root", positive=True)
+        det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
+        n = len(self.q)
+        try:
+            with time_limit(30):
+                roots = sp.roots(sp.Poly(det, om), om)
+        except Timeout:
+            roots = {}
+        # keep the n roots that are real and non-negative at the default parameters
+        values = self.dyn.sys.numeric_values()
+        keep = []
+        for r, mult in roots.items():
+            v = complex(r.evalf(subs=values))
+            if abs(v.imag) < 1e-9 * (1 + abs(v)) and v.real >= -1e-12:
+                keep += [try_simplify(r, 5)] * mult
+        if len(keep) != n:
+            raise UnsupportedError("closed-form frequencies of a gyroscopic system")
+        return keep
+
+    # ---- numeric -------------------------------------------------------------------------
+    def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        def num(A):
+            return np.array(A.evalf(30, subs=values).tolist(), dtype=complex).real.astype(float)
+
+        return num(self.M), num(self.C), num(self.K)
+
+    def numeric_modes(self, values: dict) -> tuple[np.ndarray, np.ndarray]:
+        """(ω², modes as columns) by the generalized symmetric eigensolver, M-normalized."""
+        M, C, K = self.matrices(values)
+        if np.any(C):
+            raise UnsupportedError("real normal modes of a gyroscopic or damped system")
+        w2, vecs = scipy.linalg.eigh(K, M)
+        return w2, vecs
+
+    def numeric_frequencies(self, values: dict) -> np.ndarray:
+        """Normal angular frequencies at `values` (NaN marks an unstable, imaginary one).
+
+        `scipy.linalg.eigh(K, M)` in double precision, after a diagonal scaling that makes
+        M's diagonal one; when the problem is ill-conditioned there (cond(M) or the spread
+        of the eigenvalues beyond 1e6, or gyroscopic terms spanning many decades) the
+        eigenvalues are recomputed with 50-digit mpmath arithmetic (bench/extremes.py).
+        """
+        M, C, K = self.matrices(values)
+        n = M.shape[0]
+        if not np.any(C):
+            d = 1.0 / np.sqrt(np.abs(np.diag(M)))
+            Ms, Ks = M * np.outer(d, d), K * np.outer(d, d)
+            w2 = scipy.linalg.eigh(Ks, Ms, eigvals_only=True)
+            if _ill_conditioned(Ms, w2):
+                w2 = self._precise_squared(values)
+            scale = max(1e-300, float(np.max(np.abs(w2))))
+            w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
+            return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
+        Minv = np.linalg.inv(M)
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+        lam = np.linalg.eigvals(A)
+        mags = np.abs(lam[np.abs(lam) > 0])
+        if np.linalg.cond(M) > 1e6 or (len(mags) and mags.max() > 1e6 * mags.min()):
+            lam = self._precise_state_eigenvalues(values)
+        lam = lam[np.argsort(-lam.imag)]
+        return np.sort(np.abs(lam.imag[:n]))
+
+    def _mp_matrices(self, values: dict, dps: int = 50):
+        import mpmath
+
+        def conv(A):
+            return mpmath.matrix([[mpmath.mpf(str(sp.re(sp.N(x, dps)))) for x in row]
+                                  for row in A.evalf(dps, subs=values).tolist()])
+
+        return conv(self.M), conv(self.C), conv(self.K)
+
+    def _precise_squared(self, values: dict, dps: int = 50) -> np.ndarray:
+        """ω² by Cholesky reduction and a symmetric eigensolver in mpmath."""
+        import mpmath
+
+        with mpmath.workdps(dps):
+            M, _, K = self._mp_matrices(values, dps)
+            L = mpmath.cholesky(M)
+            Linv = mpmath.inverse(L)
+            A = Linv * K * Linv.T
+            A = (A + A.T) / 2
+            w2 = mpmath.eigsy(A, eigvals_only=True)
+            return np.sort(np.array([float(x) for x in w2]))
+
+    def _precise_state_eigenvalues(self, values: dict, dps: int = 50) -> np.ndarray:
+        """Eigenvalues of the first-order (state-space) form in mpmath."""
+        import mpmath
+
+        with mpmath.workdps(dps):
+            M, C, K = self._mp_matrices(values, dps)
+            n = M.rows
+            Minv = mpmath.inverse(M)
+            A = mpmath.zeros(2 * n, 2 * n)
+            MK, MC = -Minv * K, -Minv * C
+            for i in range(n):
+                A[i, n + i] = 1
+                for j in range(n):
+                    A[n + i, j] = MK[i, j]
+                    A[n + i, n + j] = MC[i, j]
+            lam = mpmath.eig(A, left=False, right=False)
+            return np.array([complex(x) for x in lam])
+
+    def numeric_stability(self, values: dict) -> str:
+        """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
+        M, C, K = self.matrices(values)
+        n = M.shape[0]
+        if not np.any(C):
+            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+            scale = max(1.0, float(np.max(np.abs(w2))))
+            if np.any(w2 < -ZERO_TOL * scale):
+                return "unstable"
+            return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+        re = np.linalg.eigvals(A).real
+        scale = max(1.0, float(np.max(np.abs(np.linalg.eigvals(A)))))
+        if np.any(re > 1e-8 * scale):
+            return "unstable"
+        return "stable"
+
+    @cached_property
+    def stability_condition(self) -> sp.Basic:
+        """Sufficient and (without gyroscopic terms) necessary condition: K positive definite."""
+        if self.gyroscopic:
+            raise UnsupportedError("symbolic stability condition with gyroscopic terms")
+        K = self.K
+        minors = [try_simplify(K[:k, :k].det(), 5) for k in range(1, K.rows + 1)]
+        return sp.And(*[mi > 0 for mi in minors])
+
+
+def _ill_conditioned(M: np.ndarray, w2: np.ndarray) -> bool:
+    nonzero = np.abs(w2[np.abs(w2) > 0])
+    spread = nonzero.max() / nonzero.min() if len(nonzero) else 1.0
+    return bool(np.linalg.cond(M) > 1e6 or spread > 1e6)

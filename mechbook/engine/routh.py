@@ -1,0 +1,79 @@
+"""Routh's reduction: small oscillations about a steady motion.
+
+A steady motion turns cyclic coordinates φ at constant rates while the others stay put.
+Holding the conserved momenta p_φ = ∂L/∂φ̇ fixed, the remaining coordinates obey Lagrange's
+equations with L' = L − Σ p_φ φ̇ (minus Routh's function), φ̇ eliminated through p_φ. The
+steady motion is an equilibrium of L', and its small oscillations are those of L' — not of
+the original potential, whose "equilibria" would ignore the centrifugal terms.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from mechbook.core.numeval import is_zero
+from mechbook.core.timeout import Timeout, time_limit
+from mechbook.errors import UnsupportedError
+from mechbook.model.system import System
+
+
+class ReducedSystem:
+    """The system left after fixing the momenta of some cyclic coordinates.
+
+    It offers the attributes of `System` that Dynamics and Equilibria use.
+    """
+
+    def __init__(self, base: System, rates: dict[sp.Symbol, sp.Expr], point: dict,
+                 simplify: bool = False):
+        self.base = base
+        self.problem = base.problem
+        self.t = base.t
+        self.small_params = base.small_params
+        self.free_driven = base.free_driven
+        self.constraints = []
+        self.spec = base.spec
+        cyc = list(rates)
+        idx = [base.q.index(c) for c in cyc]
+        for i, c in zip(idx, cyc, strict=True):
+            if not is_zero(sp.diff(base.lagrangian, c)) or base.forces[i] != 0:
+                raise UnsupportedError(f"steady motion: {c} is not a cyclic coordinate")
+        if base.constraints:
+            raise UnsupportedError("steady motion of a system with multiplier constraints")
+        keep = [i for i in range(len(base.q)) if i not in idx]
+        self.q = [base.q[i] for i in keep]
+        self.qd = [base.qd[i] for i in keep]
+        self.qdd = [base.qdd[i] for i in keep]
+        self.coord_names = [base.coord_names[i] for i in keep]
+        self.forces = [base.forces[i] for i in keep]
+        self.names = base.names
+        L = base.lagrangian
+        cyc_rates = [base.qd[i] for i in idx]
+        momenta = [sp.diff(L, v) for v in cyc_rates]
+        # the momenta's values at the steady motion: rates given, others at rest at `point`
+        at_steady = {v: 0 for v in self.qd}
+        at_steady.update(point)
+        at_steady.update({base.qd[i]: rates[c] for i, c in zip(idx, cyc, strict=True)})
+        simp = sp.simplify if simplify else (lambda e: e)  # for a reader only
+        p_values = [simp(p.subs(at_steady)) for p in momenta]
+        try:
+            with time_limit(30):
+                sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
+                               cyc_rates, dict=True)
+        except Timeout:
+            sol = []
+        if len(sol) != 1:
+            raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
+                                   "their momenta")
+        rate_of = sol[0]
+        routh = sum((pv * v for pv, v in zip(p_values, cyc_rates, strict=True)), sp.S.Zero)
+        self.lagrangian = simp((L - routh).subs(rate_of))
+        self.momenta = dict(zip(cyc, p_values, strict=True))
+
+    def dt(self, expr):
+        out = sp.diff(expr, self.t)
+        for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True):
+            out += sp.diff(expr, q) * qd + sp.diff(expr, qd) * qdd
+        return out
+
+    def numeric_values(self) -> dict:
+        return self.problem.values()

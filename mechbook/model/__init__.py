@@ -1,0 +1,12 @@
+"""The problem model: problem files read safely and turned into symbols and a Lagrangian.
+
+    yamlio    YAML with line numbers, duplicate keys refused
+    schema    JSON-Schema validation with file:line errors (schemas/*.json)
+    expr      the safe expression parser (never eval)
+    catalog   where problem and answer files live, problem ids
+    problem   a problem file: parameters, conditions, its systems as data
+    system    one system built: coordinates, T, V, L, forces, constraints
+    bodies    rigid bodies: standard shapes' inertia, kinetic energy, Euler-angle rates
+
+May import: mechbook.core, mechbook.errors, mechbook.records.
+"""

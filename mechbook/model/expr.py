@@ -1,0 +1,231 @@
+"""Safe expression parser: problem text becomes SymPy objects without ever reaching `eval`.
+
+`sympify`, `parse_expr` and `lambdify` of strings all call Python's `eval`, so a problem file
+could run arbitrary code through them. Here the text is parsed by `ast.parse` (which only
+parses) and the tree is walked with a whitelist of node types, operators, functions and
+names; anything else is rejected with a message that says what and where.
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+from collections.abc import Mapping
+
+import sympy as sp
+
+from mechbook.errors import ExpressionError
+
+MAX_LENGTH = 20_000  # characters in one expression
+MAX_NODES = 5_000  # AST nodes in one expression
+MAX_DEPTH = 60  # nesting of brackets
+MAX_AST_DEPTH = 400  # nesting of the parsed tree (a flat sum of n terms is n deep)
+MAX_DIGITS = 1000  # largest number of digits a numeric power may produce
+MAX_EXPONENT = 64  # largest |numeric exponent| accepted
+MAX_INTEGER = 10**30  # largest integer literal accepted
+
+FUNCTIONS: dict[str, object] = {
+    "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "cot": sp.cot, "sec": sp.sec, "csc": sp.csc,
+    "asin": sp.asin, "acos": sp.acos, "atan": sp.atan, "atan2": sp.atan2,
+    "sinh": sp.sinh, "cosh": sp.cosh, "tanh": sp.tanh,
+    "asinh": sp.asinh, "acosh": sp.acosh, "atanh": sp.atanh,
+    "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt, "Abs": sp.Abs, "abs": sp.Abs,
+    "sign": sp.sign, "cbrt": sp.cbrt,
+}
+ARITY = {"atan2": (2, 2), "log": (1, 2)}
+CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
+
+_BINOPS = {
+    ast.Add: lambda a, b: a + b,
+    ast.Sub: lambda a, b: a - b,
+    ast.Mult: lambda a, b: a * b,
+    ast.Div: lambda a, b: a / b,
+    ast.Pow: None,  # handled separately (size check)
+}
+_COMPARE = {ast.Lt: sp.StrictLessThan, ast.LtE: sp.LessThan,
+            ast.Gt: sp.StrictGreaterThan, ast.GtE: sp.GreaterThan, ast.NotEq: sp.Ne}
+
+
+def _depth(text: str) -> int:
+    depth = best = 0
+    for ch in text:
+        if ch in "([{":
+            depth += 1
+            best = max(best, depth)
+        elif ch in ")]}":
+            depth -= 1
+    return best
+
+
+class _Builder:
+    def __init__(self, text: str, names: Mapping[str, sp.Basic], allow_relations: bool):
+        self.text = text
+        self.source = text.strip()
+        self.names = names
+        self.allow_relations = allow_relations
+        self.nodes = 0
+
+    def fail(self, node: ast.AST | None, what: str) -> ExpressionError:
+        col = getattr(node, "col_offset", None)
+        where = f" at column {col + 1}" if col is not None else ""
+        return ExpressionError(f"{what}{where} in expression {self.text!r}", self.text)
+
+    def build(self, node: ast.AST, depth: int = 0) -> sp.Basic:
+        self.nodes += 1
+        if self.nodes > MAX_NODES:
+            raise self.fail(None, f"expression too large (more than {MAX_NODES} nodes)")
+        if depth > MAX_AST_DEPTH:
+            raise self.fail(node, f"expression nested too deeply (more than {MAX_AST_DEPTH})")
+        method = getattr(self, "_" + type(node).__name__, None)
+        if method is None:
+            raise self.fail(node, f"{type(node).__name__} is not allowed")
+        return method(node, depth + 1)
+
+    def _Expression(self, node: ast.Expression, depth: int) -> sp.Basic:
+        return self.build(node.body, depth)
+
+    def _Constant(self, node: ast.Constant, depth: int) -> sp.Basic:
+        value = node.value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(node, f"constant {value!r} is not a number")
+        if isinstance(value, int):
+            if abs(value) > MAX_INTEGER:
+                raise self.fail(node, "integer literal too large")
+            return sp.Integer(value)
+        # decimal literals are read exactly from their source text (0.5 -> 1/2, all digits
+        # kept) so symbolic checks stay exact
+        literal = ast.get_source_segment(self.source, node) or repr(value)
+        if not math.isfinite(value) or (value != 0 and not 1e-30 <= abs(value) <= MAX_INTEGER):
+            raise self.fail(node, f"number {literal} out of range")
+        try:
+            return sp.Rational(literal.replace("_", ""))
+        except (TypeError, ValueError):
+            raise self.fail(node, f"cannot read number {literal}") from None
+
+    def _Name(self, node: ast.Name, depth: int) -> sp.Basic:
+        name = node.id
+        if name.startswith("_"):
+            raise self.fail(node, f"name {name!r} is not allowed (leading underscore)")
+        if name in self.names:
+            return self.names[name]
+        if name in CONSTANTS:
+            return CONSTANTS[name]
+        if name in FUNCTIONS:
+            raise self.fail(node, f"function {name!r} used without a call")
+        raise self.fail(node, f"unknown name {name!r} (declare it as a parameter or coordinate)")
+
+    def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Basic:
+        operand = self.build(node.operand, depth)
+        if isinstance(node.op, ast.USub):
+            return -operand
+        if isinstance(node.op, ast.UAdd):
+            return operand
+        raise self.fail(node, f"operator {type(node.op).__name__} is not allowed")
+
+    def _BinOp(self, node: ast.BinOp, depth: int) -> sp.Basic:
+        op = type(node.op)
+        if op not in _BINOPS:
+            raise self.fail(node, f"operator {op.__name__} is not allowed")
+        left = self.build(node.left, depth)
+        right = self.build(node.right, depth)
+        if op is ast.Pow:
+            if right.is_Number and abs(right) > MAX_EXPONENT:
+                raise self.fail(node, f"exponent {right} too large (at most {MAX_EXPONENT})")
+            if left.is_Number and right.is_Number and left != 0 and \
+                    float(abs(right)) * math.log10(max(float(abs(left)), 2.0)) > MAX_DIGITS:
+                raise self.fail(node, f"power too large (more than {MAX_DIGITS} digits)")
+            result = left**right
+            for power in [result, *result.atoms(sp.Pow)]:
+                if isinstance(power, sp.Pow) and power.exp.is_Number \
+                        and abs(power.exp) > MAX_EXPONENT**2:
+                    raise self.fail(node, "power too large (a tower of exponents)")
+            for number in result.atoms(sp.Rational):
+                if max(abs(number.p), number.q) > 10**MAX_DIGITS:
+                    raise self.fail(node, f"power too large (more than {MAX_DIGITS} digits)")
+            return result
+        return _BINOPS[op](left, right)
+
+    def _Call(self, node: ast.Call, depth: int) -> sp.Basic:
+        if not isinstance(node.func, ast.Name):
+            raise self.fail(node, "only calls of whitelisted functions by name are allowed")
+        name = node.func.id
+        if name not in FUNCTIONS:
+            raise self.fail(node, f"call of unknown function {name!r}")
+        if node.keywords:
+            raise self.fail(node, f"keyword arguments are not allowed in {name}()")
+        lo, hi = ARITY.get(name, (1, 1))
+        if not lo <= len(node.args) <= hi:
+            raise self.fail(node, f"{name}() takes {lo if lo == hi else f'{lo} to {hi}'} "
+                                  f"argument(s), got {len(node.args)}")
+        args = [self.build(a, depth) for a in node.args]
+        return FUNCTIONS[name](*args)
+
+    def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:
+        if not self.allow_relations:
+            raise self.fail(node, "a comparison is not allowed here")
+        terms = [self.build(node.left, depth)] + [self.build(c, depth) for c in node.comparators]
+        rels = []
+        for op, a, b in zip(node.ops, terms, terms[1:], strict=False):
+            if type(op) not in _COMPARE:
+                raise self.fail(node, f"comparison {type(op).__name__} is not allowed")
+            rels.append(_COMPARE[type(op)](a, b, evaluate=False))
+        return sp.And(*rels, evaluate=False) if len(rels) > 1 else rels[0]
+
+    def _BoolOp(self, node: ast.BoolOp, depth: int) -> sp.Basic:
+        if not self.allow_relations:
+            raise self.fail(node, "and/or is not allowed here")
+        parts = [self.build(v, depth) for v in node.values]
+        return sp.And(*parts) if isinstance(node.op, ast.And) else sp.Or(*parts)
+
+
+def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
+          allow_relations: bool = False) -> sp.Basic:
+    """Parse one expression (or, with allow_relations, a condition such as ``a < b``)."""
+    names = names or {}
+    if isinstance(text, bool):
+        raise ExpressionError(f"expected an expression, got {text!r}")
+    if isinstance(text, int | float):
+        text = repr(text)
+    if not isinstance(text, str):
+        raise ExpressionError(f"expected an expression string, got {type(text).__name__}")
+    if len(text) > MAX_LENGTH:
+        raise ExpressionError(f"expression longer than {MAX_LENGTH} characters")
+    if not text.strip():
+        raise ExpressionError("empty expression")
+    if _depth(text) > MAX_DEPTH:
+        raise ExpressionError(f"expression nested too deeply (more than {MAX_DEPTH})", text)
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as exc:
+        col = f" at column {exc.offset}" if exc.offset else ""
+        raise ExpressionError(f"syntax error{col} in expression {text!r}: {exc.msg}",
+                              text) from None
+    except (RecursionError, MemoryError, ValueError):
+        raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
+    return _Builder(text, names, allow_relations).build(tree)
+
+
+def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None) -> sp.Expr:
+    """Parse ``lhs = rhs`` (or a bare ``expr`` meaning ``expr = 0``) into ``lhs - rhs``."""
+    if not isinstance(text, str):
+        return parse(text, names)
+    pieces = _split_single_equals(text)
+    if len(pieces) == 1:
+        return parse(pieces[0], names)
+    if len(pieces) == 2:
+        return parse(pieces[0], names) - parse(pieces[1], names)
+    raise ExpressionError(f"more than one '=' in equation {text!r}", text)
+
+
+def _split_single_equals(text: str) -> list[str]:
+    out, start = [], 0
+    for i, ch in enumerate(text):
+        if ch == "=":
+            prev = text[i - 1] if i else ""
+            nxt = text[i + 1] if i + 1 < len(text) else ""
+            if prev in "<>=!" or nxt == "=":
+                continue
+            out.append(text[start:i])
+            start = i + 1
+    out.append(text[start:])
+    return out

@@ -1,0 +1,267 @@
+"""A system's Lagrangian built from its declarations: T and V directly, or from bodies.
+
+Coordinates are plain real symbols q, with companions `qdot` and `qddot`; driven coordinates
+are replaced by their prescribed functions of t. T, V and L come from whichever the problem
+states: `lagrangian`, or `kinetic`/`potential`, plus particles, rigid bodies, gravity and
+springs, each adding its own term. Nothing else is modelled.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from mechbook.core.expansion import expand_lagrangian
+from mechbook.core.numeval import without_absent
+from mechbook.errors import UnsupportedError
+from mechbook.model.bodies import body_kinetic, shape_inertia
+from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
+
+
+class System:
+    """Symbols and the Lagrangian of one system of a problem."""
+
+    def __init__(self, problem: Problem, spec: SystemSpec):
+        self.problem = problem
+        self.name = spec.name
+        self.spec = spec.data
+        self.path = spec.path
+        self.t = T
+        self.params = problem.parameters
+        self.small_params = [p.symbol for p in self.params.values() if p.small]
+        self._build_symbols()
+        self._build_energies()
+
+    # ---- symbols -------------------------------------------------------------------------
+    def _error(self, sub: tuple, message: str):
+        return self.problem.doc.error(self.path + sub, message)
+
+    def _parse(self, text, sub: tuple, relation: bool = False):
+        return self.problem.parse(text, self.path + sub, self.names, relation)
+
+    def _build_symbols(self) -> None:
+        coords = list(self.spec["coordinates"])
+        self.q = [sp.Symbol(c, real=True) for c in coords]
+        self.qd = [sp.Symbol(c + "dot", real=True) for c in coords]
+        self.qdd = [sp.Symbol(c + "ddot", real=True) for c in coords]
+        self.coord_names = coords
+        names: dict[str, sp.Basic] = dict(self.problem.names())
+        taken = set(names) | RESERVED
+        for c, q, qd, qdd in zip(coords, self.q, self.qd, self.qdd, strict=True):
+            for sym in (q, qd, qdd):
+                if sym.name in taken:
+                    raise self._error(("coordinates", c), f"name {sym.name!r} is already taken "
+                                      "(parameter, reserved word, or another coordinate)")
+                taken.add(sym.name)
+                names[sym.name] = sym
+        names["t"] = T
+        self.driven: dict[str, sp.Expr] = {}
+        self.free_driven: list[tuple[sp.Symbol, sp.Symbol, sp.Symbol]] = []
+        for name, text in (self.spec.get("driven") or {}).items():
+            if name in taken or name + "dot" in taken or name + "ddot" in taken:
+                raise self._error(("driven", name), f"name {name!r} is already taken")
+            if isinstance(text, dict):  # {free: true}: an arbitrary prescribed function of t
+                syms = tuple(sp.Symbol(name + s, real=True) for s in ("", "dot", "ddot"))
+                self.free_driven.append(syms)
+                names.update({s.name: s for s in syms})
+                taken |= {s.name for s in syms}
+                continue
+            expr = self._parse_with(text, ("driven", name), names)
+            if any(s in expr.free_symbols for s in self.q + self.qd + self.qdd):
+                raise self._error(("driven", name), "a driven coordinate is a function of t and "
+                                  "parameters only")
+            self.driven[name] = expr
+            names[name] = expr
+            names[name + "dot"] = sp.diff(expr, T)
+            names[name + "ddot"] = sp.diff(expr, T, 2)
+            taken |= {name, name + "dot", name + "ddot"}
+        self.names = names
+
+    def _parse_with(self, text, sub: tuple, names: dict):
+        return self.problem.parse(text, self.path + sub, names)
+
+    # ---- energies ------------------------------------------------------------------------
+    def _build_energies(self) -> None:
+        s = self.spec
+        if "lagrangian" in s and ("kinetic" in s or "potential" in s):
+            raise self._error(("lagrangian",), "give either 'lagrangian' or 'kinetic'/'potential'")
+        kinetic = self._parse(s["kinetic"], ("kinetic",)) if "kinetic" in s else sp.S.Zero
+        potential = self._parse(s["potential"], ("potential",)) if "potential" in s else sp.S.Zero
+        self.positions: dict[str, sp.Matrix] = {}
+        self.masses: dict[str, sp.Expr] = {}
+        for name, p in (s.get("particles") or {}).items():
+            m = self._parse(p["mass"], ("particles", name, "mass"))
+            r = sp.Matrix([self._parse(x, ("particles", name, "position", i))
+                           for i, x in enumerate(p["position"])])
+            self.positions[name], self.masses[name] = r, m
+            v = self.dt(r)
+            kinetic += m * v.dot(v) / 2
+        for name, b in (s.get("rigid_bodies") or {}).items():
+            kinetic += self._rigid_body(name, b)
+        potential += self._gravity() + self._springs()
+        if "lagrangian" in s:
+            lag = self._parse(s["lagrangian"], ("lagrangian",))
+            if self.positions or s.get("rigid_bodies"):
+                lag += kinetic - potential
+        else:
+            lag = kinetic - potential
+        if "velocity_potential" in s:
+            lag -= self._parse(s["velocity_potential"], ("velocity_potential",))
+        if lag == 0:
+            raise self._error(("coordinates",), "the system has no kinetic or potential energy")
+        if "approximation" in s:  # the approximation the problem makes, e.g. small angles
+            approx = s["approximation"]
+            point = self.point(approx["about"], ("approximation", "about"))
+            lag = expand_lagrangian(lag, self.q, self.qd, point, self.small_params,
+                                    approx.get("order", 2))
+        self.kinetic = without_absent(kinetic, [T, *self.q])
+        self.potential = without_absent(potential, [T, *self.q])
+        self.lagrangian = without_absent(lag, [T, *self.q])
+        self.forces = self._forces()
+        self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))
+                            for i, c in enumerate(s.get("constraints") or [])]
+        for i, (cname, f) in enumerate(self.constraints):
+            if f.free_symbols & set(self.qd + self.qdd):
+                raise self._error(("constraints", i, "expr"),
+                                  f"constraint {cname!r} must be holonomic: f(q, t) = 0")
+
+    def _rigid_body(self, name: str, b: dict) -> sp.Expr:
+        sub = ("rigid_bodies", name)
+        m = self._parse(b["mass"], sub + ("mass",))
+        r = sp.Matrix([self._parse(x, sub + ("position", i)) for i, x in enumerate(b["position"])])
+        self.positions[name], self.masses[name] = r, m
+        inertia = b["inertia"]
+        if isinstance(inertia, dict):
+            dims = {k: self._parse(v, sub + ("inertia", k)) for k, v in inertia.items()
+                    if k in ("radius", "length")}
+            if "sides" in inertia:
+                dims["sides"] = [self._parse(v, sub + ("inertia", "sides", i))
+                                 for i, v in enumerate(inertia["sides"])]
+            try:
+                tensor = shape_inertia(inertia["shape"], m, dims)
+            except ValueError as exc:
+                raise self._error(sub + ("inertia",), str(exc)) from None
+        elif isinstance(inertia, list):
+            tensor = sp.Matrix([[self._parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]
+                                for i, row in enumerate(inertia)])
+            if tensor != tensor.T:
+                raise self._error(sub + ("inertia",), "inertia tensor must be symmetric")
+        else:
+            tensor = self._parse(inertia, sub + ("inertia",))  # planar: scalar moment
+        omega = None
+        if "angular_velocity" in b:
+            w = b["angular_velocity"]
+            omega = (sp.Matrix([self._parse(x, sub + ("angular_velocity", i))
+                                for i, x in enumerate(w)]) if isinstance(w, list)
+                     else self._parse(w, sub + ("angular_velocity",)))
+        euler = None
+        if "euler_angles" in b:
+            euler = [self._parse(x, sub + ("euler_angles", i))
+                     for i, x in enumerate(b["euler_angles"])]
+        try:
+            return body_kinetic(m, self.dt(r), tensor, omega, euler, self.dt)
+        except ValueError as exc:
+            raise self._error(sub, str(exc)) from None
+
+    def _gravity(self) -> sp.Expr:
+        if "gravity" not in self.spec:
+            return sp.S.Zero
+        grav = self.spec["gravity"] or {}
+        if "g" in grav:
+            g = self._parse(grav["g"], ("gravity", "g"))
+        elif "g" in self.params:
+            g = self.params["g"].symbol
+        else:
+            raise self._error(("gravity",), "gravity needs a parameter 'g' (declare it; default "
+                              "value 9.81) or gravity.g")
+        if not self.positions:
+            raise self._error(("gravity",), "gravity acts on particles or rigid bodies; none given")
+        total = sp.S.Zero
+        for name, r in self.positions.items():
+            if "up" in grav:
+                up = sp.Matrix([self._parse(x, ("gravity", "up", i))
+                                for i, x in enumerate(grav["up"])])
+                if up.shape != r.shape:
+                    raise self._error(("gravity", "up"), f"'up' has {up.rows} components, "
+                                      f"{name}'s position has {r.rows}")
+            else:
+                up = sp.Matrix([0] * (r.rows - 1) + [1])  # default: last axis points up
+            total += self.masses[name] * g * r.dot(up)
+        return total
+
+    def _springs(self) -> sp.Expr:
+        total = sp.S.Zero
+        for i, spring in enumerate(self.spec.get("springs") or []):
+            sub = ("springs", i)
+            k = self._parse(spring["k"], sub + ("k",))
+            if "length" in spring:
+                length = self._parse(spring["length"], sub + ("length",))
+            else:
+                ends = []
+                for j, end in enumerate(spring["between"]):
+                    if isinstance(end, str):
+                        if end not in self.positions:
+                            raise self._error(sub + ("between", j), f"no particle or body {end!r}")
+                        ends.append(self.positions[end])
+                    else:
+                        ends.append(sp.Matrix([self._parse(x, sub + ("between", j, n))
+                                               for n, x in enumerate(end)]))
+                if ends[0].shape != ends[1].shape:
+                    raise self._error(sub + ("between",), "spring ends differ in dimension")
+                d = ends[0] - ends[1]
+                length = sp.sqrt(d.dot(d))
+            natural = (self._parse(spring["natural_length"], sub + ("natural_length",))
+                       if "natural_length" in spring else sp.S.Zero)
+            total += k * (length - natural) ** 2 / 2
+        return total
+
+    def _forces(self) -> list[sp.Expr]:
+        forces = self.spec.get("forces") or {}
+        out = []
+        for c in self.coord_names:
+            out.append(self._parse(forces[c], ("forces", c)) if c in forces else sp.S.Zero)
+        unknown = set(forces) - set(self.coord_names)
+        if unknown:
+            raise self._error(("forces", sorted(unknown)[0]), "generalized forces are keyed by "
+                              "coordinate; no coordinate of that name")
+        return out
+
+    # ---- calculus ------------------------------------------------------------------------
+    def dt(self, expr):
+        """Total time derivative along the motion: d/dt = ∂t + Σ qdot ∂q + Σ qddot ∂qdot."""
+        if isinstance(expr, sp.MatrixBase):
+            return expr.applyfunc(self.dt)
+        out = sp.diff(expr, T)
+        for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True):
+            out += sp.diff(expr, q) * qd + sp.diff(expr, qd) * qdd
+        for y, yd, ydd in self.free_driven:
+            if expr.has(ydd):
+                raise UnsupportedError("third derivative of a free driven coordinate")
+            out += sp.diff(expr, y) * yd + sp.diff(expr, yd) * ydd
+        return out
+
+    def point(self, mapping: dict, sub: tuple) -> dict[sp.Symbol, sp.Expr]:
+        """A configuration {coordinate: expr} parsed at `sub` of the file."""
+        out = {}
+        for name, text in mapping.items():
+            if name not in self.coord_names:
+                raise self._error(sub + (name,), f"{name!r} is not a coordinate of this system")
+            out[self.q[self.coord_names.index(name)]] = self._parse(text, sub + (name,))
+        return out
+
+    def numeric_values(self) -> dict[sp.Symbol, float]:
+        return self.problem.values()
+
+
+
+def system_of(problem: Problem, name: str | None = None) -> System:
+    """The built (symbolic) system `name` of a problem, or its only one; built once and
+    kept on the problem. KeyError names the systems there are."""
+    if name is None:
+        if len(problem.systems) != 1:
+            raise KeyError(f"{problem.id} has several systems: {', '.join(problem.systems)}")
+        name = next(iter(problem.systems))
+    if name not in problem.systems:
+        raise KeyError(f"{problem.id} has no system {name!r} (has {', '.join(problem.systems)})")
+    if name not in problem._cache:
+        problem._cache[name] = System(problem, problem.systems[name])
+    return problem._cache[name]

@@ -1,0 +1,15 @@
+"""Numerical integration of the full nonlinear equations of motion.
+
+    model        the equations compiled once per problem (the compile layer's scalar entry)
+    integrators  SciPy's solve_ivp methods and fixed-step RK4 / symplectic methods, one
+                 interface
+    monitors     drift of the conserved quantities the engine found
+    stiffness    time scales from the linearized equations; is a run stiff?
+    accuracy     method and tolerance for a requested accuracy (a rule measured by
+                 bench/work_precision.py)
+    simulate     initial conditions and `simulate`, the entry point of `mechbook simulate`
+    plot         coordinates against time and the phase portrait (matplotlib, Agg)
+
+May import: mechbook.engine, mechbook.model, mechbook.core, mechbook.errors,
+mechbook.records.
+"""

@@ -1,0 +1,204 @@
+"""Choosing a method and tolerance for a requested accuracy (`mechbook simulate --accuracy`).
+
+The error measure (`state_error`): the state y = (q, q̇) at the end of the run against a
+reference solution, each component divided by its own scale — the largest |y_i| along the
+reference trajectory, floored at 1e-3 of the largest coordinate (or velocity) scale so a
+component that stays near zero is not divided by zero — and the largest of these. It is
+what `rtol` aims at, measured globally instead of per step.
+
+How TABLE was derived (docs/performance.md has the data): `bench/work_precision.py` ran on
+the BENCH_SYSTEMS problem systems that can be simulated, each from its `simulate` start
+(at rest 0.1 from its stable equilibrium) over BENCH_PERIODS periods of its slowest linear
+mode, with each adaptive SciPy method at rtol = atol = 1e-3, 1e-4, …, 1e-12, and measured
+`state_error` against DOP853 at rtol 1e-13, atol 1e-15 (that reference agrees with
+mpmath's Taylor-series integrator at 20 digits and with closed forms to 1.5e-13 – 9e-13).
+For each target 10⁻ᵏ and each method, TABLE holds the loosest tolerance at which the
+method met the target on *every* system, the worst error seen there (the expected error
+`mechbook simulate` prints) and the wall time summed over the systems (the cost). A method
+is missing from a target it never met on every system. The worst system is almost always
+symon-09-21 (a particle in 3-D, 27 time units), where DOP853's error is about 100 × its
+tolerance (the median system: 10 ×); LSODA's error is erratic in the tolerance and Radau's
+cost high, so DOP853 is the cheapest at every target down to 1e-9, and only Radau reached
+1e-10 on every system.
+
+The rule (`choose`): the next target at or below the accuracy asked for; there the
+cheapest method for a non-stiff run, `stiffness.IMPLICIT` for a stiff one (the bench's
+stiffness sweep), or the method the user forced; the method's tolerance from the table.
+Longer runs: the global error of these methods grows about in proportion to the time
+integrated (the phase error of an oscillation), so a run over P > BENCH_PERIODS periods
+(of the slowest linear mode at the start) asks for accuracy × BENCH_PERIODS / P instead
+(`tests/test_accuracy.py` checks this on a pendulum over 30 periods). Chaotic motion grows
+errors exponentially: there no tolerance keeps a stated accuracy for long.
+
+Regenerate: `python bench/work_precision.py` prints the table in this form (and writes it
+to results/bench/accuracy_rule.py); paste it here when the integrators or the problems
+change.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechbook.errors import MechbookError
+
+BENCH_PERIODS = 3  # the bench integrates this many periods of the slowest linear mode
+SCIPY = ("RK45", "DOP853", "Radau", "LSODA")
+
+# target: {method: (rtol = atol, worst error over the bench systems, seconds summed)}
+# measured in 2026 on the 2-core development machine by bench/work_precision.py
+BENCH_SYSTEMS = 33
+TABLE: dict[float, dict[str, tuple[float, float, float]]] = {
+    1e-03: {
+        "RK45": (1e-06, 2.7e-04, 0.195),
+        "DOP853": (1e-05, 8.0e-04, 0.111),
+        "Radau": (1e-05, 9.7e-05, 0.559),
+        "LSODA": (1e-07, 1.0e-04, 0.148),
+    },
+    1e-04: {
+        "RK45": (1e-07, 3.0e-05, 0.285),
+        "DOP853": (1e-06, 8.9e-05, 0.139),
+        "Radau": (1e-05, 9.7e-05, 0.559),
+        "LSODA": (1e-08, 1.6e-05, 0.187),
+    },
+    1e-05: {
+        "RK45": (1e-08, 3.2e-06, 0.43),
+        "DOP853": (1e-07, 9.9e-06, 0.165),
+        "Radau": (1e-06, 5.5e-06, 0.917),
+        "LSODA": (1e-09, 1.4e-06, 0.23),
+    },
+    1e-06: {
+        "RK45": (1e-09, 3.3e-07, 0.682),
+        "DOP853": (1e-09, 1.1e-07, 0.255),
+        "Radau": (1e-07, 3.1e-07, 1.55),
+        "LSODA": (1e-10, 3.1e-07, 0.274),
+    },
+    1e-07: {
+        "RK45": (1e-10, 3.3e-08, 1.05),
+        "DOP853": (1e-10, 1.1e-08, 0.33),
+        "Radau": (1e-08, 1.7e-08, 2.66),
+        "LSODA": (1e-11, 5.0e-08, 0.368),
+    },
+    1e-08: {
+        "RK45": (1e-11, 3.3e-09, 1.65),
+        "DOP853": (1e-11, 1.1e-09, 0.422),
+        "Radau": (1e-09, 6.9e-10, 4.75),
+        "LSODA": (1e-12, 7.8e-09, 0.626),
+    },
+    1e-09: {
+        "RK45": (1e-12, 3.3e-10, 2.66),
+        "DOP853": (1e-12, 1.1e-10, 0.544),
+        "Radau": (1e-09, 6.9e-10, 4.75),
+    },
+    1e-10: {
+        "Radau": (1e-10, 2.9e-11, 8.33),
+    },
+}
+
+
+def state_error(y: np.ndarray, y_ref: np.ndarray, scale: np.ndarray) -> float:
+    """Largest componentwise |y − y_ref| / scale (see the module docstring); inf if y is
+    not finite."""
+    y, y_ref = np.asarray(y, float), np.asarray(y_ref, float)
+    if y.shape != y_ref.shape or not np.all(np.isfinite(y)):
+        return math.inf
+    return float(np.max(np.abs(y - y_ref) / scale))
+
+
+def scales(y_ref_samples: np.ndarray) -> np.ndarray:
+    """Per-component scales from reference samples (2n × N): max |y_i| along the run,
+    floored at 1e-3 of the largest coordinate scale (coordinates) or velocity scale
+    (velocities)."""
+    s = np.max(np.abs(np.asarray(y_ref_samples, float)), axis=1)
+    n = len(s) // 2
+    out = s.copy()
+    for part in (slice(0, n), slice(n, 2 * n)):
+        top = float(np.max(s[part])) if len(s[part]) else 0.0
+        out[part] = np.maximum(s[part], 1e-3 * top)
+    out[out == 0] = 1.0  # a state at rest at the origin throughout
+    return out
+
+
+@dataclass
+class Choice:
+    """Method and tolerance chosen for a requested accuracy, with what to expect."""
+
+    accuracy: float  # requested
+    target: float  # the table's target used (≤ accuracy scaled for the run's length)
+    method: str
+    rtol: float
+    expected: float  # worst error the bench saw at this setting over BENCH_PERIODS
+    periods: float | None  # slowest-mode periods in the run (None: no linear period)
+    reason: str
+
+    @property
+    def atol(self) -> float:
+        return self.rtol
+
+    def describe(self) -> str:
+        horizon = f"over {BENCH_PERIODS} periods of the slowest linear mode"
+        factor = 1.0
+        if self.periods and self.periods > BENCH_PERIODS:
+            factor = self.periods / BENCH_PERIODS
+        expect = self.expected * factor
+        text = (f"{self.method} with rtol = atol = {self.rtol:.0e} for accuracy "
+                f"{self.accuracy:.0e} ({self.reason}); expected error {expect:.1e}")
+        if factor > 1:
+            text += (f" ({self.expected:.1e} measured {horizon}, scaled to this run's "
+                     f"{self.periods:.3g} periods)")
+        else:
+            text += f" (the worst measured {horizon})"
+        return text
+
+
+def _targets() -> list[float]:
+    return sorted(TABLE, reverse=True)
+
+
+def choose(accuracy: float, *, method: str | None = None, stiff: bool = False,
+           periods: float | None = None) -> Choice:
+    """Method and tolerance for a run that should reach `accuracy` (see the docstring).
+
+    `method` forces the method (SciPy methods only; the tolerance comes from its column);
+    `stiff` picks the implicit method when none is forced; `periods` is the run's length
+    in periods of the slowest linear mode."""
+    from mechbook.numerics.stiffness import IMPLICIT
+
+    if not accuracy > 0 or not math.isfinite(accuracy):
+        raise MechbookError(f"--accuracy must be a positive number, got {accuracy}")
+    if method is not None and method not in SCIPY:
+        raise MechbookError(f"--accuracy chooses a tolerance for the adaptive methods "
+                            f"({', '.join(SCIPY)}), not for the fixed-step {method!r}: give "
+                            "--step instead")
+    if not TABLE:
+        raise MechbookError("no accuracy table (run bench/work_precision.py)")
+    wanted = accuracy
+    if periods and periods > BENCH_PERIODS:
+        wanted = accuracy * BENCH_PERIODS / periods
+    reachable = [t for t in _targets() if t <= wanted * (1 + 1e-9)]
+    note = ""
+    if not reachable:
+        reachable = [min(TABLE)]
+        note = f"; below {min(TABLE):.0e} the bench has no data: the tightest setting"
+    target = reachable[0]
+    row = TABLE[target]
+    if method is not None:
+        pick, why = method, "forced"
+    elif stiff:
+        pick, why = IMPLICIT, "stiff run"
+    else:
+        pick = min(row, key=lambda m: row[m][2])
+        why = "cheapest in the bench"
+    if pick not in row:  # the method never met this target on every system
+        own = [t for t in sorted(TABLE) if pick in TABLE[t]]
+        if not own:
+            raise MechbookError(f"{pick} met no accuracy target on every bench system")
+        target, row = own[0], TABLE[own[0]]
+        note += f"; {pick} met no target below {target:.0e} on every bench system"
+    rtol, worst, _ = row[pick]
+    return Choice(accuracy, target, pick, rtol, worst, periods, why + note)
+
+
+__all__ = ["BENCH_PERIODS", "TABLE", "Choice", "choose", "scales", "state_error"]

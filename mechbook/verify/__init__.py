@@ -1,0 +1,13 @@
+"""Verification: the book's answer keys against the engine, one outcome per part.
+
+    answers     answer keys: loading, parts, their names and parsing
+    compare     deciding agreement: numerically at random admissible points, symbolically
+                on request (ProofPolicy)
+    context     what a part is checked in: system, names, sampler, point
+    registry    every answer quantity: name -> check, schema fragment, doc line
+    quantities  the checks, one module per family of quantities
+    checker     running a key: outcomes pass / fail / erratum / unsupported / error
+
+May import: mechbook.engine, mechbook.model, mechbook.core, mechbook.errors,
+mechbook.records.
+"""

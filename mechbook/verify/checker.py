@@ -1,0 +1,68 @@
+"""Running an answer key against the engine: one outcome per part.
+
+Outcomes: pass · fail · erratum (the book's value fails, the key's corrected value passes and
+the key carries the derivation) · unsupported (the engine cannot compute it yet; never a pass)
+· error (the part could not be evaluated: a malformed key or an engine fault; counts as fail).
+"""
+
+from __future__ import annotations
+
+import time
+import traceback
+
+from mechbook.engine.analysis import Analysis
+from mechbook.errors import MechbookError, NotEquilibriumError, SpecError, UnsupportedError
+from mechbook.records import Outcome
+from mechbook.verify.answers import AnswerKey, Part
+from mechbook.verify.compare import NUMERIC, ProofPolicy
+from mechbook.verify.context import Context
+from mechbook.verify.registry import quantities
+
+
+def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) -> Outcome:
+    start = time.perf_counter()
+    out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], "error",
+                  origin=part.data.get("origin", "book"))
+    try:
+        if "unsupported" in part.data:
+            out.status, out.detail = "unsupported", part.data["unsupported"]
+            return out
+        ctx = Context(analysis, part, policy)
+        fn = quantities()[part.quantity].check
+        verdict = fn(ctx, part.data.get("book"))
+        if "erratum" in part.data:
+            corrected = fn(ctx, part.data["erratum"]["corrected"])
+            if verdict.ok:
+                out.status = "fail"
+                out.detail = "an erratum is recorded but the book's value agrees with the engine"
+            elif not corrected.ok:
+                out.status = "fail"
+                out.detail = f"the corrected value fails too: {corrected.detail}"
+            else:
+                out.status, out.method = "erratum", corrected.method
+                out.detail = f"book value fails ({verdict.detail}); corrected value passes"
+        else:
+            out.status = "pass" if verdict.ok else "fail"
+            out.method, out.detail = verdict.method, verdict.detail
+    except UnsupportedError as exc:
+        out.status, out.detail = "unsupported", exc.capability
+    except NotEquilibriumError as exc:  # the answer's point or steady rate is wrong
+        out.status, out.detail = "fail", str(exc)
+    except SpecError as exc:
+        out.status, out.detail = "error", str(exc)
+    except MechbookError as exc:
+        out.status, out.detail = "error", str(exc)
+    except Exception as exc:  # an engine fault must not hide the other parts
+        out.status = "error"
+        out.detail = f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-1).strip()}]"
+    finally:
+        out.seconds = time.perf_counter() - start
+    return out
+
+
+def check_problem(analysis: Analysis, key: AnswerKey,
+                  policy: ProofPolicy = NUMERIC) -> list[Outcome]:
+    if key.problem_id != analysis.problem.id:
+        raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem file "
+                            f"is {analysis.problem.id!r}")
+    return [check_part(analysis, part, policy) for part in key.parts]

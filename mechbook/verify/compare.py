@@ -1,0 +1,224 @@
+"""Deciding whether two expressions agree: symbolically if SymPy can, else numerically.
+
+Numeric comparison evaluates at several random admissible points (parameters drawn around
+their default values, honouring positivity and any `assume` conditions) with 30-digit
+arithmetic, so a pass means agreement to far better than the stated tolerance at each point.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from mechbook.core.numeval import NotNumeric, evaluate, holds
+from mechbook.core.timeout import Timeout, time_limit
+from mechbook.records import NUMERIC, ProofPolicy
+
+RTOL = 1e-10  # relative tolerance of a numeric comparison
+POINTS = 6  # random points per numeric comparison
+DIGITS = 30
+
+
+@dataclass
+class Verdict:
+    ok: bool
+    method: str  # 'symbolic' or 'numeric(N points, rtol)'
+    detail: str = ""
+
+
+class Sampler:
+    """Random admissible values for symbols: parameters, answer symbols and free variables."""
+
+    def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
+                 seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC):
+        self.base = dict(base)
+        self.conditions = list(conditions)
+        self.rng = np.random.default_rng(seed)
+        self.spread = spread
+        self.policy = policy  # carried with the sampler to every comparison it serves
+
+    def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
+             tries: int = 2000) -> dict[sp.Symbol, sp.Float]:
+        """One point satisfying every condition (raises if none is found). When the
+        conditions exclude the neighbourhood of the default values, the spread is widened
+        step by step (x4 each time), so an `assume:` far from the defaults still samples."""
+        spread = self.spread if spread is None else spread
+        for attempt in range(tries):
+            if attempt and attempt % (tries // 5) == 0:
+                spread *= 4
+            point = {}
+            for sym, value in self.base.items():
+                if sym.is_positive:
+                    point[sym] = value * math.exp(self.rng.uniform(-spread, spread))
+                else:
+                    point[sym] = value + self.rng.uniform(-1, 1) * max(1.0, abs(value)) * spread
+            for v in variables:
+                if v not in point:
+                    point[v] = self.rng.uniform(0.1, 1.0) if v.is_positive \
+                        else self.rng.uniform(-1.0, 1.0)
+            point = {k: sp.Float(v, DIGITS) for k, v in point.items()}
+            if all(holds(c, point) for c in self.conditions):
+                return point
+        raise ValueError("no admissible parameter point satisfies the stated conditions")
+
+    def default(self) -> dict[sp.Symbol, sp.Float]:
+        point = {k: sp.Float(v, DIGITS) for k, v in self.base.items()}
+        if all(holds(c, point) for c in self.conditions):
+            return point
+        return self.draw()
+
+
+def value(expr: sp.Basic, point: dict) -> complex:
+    """expr at `point` as a complex number (NaN if it does not evaluate)."""
+    return value_and_scale(expr, point)[0]
+
+
+def value_and_scale(expr: sp.Basic, point: dict) -> tuple[complex, float]:
+    """expr at `point` and the magnitude of what cancelled on the way (NaN if no value)."""
+    try:
+        return evaluate(expr, point, DIGITS)
+    except NotNumeric:
+        pass
+    except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+        return complex(float("nan"), 0), float("nan")
+    try:  # a part the fast evaluator does not know: let SymPy evaluate the whole
+        v = complex(sp.N(expr.subs(point), DIGITS))
+        return v, abs(v)
+    except (TypeError, ValueError, ZeroDivisionError):
+        return complex(float("nan"), 0), float("nan")
+
+
+def _free_variables(exprs: Iterable[sp.Basic], known: dict) -> set[sp.Symbol]:
+    out: set[sp.Symbol] = set()
+    for e in exprs:
+        out |= {s for s in e.free_symbols if s not in known}
+    return out
+
+
+def _symbolic_zero(expr: sp.Basic, seconds: float) -> bool:
+    try:
+        with time_limit(seconds):
+            if expr == 0:
+                return True
+            return sp.simplify(expr) == 0
+    except Timeout:
+        return False
+    except Exception:  # SymPy can raise odd errors on odd input; then decide numerically
+        return False
+
+
+def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
+    """Is `expr` identically zero (under the sampler's assumptions)? A symbolic proof is
+    attempted after the numeric pass when `symbolic` (default: the sampler's policy)."""
+    variables = _free_variables([expr], sampler.base)
+    worst = 0.0
+    valid = 0
+    for _ in range(POINTS * 3):
+        if valid >= POINTS:
+            break
+        point = sampler.draw(variables)
+        v, scale = value_and_scale(expr, point)
+        if not (np.isfinite(v.real) and np.isfinite(v.imag) and np.isfinite(scale)):
+            continue
+        valid += 1
+        rel = abs(v) / scale if scale > 0 else abs(v)
+        worst = max(worst, rel)
+        if rel > RTOL:
+            return Verdict(False, f"numeric({valid} points)",
+                           f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
+    if valid == 0:
+        return Verdict(False, "numeric", "expression does not evaluate at any sample point")
+    if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
+        return Verdict(True, "symbolic")
+    return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+
+
+def _prove(sampler: Sampler, symbolic: bool | None) -> bool:
+    return sampler.policy.prove if symbolic is None else symbolic
+
+
+def all_vanish(exprs: Sequence[sp.Basic], sampler: Sampler,
+               symbolic: bool | None = None) -> Verdict:
+    """Does every expression vanish? All are tested numerically before any symbolic proof is
+    tried, so a wrong one is reported at the cost of a few evaluations, not of simplify()."""
+    verdicts = [vanishes(e, sampler, symbolic=False) for e in exprs]
+    for v in verdicts:
+        if not v.ok:
+            return v
+    if _prove(sampler, symbolic):
+        verdicts = [Verdict(True, "symbolic") if _symbolic_zero(e, sampler.policy.seconds)
+                    else v
+                    for e, v in zip(exprs, verdicts, strict=True)]
+    return combine(verdicts)
+
+
+def combine(verdicts: Sequence[Verdict]) -> Verdict:
+    """One verdict for several: the first failure, else a pass named by how it was decided."""
+    for v in verdicts:
+        if not v.ok:
+            return v
+    methods = {v.method.split("(")[0] for v in verdicts}
+    method = "symbolic" if methods == {"symbolic"} else ("numeric" if "numeric" in methods else
+                                                          ",".join(sorted(methods)))
+    return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail))
+
+
+def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
+    """Do a and b agree identically?"""
+    variables = _free_variables([a, b], sampler.base)
+    worst = 0.0
+    valid = 0
+    for _ in range(POINTS * 3):
+        if valid >= POINTS:
+            break
+        point = sampler.draw(variables)
+        va, vb = value(a, point), value(b, point)
+        if not all(np.isfinite([va.real, va.imag, vb.real, vb.imag])):
+            continue
+        valid += 1
+        rel = abs(va - vb) / max(abs(va), abs(vb), 1e-300)
+        worst = max(worst, rel)
+        if rel > RTOL and abs(va - vb) > 1e-25:
+            return Verdict(False, f"numeric({valid} points)",
+                           f"{_num(va)} vs {_num(vb)} at {_fmt(point)}")
+    if valid == 0:
+        return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
+    if _prove(sampler, symbolic) and _symbolic_zero(a - b, sampler.policy.seconds):
+        return Verdict(True, "symbolic")
+    return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+
+
+def _num(z: complex) -> str:
+    return f"{z.real:.10g}" if abs(z.imag) < 1e-14 * max(1, abs(z)) else f"{z:.6g}"
+
+
+def _fmt(point: dict) -> str:
+    items = sorted(point.items(), key=lambda kv: kv[0].name)[:8]
+    return "{" + ", ".join(f"{k}={float(v):.4g}" for k, v in items) + "}"
+
+
+def match_multiset(book: Sequence[float], engine: Sequence[float], partial: bool = False,
+                   rtol: float = 1e-8) -> tuple[bool, str]:
+    """Compare two lists of numbers as multisets (book ⊆ engine if partial)."""
+    if any(not np.isfinite(x) for x in book):
+        return False, f"book value(s) not real and finite here: {_list(list(book))}"
+    b = sorted(book)
+    e = sorted(x for x in engine if np.isfinite(x))
+    if not partial and len(b) != len(e):
+        return False, f"book has {len(b)} values, engine {len(e)}: {_list(b)} vs {_list(e)}"
+    scale = max([abs(x) for x in b + e] + [1e-300])
+    free = list(e)
+    for x in b:
+        best = min(range(len(free)), key=lambda i: abs(free[i] - x), default=None)
+        if best is None or abs(free[best] - x) > rtol * max(abs(x), 1e-3 * scale):
+            return False, f"book value {x:.10g} not among engine values {_list(e)}"
+        free.pop(best)
+    return True, ""
+
+
+def _list(xs: Sequence[float]) -> str:
+    return "[" + ", ".join(f"{x:.8g}" for x in xs) + "]"

@@ -1,0 +1,119 @@
+"""The context an answer part is checked in: its system, names, sampler and point.
+
+A part's check reads everything it needs through a `Context`: the system the part names,
+the names it may use (parameters, coordinates, answer symbols, abbreviations, `define:`
+forms, momenta p_<q>), a `Sampler` of admissible parameter points (conditions and `assume:`
+honoured, with the user's proof policy), and the equilibrium or steady motion it refers to
+(`about:`, `steady:`), linearized by the engine on demand. Small helpers shared by several
+families of quantities live here too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from mechbook.engine.analysis import Analysis
+from mechbook.engine.linear import LinearSystem
+from mechbook.records import NUMERIC, ProofPolicy
+from mechbook.verify.answers import Part
+from mechbook.verify.compare import Sampler, value
+
+
+@dataclass
+class Context:
+    analysis: Analysis
+    part: Part
+    policy: ProofPolicy = NUMERIC
+
+    def __post_init__(self):
+        try:
+            self.system = self.analysis.system(self.part.system)
+        except KeyError as exc:  # no `system:` in a multi-system problem, or a wrong one
+            raise self.part.error(("system",) if self.part.system else (),
+                                  str(exc.args[0]) + "; name it with `system:`") from None
+        self.names = self.part.names(self.system)
+        for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
+            self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
+        for k, v in (self.part.data.get("define") or {}).items():  # e.g. alpha = theta - pi
+            if k in self.names:
+                raise self.part.error(("define", k), f"{k!r} is already a name")
+            f = self.parse(v, ("define", k))
+            self.names[k] = f
+            self.names[k + "dot"] = self.system.dt(f)
+            self.names[k + "ddot"] = self.system.dt(self.system.dt(f))
+        conds = list(self.analysis.problem.conditions)
+        conds += [self.parse(c, ("assume", i), relation=True)
+                  for i, c in enumerate(self.part.data.get("assume", []))]
+        base = dict(self.analysis.problem.values())
+        base.update(self.part.key.symbol_values)
+        self.sampler = Sampler(base, conds, policy=self.policy)
+
+    @property
+    def dyn(self):
+        return self.analysis.dynamics(self.part.system)
+
+    def parse(self, text, sub, equation=False, relation=False):
+        return self.part.parse(text, sub, self.names, equation, relation)
+
+    def point(self) -> dict:
+        about = self.part.data.get("about")
+        if about is None:
+            return self.analysis.default_point(self.part.system)
+        point = {}
+        for k, v in about.items():
+            if k not in self.system.coord_names:
+                raise self.part.error(("about", k), f"{k!r} is not a coordinate")
+            point[self.system.q[self.system.coord_names.index(k)]] = self.parse(v, ("about", k))
+        return point
+
+    def linear(self) -> LinearSystem:
+        if "steady" in self.part.data:
+            if "about" not in self.part.data:
+                raise self.part.error(("steady",), "a steady motion needs `about:` for the "
+                                      "coordinates that stay put")
+            rates = {}
+            for k, v in self.part.data["steady"].items():
+                if k not in self.system.coord_names:
+                    raise self.part.error(("steady", k), f"{k!r} is not a coordinate")
+                rates[self.system.q[self.system.coord_names.index(k)]] = \
+                    self.parse(v, ("steady", k))
+            return self.analysis.steady_linear(self.part.system, rates, self.point())
+        return self.analysis.linear(self.part.system, self.point())
+
+    def as_list(self, val, sub) -> list:
+        if isinstance(val, list):
+            return val
+        raise self.part.error(sub, "expected a list")
+
+    def as_map(self, val, sub) -> dict:
+        if isinstance(val, dict):
+            return val
+        raise self.part.error(sub, "expected a mapping")
+
+
+def strip_const(text):
+    """A first integral's text without a trailing '= constant' (or '= const')."""
+    if isinstance(text, str):
+        for tail in ("= constant", "= const", "=constant", "=const"):
+            if text.rstrip().endswith(tail):
+                return text.rstrip()[: -len(tail)]
+    return text
+
+
+def linear_accelerations(lin: LinearSystem) -> dict:
+    """q̈ solved from the linear equations M·q̈ + C·q̇ + K·δq = F."""
+    n = len(lin.q)
+    rhs = lin.F - lin.C * sp.Matrix(lin.dyn.qd) - lin.K * lin.displacement()
+    sol = lin.M.LUsolve(rhs)
+    return {lin.dyn.qdd[i]: sol[i] for i in range(n)}
+
+
+def numbers(exprs, pt) -> list[float]:
+    """Real values of expressions at a point (NaN where a value is not real)."""
+    out = []
+    for e in exprs:
+        z = value(e, pt)
+        out.append(z.real if abs(z.imag) <= 1e-12 * max(1, abs(z)) else float("nan"))
+    return out

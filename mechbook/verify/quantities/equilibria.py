@@ -1,0 +1,91 @@
+"""Quantities about static equilibria: `equilibrium`, `stability_condition`.
+"""
+
+from __future__ import annotations
+
+from mechbook.core.numeval import holds
+from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine, vanishes
+from mechbook.verify.context import Context
+from mechbook.verify.registry import quantity
+
+
+def _engine_points(ctx: Context) -> list[dict]:
+    return ctx.analysis.equilibria(ctx.part.system).symbolic
+
+
+@quantity('equilibrium',
+          book='`{at: {q: value}}` or `{where: [equations]}`',
+          how=('`at`: the equilibrium conditions vanish there; `where`: an engine '
+               'equilibrium satisfies the equations. `stable: true/false` also checks '
+               'stability'),
+          keys={"stable": {"type": "boolean"}})
+def check_equilibrium(ctx: Context, val) -> Verdict:
+    """`at:` the point satisfies the equilibrium conditions; `where:` some engine equilibrium
+    satisfies the book's equations. `stable:` also checks the stability there."""
+    val = ctx.as_map(val, ("book",))
+    eq = ctx.analysis.equilibria(ctx.part.system)
+    if "at" in val:
+        at = ctx.as_map(val["at"], ("book", "at"))
+        point = {ctx.system.q[ctx.system.coord_names.index(k)]: ctx.parse(v, ("book", "at", k))
+                 for k, v in at.items() if k in ctx.system.coord_names}
+        if len(point) != len(ctx.system.q):
+            raise ctx.part.error(("book", "at"), "give every coordinate of the point")
+        verdicts = [all_vanish(eq.residual(point), ctx.sampler)]
+        candidates = [point]
+    elif "where" in val:
+        where = [ctx.parse(w, ("book", "where", i), equation=True)
+                 for i, w in enumerate(ctx.as_list(val["where"], ("book", "where")))]
+        candidates = []
+        for pt in _engine_points(ctx):
+            if all(vanishes(w.subs(pt), ctx.sampler, symbolic=False).ok for w in where):
+                candidates.append(pt)
+        if not candidates:
+            return Verdict(False, "numeric", "no equilibrium found by the engine satisfies "
+                           f"{val['where']}; engine found {_engine_points(ctx)}")
+        verdicts = [Verdict(True, "symbolic", f"engine equilibrium {candidates[0]}")]
+    else:
+        raise ctx.part.error(("book",), "an equilibrium answer gives 'at:' or 'where:'")
+    verdict = combine(verdicts)
+    if not verdict.ok:
+        return verdict
+    if "stable" in ctx.part.data:
+        want = ctx.part.data["stable"]
+        for pt in candidates:
+            lin = ctx.analysis.linear(ctx.part.system, pt)
+            for _ in range(4):
+                got = lin.numeric_stability(ctx.sampler.draw())
+                if (got == "stable") != want:
+                    return Verdict(False, "numeric", f"engine finds the equilibrium {got}")
+    return combine(verdicts)
+
+
+@quantity('stability_condition',
+          book='relation',
+          how=('at ≥ 60 parameter points drawn widely on both sides of the boundary, the'
+               ' relation holds exactly where the linearized system is stable'))
+def check_stability_condition(ctx: Context, val) -> Verdict:
+    """The book's condition holds exactly where the engine finds the point stable, over
+    parameter points drawn widely on both sides of the boundary."""
+    cond = ctx.parse(val, ("book",), relation=True)
+    lin = ctx.linear()
+    wide = Sampler(ctx.sampler.base, ctx.sampler.conditions, spread=2.0, policy=ctx.policy)
+    seen = {True: 0, False: 0}
+    n = 0
+    for _ in range(400):
+        pt = wide.draw()
+        got = lin.numeric_stability(pt)
+        if got == "marginal":
+            continue
+        claim = holds(cond, pt)
+        if claim != (got == "stable"):
+            return Verdict(False, f"numeric({n + 1} points)",
+                           f"book says {'stable' if claim else 'unstable'}, engine finds {got} "
+                           f"at {{{', '.join(f'{k}={float(v):.4g}' for k, v in pt.items())}}}")
+        seen[claim] += 1
+        n += 1
+        if n >= 60 and min(seen.values()) >= 10:
+            break
+    if min(seen.values()) == 0:
+        return Verdict(False, "numeric", "sampling never crossed the stability boundary; "
+                       "the check cannot discriminate (widen parameters)")
+    return Verdict(True, f"numeric({n} points: {seen[True]} stable, {seen[False]} unstable)")

@@ -1,0 +1,139 @@
+"""Motions of the linearized system: `steady_state` (driven) and `motion` (general or
+from `initial:`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from mechbook.engine.linear import LinearSystem
+from mechbook.errors import UnsupportedError
+from mechbook.verify.compare import Verdict, all_vanish
+from mechbook.verify.context import Context, numbers
+from mechbook.verify.registry import POINT, quantity
+
+
+def _time_functions(ctx: Context, val, sub) -> dict[sp.Symbol, sp.Expr]:
+    """Book's {coordinate or defined name: f(t)} turned into coordinates where possible."""
+    val = ctx.as_map(val, sub)
+    define = ctx.part.data.get("define") or {}
+    funcs = {}
+    for name, text in val.items():
+        if name not in ctx.system.coord_names and name not in define:
+            raise ctx.part.error(sub + (name,), f"{name!r} is neither a coordinate nor defined")
+        funcs[name] = ctx.parse(text, sub + (name,))
+    return funcs
+
+
+@quantity('steady_state',
+          book='`{q: f(t)}`',
+          how='satisfies the linearized driven equations')
+def check_steady_state(ctx: Context, val) -> Verdict:
+    """The book's particular solution satisfies the linearized driven equations (each
+    equation whose coordinates the book gives must vanish)."""
+    lin = ctx.linear()
+    funcs = _time_functions(ctx, val, ("book",))
+    return _residual_of_motion(ctx, lin, funcs)
+
+
+def _coordinates_from(ctx: Context, funcs: dict) -> dict[sp.Symbol, sp.Expr]:
+    """Coordinates as functions of t from the book's functions (and `define:` forms)."""
+    define = ctx.part.data.get("define") or {}
+    sys = ctx.system
+    direct = {sys.q[sys.coord_names.index(k)]: v for k, v in funcs.items()
+              if k in sys.coord_names}
+    defined = {k: v for k, v in funcs.items() if k in define}
+    if not defined:
+        return direct
+    unknowns = [q for q in sys.q if q not in direct]
+    eqs = [ctx.parse(define[k], ("define", k)).subs(direct) - v for k, v in defined.items()]
+    sol = sp.solve(eqs, unknowns, dict=True)
+    if len(sol) != 1:
+        raise ctx.part.error(("define",), "the defined coordinates do not determine the motion")
+    direct.update(sol[0])
+    return direct
+
+
+def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict:
+    coords = _coordinates_from(ctx, funcs)
+    t = ctx.system.t
+    subs = {}
+    for q, qd, qdd in zip(lin.dyn.q, lin.dyn.qd, lin.dyn.qdd, strict=True):
+        if q in coords:
+            f = coords[q]
+            subs.update({q: f, qd: sp.diff(f, t), qdd: sp.diff(f, t, 2)})
+    checked = []
+    for e in lin.equations():
+        r = e.subs(subs)
+        if r.free_symbols & set(lin.dyn.q + lin.dyn.qd + lin.dyn.qdd):
+            continue
+        checked.append(r)
+    if not checked:
+        raise UnsupportedError("checking a motion that leaves every equation with unknown "
+                               "coordinates (give the initial conditions instead)")
+    return all_vanish(checked, ctx.sampler)
+
+
+@quantity('motion',
+          book='`{q or defined name: f(t)}`',
+          how=('with `initial:`, equals the modal solution of the linearized '
+               'initial-value problem at several times; without, satisfies the '
+               'linearized equations for any value of its constants'),
+          keys={"initial": POINT})
+def check_motion(ctx: Context, val) -> Verdict:
+    """With `initial:`, compare with the modal solution of the linearized initial-value
+    problem at several times; without, the book's general solution must satisfy the
+    linearized equations for any values of its constants."""
+    lin = ctx.linear()
+    funcs = _time_functions(ctx, val, ("book",))
+    if "initial" not in ctx.part.data:
+        return _residual_of_motion(ctx, lin, funcs)
+    if lin.gyroscopic or lin.driven:
+        raise UnsupportedError("initial-value solution of a driven or gyroscopic system")
+    init = ctx.as_map(ctx.part.data["initial"], ("initial",))
+    sys = ctx.system
+    define = ctx.part.data.get("define") or {}
+    forms = {k: ctx.parse(v, ("define", k)) for k, v in define.items()}
+    t = sys.t
+    for _ in range(4):
+        pt = ctx.sampler.draw()
+        q0 = np.zeros(len(sys.q))
+        v0 = np.zeros(len(sys.q))
+        for k, text in init.items():
+            x = numbers([ctx.parse(text, ("initial", k))], pt)[0]
+            if k in sys.coord_names:
+                q0[sys.coord_names.index(k)] = x
+            elif k.endswith("dot") and k[:-3] in sys.coord_names:
+                v0[sys.coord_names.index(k[:-3])] = x
+            else:
+                raise ctx.part.error(("initial", k), "initial values are given for coordinates "
+                                     "(x) and their velocities (xdot)")
+        eq0 = np.array(numbers([lin.point.get(q, 0) for q in sys.q], pt))
+        w2, U = lin.numeric_modes(pt)
+        Mn = lin.matrices(pt)[0]
+        a = U.T @ Mn @ (q0 - eq0)
+        b = U.T @ Mn @ v0
+        for tv in (0.37, 1.3, 2.9, 7.1):
+            eta = np.empty(len(w2))
+            for k, x in enumerate(w2):
+                if abs(x) < 1e-10 * max(1.0, np.max(np.abs(w2))):
+                    eta[k] = a[k] + b[k] * tv
+                elif x > 0:
+                    w = np.sqrt(x)
+                    eta[k] = a[k] * np.cos(w * tv) + b[k] * np.sin(w * tv) / w
+                else:
+                    raise UnsupportedError("motion about an unstable equilibrium")
+            q = eq0 + U @ eta
+            env = dict(pt)
+            env[t] = sp.Float(tv, 30)
+            env.update({sq: sp.Float(x, 30) for sq, x in zip(sys.q, q, strict=True)})
+            for name, f in funcs.items():
+                expected = (q[sys.coord_names.index(name)] if name in sys.coord_names
+                            else numbers([forms[name]], env)[0])
+                got = numbers([f], env)[0]
+                scale = max(np.max(np.abs(q)), np.max(np.abs(q0)), 1e-300)
+                if not abs(got - expected) <= 1e-8 * max(abs(expected), scale):
+                    return Verdict(False, "numeric", f"{name}(t={tv}) = {got:.10g}, "
+                                   f"engine {expected:.10g}")
+    return Verdict(True, "numeric(4 points x 4 times, modal solution)")

@@ -1,0 +1,297 @@
+"""Small oscillations: `frequencies`, `period`, `normal_modes`, `normal_coordinates`,
+`mode_count`, `mode_node`, and the asymptotic (`limit:`) form of the first and third.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from mechbook.engine.linear import LinearSystem
+from mechbook.errors import UnsupportedError
+from mechbook.verify.compare import Verdict, match_multiset, vanishes
+from mechbook.verify.context import Context, numbers
+from mechbook.verify.registry import EXPR, LIMIT, quantity
+
+
+def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:
+    return [ctx.parse(v, ("book", i)) for i, v in enumerate(ctx.as_list(val, ("book",)))]
+
+
+@quantity('frequencies',
+          book='list of ω',
+          how=("multiset equality with the engine's normal frequencies at random points "
+               '(numeric `eigh`, or state-space eigenvalues with gyroscopic terms), '
+               'symbolic with `--prove` where SymPy confirms; `partial: true` for a '
+               'subset; `limit: {parameter, to: 0 or oo, order}` for asymptotic formulas'),
+          keys={"partial": {"type": "boolean"},
+                "limit": LIMIT})
+def check_frequencies(ctx: Context, val) -> Verdict:
+    """Multiset of normal angular frequencies (numeric eigh at random points; symbolic where
+    SymPy can); `partial: true` allows the book to list a subset; `limit:` compares an
+    asymptotic formula."""
+    book = _book_frequencies(ctx, val)
+    lin = ctx.linear()
+    partial = bool(ctx.part.data.get("partial"))
+    if "limit" in ctx.part.data:
+        return _check_limit(ctx, book, lin)
+    n = 0
+    for _ in range(6):
+        pt = ctx.sampler.draw()
+        ok, why = match_multiset(numbers(book, pt), list(lin.numeric_frequencies(pt)), partial)
+        n += 1
+        if not ok:
+            return Verdict(False, f"numeric({n} points)", why)
+    return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or
+                   f"numeric({n} points, eigensolver)")
+
+
+def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
+    """'symbolic' when, asked to prove (`--prove`), the engine's closed-form frequencies
+    match the book's exactly; the numeric multiset comparison has already decided."""
+    if not ctx.policy.prove:
+        return None
+    try:
+        engine = list(lin.frequencies)
+    except UnsupportedError:
+        return None
+    pt = ctx.sampler.draw()
+    eng_vals = numbers(engine, pt)
+    used = set()
+    for b in book:
+        bv = numbers([b], pt)[0]
+        idx = [i for i in range(len(engine)) if i not in used
+               and abs(eng_vals[i] - bv) <= 1e-8 * max(1, abs(bv))]
+        if not idx or not vanishes(b**2 - engine[idx[0]] ** 2, ctx.sampler).method == "symbolic":
+            return None
+        used.add(idx[0])
+    return "symbolic"
+
+
+def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
+    def error(pt) -> float:
+        eng = list(lin.numeric_frequencies(pt))
+        worst = 0.0
+        for b in numbers(book, pt):  # one-to-one: each engine frequency matches once
+            if not eng:
+                return float("inf")
+            nearest = min(range(len(eng)), key=lambda i, b=b: abs(eng[i] - b))
+            worst = max(worst, abs(eng.pop(nearest) - b) / max(abs(b), 1e-300))
+        return worst
+
+    return _asymptotic(ctx, error)
+
+
+def _asymptotic(ctx: Context, error) -> Verdict:
+    """`limit: {parameter, to, order}`: the book's formula holds in a limit of the
+    parameters. The relative error `error(point)` must fall as the parameter goes to 0 or ∞
+    by decades, faster than 10^-order per decade (halved, for safety), and end below 1e-3."""
+    spec = ctx.part.data["limit"]
+    name = spec["parameter"]
+    if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
+        raise ctx.part.error(("limit", "parameter"), f"unknown parameter {name!r}")
+    sym = ctx.names[name]
+    order = spec.get("order", 0)
+    to_zero = str(spec["to"]) == "0"
+    base = ctx.sampler.default()
+    errors = []
+    for eps in (1e-3, 1e-4, 1e-5):
+        pt = dict(base)
+        pt[sym] = base[sym] * eps if to_zero else base[sym] / eps
+        errors.append(error(pt))
+    ratios = [errors[i + 1] / errors[i] if errors[i] > 1e-14 else 0.0 for i in range(2)]
+    needed = 0.5 * 10.0 ** (-order)
+    ok = errors[-1] < 1e-3 and all(r <= needed for r in ratios)
+    detail = (f"relative error {errors[0]:.2g}, {errors[1]:.2g}, {errors[2]:.2g} as "
+              f"{name} -> {spec['to']} by decades (needs decrease faster than x{needed:g})")
+    return Verdict(ok, "numeric(asymptotic)", detail)
+
+
+@quantity('period',
+          book='expression',
+          how="2π/ω for one of the engine's nonzero frequencies")
+def check_period(ctx: Context, val) -> Verdict:
+    """2π/ω for one of the engine's nonzero frequencies."""
+    period = ctx.parse(val, ("book",))
+    lin = ctx.linear()
+    for _ in range(6):
+        pt = ctx.sampler.draw()
+        p = numbers([period], pt)[0]
+        freqs = [w for w in lin.numeric_frequencies(pt) if w > 0]
+        if not any(abs(2 * np.pi / w - p) <= 1e-8 * p for w in freqs):
+            return Verdict(False, "numeric", f"period {p:.10g} vs engine "
+                           f"{[2 * np.pi / w for w in freqs]}")
+    try:
+        if ctx.policy.prove and any(vanishes(period - 2 * sp.pi / w, ctx.sampler).method
+                                    == "symbolic" for w in lin.frequencies if w != 0):
+            return Verdict(True, "symbolic")
+    except UnsupportedError:
+        pass
+    return Verdict(True, "numeric(6 points)")
+
+
+def _mode_residual(lin: LinearSystem, freq: sp.Expr, shape: sp.Matrix, pt: dict) -> float:
+    M, C, K = lin.matrices(pt)
+    w = numbers([freq], pt)[0]
+    u = np.array(numbers(list(shape), pt))
+    return _eig_residual(K, M, w**2, u) if np.any(u) else np.inf
+
+
+def _eig_residual(K: np.ndarray, M: np.ndarray, w2: float, u: np.ndarray) -> float:
+    """|(K − ω²M)u| relative to the size of its terms (norm-wise, robust to zero entries)."""
+    r = (K - w2 * M) @ u
+    scale = (np.linalg.norm(K, 2) + abs(w2) * np.linalg.norm(M, 2)) * np.linalg.norm(u)
+    return float(np.linalg.norm(r) / max(scale, 1e-300))
+
+
+@quantity('normal_modes',
+          book='list of `{frequency, shape: {q: amplitude}}`',
+          how=('(K − ω²M)u = 0: shapes compared up to scale and sign; any vector of a '
+               'degenerate eigenspace passes; with `limit:`, each book mode must '
+               'approach an engine mode (frequency and the angle between shapes) as the '
+               'parameter goes to its limit'),
+          keys={"limit": LIMIT})
+def check_normal_modes(ctx: Context, val) -> Verdict:
+    """Each (frequency, shape) satisfies (K − ω²M)·u = 0: shape up to scale and sign, and any
+    vector of a degenerate eigenspace is accepted."""
+    lin = ctx.linear()
+    modes = ctx.as_list(val, ("book",))
+    if "limit" in ctx.part.data:
+        return _modes_limit(ctx, modes, lin)
+    for _ in range(5):
+        pt = ctx.sampler.draw()
+        for i, mode in enumerate(modes):
+            mode = ctx.as_map(mode, ("book", i))
+            freq = ctx.parse(mode["frequency"], ("book", i, "frequency"))
+            shape = _shape(ctx, mode.get("shape"), ("book", i, "shape"))
+            if abs(numbers([freq], pt)[0]) not in _near(lin.numeric_frequencies(pt),
+                                                         numbers([freq], pt)[0]):
+                return Verdict(False, "numeric", f"mode {i}: frequency not an engine frequency")
+            res = _mode_residual(lin, freq, shape, pt)
+            if res > 1e-8:
+                return Verdict(False, "numeric", f"mode {i}: (K - w^2 M) u relative residual "
+                               f"{res:.3g}")
+    return Verdict(True, "numeric(5 points)")
+
+
+def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
+    """Modes in a limit of the parameters: each book mode must approach one engine mode, in
+    frequency (relative error) and in shape (the sine of the angle between the shapes)."""
+    parsed = []
+    for i, mode in enumerate(modes):
+        mode = ctx.as_map(mode, ("book", i))
+        parsed.append((ctx.parse(mode["frequency"], ("book", i, "frequency")),
+                       _shape(ctx, mode.get("shape"), ("book", i, "shape"))))
+
+    def error(pt) -> float:
+        w2, vecs = lin.numeric_modes(pt)
+        free = list(range(len(w2)))
+        worst = 0.0
+        for freq, shape in parsed:
+            w = numbers([freq], pt)[0]
+            u = np.array(numbers(list(shape), pt))
+            if not free or not np.any(u):
+                return float("inf")
+            best = float("inf")
+            for j in free:
+                v = vecs[:, j]
+                cos = abs(u @ v) / (np.linalg.norm(u) * np.linalg.norm(v))
+                sin = float(np.sqrt(max(0.0, 1.0 - cos**2)))
+                dw = abs(np.sqrt(abs(w2[j])) - w) / max(abs(w), 1e-300)
+                best_j = max(sin, dw)
+                if best_j < best:
+                    best, pick = best_j, j
+            free.remove(pick)
+            worst = max(worst, best)
+        return worst
+
+    return _asymptotic(ctx, error)
+
+
+def _near(values, x, rtol=1e-8):
+    return [x] if any(abs(v - x) <= rtol * max(1, abs(x)) for v in values) else []
+
+
+def _shape(ctx: Context, shape, sub) -> sp.Matrix:
+    shape = ctx.as_map(shape, sub)
+    unknown = set(shape) - set(ctx.system.coord_names)
+    if unknown:
+        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate")
+    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0
+                      for c in ctx.system.coord_names])
+
+
+@quantity('normal_coordinates',
+          book='list of `{coordinate: linear form, frequency?}`',
+          how='c·q is a normal coordinate iff M⁻¹c is a mode')
+def check_normal_coordinates(ctx: Context, val) -> Verdict:
+    """A linear form c·q is a normal coordinate iff u = M⁻¹c is a mode: (K − ω²M)u = 0."""
+    lin = ctx.linear()
+    items = ctx.as_list(val, ("book",))
+    rows = []
+    for _ in range(5):
+        pt = ctx.sampler.draw()
+        M, C, K = lin.matrices(pt)
+        rows = []
+        for i, item in enumerate(items):
+            item = ctx.as_map(item, ("book", i))
+            form = ctx.parse(item["coordinate"], ("book", i, "coordinate"))
+            c = sp.Matrix([sp.diff(form, q) for q in ctx.system.q])
+            if any(s in ctx.system.q for x in c for s in x.free_symbols):
+                raise ctx.part.error(("book", i, "coordinate"), "a normal coordinate is linear "
+                                     "in the coordinates")
+            cv = np.array(numbers(list(c), pt))
+            rows.append(cv)
+            u = np.linalg.solve(M, cv)
+            w2 = float(u @ K @ u / (u @ M @ u))
+            if _eig_residual(K, M, w2, u) > 1e-8:
+                return Verdict(False, "numeric", f"{item['coordinate']} is not a normal "
+                               "coordinate (M^-1 c is not a mode)")
+            if "frequency" in item:
+                w = numbers([ctx.parse(item["frequency"], ("book", i, "frequency"))], pt)[0]
+                if abs(np.sqrt(max(w2, 0)) - w) > 1e-8 * max(1, w):
+                    return Verdict(False, "numeric", f"{item['coordinate']}: frequency "
+                                   f"{w:.10g}, engine {np.sqrt(max(w2, 0)):.10g}")
+        if len(rows) == len(ctx.system.q) and np.linalg.matrix_rank(np.array(rows)) < len(rows):
+            return Verdict(False, "numeric", "the normal coordinates are not independent")
+    return Verdict(True, "numeric(5 points)")
+
+
+@quantity('mode_count',
+          book='integer',
+          how='the number of degrees of freedom')
+def check_mode_count(ctx: Context, val) -> Verdict:
+    n = len(ctx.system.q)
+    ok = isinstance(val, int) and val == n
+    return Verdict(ok, "exact", f"book {val}, engine {n} degrees of freedom")
+
+
+@quantity('mode_node',
+          book='`{symbol: value}`',
+          how=('the point (`position:`, linear in the displacements) does not move in '
+               'the mode of `frequency:`'),
+          keys={"position": EXPR,
+                "frequency": EXPR})
+def check_mode_node(ctx: Context, val) -> Verdict:
+    """A point whose position (linear in the small displacements) stays put in the mode of a
+    given frequency: ∇position · u = 0. The book's value fixes the point's parameter."""
+    book = ctx.as_map(val, ("book",))
+    lin = ctx.linear()
+    subs = {ctx.names[k]: ctx.parse(v, ("book", k)) for k, v in book.items()}
+    position = ctx.parse(ctx.part.data["position"], ("position",)).subs(subs)
+    freq = ctx.parse(ctx.part.data["frequency"], ("frequency",))
+    point = lin.point
+    grad = [sp.diff(position, q).subs(point) for q in ctx.system.q]
+    for _ in range(5):
+        pt = ctx.sampler.draw()
+        w2, vecs = lin.numeric_modes(pt)
+        w = numbers([freq], pt)[0]
+        idx = [i for i, x in enumerate(w2) if abs(np.sqrt(max(x, 0)) - w) <= 1e-8 * max(1, w)]
+        if not idx:
+            return Verdict(False, "numeric", "frequency is not an engine frequency")
+        g = np.array(numbers(grad, pt))
+        for i in idx:
+            u = vecs[:, i]
+            if abs(g @ u) > 1e-9 * (np.abs(g) @ np.abs(u)):
+                return Verdict(False, "numeric", f"the point moves in that mode ({g @ u:.3g})")
+    return Verdict(True, "numeric(5 points)")
