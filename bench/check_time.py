@@ -100,7 +100,7 @@ print(json.dumps(out))
     pick = {
         "total": ["total"],
         "checking the parts": ["checker.py:check_problem", "checker.py:check_part"],
-        "cross-checks": ["crosscheck.py:crosscheck_problem"],
+        "cross-checks": ["crosscheck.py:crosscheck_problem", "__init__.py:crosscheck_problem"],
         "derive for display": ["derive.py:derive"],
         "stored summary": ["derive.py:computed"],
         "SymPy simplify": ["simplify.py:simplify"],
@@ -124,6 +124,8 @@ def time_tests(tree: Path) -> float:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", default=DEFAULT_BEFORE, help="git ref of the 'before' tree")
+    ap.add_argument("--after", default=None,
+                    help="git ref of the 'after' tree (default: this working tree)")
     ap.add_argument("--ids", nargs="*", default=None, help="problems (default: all in both)")
     ap.add_argument("--profile", nargs="*", default=[], metavar="ID")
     ap.add_argument("--tests", action="store_true", help="also time the test suites")
@@ -133,14 +135,22 @@ def main() -> None:
 
     with tempfile.TemporaryDirectory(prefix="mechbook-bench-") as tmp:
         tmp = Path(tmp)
-        old = tmp / "before"
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(old),
-                        args.before], check=True, capture_output=True)
+        trees = {"before": args.before, "after": args.after}
+        made = []
         try:
-            report = measure(args, old, tmp)
+            for label, ref in trees.items():
+                if ref is None:
+                    continue
+                path = tmp / label
+                subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach",
+                                str(path), ref], check=True, capture_output=True)
+                made.append(path)
+            new = tmp / "after" if args.after else ROOT
+            report = measure(args, tmp / "before", new, tmp)
         finally:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(old)],
-                           capture_output=True)
+            for path in made:
+                subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force",
+                                str(path)], capture_output=True)
     text = "\n".join(report)
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -152,16 +162,16 @@ def ids_of(tree: Path) -> list[str]:
     return sorted(f"{p.parent.name}-{p.stem}" for p in (tree / "problems").glob("*/*.yaml"))
 
 
-def measure(args, old: Path, tmp: Path) -> list[str]:
-    ids = args.ids or sorted(set(ids_of(old)) & set(ids_of(ROOT)))
+def measure(args, old: Path, new: Path, tmp: Path) -> list[str]:
+    ids = args.ids or sorted(set(ids_of(old)) & set(ids_of(new)))
     cores = os.cpu_count() or 1
     print(f"{len(ids)} problems; before = {args.before}; {cores} cores", file=sys.stderr)
     before = run_check(old, ids, tmp / "before.h5", [])
     print(f"before: {before['wall']:.1f} s", file=sys.stderr)
-    one = run_check(ROOT, ids, tmp / "after1.h5", ["-j", "1"])
+    one = run_check(new, ids, tmp / "after1.h5", ["-j", "1"])
     print(f"after -j 1: {one['wall']:.1f} s", file=sys.stderr)
-    many = run_check(ROOT, ids, tmp / "after.h5", [])
-    warm = run_check(ROOT, ids, tmp / "after.h5", [])
+    many = run_check(new, ids, tmp / "after.h5", [])
+    warm = run_check(new, ids, tmp / "after.h5", [])
     print(f"after -j {cores}: {many['wall']:.1f} s, warm {warm['wall']:.2f} s", file=sys.stderr)
     rows = []
     for pid in ids:
@@ -195,7 +205,7 @@ def measure(args, old: Path, tmp: Path) -> list[str]:
         out += ["", "Where the time went (cProfile, cumulative seconds, cold, one core):", ""]
         labels = None
         for pid in args.profile:
-            for label, tree in (("before", old), ("after", ROOT)):
+            for label, tree in (("before", old), ("after", new)):
                 prof = profile_problem(tree, pid)
                 if labels is None:
                     labels = list(prof)
@@ -205,7 +215,7 @@ def measure(args, old: Path, tmp: Path) -> list[str]:
                            + " | ".join(f"{prof.get(k, 0.0):.1f}" for k in labels) + " |")
                 print(f"profiled {pid} {label}", file=sys.stderr)
     if args.tests:
-        tb, ta = time_tests(old), time_tests(ROOT)
+        tb, ta = time_tests(old), time_tests(new)
         out += ["", f"`pytest -n auto` (the test suite of each tree): before {tb:.0f} s, "
                 f"after {ta:.0f} s."]
     return out
