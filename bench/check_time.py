@@ -33,6 +33,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_BEFORE = "27ee053"
+PROFILE_LIMIT = 600  # seconds per profiled problem (cProfile slows SymPy several times)
 LINE = re.compile(r"^\[\d+/\d+\] (\S+) \(([0-9.]+) s\): (.*)$")
 SUMMARY = re.compile(r"^(\d+) problems, (\d+) parts: (.*)$")
 CROSS = re.compile(r"^cross-checks: (.*)$")
@@ -89,9 +90,13 @@ total = max(ct for (_, _, _, ct, _) in st.stats.values())
 out["total"] = total
 print(json.dumps(out))
 """
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          cwd=tree)
     import json
+
+    try:
+        proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                              cwd=tree, timeout=PROFILE_LIMIT)
+    except subprocess.TimeoutExpired:
+        return {"total": float("inf")}  # shown as "inf": over PROFILE_LIMIT under cProfile
 
     lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("{")]
     if not lines:

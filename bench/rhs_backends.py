@@ -43,7 +43,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mechbook.core import compile as rhsmod  # noqa: E402
-
 from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError  # noqa: E402
 from mechbook.model.catalog import all_ids, problem_path  # noqa: E402

@@ -59,13 +59,12 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.numerics import accuracy  # noqa: E402
-
 from mechbook.core.timeout import Timeout  # noqa: E402
 from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError, UnsupportedError  # noqa: E402
 from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
 from mechbook.model.problem import load_problem  # noqa: E402
+from mechbook.numerics import accuracy  # noqa: E402
 from mechbook.numerics.integrators import IntegratorError, integrate, make_integrator  # noqa: E402
 from mechbook.numerics.model import build_model  # noqa: E402
 from mechbook.numerics.monitors import conserved_quantities, drifts  # noqa: E402
