@@ -162,13 +162,29 @@ class LinearSweep:
             raise UnsupportedError(f"sweeping: the linear system depends on {', '.join(unknown)}"
                                    ", which is not a parameter")
         self.gyroscopic = lin.gyroscopic
-        entries = [e for m in mats for e in m]
+        # the point itself (and a steady motion's momenta): where they are not real, the
+        # equilibrium does not exist, whatever finite values M, C, K take there
+        where = [sp.S(v) for v in lin.point.values()]
+        where += [sp.S(v) for v in (getattr(lin.dyn.sys, "momenta", None) or {}).values()]
+        where = [w for w in where if w.free_symbols]
+        unknown = sorted(str(s) for s in set().union(set(), *(w.free_symbols for w in where))
+                         - set(self.symbols))
+        if unknown:
+            raise UnsupportedError(f"sweeping: the point depends on {', '.join(unknown)}, "
+                                   "which is not a parameter")
+        entries = [e for m in mats for e in m] + where
         self._fn = compile_batch(self.symbols, entries, backend)
+        self._where = len(where)
 
     def matrices(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, C, K of shape (k, n, n) at the k rows of X."""
         n = self.n
-        out = self._fn(np.asarray(X, dtype=float)).reshape(-1, 3, n, n)
+        raw = self._fn(np.asarray(X, dtype=float))
+        out = raw[:, : 3 * n * n].reshape(-1, 3, n, n)
+        if self._where:
+            gone = ~np.all(np.isfinite(raw[:, 3 * n * n:]), axis=1)
+            out = out.copy()
+            out[gone] = np.nan  # no such point here
         return out[:, 0], out[:, 1], out[:, 2]
 
     # ---- float64, stacked ----------------------------------------------------------------
@@ -286,18 +302,42 @@ class LinearSweep:
         w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
         return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
 
-    def precise_stability(self, values: dict, dps: int = 30) -> tuple[int, float]:
-        """(stability code, growth rate) at one point with `dps` digits."""
+    def precise_stability(self, values: dict, dps: int = 30) -> tuple[int, np.ndarray]:
+        """(stability code, spectrum) at one point with `dps` digits: the spectrum is ω²
+        ascending, or the state-space eigenvalues."""
         if self.gyroscopic:
             lam = self.lin._precise_state_eigenvalues(values, dps)
             scale = max(1.0, float(np.max(np.abs(lam))))
-            re = float(lam.real.max())
-            unstable = re > GROWTH_TOL * scale
-            return (UNSTABLE if unstable else STABLE), (re if unstable else 0.0)
-        w2 = self.lin._precise_squared(values, dps)
+            return (UNSTABLE if lam.real.max() > GROWTH_TOL * scale else STABLE), lam
+        w2 = np.sort(self.lin._precise_squared(values, dps))
         s1 = max(1.0, float(np.max(np.abs(w2))))
         if np.any(w2 < -ZERO_TOL * s1):
-            return UNSTABLE, float(np.sqrt(-w2.min()))
+            return UNSTABLE, w2
         if np.any(np.abs(w2) <= ZERO_TOL * s1):
-            return MARGINAL, 0.0
-        return STABLE, 0.0
+            return MARGINAL, w2
+        return STABLE, w2
+
+    def spectrum(self, X: np.ndarray) -> np.ndarray:
+        """The float64 spectrum at the rows of X (as `precise_stability` gives it)."""
+        M, C, K = self.matrices(X)
+        n = self.n
+        if not self.gyroscopic:
+            return np.array([np.sort(_generalized_eigvalsh(K[i], M[i])) for i in range(len(M))])
+        out = []
+        for i in range(len(M)):
+            A = np.zeros((2 * n, 2 * n))
+            A[:n, n:] = np.eye(n)
+            A[n:, :n] = -np.linalg.solve(M[i], K[i])
+            A[n:, n:] = -np.linalg.solve(M[i], C[i])
+            out.append(np.linalg.eigvals(A))
+        return np.array(out)
+
+
+def _generalized_eigvalsh(K: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """ω² of one point by the same scaled Cholesky reduction as the stacked path."""
+    d = 1.0 / np.sqrt(np.abs(np.diag(M)))
+    D = np.outer(d, d)
+    L = np.linalg.cholesky((M * D + (M * D).T) / 2)
+    Linv = np.linalg.inv(L)
+    A = Linv @ (K * D) @ Linv.T
+    return np.linalg.eigvalsh((A + A.T) / 2)

@@ -1,0 +1,484 @@
+"""`mechbook sweep`: one result of a problem mapped over a grid of parameter values.
+
+The problem is derived once and its linear system (about `--about`, a steady motion
+`--steady`, an answer part's point `--part`, or the stable equilibrium) compiled once with
+the parameters as arguments (mechbook.engine.sweep); the grid is cut into blocks, evaluated
+in this process, on a local process pool (`-j`), or on a Dask cluster (`--scheduler`,
+mechbook.app.distributed), and put back together in grid order. Quantities:
+
+    frequencies  the normal angular frequencies at every point (ascending; NaN: unstable)
+    stability    stable / marginal / unstable / undefined at every point, and the largest
+                 growth rate
+    drift        how far the frequency measured from the nonlinear motion at a finite
+                 amplitude drifts from the small-oscillation one: one axis must be the
+                 pseudo-parameter `amplitude` (mechbook.crosscheck.amplitude)
+
+The float64 path is then checked against the 30-digit one at sampled points (random ones
+and, for a stability map, ones beside the boundary) and the largest relative difference is
+reported; the book's answer at the same point (its stability condition, its frequencies),
+evaluated over the same grid, is kept beside the engine's for the plot and for a count of
+where they disagree (mechbook.app.sweep_book).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+
+from mechbook.core.compile import DEFAULT_BACKEND
+from mechbook.engine.sweep import STABILITY_NAMES, UNDEFINED, Axis, Grid
+from mechbook.errors import MechbookError
+
+QUANTITIES = ("frequencies", "stability", "drift")
+AMPLITUDE = "amplitude"
+BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
+DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
+SAMPLES = 24  # points of the 30-digit accuracy check
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Everything that defines a sweep, as plain data (it travels to cluster workers)."""
+
+    pid: str
+    files: tuple[tuple[str, bytes], ...]  # the problem's and answer key's files
+    quantity: str
+    axes: tuple[Axis, ...]
+    system: str | None = None
+    about: tuple[tuple[str, str], ...] = ()
+    steady: tuple[tuple[str, str], ...] = ()
+    part: str | None = None
+    backend: str = DEFAULT_BACKEND
+
+    @property
+    def key(self) -> str:
+        h = hashlib.sha256(repr((self.pid, self.quantity, self.axes, self.system, self.about,
+                                 self.steady, self.part, self.backend)).encode())
+        for name, data in self.files:
+            h.update(name.encode() + b"\0" + data)
+        return h.hexdigest()
+
+
+def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
+              system: str | None = None, about: dict | None = None,
+              steady: dict | None = None, part: str | None = None,
+              backend: str = DEFAULT_BACKEND) -> SweepSpec:
+    from mechbook.app.distributed import tree_files
+
+    if quantity not in QUANTITIES:
+        raise MechbookError(f"unknown quantity {quantity!r}; known: {', '.join(QUANTITIES)}")
+    files = tree_files(pid, base)
+    if not files:
+        raise MechbookError(f"no problem {pid} under {base}")
+    return SweepSpec(pid, tuple(sorted(files.items())), quantity, tuple(axes), system,
+                     tuple((about or {}).items()), tuple((steady or {}).items()), part,
+                     backend)
+
+
+class Sweeper:
+    """A sweep's derived and compiled state, built once per process."""
+
+    def __init__(self, spec: SweepSpec, base: Path):
+        from mechbook.engine.analysis import Analysis
+        from mechbook.engine.sweep import LinearSweep
+        from mechbook.model.catalog import answer_path, problem_path
+        from mechbook.model.expr import parse
+        from mechbook.model.problem import load_problem
+        from mechbook.verify.answers import load_answers
+
+        self.spec = spec
+        self.problem = load_problem(problem_path(spec.pid, base))
+        self.analysis = Analysis(self.problem)
+        apath = answer_path(spec.pid, base)
+        self.key = load_answers(apath) if apath.exists() else None
+        fixed = dict(self.problem.values())
+        symbols = list(fixed)
+        if spec.part is not None:
+            from mechbook.verify.context import Context
+
+            part = self._part(spec.part)
+            self.context = Context(self.analysis, part)
+            self.system = self.context.system
+            self.lin = self.context.linear()
+            fixed.update(self.key.symbol_values)
+            symbols += [s for s in self.key.symbol_values if s not in symbols]
+        else:
+            self.context = None
+            try:
+                self.system = self.analysis.system(spec.system)
+            except KeyError as exc:
+                raise MechbookError(str(exc.args[0]) + "; name it with --system") from None
+            names = dict(self.system.names)
+
+            def point(pairs, what):
+                out = {}
+                for name, text in pairs:
+                    if name not in self.system.coord_names:
+                        raise MechbookError(f"--{what} {name}=...: {name!r} is not a coordinate "
+                                            f"of {spec.pid} (coordinates: "
+                                            f"{', '.join(self.system.coord_names)})")
+                    q = self.system.q[self.system.coord_names.index(name)]
+                    out[q] = parse(text, names)
+                return out
+
+            about, steady = point(spec.about, "about"), point(spec.steady, "steady")
+            if steady:
+                self.lin = self.analysis.steady_linear(self.system.name, steady, about)
+            elif about:
+                self.lin = self.analysis.linear(self.system.name, about)
+            else:
+                self.lin = self.analysis.linear(self.system.name,
+                                                self.analysis.default_point(self.system.name))
+        self.steady = dict(getattr(self.lin.dyn.sys, "momenta", None) or {})
+        self.amplitude = None
+        names = [str(s) for s in symbols]
+        if spec.quantity == "drift":
+            if AMPLITUDE in names:
+                raise MechbookError(f"{spec.pid} has a parameter named {AMPLITUDE!r}: a drift "
+                                    "sweep cannot tell it from the amplitude")
+            if AMPLITUDE not in [a.name for a in spec.axes]:
+                raise MechbookError(f"a drift sweep needs --param {AMPLITUDE}=LO:HI:N (the "
+                                    "largest coordinate displacement of the start)")
+            self.amplitude = sp.Symbol(AMPLITUDE)
+            symbols.append(self.amplitude)
+        try:
+            self.grid = Grid(list(spec.axes), symbols, fixed)
+        except ValueError as exc:
+            raise MechbookError(str(exc)) from None
+        self.linear = LinearSweep(self.lin, [s for s in symbols if s is not self.amplitude],
+                                  spec.backend)
+        self._models: dict = {}
+
+    def _part(self, name: str):
+        if self.key is None:
+            raise MechbookError(f"--part {name}: {self.spec.pid} has no answer key")
+        for p in self.key.parts:
+            if p.name == name:
+                return p
+        raise MechbookError(f"--part {name}: no such part (parts: "
+                            f"{', '.join(p.name for p in self.key.parts)})")
+
+    @property
+    def modes(self) -> int:
+        return self.linear.n
+
+    def point_text(self) -> str:
+        pt = ", ".join(f"{k} = {sp.sstr(v)}" for k, v in self.lin.point.items()) or "origin"
+        if self.steady:
+            pt += "; steady, momenta " + ", ".join(f"p_{k} = {sp.sstr(v)}"
+                                                   for k, v in self.steady.items())
+        return pt
+
+    def block_size(self) -> int:
+        if self.spec.quantity == "drift":
+            return DRIFT_BLOCK
+        return max(1000, BLOCK_ENTRIES // (3 * self.modes**2 + 2 * self.modes + 1))
+
+    # ---- one block ---------------------------------------------------------------------
+    def block(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        X = self.grid.block(start, stop)
+        if self.spec.quantity == "drift":
+            return self._drift(X)
+        lin_cols = [j for j, s in enumerate(self.grid.symbols) if s is not self.amplitude]
+        got = self.linear.evaluate(X[:, lin_cols], ("frequencies", "stability"))
+        out = {"ill": np.array([got.ill]), "precise": np.array([got.precise]),
+               "stability": got.stability}
+        if self.spec.quantity == "frequencies":
+            out["frequencies"] = got.frequencies
+        else:
+            out["growth"] = got.growth
+        return out
+
+    def _drift(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        from mechbook.crosscheck.amplitude import amplitude_response
+
+        k, n = X.shape[0], self.modes
+        linear = np.full((k, n), np.nan)
+        measured = np.full((k, n), np.nan)
+        a_col = self.grid.symbols.index(self.amplitude)
+        for i, row in enumerate(X):
+            values = {s: float(x) for s, x in zip(self.grid.symbols, row, strict=True)
+                      if s is not self.amplitude}
+            try:
+                lin, meas = amplitude_response(self.analysis, self.lin, values, [row[a_col]],
+                                               self._models)
+            except (MechbookError, ValueError, np.linalg.LinAlgError, ZeroDivisionError):
+                continue  # no oscillation to measure there: NaN
+            linear[i, : len(lin)], measured[i, : len(lin)] = lin, meas[0]
+        with np.errstate(all="ignore"):
+            rel = (measured - linear) / linear
+        return {"linear": linear, "measured": measured, "relative_error": rel,
+                "ill": np.array([0]), "precise": np.array([0])}
+
+    # ---- accuracy: float64 against 30 digits ---------------------------------------------
+    def accuracy(self, arrays: dict[str, np.ndarray], samples: int = SAMPLES,
+                 seed: int = 0) -> dict:
+        """The float64 results at sampled points against the 30-digit path (the matrices
+        substituted symbolically, the eigenproblem in mpmath)."""
+        rng = np.random.default_rng(seed)
+        shape = self.grid.shape
+        if self.spec.quantity == "stability":
+            codes = arrays["stability"]
+            defined = np.flatnonzero(codes.reshape(-1) != UNDEFINED)
+            edge = _boundary(codes)
+        elif self.spec.quantity == "frequencies":
+            defined = np.flatnonzero(np.any(np.isfinite(arrays["frequencies"]), axis=-1)
+                                     .reshape(-1))
+            edge = np.zeros(0, dtype=int)
+        else:
+            defined = np.flatnonzero(np.any(np.isfinite(arrays["linear"]), axis=-1)
+                                     .reshape(-1))
+            edge = np.zeros(0, dtype=int)
+        if not len(defined):
+            return {"samples": 0, "max_rel_diff": float("nan"), "disagree": 0}
+        chosen = list(rng.choice(edge, min(len(edge), samples // 3), replace=False)) \
+            if len(edge) else []
+        rest = np.setdiff1d(defined, chosen)
+        chosen += list(rng.choice(rest, min(len(rest), samples - len(chosen)), replace=False))
+        worst, disagree, worst_at = 0.0, [], None
+        for flat in sorted(int(c) for c in chosen):
+            values = {s: v for s, v in self.grid.values_at(flat).items()
+                      if s is not self.amplitude}
+            idx = np.unravel_index(flat, shape)
+            where = {a.name: float(v) for a, v in
+                     zip(self.grid.axes, (self.grid.coords()[a.name][i] for a, i in
+                                          zip(self.grid.axes, idx, strict=True)), strict=True)}
+            try:
+                if self.spec.quantity == "stability":
+                    code, ref = self.linear.precise_stability(values)
+                    if code != arrays["stability"][idx]:
+                        disagree.append(where)
+                        continue
+                    X = np.array([[values[s] for s in self.linear.symbols]])
+                    got = self.linear.spectrum(X)[0]
+                    scale = float(np.max(np.abs(ref))) or 1.0
+                    # each exact eigenvalue against the nearest float64 one
+                    rel = float(np.max(np.min(np.abs(ref[:, None] - got[None, :]), axis=1)))
+                    if rel / scale >= worst:
+                        worst, worst_at = rel / scale, where
+                    continue
+                else:
+                    ref = self.linear.precise_frequencies(values)
+                    name = "frequencies" if self.spec.quantity == "frequencies" else "linear"
+                    got = arrays[name][idx]
+                    if not np.array_equal(np.isfinite(ref), np.isfinite(got)):
+                        disagree.append(where)
+                        continue
+                    scale = float(np.nanmax(np.abs(ref))) if np.any(np.isfinite(ref)) else 1.0
+            except (ValueError, ZeroDivisionError, TypeError, ArithmeticError) as exc:
+                disagree.append({**where, "error": str(exc)[:80]})
+                continue
+            diff = np.abs(np.nan_to_num(got) - np.nan_to_num(ref))
+            rel = float(np.max(diff)) / scale if scale > 0 and np.any(diff) else 0.0
+            if rel >= worst:
+                worst, worst_at = rel, where
+        return {"samples": len(chosen), "boundary_samples": min(len(edge), samples // 3),
+                "max_rel_diff": worst, "worst_at": worst_at, "disagree": len(disagree),
+                "disagree_at": disagree[:5]}
+
+
+def _boundary(codes: np.ndarray) -> np.ndarray:
+    """Flat indices of grid points whose stability differs from a neighbour's."""
+    mark = np.zeros(codes.shape, dtype=bool)
+    for ax in range(codes.ndim):
+        if codes.shape[ax] < 2:
+            continue
+        a = np.swapaxes(codes, 0, ax)
+        m = np.swapaxes(mark, 0, ax)
+        diff = (a[1:] != a[:-1]) & (a[1:] != UNDEFINED) & (a[:-1] != UNDEFINED)
+        m[1:] |= diff
+        m[:-1] |= diff
+    return np.flatnonzero(mark.reshape(-1))
+
+
+# ---- where blocks run ------------------------------------------------------------------------
+_SWEEPERS: dict[str, Sweeper] = {}  # per process: one sweeper per sweep (compiled once)
+
+
+def block_of(spec: SweepSpec, start: int, stop: int) -> dict[str, np.ndarray]:
+    """One block on whatever process runs it: derived and compiled on first use there."""
+    from mechbook.app.distributed import materialize
+
+    if spec.key not in _SWEEPERS:
+        _SWEEPERS[spec.key] = Sweeper(spec, materialize(dict(spec.files)))
+    return _SWEEPERS[spec.key].block(start, stop)
+
+
+def cluster_block(spec: SweepSpec, start: int, stop: int, timeout: float,
+                  memory_mb: float) -> dict[str, np.ndarray]:
+    """A block on a Dask worker, inside that worker's limited child process."""
+    from mechbook.app.distributed import limited
+
+    return limited(block_of, (spec, start, stop), timeout, memory_mb)
+
+
+@dataclass
+class SweepResult:
+    spec: SweepSpec
+    coords: dict[str, np.ndarray]
+    arrays: dict[str, np.ndarray]
+    dims: dict[str, tuple[str, ...]]
+    attrs: dict = field(default_factory=dict)
+    book: dict = field(default_factory=dict)  # mechbook.app.sweep_book.BookOverlay fields
+
+
+def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None = None,
+              timeout: float = 600.0, memory_mb: float = 8000.0, samples: int = SAMPLES,
+              progress: Callable[[int, int], None] | None = None) -> SweepResult:
+    """Build the sweep here (for the accuracy check and the book), evaluate every block
+    where asked, and assemble the result in grid order."""
+    t0 = time.perf_counter()
+    sweeper = Sweeper(spec, base)
+    built = time.perf_counter() - t0
+    size, step = sweeper.grid.size, sweeper.block_size()
+    ranges = [(s, min(s + step, size)) for s in range(0, size, step)]
+    progress = progress or (lambda done, total: None)
+    t1 = time.perf_counter()
+    parts: dict[int, dict] = {}
+    if scheduler:
+        from dask.distributed import as_completed
+
+        from mechbook.app.distributed import connect
+
+        with connect(scheduler) as client:
+            futures = {client.submit(cluster_block, spec, a, b, timeout, memory_mb,
+                                     pure=False): a for a, b in ranges}
+            for fut in as_completed(futures):
+                parts[futures[fut]] = fut.result()
+                progress(len(parts), len(ranges))
+        where = f"Dask cluster at {scheduler}"
+    elif jobs > 1 and len(ranges) > 1:
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        from mechbook.app.batch import _context
+
+        with ProcessPoolExecutor(jobs, mp_context=_context()) as pool:
+            futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
+            for fut in as_completed(futures):
+                parts[futures[fut]] = fut.result()
+                progress(len(parts), len(ranges))
+        where = f"{jobs} local processes"
+    else:
+        for a, b in ranges:
+            parts[a] = sweeper.block(a, b)
+            progress(len(parts), len(ranges))
+        where = "this process"
+    seconds = time.perf_counter() - t1
+    arrays, dims = _assemble(sweeper, [parts[a] for a, _ in ranges])
+    t2 = time.perf_counter()
+    accuracy = sweeper.accuracy(arrays, samples)
+    attrs = {
+        "problem": spec.pid, "title": sweeper.problem.title, "quantity": spec.quantity,
+        "system": sweeper.system.name, "point": sweeper.point_text(),
+        "axes": " ".join(a.text() for a in spec.axes), "points": size, "modes": sweeper.modes,
+        "gyroscopic": bool(sweeper.linear.gyroscopic), "backend": spec.backend,
+        "where": where, "blocks": len(ranges), "build_seconds": built,
+        "evaluate_seconds": seconds, "points_per_second": size / max(seconds, 1e-9),
+        "accuracy_seconds": time.perf_counter() - t2,
+        "ill_conditioned": int(sum(int(p["ill"][0]) for p in parts.values())),
+        "precise_50_digits": int(sum(int(p["precise"][0]) for p in parts.values())),
+        "accuracy_samples": accuracy["samples"],
+        "max_rel_diff_float64_vs_30_digits": accuracy["max_rel_diff"],
+        "accuracy_disagreements": accuracy["disagree"], "accuracy": accuracy,
+        "fixed": {str(s): v for s, v in sweeper.grid.fixed.items()
+                  if str(s) not in {a.name for a in spec.axes}},
+        "problem_sha256": sweeper.problem.sha256,
+    }
+    if spec.part:
+        attrs["part"] = spec.part
+    result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
+    from mechbook.app.sweep_book import book_overlay
+
+    result.book = book_overlay(sweeper, result)
+    return result
+
+
+def _assemble(sweeper: Sweeper, parts: list[dict]) -> tuple[dict, dict]:
+    shape = sweeper.grid.shape
+    names = tuple(a.name for a in sweeper.grid.axes)
+    arrays, dims = {}, {}
+    for key in parts[0]:
+        if key in ("ill", "precise"):
+            continue
+        full = np.concatenate([p[key] for p in parts], axis=0)
+        if full.ndim == 2:
+            arrays[key] = full.reshape(*shape, full.shape[1])
+            dims[key] = names + ("mode",)
+        else:
+            arrays[key] = full.reshape(shape)
+            dims[key] = names
+    return arrays, dims
+
+
+def summary(result: SweepResult) -> list[str]:
+    """What the command prints: the run, the numbers, the accuracy, the book."""
+    a = result.attrs
+    lines = [f"{a['problem']}: {a['title']}",
+             f"{a['quantity']} about {a['point']} [system {a['system']}"
+             + (", gyroscopic" if a["gyroscopic"] else "") + "]",
+             f"grid {a['axes']}: {a['points']} points in {a['blocks']} blocks on "
+             f"{a['where']}; derived and compiled in {a['build_seconds']:.2f} s, evaluated "
+             f"in {a['evaluate_seconds']:.2f} s ({a['points_per_second']:.3g} points/s)"]
+    if a["fixed"]:
+        lines.append("fixed: " + ", ".join(f"{k}={v:g}" for k, v in a["fixed"].items()))
+    arr = result.arrays
+    if a["quantity"] == "stability":
+        codes, counts = np.unique(arr["stability"], return_counts=True)
+        lines.append("stability: " + ", ".join(f"{STABILITY_NAMES[int(c)]} {n}"
+                                               for c, n in zip(codes, counts, strict=True)))
+    if "frequencies" in arr:
+        f = arr["frequencies"]
+        undefined = arr["stability"] == UNDEFINED
+        unstable = np.any(np.isnan(f), -1) & ~undefined
+        if np.any(np.isfinite(f)):
+            lines.append(f"frequencies: {np.nanmin(f):.6g} to {np.nanmax(f):.6g} rad/s; "
+                         f"points with an unstable mode: {int(unstable.sum())}; where the "
+                         f"point does not exist or M is singular: {int(undefined.sum())}")
+    if "relative_error" in arr:
+        lines += _drift_lines(result)
+    acc = a["accuracy"]
+    if a["quantity"] == "drift":
+        lines.append("accuracy: measured frequencies from DOP853 at rtol 1e-12 (the linear "
+                     "reference below)")
+    if acc["samples"]:
+        what = ("eigenvalues: state-space λ" if a["gyroscopic"] else "eigenvalues: ω²") \
+            if a["quantity"] == "stability" else "frequencies"
+        line = (f"float64 vs 30 digits at {acc['samples']} sampled points"
+                + (f" ({acc['boundary_samples']} beside the boundary)"
+                   if acc.get("boundary_samples") else "")
+                + f": largest relative difference {acc['max_rel_diff']:.2e} ({what})")
+        if acc["disagree"]:
+            line += f"; {acc['disagree']} points disagree: {acc['disagree_at']}"
+        lines.append(line)
+    if a["ill_conditioned"]:
+        lines.append(f"ill-conditioned points (float64 not trusted): {a['ill_conditioned']}, "
+                     f"of which {a['precise_50_digits']} recomputed with 50 digits")
+    lines += result.book.get("lines", [])
+    return lines
+
+
+def _drift_lines(result: SweepResult) -> list[str]:
+    rel = np.abs(result.arrays["relative_error"])
+    amps = result.coords[AMPLITUDE]
+    out = []
+    if len(result.spec.axes) != 1:
+        worst = np.nanmax(rel) if np.any(np.isfinite(rel)) else float("nan")
+        return [f"largest |relative error| of the linear frequency: {worst:.3g}"]
+    for m in range(rel.shape[-1]):
+        col = rel[..., m]
+        if not np.any(np.isfinite(col)):
+            continue
+        bits = []
+        for tol in (1e-3, 1e-2, 1e-1):
+            over = np.flatnonzero(col > tol)
+            bits.append(f"{tol:g} from amplitude {amps[over[0]]:.3g}" if len(over)
+                        else f"{tol:g} not reached")
+        out.append(f"mode {m} (ω {np.nanmedian(result.arrays['linear'][..., m]):.6g}): "
+                   f"|relative error| exceeds " + ", ".join(bits))
+    return out
