@@ -120,11 +120,11 @@ class ClusterBatch:
     """`mechbook check` on a Dask cluster: one task per problem, results handed to
     `on_done` as they arrive (the client stays the store's only writer)."""
 
-    def __init__(self, address: str, base: Path, options: BatchOptions = BatchOptions(),
+    def __init__(self, address: str, base: Path, options: BatchOptions | None = None,
                  on_done: Callable[[ProblemRun], None] | None = None):
         self.address = address
         self.base = base
-        self.options = options
+        self.options = options or BatchOptions()
         self.on_done = on_done or (lambda run: None)
 
     def run(self, ids: list[str]) -> list[ProblemRun]:

@@ -151,8 +151,23 @@ class Sweeper:
             self.grid = Grid(list(spec.axes), symbols, fixed)
         except ValueError as exc:
             raise MechbookError(str(exc)) from None
-        self.linear = LinearSweep(self.lin, [s for s in symbols if s is not self.amplitude],
-                                  spec.backend)
+        for a in spec.axes:  # SymPy simplified with these assumptions: honour them
+            sym = symbols[names.index(a.name)] if a.name in names else self.amplitude
+            if (sym.is_positive or sym is self.amplitude) and min(a.lo, a.hi) <= 0:
+                raise MechbookError(f"--param {a.text()}: {a.name} is positive; sweep it over "
+                                    "positive values")
+            if sym.is_nonzero and min(a.lo, a.hi) <= 0 <= max(a.lo, a.hi):
+                raise MechbookError(f"--param {a.text()}: {a.name} is nonzero; keep 0 out of "
+                                    "its range")
+        self.lin_symbols = [s for s in symbols if s is not self.amplitude]
+        self.linear = LinearSweep(self.lin, self.lin_symbols, spec.backend)
+        # the problem's conditions, and a part's `assume:`: points outside are undefined
+        self.conditions = list(self.context.sampler.conditions if self.context
+                               else self.problem.conditions)
+        loose = sorted({str(x) for c in self.conditions for x in c.free_symbols}
+                       - {str(x) for x in self.lin_symbols})
+        if loose:
+            raise MechbookError(f"the conditions use {', '.join(loose)}, which has no value")
         self._models: dict = {}
 
     def _part(self, name: str):
@@ -187,6 +202,10 @@ class Sweeper:
             return self._drift(X)
         lin_cols = [j for j, s in enumerate(self.grid.symbols) if s is not self.amplitude]
         got = self.linear.evaluate(X[:, lin_cols], ("frequencies", "stability"))
+        outside = ~self.admissible(X[:, lin_cols])
+        got.stability[outside] = UNDEFINED
+        got.frequencies[outside] = np.nan
+        got.growth[outside] = np.nan
         out = {"ill": np.array([got.ill]), "precise": np.array([got.precise]),
                "stability": got.stability}
         if self.spec.quantity == "frequencies":
@@ -195,6 +214,12 @@ class Sweeper:
             out["growth"] = got.growth
         return out
 
+    def admissible(self, X: np.ndarray) -> np.ndarray:
+        """Where the conditions hold, at rows of X (columns: `lin_symbols`)."""
+        from mechbook.engine.sweep import condition_mask
+
+        return condition_mask(self.conditions, self.lin_symbols, X, self.spec.backend)
+
     def _drift(self, X: np.ndarray) -> dict[str, np.ndarray]:
         from mechbook.crosscheck.amplitude import amplitude_response
 
@@ -202,7 +227,10 @@ class Sweeper:
         linear = np.full((k, n), np.nan)
         measured = np.full((k, n), np.nan)
         a_col = self.grid.symbols.index(self.amplitude)
+        ok = self.admissible(X[:, [j for j in range(X.shape[1]) if j != a_col]])
         for i, row in enumerate(X):
+            if not ok[i]:
+                continue
             values = {s: float(x) for s, x in zip(self.grid.symbols, row, strict=True)
                       if s is not self.amplitude}
             try:
@@ -386,6 +414,7 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         "accuracy_samples": accuracy["samples"],
         "max_rel_diff_float64_vs_30_digits": accuracy["max_rel_diff"],
         "accuracy_disagreements": accuracy["disagree"], "accuracy": accuracy,
+        "conditions": [sp.sstr(c) for c in sweeper.conditions],
         "fixed": {str(s): v for s, v in sweeper.grid.fixed.items()
                   if str(s) not in {a.name for a in spec.axes}},
         "problem_sha256": sweeper.problem.sha256,
@@ -427,6 +456,8 @@ def summary(result: SweepResult) -> list[str]:
              f"in {a['evaluate_seconds']:.2f} s ({a['points_per_second']:.3g} points/s)"]
     if a["fixed"]:
         lines.append("fixed: " + ", ".join(f"{k}={v:g}" for k, v in a["fixed"].items()))
+    if a["conditions"]:
+        lines.append("conditions (points outside are undefined): " + ", ".join(a["conditions"]))
     arr = result.arrays
     if a["quantity"] == "stability":
         codes, counts = np.unique(arr["stability"], return_counts=True)
@@ -438,8 +469,9 @@ def summary(result: SweepResult) -> list[str]:
         unstable = np.any(np.isnan(f), -1) & ~undefined
         if np.any(np.isfinite(f)):
             lines.append(f"frequencies: {np.nanmin(f):.6g} to {np.nanmax(f):.6g} rad/s; "
-                         f"points with an unstable mode: {int(unstable.sum())}; where the "
-                         f"point does not exist or M is singular: {int(undefined.sum())}")
+                         f"points with an unstable mode: {int(unstable.sum())}; undefined "
+                         f"(no such point, outside the conditions, or M singular): "
+                         f"{int(undefined.sum())}")
     if "relative_error" in arr:
         lines += _drift_lines(result)
     acc = a["accuracy"]

@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
-from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED
+from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED, relations, truth
 from mechbook.errors import MechbookError, UnsupportedError
 
 
@@ -103,41 +103,14 @@ def _columns(sweeper, exprs: list[sp.Expr], extra: dict) -> np.ndarray:
     return np.concatenate(out, axis=0)
 
 
-def _truth(cond, cols: dict) -> np.ndarray:
-    if isinstance(cond, sp.And):
-        return np.logical_and.reduce([_truth(a, cols) for a in cond.args])
-    if isinstance(cond, sp.Or):
-        return np.logical_or.reduce([_truth(a, cols) for a in cond.args])
-    if isinstance(cond, sp.Not):
-        return ~_truth(cond.args[0], cols)
-    if cond is sp.true:
-        return np.ones(len(next(iter(cols.values()))), dtype=bool)
-    if cond is sp.false:
-        return np.zeros(len(next(iter(cols.values()))), dtype=bool)
-    m = cols[cond]
-    if isinstance(cond, (sp.StrictLessThan, sp.LessThan)):
-        return m < 0 if isinstance(cond, sp.StrictLessThan) else m <= 0
-    if isinstance(cond, (sp.StrictGreaterThan, sp.GreaterThan)):
-        return m > 0 if isinstance(cond, sp.StrictGreaterThan) else m >= 0
-    raise MechbookError(f"cannot map the relation {cond}")
-
-
-def _relations(cond) -> list:
-    if isinstance(cond, (sp.And, sp.Or, sp.Not)):
-        return [r for a in cond.args for r in _relations(a)]
-    if isinstance(cond, sp.core.relational.Relational):
-        return [cond]
-    return []
-
-
 def _stability(out: dict, ctx, part, sweeper, result) -> None:
     cond = ctx.parse(part.data["book"], ("book",), relation=True)
-    rels = _relations(cond)
+    rels = relations(cond)
     extra = dict(sweeper.key.symbol_values)
     margins = _columns(sweeper, [r.lhs - r.rhs for r in rels], extra) if rels else \
         np.zeros((sweeper.grid.size, 0))
     cols = {r: margins[:, i] for i, r in enumerate(rels)}
-    stable = _truth(cond, cols) if rels else np.full(sweeper.grid.size, bool(cond))
+    stable = truth(cond, cols, sweeper.grid.size)
     shape = sweeper.grid.shape
     out["stable"] = stable.reshape(shape)
     if len(rels) == 1:
@@ -145,6 +118,7 @@ def _stability(out: dict, ctx, part, sweeper, result) -> None:
     out["condition"] = str(part.data["book"]) + _abbreviations(sweeper.key, str(part.data["book"]))
     out["cite"] = part.data.get("cite", part.name)
     out["part"] = part.name
+    out["origin"] = part.data.get("origin", "book")
     codes = result.arrays["stability"].reshape(-1)
     decided = (codes != UNDEFINED) & (codes != MARGINAL) & np.all(np.isfinite(margins), axis=1)
     engine = codes == STABLE
@@ -155,9 +129,14 @@ def _stability(out: dict, ctx, part, sweeper, result) -> None:
         idx = np.unravel_index(np.flatnonzero(differ)[0], shape)
         where = " (first at " + ", ".join(f"{a.name}={result.coords[a.name][i]:.4g}" for a, i
                                          in zip(sweeper.grid.axes, idx, strict=True)) + ")"
-    out["lines"].append(f"book ({out['cite']}): {out['condition']}; agrees with the engine at "
+    out["lines"].append(f"{_who(out)} ({out['cite']}): {out['condition']}; agrees with the engine at "
                         f"{int(decided.sum()) - out['disagree']} of {int(decided.sum())} "
                         f"decided points{where}")
+
+
+def _who(out: dict) -> str:
+    """'book', or 'key (derived)' for a part with no printed answer."""
+    return "book" if out.get("origin", "book") == "book" else f"key ({out['origin']})"
 
 
 def _abbreviations(key, text: str) -> str:
@@ -178,6 +157,7 @@ def _frequencies(out: dict, ctx, part, sweeper, result) -> None:
     out["frequencies"] = vals.reshape(*shape, vals.shape[1])
     out["cite"] = part.data.get("cite", part.name)
     out["part"] = part.name
+    out["origin"] = part.data.get("origin", "book")
     engine = result.arrays["frequencies"].reshape(-1, result.arrays["frequencies"].shape[-1])
     if vals.shape[1] == engine.shape[1]:
         with np.errstate(all="ignore"):
@@ -185,9 +165,9 @@ def _frequencies(out: dict, ctx, part, sweeper, result) -> None:
         ok = np.all(np.isfinite(rel), axis=1)
         worst = float(np.max(rel[ok])) if ok.any() else float("nan")
         out["max_rel_diff"] = worst
-        out["lines"].append(f"book ({out['cite']}): largest relative difference from the "
+        out["lines"].append(f"{_who(out)} ({out['cite']}): largest relative difference from the "
                             f"engine {worst:.2e} over {int(ok.sum())} points where both are "
                             "real")
     else:
-        out["lines"].append(f"book ({out['cite']}): gives {vals.shape[1]} frequencies, the "
+        out["lines"].append(f"{_who(out)} ({out['cite']}): gives {vals.shape[1]} frequencies, the "
                             f"engine {engine.shape[1]} (drawn, not compared)")

@@ -118,8 +118,8 @@ def write_netcdf(result, path: str | Path) -> Path:
                 f.create_variable(dim, (dim,), data=np.asarray(values))
             for key, (dims, arr) in vars_.items():
                 f.create_variable(key, dims, data=arr, compression="gzip")
-            for k, v in attrs.items():
-                f.attrs[k] = _attr(v)
+            for k, v in attrs.items():  # netCDF has no boolean attributes
+                f.attrs[k] = int(v) if isinstance(v, (bool, np.bool_)) else _attr(v)
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except BaseException:

@@ -82,7 +82,7 @@ def _stability(plt, result, axes, cut):
             flips = np.flatnonzero(np.diff(book["stable"][cut].astype(int)) != 0)
             for j, k in enumerate(flips):
                 ax.axvline((x[k] + x[k + 1]) / 2, color="k", ls="--", lw=1.5,
-                           label=f"book: {book['condition']}" if j == 0 else None)
+                           label=f"{_who(book)}: {book['condition']}" if j == 0 else None)
         ax.legend(handles=handles + ax.get_legend_handles_labels()[0], fontsize=8,
                   loc="best")
         ax.set_xlim(x[0], x[-1])
@@ -102,7 +102,7 @@ def _stability(plt, result, axes, cut):
             ax.contour(x, y, field.T, levels=[level], colors="#08306b", linewidths=2.2,
                        linestyles="--")
         handles.append(plt.Line2D([], [], color="#08306b", lw=2.2, ls="--",
-                                  label=f"book: {book['condition']}"))
+                                  label=f"{_who(book)}: {book['condition']}"))
     ax.set_xlabel(axes[0])
     ax.set_ylabel(axes[1])
     ax.legend(handles=handles, fontsize=8, loc="upper left", framealpha=0.9)
@@ -127,7 +127,7 @@ def _frequencies(plt, result, axes, cut):
         if book is not None:
             b = book[cut]
             for m in range(b.shape[-1]):
-                ax.plot(x, b[:, m], "k--", lw=1.0, label="book" if m == 0 else None)
+                ax.plot(x, b[:, m], "k--", lw=1.0, label=_who(result.book) if m == 0 else None)
         ax.set_xlabel(axes[0])
         ax.set_ylabel("ω (rad/s)")
         ax.set_xlim(x[0], x[-1])
@@ -182,6 +182,10 @@ def _drift(plt, result, axes, cut):
     ax.set_xlabel("amplitude")
     ax.set_ylabel(other)
     return fig
+
+
+def _who(book: dict) -> str:
+    return "book" if book.get("origin", "book") == "book" else f"key ({book['origin']})"
 
 
 def _edges(x: np.ndarray) -> np.ndarray:

@@ -143,6 +143,60 @@ class Block:
     notes: list[str] = field(default_factory=list)
 
 
+def relations(cond) -> list:
+    """The relations (a < b, …) a condition is built of with And / Or / Not."""
+    if isinstance(cond, (sp.And, sp.Or, sp.Not)):
+        return [r for a in cond.args for r in relations(a)]
+    if isinstance(cond, sp.core.relational.Relational):
+        return [cond]
+    return []
+
+
+def truth(cond, margins: dict, size: int) -> np.ndarray:
+    """A condition's truth at `size` points, given each relation's margin lhs − rhs there
+    (False where a margin is NaN: a point where the condition cannot be told holds none)."""
+    if isinstance(cond, sp.And):
+        return np.logical_and.reduce([truth(a, margins, size) for a in cond.args])
+    if isinstance(cond, sp.Or):
+        return np.logical_or.reduce([truth(a, margins, size) for a in cond.args])
+    if isinstance(cond, sp.Not):
+        return ~truth(cond.args[0], margins, size) & _decided(cond.args[0], margins, size)
+    if cond is sp.true or cond is sp.false:
+        return np.full(size, cond is sp.true)
+    m = margins[cond]
+    if isinstance(cond, sp.StrictLessThan):
+        return m < 0
+    if isinstance(cond, sp.LessThan):
+        return m <= 0
+    if isinstance(cond, sp.StrictGreaterThan):
+        return m > 0
+    if isinstance(cond, sp.GreaterThan):
+        return m >= 0
+    if isinstance(cond, sp.Ne):
+        return np.isfinite(m) & (m != 0)
+    raise UnsupportedError(f"mapping the relation {cond} over a grid")
+
+
+def _decided(cond, margins: dict, size: int) -> np.ndarray:
+    rels = relations(cond)
+    if not rels:
+        return np.ones(size, dtype=bool)
+    return np.logical_and.reduce([np.isfinite(margins[r]) for r in rels])
+
+
+def condition_mask(conditions: Sequence, symbols: Sequence[sp.Symbol], X: np.ndarray,
+                   backend: str = DEFAULT_BACKEND) -> np.ndarray:
+    """Where every condition holds, at the rows of X (columns in `symbols` order)."""
+    rels = [r for c in conditions for r in relations(c)]
+    size = X.shape[0]
+    if not rels:
+        return np.logical_and.reduce([np.full(size, bool(c)) for c in conditions]) \
+            if conditions else np.ones(size, dtype=bool)
+    cols = compile_batch(list(symbols), [r.lhs - r.rhs for r in rels], backend)(X)
+    margins = {r: cols[:, i] for i, r in enumerate(rels)}
+    return np.logical_and.reduce([truth(c, margins, size) for c in conditions])
+
+
 class LinearSweep:
     """M(p), C(p), K(p) of one linear system compiled once for stacked evaluation."""
 
