@@ -115,7 +115,8 @@ def _stability(out: dict, ctx, part, sweeper, result) -> None:
     out["stable"] = stable.reshape(shape)
     if len(rels) == 1:
         out["margin"] = margins[:, 0].reshape(shape)
-    out["condition"] = str(part.data["book"]) + _abbreviations(sweeper.key, str(part.data["book"]))
+    text = str(part.data["book"])
+    out["condition"] = text + _abbreviations(sweeper.key, text)
     out["cite"] = part.data.get("cite", part.name)
     out["part"] = part.name
     out["origin"] = part.data.get("origin", "book")
@@ -129,8 +130,8 @@ def _stability(out: dict, ctx, part, sweeper, result) -> None:
         idx = np.unravel_index(np.flatnonzero(differ)[0], shape)
         where = " (first at " + ", ".join(f"{a.name}={result.coords[a.name][i]:.4g}" for a, i
                                          in zip(sweeper.grid.axes, idx, strict=True)) + ")"
-    out["lines"].append(f"{_who(out)} ({out['cite']}): {out['condition']}; agrees with the engine at "
-                        f"{int(decided.sum()) - out['disagree']} of {int(decided.sum())} "
+    out["lines"].append(f"{_who(out)} ({out['cite']}): {out['condition']}; agrees with the "
+                        f"engine at {int(decided.sum()) - out['disagree']} of {int(decided.sum())} "
                         f"decided points{where}")
 
 
