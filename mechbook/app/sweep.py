@@ -193,7 +193,7 @@ class Sweeper:
     def block_size(self) -> int:
         if self.spec.quantity == "drift":
             return DRIFT_BLOCK
-        return max(1000, BLOCK_ENTRIES // (3 * self.modes**2 + 2 * self.modes + 1))
+        return max(1, BLOCK_ENTRIES // (3 * self.modes**2 + 2 * self.modes + 1))
 
     # ---- one block ---------------------------------------------------------------------
     def block(self, start: int, stop: int) -> dict[str, np.ndarray]:

@@ -304,11 +304,8 @@ class LinearSweep:
         marginal = np.any(np.abs(w2) <= ZERO_TOL * s1[:, None], axis=1)
         stab[idx] = np.where(unstable, UNSTABLE, np.where(marginal, MARGINAL, STABLE))
         growth[idx] = np.sqrt(np.maximum(-w2[:, 0], 0.0)) * unstable
-        nz = np.where(np.abs(w2) > 0, np.abs(w2), np.nan)
-        with np.errstate(all="ignore"):
-            spread = np.nanmax(nz, axis=1) / np.nanmin(nz, axis=1)
         cond = m_eig[:, -1] / m_eig[:, 0]
-        ill[idx] = (cond > ILL_CONDITIONED) | (np.nan_to_num(spread, nan=1.0) > ILL_CONDITIONED)
+        ill[idx] = (cond > ILL_CONDITIONED) | (_spread(np.abs(w2)) > ILL_CONDITIONED)
         return ill
 
     def _state_space(self, M, C, K, ok, freq, stab, growth) -> np.ndarray:
@@ -336,11 +333,7 @@ class LinearSweep:
         re = lam.real.max(axis=1)
         stab[idx] = np.where(re > GROWTH_TOL * scale, UNSTABLE, STABLE)
         growth[idx] = np.maximum(re, 0.0) * (re > GROWTH_TOL * scale)
-        nz = np.where(mag > 0, mag, np.nan)
-        with np.errstate(all="ignore"):
-            spread = np.nanmax(nz, axis=1) / np.nanmin(nz, axis=1)
-        ill[idx] = (cond[idx] > ILL_CONDITIONED) | (np.nan_to_num(spread, nan=1.0)
-                                                    > ILL_CONDITIONED)
+        ill[idx] = (cond[idx] > ILL_CONDITIONED) | (_spread(mag) > ILL_CONDITIONED)
         return ill
 
     # ---- the high-precision path, one point at a time --------------------------------------
@@ -385,6 +378,14 @@ class LinearSweep:
             A[n:, n:] = -np.linalg.solve(M[i], C[i])
             out.append(np.linalg.eigvals(A))
         return np.array(out)
+
+
+def _spread(mag: np.ndarray) -> np.ndarray:
+    """Per row: largest over smallest nonzero magnitude (1 where none is nonzero)."""
+    nonzero = mag > 0
+    hi = np.max(np.where(nonzero, mag, 0.0), axis=1)
+    lo = np.min(np.where(nonzero, mag, np.inf), axis=1)
+    return np.where(nonzero.any(axis=1), hi / np.where(np.isfinite(lo), lo, 1.0), 1.0)
 
 
 def _generalized_eigvalsh(K: np.ndarray, M: np.ndarray) -> np.ndarray:
