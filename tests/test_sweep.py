@@ -278,3 +278,24 @@ def test_sweep_command_prints_stores_and_plots(tmp_path):
     bad = CliRunner().invoke(main, ["--root", str(TREE), "sweep", "lim-9001", "--param",
                                     "Omega=1:3"])
     assert bad.exit_code == 2 and "NAME=LO:HI:N" in bad.output
+
+
+def test_ill_conditioned_points_are_recomputed_with_50_digits(tmp_path):
+    """Two unequal masses on the chain: with m2/m1 = 1e-10 the ω² spread is beyond 1e6, the
+    float64 result is not trusted there and the point is recomputed with 50 digits; the
+    result is the one-point path's (which falls back the same way)."""
+    path = tmp_path / "problems" / "lim" / "9004.yaml"
+    path.parent.mkdir(parents=True)
+    path.write_text(CHAIN.replace("lim-9003", "lim-9004").replace(
+        "m: {value: 1.0}", "m1: {value: 1.0}\n  m2: {value: 1.0}").replace(
+        "kinetic: m*(x1dot**2 + x2dot**2)/2", "kinetic: (m1*x1dot**2 + m2*x2dot**2)/2"))
+    an = Analysis(load_problem(path))
+    lin = an.linear(None, {q: sp.S.Zero for q in an.system().q})
+    syms = symbols(an.problem)
+    X = np.array([[1.0, 1.0, 2.0], [1.0, 1e-10, 2.0]])  # columns m1, m2, k
+    assert [str(s) for s in syms] == ["m1", "m2", "k"]
+    got = LinearSweep(lin, syms).evaluate(X)
+    assert got.ill == 1 and got.precise == 1
+    for i in range(2):
+        one = lin.numeric_frequencies(dict(zip(syms, X[i], strict=True)))
+        assert np.allclose(got.frequencies[i], one, rtol=1e-12)

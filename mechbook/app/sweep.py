@@ -207,10 +207,8 @@ class Sweeper:
         got.frequencies[outside] = np.nan
         got.growth[outside] = np.nan
         out = {"ill": np.array([got.ill]), "precise": np.array([got.precise]),
-               "stability": got.stability}
-        if self.spec.quantity == "frequencies":
-            out["frequencies"] = got.frequencies
-        else:
+               "stability": got.stability, "frequencies": got.frequencies}
+        if self.spec.quantity == "stability":
             out["growth"] = got.growth
         return out
 
@@ -463,7 +461,7 @@ def summary(result: SweepResult) -> list[str]:
         codes, counts = np.unique(arr["stability"], return_counts=True)
         lines.append("stability: " + ", ".join(f"{STABILITY_NAMES[int(c)]} {n}"
                                                for c, n in zip(codes, counts, strict=True)))
-    if "frequencies" in arr:
+    if a["quantity"] == "frequencies":
         f = arr["frequencies"]
         undefined = arr["stability"] == UNDEFINED
         unstable = np.any(np.isnan(f), -1) & ~undefined

@@ -95,6 +95,16 @@ def _stability(plt, result, axes, cut):
         ax.contour(x, y, np.where(defined, engine_stable, np.nan).T, levels=[0.5],
                    colors="k", linewidths=1.0)
         handles.append(plt.Line2D([], [], color="k", lw=1.0, label="engine's boundary"))
+    freq = result.arrays["frequencies"][cut]
+    lowest = np.min(np.where((codes[..., None] == STABLE) & np.isfinite(freq), freq, np.inf),
+                    axis=-1)
+    lowest = np.where(np.isfinite(lowest), lowest, np.nan)
+    if np.any(np.isfinite(lowest)) and np.nanmax(lowest) > np.nanmin(lowest):
+        cs = ax.contour(x, y, lowest.T, levels=6, colors="#4d4d4d", linewidths=0.6,
+                        alpha=0.8)
+        ax.clabel(cs, fontsize=7, fmt="%.3g")
+        handles.append(plt.Line2D([], [], color="#4d4d4d", lw=0.6,
+                                  label="lowest frequency where stable (rad/s)"))
     if "stable" in book:
         field = book["margin"][cut] if "margin" in book else book["stable"][cut].astype(float)
         level = 0.0 if "margin" in book else 0.5
