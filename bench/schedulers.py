@@ -94,7 +94,8 @@ def bench_dask(workers: int, problems: list[str], options: BatchOptions) -> dict
         row["task_ms"] = (time.perf_counter() - t) / 200 * 1e3
         t = time.perf_counter()
         runs = client.gather([client.submit(check_task, pid, tree_files(pid, ROOT), options,
-                                            str(ROOT), pure=False) for pid in problems])
+                                            str(ROOT), pure=False, priority=len(problems) - i)
+                              for i, pid in enumerate(problems)])
         row["check_s"] = time.perf_counter() - t
         row["check_ok"] = all(not r.error for r in runs)
         row["rss_busy_mb"] = _rss_mb([os.getpid(), *_descendants(os.getpid())])

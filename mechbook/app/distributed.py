@@ -22,9 +22,11 @@ workers with DASK_DISTRIBUTED__WORKER__DAEMON=False (README), as `local_cluster`
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import multiprocessing as mp
 import os
+import shutil
 import tempfile
 import time
 from collections.abc import Callable
@@ -66,6 +68,7 @@ def materialize(files: dict[str, bytes]) -> Path:
     key = digest.hexdigest()
     if key not in _TREES or not _TREES[key].exists():
         base = Path(tempfile.mkdtemp(prefix="mechbook-tree-"))
+        atexit.register(shutil.rmtree, base, True)  # removed when the worker exits
         (base / "problems").mkdir()
         for name, data in files.items():
             target = base / name
@@ -132,10 +135,12 @@ class ClusterBatch:
 
         done: dict[str, ProblemRun] = {}
         with connect(self.address) as client:
+            # in the order given (the longest first), as the local pool does
             futures = {client.submit(check_task, pid, tree_files(pid, self.base),
                                      self.options, str(self.base), pure=False,
+                                     priority=len(ids) - i,
                                      key=f"mechbook-check-{pid}-{os.getpid()}-{time.time_ns()}"):
-                       pid for pid in ids}
+                       pid for i, pid in enumerate(ids)}
             for fut in as_completed(futures):
                 pid = futures[fut]
                 try:
@@ -231,10 +236,14 @@ def limited(fn, args: tuple, timeout: float, memory_mb: float):
 
 def local_cluster(workers: int = 2):
     """A Dask cluster on this machine (tests, and trying `--scheduler` out): `workers`
-    processes of one thread each, allowed to start the children that enforce limits."""
+    processes of one thread each, allowed to start the children that enforce limits, and
+    handed one task at a time (worker-saturation 1.0: Dask's default 1.1 queues a second
+    task on a one-thread worker, which then waits behind a long problem while another
+    worker idles)."""
     import dask
     from dask.distributed import LocalCluster
 
-    with dask.config.set({"distributed.worker.daemon": False}):
+    with dask.config.set({"distributed.worker.daemon": False,
+                          "distributed.scheduler.worker-saturation": 1.0}):
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                             dashboard_address=None, host="127.0.0.1")
