@@ -299,3 +299,16 @@ def test_ill_conditioned_points_are_recomputed_with_50_digits(tmp_path):
     for i in range(2):
         one = lin.numeric_frequencies(dict(zip(syms, X[i], strict=True)))
         assert np.allclose(got.frequencies[i], one, rtol=1e-12)
+
+
+def test_a_local_process_pool_gives_the_same_result(monkeypatch):
+    import mechbook.app.sweep as sweep_mod
+
+    monkeypatch.setattr(sweep_mod, "BLOCK_ENTRIES", 2000)
+    spec = make_spec("lim-9001", TREE, "frequencies",
+                     [parse_axis("Omega=0.2:3:20"), parse_axis("k2=0.5:5:20")])
+    one = run_sweep(spec, TREE, samples=2)
+    two = run_sweep(spec, TREE, jobs=2, samples=2)
+    assert two.attrs["blocks"] > 2 and "2 local processes" in two.attrs["where"]
+    for key in one.arrays:
+        assert np.array_equal(one.arrays[key], two.arrays[key], equal_nan=True), key

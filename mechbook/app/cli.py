@@ -403,8 +403,9 @@ def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity
     in stacked batches; the float64 result is checked against 30 digits at sampled points
     and the book's answer at the same point is drawn over (and compared)."""
     from mechbook.app.distributed import scheduler_address
-    from mechbook.app.sweep import make_spec, run_sweep, summary
+    from mechbook.app.sweep import make_spec, run_sweep
     from mechbook.app.sweep_io import STORE_POINTS, write_netcdf, write_store
+    from mechbook.app.sweep_text import summary
     from mechbook.engine.sweep import parse_axis
 
     base = _resolve_root(ctx)

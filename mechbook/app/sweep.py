@@ -32,7 +32,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import DEFAULT_BACKEND
-from mechbook.engine.sweep import STABILITY_NAMES, UNDEFINED, Axis, Grid
+from mechbook.engine.sweep import UNDEFINED, Axis, Grid
 from mechbook.errors import MechbookError
 
 QUANTITIES = ("frequencies", "stability", "drift")
@@ -242,86 +242,6 @@ class Sweeper:
         return {"linear": linear, "measured": measured, "relative_error": rel,
                 "ill": np.array([0]), "precise": np.array([0])}
 
-    # ---- accuracy: float64 against 30 digits ---------------------------------------------
-    def accuracy(self, arrays: dict[str, np.ndarray], samples: int = SAMPLES,
-                 seed: int = 0) -> dict:
-        """The float64 results at sampled points against the 30-digit path (the matrices
-        substituted symbolically, the eigenproblem in mpmath)."""
-        rng = np.random.default_rng(seed)
-        shape = self.grid.shape
-        if self.spec.quantity == "stability":
-            codes = arrays["stability"]
-            defined = np.flatnonzero(codes.reshape(-1) != UNDEFINED)
-            edge = _boundary(codes)
-        elif self.spec.quantity == "frequencies":
-            defined = np.flatnonzero(np.any(np.isfinite(arrays["frequencies"]), axis=-1)
-                                     .reshape(-1))
-            edge = np.zeros(0, dtype=int)
-        else:
-            defined = np.flatnonzero(np.any(np.isfinite(arrays["linear"]), axis=-1)
-                                     .reshape(-1))
-            edge = np.zeros(0, dtype=int)
-        if not len(defined):
-            return {"samples": 0, "max_rel_diff": float("nan"), "disagree": 0}
-        chosen = list(rng.choice(edge, min(len(edge), samples // 3), replace=False)) \
-            if len(edge) else []
-        rest = np.setdiff1d(defined, chosen)
-        chosen += list(rng.choice(rest, min(len(rest), samples - len(chosen)), replace=False))
-        worst, disagree, worst_at = 0.0, [], None
-        for flat in sorted(int(c) for c in chosen):
-            values = {s: v for s, v in self.grid.values_at(flat).items()
-                      if s is not self.amplitude}
-            idx = np.unravel_index(flat, shape)
-            where = {a.name: float(v) for a, v in
-                     zip(self.grid.axes, (self.grid.coords()[a.name][i] for a, i in
-                                          zip(self.grid.axes, idx, strict=True)), strict=True)}
-            try:
-                if self.spec.quantity == "stability":
-                    code, ref = self.linear.precise_stability(values)
-                    if code != arrays["stability"][idx]:
-                        disagree.append(where)
-                        continue
-                    X = np.array([[values[s] for s in self.linear.symbols]])
-                    got = self.linear.spectrum(X)[0]
-                    scale = float(np.max(np.abs(ref))) or 1.0
-                    # each exact eigenvalue against the nearest float64 one
-                    rel = float(np.max(np.min(np.abs(ref[:, None] - got[None, :]), axis=1)))
-                    if rel / scale >= worst:
-                        worst, worst_at = rel / scale, where
-                    continue
-                else:
-                    ref = self.linear.precise_frequencies(values)
-                    name = "frequencies" if self.spec.quantity == "frequencies" else "linear"
-                    got = arrays[name][idx]
-                    if not np.array_equal(np.isfinite(ref), np.isfinite(got)):
-                        disagree.append(where)
-                        continue
-                    scale = float(np.nanmax(np.abs(ref))) if np.any(np.isfinite(ref)) else 1.0
-            except (ValueError, ZeroDivisionError, TypeError, ArithmeticError) as exc:
-                disagree.append({**where, "error": str(exc)[:80]})
-                continue
-            diff = np.abs(np.nan_to_num(got) - np.nan_to_num(ref))
-            rel = float(np.max(diff)) / scale if scale > 0 and np.any(diff) else 0.0
-            if rel >= worst:
-                worst, worst_at = rel, where
-        return {"samples": len(chosen), "boundary_samples": min(len(edge), samples // 3),
-                "max_rel_diff": worst, "worst_at": worst_at, "disagree": len(disagree),
-                "disagree_at": disagree[:5]}
-
-
-def _boundary(codes: np.ndarray) -> np.ndarray:
-    """Flat indices of grid points whose stability differs from a neighbour's."""
-    mark = np.zeros(codes.shape, dtype=bool)
-    for ax in range(codes.ndim):
-        if codes.shape[ax] < 2:
-            continue
-        a = np.swapaxes(codes, 0, ax)
-        m = np.swapaxes(mark, 0, ax)
-        diff = (a[1:] != a[:-1]) & (a[1:] != UNDEFINED) & (a[:-1] != UNDEFINED)
-        m[1:] |= diff
-        m[:-1] |= diff
-    return np.flatnonzero(mark.reshape(-1))
-
 
 # ---- where blocks run ------------------------------------------------------------------------
 _SWEEPERS: dict[str, Sweeper] = {}  # per process: one sweeper per sweep (compiled once)
@@ -397,8 +317,10 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         where = "this process"
     seconds = time.perf_counter() - t1
     arrays, dims = _assemble(sweeper, [parts[a] for a, _ in ranges])
+    from mechbook.app.sweep_accuracy import sample_accuracy
+
     t2 = time.perf_counter()
-    accuracy = sweeper.accuracy(arrays, samples)
+    accuracy = sample_accuracy(sweeper, arrays, samples)
     attrs = {
         "problem": spec.pid, "title": sweeper.problem.title, "quantity": spec.quantity,
         "system": sweeper.system.name, "point": sweeper.point_text(),
@@ -441,74 +363,3 @@ def _assemble(sweeper: Sweeper, parts: list[dict]) -> tuple[dict, dict]:
             arrays[key] = full.reshape(shape)
             dims[key] = names
     return arrays, dims
-
-
-def summary(result: SweepResult) -> list[str]:
-    """What the command prints: the run, the numbers, the accuracy, the book."""
-    a = result.attrs
-    lines = [f"{a['problem']}: {a['title']}",
-             f"{a['quantity']} about {a['point']} [system {a['system']}"
-             + (", gyroscopic" if a["gyroscopic"] else "") + "]",
-             f"grid {a['axes']}: {a['points']} points in {a['blocks']} blocks on "
-             f"{a['where']}; derived and compiled in {a['build_seconds']:.2f} s, evaluated "
-             f"in {a['evaluate_seconds']:.2f} s ({a['points_per_second']:.3g} points/s)"]
-    if a["fixed"]:
-        lines.append("fixed: " + ", ".join(f"{k}={v:g}" for k, v in a["fixed"].items()))
-    if a["conditions"]:
-        lines.append("conditions (points outside are undefined): " + ", ".join(a["conditions"]))
-    arr = result.arrays
-    if a["quantity"] == "stability":
-        codes, counts = np.unique(arr["stability"], return_counts=True)
-        lines.append("stability: " + ", ".join(f"{STABILITY_NAMES[int(c)]} {n}"
-                                               for c, n in zip(codes, counts, strict=True)))
-    if a["quantity"] == "frequencies":
-        f = arr["frequencies"]
-        undefined = arr["stability"] == UNDEFINED
-        unstable = np.any(np.isnan(f), -1) & ~undefined
-        if np.any(np.isfinite(f)):
-            lines.append(f"frequencies: {np.nanmin(f):.6g} to {np.nanmax(f):.6g} rad/s; "
-                         f"points with an unstable mode: {int(unstable.sum())}; undefined "
-                         f"(no such point, outside the conditions, or M singular): "
-                         f"{int(undefined.sum())}")
-    if "relative_error" in arr:
-        lines += _drift_lines(result)
-    acc = a["accuracy"]
-    if a["quantity"] == "drift":
-        lines.append("accuracy: measured frequencies from DOP853 at rtol 1e-12 (the linear "
-                     "reference below)")
-    if acc["samples"]:
-        what = ("eigenvalues: state-space λ" if a["gyroscopic"] else "eigenvalues: ω²") \
-            if a["quantity"] == "stability" else "frequencies"
-        line = (f"float64 vs 30 digits at {acc['samples']} sampled points"
-                + (f" ({acc['boundary_samples']} beside the boundary)"
-                   if acc.get("boundary_samples") else "")
-                + f": largest relative difference {acc['max_rel_diff']:.2e} ({what})")
-        if acc["disagree"]:
-            line += f"; {acc['disagree']} points disagree: {acc['disagree_at']}"
-        lines.append(line)
-    if a["ill_conditioned"]:
-        lines.append(f"ill-conditioned points (float64 not trusted): {a['ill_conditioned']}, "
-                     f"of which {a['precise_50_digits']} recomputed with 50 digits")
-    lines += result.book.get("lines", [])
-    return lines
-
-
-def _drift_lines(result: SweepResult) -> list[str]:
-    rel = np.abs(result.arrays["relative_error"])
-    amps = result.coords[AMPLITUDE]
-    out = []
-    if len(result.spec.axes) != 1:
-        worst = np.nanmax(rel) if np.any(np.isfinite(rel)) else float("nan")
-        return [f"largest |relative error| of the linear frequency: {worst:.3g}"]
-    for m in range(rel.shape[-1]):
-        col = rel[..., m]
-        if not np.any(np.isfinite(col)):
-            continue
-        bits = []
-        for tol in (1e-3, 1e-2, 1e-1):
-            over = np.flatnonzero(col > tol)
-            bits.append(f"{tol:g} from amplitude {amps[over[0]]:.3g}" if len(over)
-                        else f"{tol:g} not reached")
-        out.append(f"mode {m} (ω {np.nanmedian(result.arrays['linear'][..., m]):.6g}): "
-                   f"|relative error| exceeds " + ", ".join(bits))
-    return out

@@ -261,8 +261,14 @@ class LinearSweep:
         if precise and 0 < block.ill <= PRECISE_LIMIT:
             for i in np.flatnonzero(ill):
                 values = {s: float(x) for s, x in zip(self.symbols, X[i], strict=True)}
-                freq[i] = self.precise_frequencies(values, dps=50)
-            block.precise = block.ill
+                try:
+                    freq[i] = self.precise_frequencies(values, dps=50)
+                    block.precise += 1
+                except (ValueError, ZeroDivisionError, ArithmeticError, TypeError):
+                    pass  # kept at float64, and counted as such
+            if block.precise < block.ill:
+                block.notes.append(f"{block.ill - block.precise} ill-conditioned points kept "
+                                   "at float64 (the 50-digit path failed there)")
         elif block.ill:
             block.notes.append(f"{block.ill} ill-conditioned points kept at float64 (more "
                                f"than {PRECISE_LIMIT} in a block to recompute)")
