@@ -275,6 +275,14 @@ def test_sweep_command_prints_stores_and_plots(tmp_path):
     assert "agrees with the engine at 800 of 800" in out.output
     assert plot.stat().st_size > 10_000
     assert read_store("lim-9001", "stability-Omega-k2", store)["attrs"]["points"] == 800
+    # a check run into the same store keeps the sweep, and `show` lists it
+    checked = CliRunner().invoke(main, ["--root", str(TREE), "check", "lim-9001", "--store",
+                                        str(store), "--no-crosscheck", "--fresh", "-j", "1"])
+    assert checked.exit_code == 0, checked.output
+    listed = CliRunner().invoke(main, ["--root", str(TREE), "show", "lim-9001", "--store",
+                                       str(store)])
+    assert "sweep stored: /sweeps/lim-9001/stability-Omega-k2: stability over " \
+        "Omega=0.2:3:40 k2=0.5:5:20 about x = 0, y = 0" in listed.output, listed.output
     bad = CliRunner().invoke(main, ["--root", str(TREE), "sweep", "lim-9001", "--param",
                                     "Omega=1:3"])
     assert bad.exit_code == 2 and "NAME=LO:HI:N" in bad.output

@@ -253,6 +253,10 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
                        f"parts: {parts}] {x.get('detail', '')}")
     for name in rec.get("simulations", []):
         click.echo(f"simulation stored: /problems/{problem_id}/simulations/{name}")
+    from mechbook.app.sweep_io import stored_sweeps
+
+    for name, text in stored_sweeps(problem_id, path):
+        click.echo(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")
 
 
 @main.command()

@@ -102,6 +102,21 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
     return {"attrs": attrs, "coords": coords, "variables": vars_}
 
 
+def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
+    """(name, one-line description) of a problem's stored sweeps."""
+    out = []
+    try:
+        with h5py.File(path, "r") as f:
+            for name, g in f.get("sweeps", {}).get(pid, {}).items():
+                a = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
+                where = f" in {a['file']}" if a.get("file") else ""
+                out.append((name, f"{a.get('quantity')} over {a.get('axes')} about "
+                                  f"{a.get('point')}{where}"))
+    except OSError:
+        pass
+    return out
+
+
 def write_netcdf(result, path: str | Path) -> Path:
     """The sweep as a netCDF-4 file (written beside, then renamed into place)."""
     import h5netcdf
