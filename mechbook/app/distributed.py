@@ -1,15 +1,16 @@
 """Checks and sweeps on a running Dask cluster (`--scheduler ADDRESS` or $MECHBOOK_SCHEDULER).
 
 Why Dask distributed and not Ray (bench/schedulers.py measured both on this 2-core machine;
-docs/performance.md has the table): a local Dask cluster of 2 workers is ready in about a
-second and uses a fraction of the memory of Ray's (GCS, raylet, dashboard and object store
-start with it, several seconds), its per-task overhead is lower, it is pure Python on
-PyPI with a small footprint, and what Ray offers beyond it (killing a running task) does not
-spare us our own limits: a check must be stopped with the stage it was in, and the memory
-bound read from /proc, exactly as the local pool does. So the limits stay ours on every
-scheduler: each task runs its work in a child process of the Dask worker (the local pool's
-code, `mechbook.app.batch`, for a check; `_Sidecar` below for a sweep block), killed and
-replaced when it passes the time or memory bound.
+docs/performance.md has the table): a local Dask cluster of 2 workers is ready in about 2 s
+against Ray's 5-10 s, uses about a third of the memory (Ray starts its GCS, raylet and
+object store with it) and a tenth of the installed size, and is pure Python on PyPI. Ray's
+lower per-task overhead (about 1 ms against 2-5 ms) does not count for tasks of seconds,
+and what Ray offers beyond Dask (killing a running task) does not spare us our own limits:
+a check must be stopped with the stage it was in, and the memory bound read from /proc,
+exactly as the local pool does. So the limits stay ours on every scheduler: each task runs
+its work in a child process of the Dask worker (the local pool's code, `mechbook.app.batch`,
+for a check; `Sidecar` below for a sweep block), killed and replaced when it passes the
+time or memory bound.
 
 What travels: problem and answer files go with each task as text (the workers need no copy
 of the tree and no shared file system), results come back as plain data (`ProblemRun`,
