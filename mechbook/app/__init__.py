@@ -2,6 +2,10 @@
 
     run          checking one problem (what a worker does), plain data out
     batch        a pool of worker processes with time and memory limits
+    distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
+    sweep        `mechbook sweep`: a result over a grid of parameters (sweep_accuracy:
+                 float64 against 30 digits; sweep_book: the book's answer on the grid;
+                 sweep_io: store and netCDF; sweep_plot; sweep_text: what it prints)
     store        the HDF5 store, written atomically under a lock
     fingerprint  content hashes for the warm-run cache
     validate     `mechbook validate`

@@ -1,4 +1,4 @@
-"""The `mechbook` command line: list, solve, check, validate, show, simulate."""
+"""The `mechbook` command line: list, solve, check, validate, show, simulate, sweep."""
 
 from __future__ import annotations
 
@@ -121,10 +121,15 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
                    "also try a symbolic proof with SymPy; the method column says which it got.")
 @click.option("--prove-seconds", type=click.FloatRange(min=0, min_open=True), default=10.0,
               show_default=True, help="Time limit of each symbolic proof attempt.")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Run the problems on the Dask cluster whose scheduler is at ADDRESS "
+                   "(tcp://host:8786; default $MECHBOOK_SCHEDULER, else the local pool). "
+                   "The limits hold per problem on the workers.")
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
           verbose: bool, fresh: bool, no_crosscheck: bool, jobs: int, timeout: float,
-          memory_mb: float, serial: bool, prove: bool, prove_seconds: float) -> None:
+          memory_mb: float, serial: bool, prove: bool, prove_seconds: float,
+          scheduler: str | None) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail.
 
     Problems run in parallel worker processes, the longest first; each finished problem is
@@ -166,9 +171,16 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
                   key=lambda pid: -past.get(pid, float("inf")))
     options = BatchOptions(jobs, timeout, memory_mb, serial=serial, run=RunOptions(
         crosscheck=not no_crosscheck, policy=ProofPolicy(prove, prove_seconds)))
+    from mechbook.app.distributed import ClusterBatch, scheduler_address
+
+    address = None if serial else scheduler_address(scheduler)
     try:
-        for run in Batch(base, options, on_done=finished).run(todo):
+        batch = ClusterBatch(address, base, options, on_done=finished) if address and todo \
+            else Batch(base, options, on_done=finished)
+        for run in batch.run(todo):
             runs[run.pid] = run
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
     finally:
         progress.close()
     ordered = [runs[pid] for pid in ids]
@@ -241,6 +253,10 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
                        f"parts: {parts}] {x.get('detail', '')}")
     for name in rec.get("simulations", []):
         click.echo(f"simulation stored: /problems/{problem_id}/simulations/{name}")
+    from mechbook.app.sweep_io import stored_sweeps
+
+    for name, text in stored_sweeps(problem_id, path):
+        click.echo(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")
 
 
 @main.command()
@@ -336,3 +352,108 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
         click.echo(f"plot written to {plot_simulation(sim, plot_path)}")
     if not traj.success:
         sys.exit(1)
+
+
+@main.command()
+@click.argument("problem_id")
+@click.option("--param", "params", multiple=True, required=True, metavar="NAME=LO:HI:N[:log]",
+              help="A swept parameter: N values from LO to HI (evenly; ':log' evenly in log). "
+                   "Repeat for a plane or more; the others stay at their values (N=1 fixes "
+                   "one: k=2:2:1). For --quantity drift one must be 'amplitude'.")
+@click.option("--quantity", type=click.Choice(["frequencies", "stability", "drift"]),
+              default="frequencies", show_default=True,
+              help="frequencies: the normal frequencies; stability: stable / marginal / "
+                   "unstable and the growth rate; drift: the frequency measured from the "
+                   "nonlinear motion at each amplitude against the linear one.")
+@click.option("--system", default=None, help="Which system of a multi-system problem.")
+@click.option("--about", multiple=True, metavar="COORD=EXPR",
+              help="The equilibrium to linearize about (theta=pi); default: the stable one.")
+@click.option("--steady", multiple=True, metavar="COORD=RATE",
+              help="A steady motion: a cyclic coordinate turning at RATE (with --about for "
+                   "the others), reduced by Routh's procedure.")
+@click.option("--part", default=None,
+              help="Take the point (and the book's answer drawn over) from this answer part.")
+@click.option("--backend", type=click.Choice(["llvm", "symengine", "sympy"]), default="llvm",
+              show_default=True, help="How M(p), C(p), K(p) are compiled.")
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Local worker processes for the blocks (1: this process).")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Evaluate the blocks on the Dask cluster at ADDRESS (default "
+                   "$MECHBOOK_SCHEDULER, else locally).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
+              default=DEFAULT_TIMEOUT, show_default=True,
+              help="Wall-clock seconds allowed per block on a cluster worker.")
+@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+              show_default=True, help="Resident memory (MB) allowed per cluster worker's block.")
+@click.option("--samples", type=click.IntRange(min=0), default=24, show_default=True,
+              help="Points where the float64 result is checked against 30 digits.")
+@click.option("--name", default=None, help="Name of the stored sweep (default QUANTITY-AXES).")
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 store to add the sweep to.")
+@click.option("--no-store", is_flag=True, help="Do not store the sweep.")
+@click.option("--out", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write the sweep to this netCDF-4 file (named dimensions); a "
+                                 "sweep too large for the store goes to results/sweeps/ anyway.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write the figure here (PNG, SVG, PDF by suffix).")
+@click.pass_context
+def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity: str,
+          system: str | None, about: tuple[str, ...], steady: tuple[str, ...],
+          part: str | None, backend: str, jobs: int, scheduler: str | None, timeout: float,
+          memory_mb: float, samples: int, name: str | None, store_path: Path, no_store: bool,
+          out_path: Path | None, plot_path: Path | None) -> None:
+    """Map a problem's frequencies, stability or frequency drift over a grid of parameter
+    values: derived once, M(p), C(p), K(p) compiled once, every point's eigenproblem solved
+    in stacked batches; the float64 result is checked against 30 digits at sampled points
+    and the book's answer at the same point is drawn over (and compared)."""
+    from mechbook.app.distributed import scheduler_address
+    from mechbook.app.sweep import make_spec, run_sweep
+    from mechbook.app.sweep_io import STORE_POINTS, write_netcdf, write_store
+    from mechbook.app.sweep_text import summary
+    from mechbook.engine.sweep import parse_axis
+
+    base = _resolve_root(ctx)
+
+    def pairs(items: tuple[str, ...], what: str) -> dict[str, str]:
+        out = {}
+        for item in items:
+            key, sep, val = item.partition("=")
+            if not sep or not key.strip() or not val.strip():
+                raise click.BadParameter(f"{item!r}: expected NAME=EXPR", param_hint=what)
+            out[key.strip()] = val.strip()
+        return out
+
+    try:
+        axes = [parse_axis(p) for p in params]
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), param_hint="--param") from None
+    if (about or steady) and part:
+        raise click.UsageError("--part takes the point from the answer key: drop --about/"
+                               "--steady, or --part")
+    try:
+        spec = make_spec(problem_id, base, quantity, axes, system=system,
+                         about=pairs(about, "--about"), steady=pairs(steady, "--steady"),
+                         part=part, backend=backend)
+        result = run_sweep(spec, base, jobs=jobs, scheduler=scheduler_address(scheduler),
+                           timeout=timeout, memory_mb=memory_mb, samples=samples)
+    except (MechbookError, KeyError) as exc:
+        raise click.ClickException(str(exc).strip("'\"")) from None
+    for line in summary(result):
+        click.echo(line)
+    run_name = name or "-".join([quantity] + [a.name for a in axes])
+    big = result.attrs["points"] > STORE_POINTS
+    if out_path is None and big and not no_store:
+        out_path = base / "results" / "sweeps" / f"{problem_id}-{run_name}.nc"
+    if out_path is not None:
+        result.attrs["file"] = str(write_netcdf(result, out_path))
+        click.echo(f"written to {out_path} (netCDF-4, dimensions "
+                   f"{', '.join(result.coords)})")
+    if not no_store:
+        path = store_path if store_path.is_absolute() else base / store_path
+        write_store(result, run_name, path)
+        where = "its attributes and the file's path" if big else "stored"
+        click.echo(f"{where} as /sweeps/{problem_id}/{run_name} in {path}")
+    if plot_path is not None:
+        from mechbook.app.sweep_plot import plot_sweep
+
+        click.echo(f"plot written to {plot_sweep(result, plot_path)}")

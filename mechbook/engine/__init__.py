@@ -7,6 +7,8 @@ reader asks (mechbook solve).
     routh       Routh's reduction about a steady motion
     phase       the phase-space flow in (q, p)
     analysis    one problem's results, cached per system and point (what checks pull from)
+    sweep       a linear system over a grid of parameters: compiled once, stacked
+                eigensolvers, the 30-digit path at single points
     derive      results as text for a reader, and the summary a check run stores
 
 May import: mechbook.model, mechbook.core, mechbook.errors, mechbook.records.
