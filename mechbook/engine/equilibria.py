@@ -10,7 +10,6 @@ M·δq̈ + C·δq̇ + K·δq = F(t); a point that is not an equilibrium is refus
 
 from __future__ import annotations
 
-import time
 from functools import cached_property
 
 import numpy as np
@@ -20,7 +19,7 @@ import sympy as sp
 from mechbook.core.compile import compile_exprs
 from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import NotNumeric, evaluate, without_absent
-from mechbook.core.timeout import Timeout, time_limit, try_simplify
+from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import NotEquilibriumError, UnsupportedError
@@ -67,10 +66,10 @@ class Equilibria:
             return self._solved
         if budget is not None and self._gave_up_at is not None and budget <= self._gave_up_at:
             return []
-        deadline = None if budget is None else time.monotonic() + budget
+        deadline = None if budget is None else cpu_time() + budget
 
         def limit(cap: float) -> float:
-            return cap if deadline is None else min(cap, deadline - time.monotonic())
+            return cap if deadline is None else min(cap, deadline - cpu_time())
 
         conds = []
         for c in self.conditions:  # simplified first: solve finds more this way
@@ -86,7 +85,7 @@ class Equilibria:
             with time_limit(seconds):
                 sols = sp.solve(conds, self.dyn.q, dict=True)
         except (Timeout, NotImplementedError):
-            if deadline is not None and time.monotonic() >= deadline - 1e-3:
+            if deadline is not None and cpu_time() >= deadline - 1e-3:
                 self._gave_up_at = budget  # cut short by the budget: may retry with more
                 return []
             self._solved = []
