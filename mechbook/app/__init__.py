@@ -9,7 +9,13 @@
     store        the HDF5 store, written atomically under a lock
     fingerprint  content hashes for the warm-run cache
     validate     `mechbook validate`
+    limits       the batch's default limits (light: the command line's --help shows them)
     cli          the `mechbook` command (imports the engine only inside commands)
+    api          the Python API: mechbook.load(id) -> derived results as SymPy objects
+    mathml       SymPy expressions as MathML (the report, notebooks)
+    formats      check results as JSON (schemas/check-result.json) and JUnit XML
+    frames       the store as pandas DataFrames: mechbook.results(path)
+    report/      `mechbook report`: the static HTML report
 
 May import: everything in mechbook.
 """

@@ -24,10 +24,9 @@ from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
+from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.run import ProblemRun, RunOptions
 
-DEFAULT_TIMEOUT = 600.0  # seconds per problem; the slowest takes well under a minute
-DEFAULT_MEMORY_MB = 8000  # resident memory per worker
 MAX_TASKS = 20  # problems per worker before it is replaced
 POLL = 0.25  # seconds between checks of the limits
 

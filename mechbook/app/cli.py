@@ -1,4 +1,10 @@
-"""The `mechbook` command line: list, solve, check, validate, show, simulate, sweep."""
+"""The `mechbook` command line: list, solve, check, validate, show, simulate, sweep, report,
+completion.
+
+Only click and a few small modules are imported at the top: --help, list, shell completion
+and argument errors answer without loading SymPy, NumPy or the engine, which each command
+imports when it runs (a test keeps it so; docs/performance.md has the timing).
+"""
 
 from __future__ import annotations
 
@@ -8,14 +14,25 @@ from pathlib import Path
 import click
 
 from mechbook import __version__
-from mechbook.app.batch import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
-from mechbook.app.console import Progress, print_table
+from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, answer_path, problem_path, root
 
-# The engine (SymPy, SciPy) is imported inside the commands that need it, so --help, list
-# and argument errors answer at once.
 DEFAULT_PATH = DEFAULT_STORE
+SHELLS = ("bash", "zsh", "fish")
+
+
+def _complete_ids(ctx: click.Context, param: click.Parameter, incomplete: str) -> list:
+    """Shell completion of problem ids: the files under the tree's problems/ (no engine)."""
+    from click.shell_completion import CompletionItem
+
+    try:
+        opt = ctx.find_root().params.get("root_dir")
+        base = Path(opt) if opt else root()
+        ids = all_ids(base)
+    except (MechbookError, OSError):
+        return []
+    return [CompletionItem(pid) for pid in ids if pid.startswith(incomplete)]
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -42,46 +59,54 @@ def _resolve_root(ctx: click.Context) -> Path:
 @main.command("list")
 @click.pass_context
 def list_cmd(ctx: click.Context) -> None:
-    """List every problem with its title and number of answer parts."""
-    from mechbook.model.problem import load_problem
+    """List every problem with its title and number of answer parts.
+
+    Reads the files' YAML and the problem schema only (fast, no engine): `mechbook validate`
+    checks every expression."""
+    from mechbook.model.books import file_id_error
+    from mechbook.model.schema import validate
+    from mechbook.model.yamlio import load
 
     base = _resolve_root(ctx)
     for pid in all_ids(base):
         try:
-            p = load_problem(problem_path(pid, base))
-            title = p.title
+            doc = load(problem_path(pid, base))
+            validate(doc, "problem")
+            why = file_id_error(doc.data["id"], problem_path(pid, base))
+            if why:
+                raise doc.error(("id",), why)
+            title = doc.data["title"]
         except MechbookError as exc:
             title = f"INVALID: {exc}"
-        apath = answer_path(pid, base)
         parts = "no answer key"
-        if apath.exists():
-            from mechbook.verify.answers import load_answers
-            try:
-                parts = f"{len(load_answers(apath).parts)} parts"
-            except MechbookError:
-                parts = "INVALID answer key"
+        try:
+            apath = answer_path(pid, base)
+            if apath.exists():
+                found = load(apath).data.get("parts")
+                parts = f"{len(found)} parts" if isinstance(found, list) else \
+                    "INVALID answer key"
+        except MechbookError:
+            parts = "INVALID answer key"
         click.echo(f"{pid:<22} {parts:<16} {title}")
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--system", default=None, help="Which system of a multi-system problem.")
 @click.option("--no-simplify", is_flag=True, help="Skip SymPy simplification (faster).")
 @click.pass_context
 def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: bool) -> None:
     """Derive and print a problem's results (what its `compute:` asks for), simplified."""
-    from mechbook.engine.analysis import Analysis
+    from mechbook.app.api import load
     from mechbook.engine.derive import derive
-    from mechbook.model.problem import load_problem
 
     base = _resolve_root(ctx)
     try:
-        problem = load_problem(problem_path(problem_id, base))
-        analysis = Analysis(problem, simplify=not no_simplify)
-        names = [system] if system else list(problem.systems)
+        problem = load(problem_id, base, simplify=not no_simplify)
+        names = [system] if system else problem.systems
         click.echo(f"{problem.id}: {problem.title}  [{problem.source}]")
         for name in names:
-            res = derive(analysis, name)
+            res = derive(problem.analysis, name)
             if len(problem.systems) > 1:
                 click.echo(f"\n== system {name}")
             for key, text in res.text.items():
@@ -95,7 +120,7 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
 
 
 @main.command()
-@click.argument("problem_ids", nargs=-1)
+@click.argument("problem_ids", nargs=-1, shell_complete=_complete_ids)
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to write results to.")
 @click.option("--no-store", is_flag=True, help="Do not write results.")
@@ -125,11 +150,17 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
               help="Run the problems on the Dask cluster whose scheduler is at ADDRESS "
                    "(tcp://host:8786; default $MECHBOOK_SCHEDULER, else the local pool). "
                    "The limits hold per problem on the workers.")
+@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
+              show_default=True,
+              help="table: for people; json: one JSON document on stdout (its schema: "
+                   "mechbook/app/schemas/check-result.json), progress stays on stderr.")
+@click.option("--junit-xml", "junit_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Also write the outcomes as JUnit XML here (for CI).")
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
           verbose: bool, fresh: bool, no_crosscheck: bool, jobs: int, timeout: float,
           memory_mb: float, serial: bool, prove: bool, prove_seconds: float,
-          scheduler: str | None) -> None:
+          scheduler: str | None, fmt: str, junit_path: Path | None) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail.
 
     Problems run in parallel worker processes, the longest first; each finished problem is
@@ -138,7 +169,11 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     frequency part's linear system is confirmed by simulating the nonlinear equations along
     every mode, and each system's Lagrange equations against Newton's law
     (docs/numerics.md); a cross-check fail also exits 1."""
+    import json
+
     from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.app.console import Progress, print_table
+    from mechbook.app.formats import failures, to_json, write_junit
     from mechbook.app.run import RunOptions, cached_runs
     from mechbook.app.store import durations, write
     from mechbook.records import ProofPolicy
@@ -184,12 +219,17 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     finally:
         progress.close()
     ordered = [runs[pid] for pid in ids]
-    print_table(ordered, verbose)
-    if not no_store and any(r.record is not None for r in ordered):
-        click.echo(f"results written to {store_file}")
-    bad = sum(1 for r in ordered if r.error) + sum(1 for r in ordered for o in r.outcomes
-                                                   if o.status in ("fail", "error"))
-    bad += sum(1 for r in ordered for x in r.crosschecks if x.failed)
+    stored = not no_store and any(r.record is not None or r.cached for r in ordered)
+    if fmt == "json":
+        doc = to_json(ordered, base, store_file if stored else None)
+        click.echo(json.dumps(doc, indent=1, ensure_ascii=False))
+    else:
+        print_table(ordered, verbose)
+        if not no_store and any(r.record is not None for r in ordered):
+            click.echo(f"results written to {store_file}")
+    if junit_path is not None:
+        click.echo(f"JUnit XML written to {write_junit(ordered, junit_path)}", err=True)
+    bad = failures(ordered)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
         sys.exit(1)
@@ -214,7 +254,7 @@ def validate(files: tuple[Path, ...]) -> None:
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to read.")
 @click.pass_context
@@ -260,7 +300,7 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--system", default=None, help="Which system of a multi-system problem.")
 @click.option("--method", default=None,
               type=click.Choice(["RK45", "DOP853", "Radau", "LSODA", "RK4", "leapfrog",
@@ -306,24 +346,20 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
              store_path: Path, no_store: bool) -> None:
     """Integrate a problem's full nonlinear equations of motion; report the drift of every
     conserved quantity the engine found; store the trajectory (and plot it)."""
-    from mechbook.app.store import write_simulation
+    from mechbook.app.api import load
     from mechbook.core.compile import DEFAULT_BACKEND
-    from mechbook.engine.analysis import Analysis
-    from mechbook.model.problem import load_problem
     from mechbook.numerics.simulate import parse_assignments
-    from mechbook.numerics.simulate import simulate as run_simulation
 
     base = _resolve_root(ctx)
     try:
-        problem = load_problem(problem_path(problem_id, base))
-        analysis = Analysis(problem)
-        sim = run_simulation(analysis, system, init=parse_assignments(init),
-                             t_span=(0.0, t_end), method=method, points=points,
-                             backend=backend or DEFAULT_BACKEND, accuracy=accuracy,
-                             parameters=parse_assignments(params), rtol=rtol, atol=atol,
-                             max_step=max_step, step=step)
+        problem = load(problem_id, base, simplify=False)
+        run = problem.simulate(t_end, system, init=parse_assignments(init), method=method,
+                               points=points, backend=backend or DEFAULT_BACKEND,
+                               accuracy=accuracy, parameters=parse_assignments(params),
+                               rtol=rtol, atol=atol, max_step=max_step, step=step)
     except (MechbookError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
+    sim = run.run
     traj = sim.trajectory
     click.echo(f"{problem.id} [{sim.system}]: {problem.title}")
     click.echo("initial: " + ", ".join(f"{k}={v:.6g}" for k, v in sim.initial.items())
@@ -342,20 +378,15 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
         click.echo("no conserved quantity found by the engine: nothing to monitor")
     if not no_store:
         path = store_path if store_path.is_absolute() else base / store_path
-        run_name = name or f"{sim.system}-{traj.method}"
-        write_simulation(problem.id, run_name, sim.arrays(), sim.settings(),
-                         {f"monitors/{d.name}": d.attrs() for d in sim.drifts}, path)
-        click.echo(f"stored as /problems/{problem.id}/simulations/{run_name} in {path}")
+        click.echo(f"stored as {run.store(path, name)} in {path}")
     if plot_path is not None:
-        from mechbook.numerics.plot import plot_simulation
-
-        click.echo(f"plot written to {plot_simulation(sim, plot_path)}")
+        click.echo(f"plot written to {run.plot(plot_path)}")
     if not traj.success:
         sys.exit(1)
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=LO:HI:N[:log]",
               help="A swept parameter: N values from LO to HI (evenly; ':log' evenly in log). "
                    "Repeat for a plane or more; the others stay at their values (N=1 fixes "
@@ -457,3 +488,63 @@ def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity
         from mechbook.app.sweep_plot import plot_sweep
 
         click.echo(f"plot written to {plot_sweep(result, plot_path)}")
+
+
+@main.command()
+@click.argument("problem_ids", nargs=-1, shell_complete=_complete_ids)
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 file to read outcomes from.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("results/report"), show_default=True,
+              help="Directory to write the report to (index.html and problems/).")
+@click.option("-j", "--jobs", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Worker processes (0: one per core).")
+@click.option("--serial", is_flag=True, help="Build the pages in this process.")
+@click.option("--seconds", type=click.FloatRange(min=0, min_open=True), default=20.0,
+              show_default=True, help="Time limit of each derivation step of a page.")
+@click.option("--simplify-seconds", type=click.FloatRange(min=0), default=3.0,
+              show_default=True,
+              help="Time limit of simplifying each expression shown (0: show unsimplified).")
+@click.option("--no-simulate", is_flag=True, help="Leave out the simulated trajectories.")
+@click.option("--t-end", type=click.FloatRange(min=0, min_open=True), default=10.0,
+              show_default=True, help="End time of the simulated trajectories.")
+@click.pass_context
+def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, out_dir: Path,
+           jobs: int, serial: bool, seconds: float, simplify_seconds: float,
+           no_simulate: bool, t_end: float) -> None:
+    """Write a static HTML report (all problems by default): an index of every part's
+    outcome with filters, errata and unsupported parts, and one page per problem with the
+    derivation as mathematics, the book's value beside the engine's, cross-checks and
+    figures. Outcomes come from the store (`mechbook check` first); works offline."""
+    from mechbook.app.report.build import ReportOptions, build_report
+    from mechbook.app.report.page import PageOptions
+
+    base = _resolve_root(ctx)
+    ids = list(problem_ids) or all_ids(base)
+    for pid in ids:
+        try:
+            if not problem_path(pid, base).exists():
+                raise click.ClickException(f"no problem {pid}")
+        except MechbookError as exc:
+            raise click.ClickException(str(exc)) from None
+    store = store_path if store_path.is_absolute() else base / store_path
+    out = out_dir if out_dir.is_absolute() else base / out_dir
+    page = PageOptions(seconds=seconds, simplify_seconds=simplify_seconds,
+                       simplify_budget=30.0 if simplify_seconds > 0 else 0.0,
+                       simulate=not no_simulate, t_end=t_end)
+    index = build_report(base, store, out, ids, ReportOptions(jobs, serial, page),
+                         log=lambda text: click.echo(text, err=True))
+    click.echo(f"report written to {index}")
+
+
+@main.command()
+@click.argument("shell", type=click.Choice(SHELLS))
+def completion(shell: str) -> None:
+    """Print the shell completion script (commands, options, problem ids) for SHELL.
+
+    bash: eval "$(mechbook completion bash)" in ~/.bashrc; zsh: the same in ~/.zshrc;
+    fish: mechbook completion fish > ~/.config/fish/completions/mechbook.fish"""
+    from click.shell_completion import get_completion_class
+
+    cls = get_completion_class(shell)
+    click.echo(cls(main, {}, "mechbook", "_MECHBOOK_COMPLETE").source())

@@ -3,7 +3,8 @@
     yamlio    YAML with line numbers, duplicate keys refused
     schema    JSON-Schema validation with file:line errors (schemas/*.json)
     expr      the safe expression parser (never eval)
-    catalog   where problem and answer files live, problem ids
+    books     books.yaml: the declared books, problem ids <book>-<number>
+    catalog   where problem and answer files live
     problem   a problem file: parameters, conditions, its systems as data
     system    one system built: coordinates, T, V, L, forces, constraints
     bodies    rigid bodies: standard shapes' inertia, kinetic energy, Euler-angle rates

@@ -6,6 +6,8 @@ import os
 from pathlib import Path
 
 from mechbook.errors import MechbookError
+from mechbook.model.books import book_of
+from mechbook.model.books import split_id as _split_id
 
 DEFAULT_STORE = Path("results/mechbook.h5")  # relative to the tree's root
 
@@ -25,18 +27,18 @@ def root(start: str | Path | None = None) -> Path:
 
 def split_id(pid: str) -> tuple[str, str]:
     """'lim-2031' -> ('lim', '2031'); 'symon-09-12' -> ('symon', '09-12')."""
-    book, _, rest = pid.partition("-")
-    if not rest:
-        raise MechbookError(f"bad problem id {pid!r} (expected e.g. lim-2031 or symon-09-12)")
-    return book, rest
+    return _split_id(pid)
 
 
 def problem_path(pid: str, base: Path) -> Path:
+    """problems/<book>/<number>.yaml; the id checked against the tree's books.yaml."""
+    book_of(pid, base)
     book, rest = split_id(pid)
     return base / "problems" / book / f"{rest}.yaml"
 
 
 def answer_path(pid: str, base: Path) -> Path:
+    book_of(pid, base)
     book, rest = split_id(pid)
     return base / "answers" / book / f"{rest}.yaml"
 

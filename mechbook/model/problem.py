@@ -14,6 +14,7 @@ from pathlib import Path
 import sympy as sp
 
 from mechbook.errors import ExpressionError
+from mechbook.model.books import file_id_error
 from mechbook.model.expr import CONSTANTS, FUNCTIONS, parse
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, load
@@ -114,9 +115,9 @@ def load_problem(path: str | Path) -> Problem:
         if "coordinates" not in data:
             raise doc.error((), "'coordinates' is required (or a 'systems' mapping)")
         systems = {"main": SystemSpec("main", {k: data[k] for k in SYSTEM_KEYS if k in data}, ())}
-    expected = Path(path).stem
-    if not data["id"].endswith(expected):
-        raise doc.error(("id",), f"id {data['id']!r} does not match the file name {expected!r}")
+    why = file_id_error(data["id"], path)
+    if why:
+        raise doc.error(("id",), why)
     sha = hashlib.sha256(Path(path).read_bytes()).hexdigest()
     problem = Problem(data["id"], data["title"], data["source"], str(path), doc, params, systems,
                       sha, data.get("description", ""))
