@@ -34,12 +34,15 @@ class Sampler:
     """Random admissible values for symbols: parameters, answer symbols and free variables."""
 
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
-                 seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC):
+                 seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
+                 rtol: float = RTOL, fixed: Sequence[sp.Symbol] = ()):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
         self.spread = spread
         self.policy = policy  # carried with the sampler to every comparison it serves
+        self.rtol = rtol  # relative tolerance of `equal` and `vanishes` (a numeric estimate's)
+        self.fixed = set(fixed)  # symbols kept at their base values (a numeric estimate)
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
              tries: int = 2000) -> dict[sp.Symbol, sp.Float]:
@@ -52,7 +55,9 @@ class Sampler:
                 spread *= 4
             point = {}
             for sym, value in self.base.items():
-                if sym.is_positive:
+                if sym in self.fixed:
+                    point[sym] = value
+                elif sym.is_positive:
                     point[sym] = value * math.exp(self.rng.uniform(-spread, spread))
                 else:
                     point[sym] = value + self.rng.uniform(-1, 1) * max(1.0, abs(value)) * spread
@@ -127,14 +132,15 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
         valid += 1
         rel = abs(v) / scale if scale > 0 else abs(v)
         worst = max(worst, rel)
-        if rel > RTOL:
+        if rel > sampler.rtol:
             return Verdict(False, f"numeric({valid} points)",
                            f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
         return Verdict(True, "symbolic")
-    return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+    return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
+                   f"worst relative {worst:.2g}")
 
 
 def _prove(sampler: Sampler, symbolic: bool | None) -> bool:
@@ -182,14 +188,15 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
         valid += 1
         rel = abs(va - vb) / max(abs(va), abs(vb), 1e-300)
         worst = max(worst, rel)
-        if rel > RTOL and abs(va - vb) > 1e-25:
+        if rel > sampler.rtol and abs(va - vb) > 1e-25:
             return Verdict(False, f"numeric({valid} points)",
                            f"{_num(va)} vs {_num(vb)} at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(a - b, sampler.policy.seconds):
         return Verdict(True, "symbolic")
-    return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+    return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
+                   f"worst relative {worst:.2g}")
 
 
 def _num(z: complex) -> str:
