@@ -20,7 +20,7 @@ ALLOWED = {
     "model": BASE | {"core"},
     "engine": BASE | {"core", "model"},
     "numerics": BASE | {"core", "model", "engine"},
-    "verify": BASE | {"core", "model", "engine"},
+    "verify": BASE | {"core", "model", "engine", "numerics"},
     "crosscheck": BASE | {"core", "model", "engine", "numerics", "verify"},
     "app": BASE | {"core", "model", "engine", "numerics", "verify", "crosscheck", "app"},
     "__init__": set(),

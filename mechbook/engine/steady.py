@@ -74,7 +74,7 @@ class SteadyFamily:
         rate_of = {sys.qd[sys.q.index(unknown)]: x}
         others = [sys.qd[sys.q.index(q)] for q in moving if q != unknown]
         at_rest = {sys.qd[sys.q.index(q)]: sp.S.Zero for q in point}
-        eqs = [h.subs(at_rest).subs(rate_of) for h in hold]
+        eqs = [h.subs(point).subs(at_rest).subs(rate_of) for h in hold]
         if len(eqs) != len(others):
             raise UnsupportedError(f"steady motion: {len(others)} other cyclic rate(s) need as "
                                    f"many `hold:` relations, {len(eqs)} given")
