@@ -15,7 +15,7 @@ import sympy as sp
 from mechbook.core.expansion import expand_lagrangian
 from mechbook.core.numeval import without_absent
 from mechbook.errors import UnsupportedError
-from mechbook.model.attitude import body_rates, euler_chain
+from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
@@ -195,20 +195,25 @@ class System:
         return None
 
     def _rate_names(self, name: str, sub: tuple, b: dict) -> None:
-        """`rates: [w1, w2, w3]`: names for the body-axis components of ω (functions of the
-        state), each with its time derivative `<name>dot` (which holds accelerations)."""
-        if "rates" not in b:
-            return
-        if name not in self.body_rates or self.body_rates[name] is None:
-            raise self._error(sub + ("rates",), "'rates' names the body-axis angular velocity "
-                              "of a 3-D body with an attitude or a vector angular_velocity")
-        for i, rname in enumerate(b["rates"]):
-            for n in (rname, rname + "dot"):
-                if n in self.names or n in RESERVED:
-                    raise self._error(sub + ("rates", i), f"name {n!r} is already taken")
-            expr = self.body_rates[name][i]
-            self.names[rname] = expr
-            self.names[rname + "dot"] = self.dt(expr)
+        """`rates: [w1, w2, w3]` and `space_rates: [wx, wy, wz]`: names for the body-axis
+        and the space-axis components of ω (functions of the state), each with its time
+        derivative `<name>dot` (which holds accelerations)."""
+        for key in ("rates", "space_rates"):
+            if key not in b:
+                continue
+            omega = self.body_rates.get(name)
+            if omega is None or (key == "space_rates" and name not in self.attitudes):
+                raise self._error(sub + (key,), f"'{key}' names the angular velocity of a 3-D "
+                                  "body with an attitude (or, for 'rates', a vector "
+                                  "angular_velocity)")
+            if key == "space_rates":
+                omega = rotation_matrix(self.attitudes[name]) * omega
+            for i, rname in enumerate(b[key]):
+                for n in (rname, rname + "dot"):
+                    if n in self.names or n in RESERVED:
+                        raise self._error(sub + (key, i), f"name {n!r} is already taken")
+                self.names[rname] = omega[i]
+                self.names[rname + "dot"] = self.dt(omega[i])
 
     def _gravity(self) -> sp.Expr:
         if "gravity" not in self.spec:

@@ -83,7 +83,8 @@ def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float
     """Integrate from (q0, q̇0) until `extremes` turning points of the signal are found.
 
     `fn(x)` with x = (t, q, q̇) returns (signal, d signal/dt); `time_scale` is the length
-    of one integration chunk (a guess at the period; chunks continue up to max_chunks)."""
+    of the first integration chunk (a guess at the period); a chunk without a turning point
+    makes the next one half as long again, so a poor guess costs a few chunks only."""
     n = model.n
 
     def rate(t, y):
@@ -109,9 +110,12 @@ def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float
             values.append(sig[0])
             kinds.append(-1 if later > 0 else +1)
             states.append(ye)
+        found = len(sol.t_events[0])
         t0, y = sol.t[-1], sol.y[:, -1]
         if len(times) >= extremes:
             break
+        if not found:
+            time_scale *= 1.5
     else:
         raise UnsupportedError(f"measurement: fewer than {extremes} turning points in "
                                f"{max_chunks} chunks of {time_scale:.3g}")

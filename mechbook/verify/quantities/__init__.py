@@ -8,6 +8,7 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     motion,
     oscillations,
     phase,
+    rotation,
     steady,
     trajectory,
     words,

@@ -12,7 +12,7 @@ import sympy as sp
 
 from mechbook.core.numeval import holds
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
-from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine
+from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine, match_multiset
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import _asymptotic
 from mechbook.verify.registry import ESTIMATE, LIMIT, quantity
@@ -77,6 +77,13 @@ def check_steady_rates(ctx: Context, val) -> Verdict:
                 worst = max(worst, min(abs(e - b) for e in engine) / max(abs(b), 1e-300))
             return worst
         return _asymptotic(ctx, error)
+    if "estimate" in ctx.part.data:  # the book's numbers: its rates against the engine's
+        pt = ctx.sampler.draw()
+        engine = fam.real_rates(pt)
+        ok, why = match_multiset(numbers(book, pt), engine, bool(ctx.part.data.get("partial")),
+                                 rtol=ctx.sampler.rtol)
+        return Verdict(ok, f"estimate(rtol {ctx.sampler.rtol:g})",
+                       why or f"engine's steady rates {[f'{e:.6g}' for e in engine]}")
     verdicts = [all_vanish(fam.residuals_at(b), ctx.sampler) for b in book]
     verdict = combine(verdicts)
     if not verdict.ok or ctx.part.data.get("partial"):
@@ -145,19 +152,21 @@ VERDICTS = ("stable", "unstable")
 @quantity('stability',
           book='`stable` or `unstable`',
           how=('the linearized motion about the equilibrium or steady motion (`about:`, '
-               '`steady:`) is so at every one of 12 admissible parameter points (`assume:` '
-               'bounds the region); no boundary crossing is needed. Points where the '
-               'linearization is marginal are not counted (8 decided points needed)'),
+               '`steady:`) is so at every one of 12 parameter points drawn widely (factors '
+               'up to e² about the defaults; `assume:` bounds the region); no boundary '
+               'crossing is needed. Points where the linearization is marginal are not '
+               'counted (8 decided points needed)'),
           keys={})
 def check_stability(ctx: Context, val) -> Verdict:
     if val not in VERDICTS:
         raise ctx.part.error(("book",), f"book must be one of {VERDICTS}")
     lin = ctx.linear()
+    wide = Sampler(ctx.sampler.base, ctx.sampler.conditions, spread=2.0, policy=ctx.policy)
     decided = 0
     for i in range(40):
         if decided >= 12:
             break
-        pt = ctx.sampler.draw()
+        pt = wide.draw()
         got = lin.numeric_stability(pt)
         if got == "marginal":
             continue

@@ -126,7 +126,7 @@ def _compare(ctx: Context, motion: _Motion, book: list, engine_of, what: str,
         def error(pt) -> float:
             eng = engine_of(pt)
             worst = 0.0
-            for b in numbers(book, pt):
+            for b in _at_start(motion, book, pt):
                 worst = max(worst, min(abs(e - b) for e in eng) / max(abs(b), 1e-300))
             return worst
 
@@ -135,10 +135,17 @@ def _compare(ctx: Context, motion: _Motion, book: list, engine_of, what: str,
     for n in range(1, motion.points() + 1):
         pt = ctx.sampler.draw()
         eng = engine_of(pt)
-        ok, why = match_multiset(numbers(book, pt), eng, partial, rtol=motion.rtol)
+        ok, why = match_multiset(_at_start(motion, book, pt), eng, partial, rtol=motion.rtol)
         if not ok:
             return Verdict(False, f"{how}({n} points)", f"{what}: {why}")
     return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})")
+
+
+def _at_start(motion: _Motion, book: list, pt: dict) -> list[float]:
+    """Book values at the parameter point; a value may use functions of the state (first
+    integrals such as L²/2T), evaluated at the start."""
+    start = motion.state(pt)
+    return numbers([sp.S(b).subs(start) for b in book], pt)
 
 
 def _extremes(motion: _Motion, pt: dict) -> list[float]:
