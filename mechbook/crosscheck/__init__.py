@@ -38,7 +38,8 @@ from mechbook.verify.context import Context  # how a part names its point
 
 FREQUENCY_QUANTITIES = ("frequencies", "period", "normal_modes", "normal_coordinates",
                         "mode_node", "stability_condition", "stability")
-EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force")
+EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "identity", "solution",
+                       "precession_rate", "rotation_matrix")
 LOOSE_BUDGET = 3.0  # seconds for the engine's own closed-form equilibria (no part asks)
 
 # ---- one problem -------------------------------------------------------------------------------
