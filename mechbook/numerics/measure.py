@@ -121,3 +121,26 @@ def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float
                                f"{max_chunks} chunks of {time_scale:.3g}")
     return Measured(np.array(times), np.array(values), np.array(kinds),
                     np.array(states).T, nfev)
+
+
+def first_event(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float,
+                max_chunks: int = 400) -> tuple[float, np.ndarray]:
+    """(t, state) at the first t > 0 where the compiled `fn(x)[0]` (x = (t, q, q̇)) changes
+    sign, integrating chunk by chunk (each half as long again as the last)."""
+    def event(t, y):
+        return fn(np.concatenate(([t], y)))[0]
+
+    event.terminal = True
+    t0, y = 0.0, np.concatenate((q0, qd0))
+    for _ in range(max_chunks):
+        sol = solve_ivp(model.rhs, (t0, t0 + time_scale), y, method="DOP853", rtol=TOLERANCE,
+                        atol=TOLERANCE, events=[event])
+        if sol.status < 0:
+            raise UnsupportedError(f"measurement: the integration failed: {sol.message}")
+        hits = [(te, ye) for te, ye in zip(sol.t_events[0], sol.y_events[0], strict=True)
+                if te > 1e-12 * max(1.0, time_scale)]
+        if hits:
+            return float(hits[0][0]), np.asarray(hits[0][1])
+        t0, y = sol.t[-1], sol.y[:, -1]
+        time_scale *= 1.5
+    raise UnsupportedError(f"measurement: the event did not happen in {max_chunks} chunks")

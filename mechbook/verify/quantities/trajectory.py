@@ -1,5 +1,5 @@
 """Quantities of the nonlinear motion from a given start: `turning_points`, `excursion`,
-`motion_frequency`, `mean_rate`.
+`motion_frequency`, `mean_rate`, `event_time`.
 
 A part gives the start (`initial:` coordinates and velocities, zero unless given) and the
 oscillating `coordinate:` (or `signal:`, any function of the state, for turning points).
@@ -21,7 +21,7 @@ import sympy as sp
 
 from mechbook.engine.levelset import LevelSet
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.measure import MEASURE_RTOL, measure, signal_functions
+from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
 from mechbook.numerics.model import build_model
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
@@ -40,20 +40,7 @@ class _Motion:
     def __init__(self, ctx: Context):
         self.ctx = ctx
         data, sys = ctx.part.data, ctx.system
-        if "initial" not in data:
-            raise ctx.part.error((), "a trajectory quantity needs `initial:` (the start)")
-        self.start = {}
-        for k, v in ctx.as_map(data["initial"], ("initial",)).items():
-            if k in sys.coord_names:
-                sym = sys.q[sys.coord_names.index(k)]
-            elif k.endswith("dot") and k[:-3] in sys.coord_names:
-                sym = sys.qd[sys.coord_names.index(k[:-3])]
-            else:
-                raise ctx.part.error(("initial", k), f"{k!r} is neither a coordinate nor a "
-                                     "velocity")
-            self.start[sym] = ctx.parse(v, ("initial", k))
-        for sym in sys.q + sys.qd:
-            self.start.setdefault(sym, sp.S.Zero)
+        self.start = _start(ctx)
         name = data.get("coordinate")
         self.of = None
         if "signal" in data:
@@ -98,6 +85,25 @@ class _Motion:
         return LEVEL_POINTS if self.level else MEASURED_POINTS
 
 
+def _start(ctx: Context) -> dict:
+    """The initial state of `initial:` (coordinates and velocities; the rest zero)."""
+    data, sys = ctx.part.data, ctx.system
+    if "initial" not in data:
+        raise ctx.part.error((), "a trajectory quantity needs `initial:` (the start)")
+    start = {}
+    for k, v in ctx.as_map(data["initial"], ("initial",)).items():
+        if k in sys.coord_names:
+            sym = sys.q[sys.coord_names.index(k)]
+        elif k.endswith("dot") and k[:-3] in sys.coord_names:
+            sym = sys.qd[sys.coord_names.index(k[:-3])]
+        else:
+            raise ctx.part.error(("initial", k), f"{k!r} is neither a coordinate nor a velocity")
+        start[sym] = ctx.parse(v, ("initial", k))
+    for sym in sys.q + sys.qd:
+        start.setdefault(sym, sp.S.Zero)
+    return start
+
+
 def _level(ctx: Context, coordinate) -> LevelSet:
     cache = ctx.analysis.__dict__.setdefault("_level_sets", {})
     key = (ctx.part.system, str(coordinate))
@@ -126,7 +132,7 @@ def _compare(ctx: Context, motion: _Motion, book: list, engine_of, what: str,
         def error(pt) -> float:
             eng = engine_of(pt)
             worst = 0.0
-            for b in _at_start(motion, book, pt):
+            for b in _at_start(motion.start, book, pt):
                 worst = max(worst, min(abs(e - b) for e in eng) / max(abs(b), 1e-300))
             return worst
 
@@ -135,17 +141,17 @@ def _compare(ctx: Context, motion: _Motion, book: list, engine_of, what: str,
     for n in range(1, motion.points() + 1):
         pt = ctx.sampler.draw()
         eng = engine_of(pt)
-        ok, why = match_multiset(_at_start(motion, book, pt), eng, partial, rtol=motion.rtol)
+        ok, why = match_multiset(_at_start(motion.start, book, pt), eng, partial, rtol=motion.rtol)
         if not ok:
             return Verdict(False, f"{how}({n} points)", f"{what}: {why}")
     return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})")
 
 
-def _at_start(motion: _Motion, book: list, pt: dict) -> list[float]:
+def _at_start(start: dict, book: list, pt: dict) -> list[float]:
     """Book values at the parameter point; a value may use functions of the state (first
     integrals such as L²/2T), evaluated at the start."""
-    start = motion.state(pt)
-    return numbers([sp.S(b).subs(start) for b in book], pt)
+    state = {k: v.subs(pt) for k, v in start.items()}
+    return numbers([sp.S(b).subs(state) for b in book], pt)
 
 
 def _extremes(motion: _Motion, pt: dict) -> list[float]:
@@ -228,3 +234,42 @@ def check_mean_rate(ctx: Context, val) -> Verdict:
 
     return _compare(ctx, motion, _book_values(ctx, val), engine, "mean rate")
 
+
+
+@quantity('event_time',
+          book='expression: the time of the event (or, with `advance:`, how far that '
+               'coordinate has moved by then)',
+          how=('the first t > 0 at which `event:` (a function of the state and t) changes '
+               'sign along the motion from `initial:`, measured by integrating the full '
+               'equations (DOP853 at 1e-12; rtol 1e-7, or an `estimate:`\'s)'),
+          keys={"initial": POINT, "event": EXPR, "advance": {"type": "string"},
+                "estimate": ESTIMATE})
+def check_event_time(ctx: Context, val) -> Verdict:
+    sys = ctx.system
+    if "event" not in ctx.part.data:
+        raise ctx.part.error((), "an event time needs `event:` (what changes sign)")
+    event = ctx.parse(ctx.part.data["event"], ("event",))
+    start = _start(ctx)
+    name = ctx.part.data.get("advance")
+    if name is not None and name not in sys.coord_names:
+        raise ctx.part.error(("advance",), f"{name!r} is not a coordinate")
+    rtol = ctx.sampler.rtol if "estimate" in ctx.part.data else MEASURE_RTOL
+    book = _book_values(ctx, val)
+    for n in range(1, MEASURED_POINTS + 1):
+        pt = ctx.sampler.draw()
+        params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
+        model = build_model(sys, ctx.dyn, params)
+        fn = signal_functions(sys, ctx.dyn, pt, event.subs(pt))
+        st = {k: v.subs(pt) for k, v in start.items()}
+        q0 = np.array([float(st[q]) for q in sys.q])
+        qd0 = np.array([float(st[v]) for v in sys.qd])
+        t, y = first_event(model, fn, q0, qd0, 1.0 / (1.0 + float(np.max(np.abs(qd0)))))
+        if name is None:
+            engine = t
+        else:
+            i = sys.coord_names.index(name)
+            engine = float(y[i] - q0[i])
+        ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
+        if not ok:
+            return Verdict(False, f"measured({n} points)", f"event: {why}")
+    return Verdict(True, f"measured({MEASURED_POINTS} points, rtol {rtol:g})")
