@@ -50,6 +50,9 @@ class Sampler:
         conditions exclude the neighbourhood of the default values, the spread is widened
         step by step (x4 each time), so an `assume:` far from the defaults still samples."""
         spread = self.spread if spread is None else spread
+        # a condition may bound a state variable (an `assume:` such as r > 0): draw it too
+        extra = set().union(*(c.free_symbols for c in self.conditions)) - set(self.base)
+        variables = list(variables) + sorted(extra - set(variables), key=str)
         for attempt in range(tries):
             if attempt and attempt % (tries // 5) == 0:
                 spread *= 4
