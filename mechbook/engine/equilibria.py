@@ -150,10 +150,11 @@ class Equilibria:
         # each second derivative from the smallest expression that still holds it:
         # A from L at the point (a function of q̇), C and the force from L at rest,
         # B from ∂L/∂q̇ at rest
+        held = getattr(self.sys, "deferred", {})  # Routh's held momenta: symbols until now
         L_at, L_rest = dyn.L.subs(at), dyn.L.subs(rest)
         b = [sp.diff(dyn.L, v).subs(rest) for v in dyn.qd]
         dq = [sp.diff(L_rest, q) for q in dyn.q]
-        force = [g.subs(at) for g in dq]
+        force = [g.subs(at).subs(held) for g in dq]
         bad = [g for g in force if not _is_zero(g, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
@@ -161,9 +162,9 @@ class Equilibria:
                                       "is left there")
         simp = (lambda x: try_simplify(x, 5)) if dyn.simplify else (lambda x: x)
         dv = [sp.diff(L_at, v) for v in dyn.qd]
-        A = sp.Matrix(n, n, lambda i, j: simp(sp.diff(dv[i], dyn.qd[j]).subs(rest)))
-        B = sp.Matrix(n, n, lambda i, j: sp.diff(b[i], dyn.q[j]).subs(at))
-        C = sp.Matrix(n, n, lambda i, j: sp.diff(dq[i], dyn.q[j]).subs(at))
+        A = sp.Matrix(n, n, lambda i, j: simp(sp.diff(dv[i], dyn.qd[j]).subs(rest).subs(held)))
+        B = sp.Matrix(n, n, lambda i, j: sp.diff(b[i], dyn.q[j]).subs(at).subs(held))
+        C = sp.Matrix(n, n, lambda i, j: sp.diff(dq[i], dyn.q[j]).subs(at).subs(held))
         return LinearSystem(dyn, dict(point), A, (B - B.T).applyfunc(simp),
                             (-C).applyfunc(simp), sp.zeros(n, 1))
 
@@ -179,8 +180,9 @@ class Equilibria:
         sub.update({s: EPS * s for s in self.sys.small_params})
         lin = []
         zeroth = []
+        held = getattr(self.sys, "deferred", {})  # Routh's held momenta (see routh.py)
         for e in dyn.residuals:
-            e_sub = e.subs(sub, simultaneous=True)
+            e_sub = e.subs(sub, simultaneous=True).subs(held)
             zeroth.append(e_sub.subs(EPS, 0))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
         bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
