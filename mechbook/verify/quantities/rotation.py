@@ -119,10 +119,12 @@ def check_identity(ctx: Context, val) -> Verdict:
     out = []
     for i, v in enumerate(vals):
         sub = ("book", i) if isinstance(val, list) else ("book",)
-        e = with_momenta(ctx, ctx.parse(v, sub, equation=True))
-        if not e.free_symbols & set(ctx.system.q + ctx.system.qd + ctx.dyn.qdd):
+        sides = [with_momenta(ctx, ctx.parse(x, sub)) for x in str(v).split("=")] \
+            if str(v).count("=") == 1 else [with_momenta(ctx, ctx.parse(v, sub)), sp.S.Zero]
+        state = set(ctx.system.q + ctx.system.qd + ctx.dyn.qdd)
+        if not any(x.free_symbols & state for x in sides):
             raise ctx.part.error(sub, "an identity must involve the state")
-        out.append(on_shell(ctx, e))
+        out.append(on_shell(ctx, sides[0] - sides[1]))
     return all_vanish(out, ctx.sampler)
 
 
