@@ -418,8 +418,14 @@ def _free_of(expr, symbols) -> bool:
 def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     if str(old) == str(new):
         return True
-    if slot.kind in ("count", "flag", "relation", "verdict"):
+    if slot.kind in ("count", "flag", "verdict"):
         return False
+    if slot.kind == "relation":  # the same condition once parsed (factors reordered)
+        try:
+            return ctx.parse(old, slot.path, relation=True) == \
+                ctx.parse(new, slot.path, relation=True)
+        except Exception:  # noqa: BLE001 - a mutant that does not parse is not the same
+            return False
     sys = ctx.system
     motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}
     sub = slot.path

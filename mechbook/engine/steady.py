@@ -59,6 +59,7 @@ class SteadyFamily:
     x: sp.Symbol
     rates: dict  # cyclic velocity symbol -> expression in x
     conditions: list[sp.Expr]
+    state: dict  # the steady state: point, velocities (at rest or rates in x)
 
     @classmethod
     def build(cls, dyn: Dynamics, point: dict, unknown: sp.Symbol,
@@ -96,7 +97,8 @@ class SteadyFamily:
         for q, e in zip(sys.q, dyn.residuals, strict=True):
             if q in point:
                 conds.append(e.subs(state))
-        return cls(dyn, dict(point), unknown, x, rate_of, conds)
+        steady = {k: v for k, v in state.items() if k not in sys.qdd}
+        return cls(dyn, dict(point), unknown, x, rate_of, conds, steady)
 
     def residuals_at(self, rate: sp.Expr) -> list[sp.Expr]:
         """The conditions with x = rate (zero iff that rate is a steady motion)."""
@@ -159,6 +161,9 @@ def polynomial_roots(expr: sp.Expr, x: sp.Symbol, values: dict) -> list[float]:
     num = sp.expand(sp.together(expr.subs(values)).as_numer_denom()[0])
     if num == 0:
         raise UnsupportedError("the equation holds for every rate")
+    if num.free_symbols - {x}:
+        raise ValueError("the equation has symbols other than the rate: "
+                         + ", ".join(sorted(map(str, num.free_symbols - {x}))))
     try:
         poly = sp.Poly(num, x)
     except sp.PolynomialError:

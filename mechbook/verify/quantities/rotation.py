@@ -87,7 +87,7 @@ def _vector(ctx: Context, name: str, spec, frame: str, key: str) -> sp.Matrix:
 
 @quantity('precession_rate',
           book='expression: the angular rate of `vector:` about `axis:`',
-          how=('n̂·(u × du/dt)/|u − (u·n̂)n̂|² in the axes of `frame:` (body: relative to '
+          how=('n̂·(u × du/dt)/‖u − (u·n̂)n̂‖² in the axes of `frame:` (body: relative to '
                'the body, space: relative to space), du/dt along the motion (engine '
                'accelerations); equal to the book\'s as functions of the state at random '
                'states; `vector:`/`axis:` are omega, L, e1, e2, e3 (body axes), x, y, z '
