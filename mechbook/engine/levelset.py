@@ -32,6 +32,8 @@ from mechbook.engine.steady import cyclic_check
 from mechbook.errors import UnsupportedError
 
 DPS = 50
+MAX_STEP = 0.02  # largest step of the search for a turning point, relative to 1 + |c0|
+MAX_STEPS = 5000
 
 
 class LevelSet:
@@ -57,7 +59,7 @@ class LevelSet:
         eqs = [p - sp.diff(L, v) for p, v in zip(self.P, self.rates, strict=True)]
         try:
             with time_limit(30):
-                sol = sp.solve(eqs, self.rates, dict=True)
+                sol = sp.solve(eqs, self.rates, dict=True) if eqs else [{}]
         except Timeout:
             sol = []
         if len(sol) != 1:
@@ -120,22 +122,23 @@ class Orbit:
             return mpmath.mpf(-1)
 
     def _edge(self, direction: int):
-        """The turning point reached moving from c0 in `direction`."""
+        """The turning point reached moving from c0 in `direction`: steps that double
+        from 1e-35 (a fast top's orbit is 1e-12 wide) up to MAX_STEP*(1 + |c0|), then
+        steps of that size (so a forbidden region is not stepped over), then bisection."""
         with mpmath.workdps(DPS):
             h = mpmath.mpf(10) ** (-(DPS - 15))
-            inside = self.c0
-            for _ in range(400):
-                c = self.c0 + direction * h
+            cap = MAX_STEP * (1 + abs(self.c0))
+            inside, step = self.c0, h
+            for _ in range(MAX_STEPS):
+                c = inside + direction * step
                 k = self.kinetic(c)
                 if not mpmath.isfinite(k) or k < 0:
                     break
                 inside = c
-                h *= 2
-                if h > 1e6:
-                    raise UnsupportedError("level set: no turning point (the coordinate runs "
-                                           "away or goes round)")
+                step = min(2 * step, cap)
             else:
-                raise UnsupportedError("level set: no turning point found")
+                raise UnsupportedError("level set: no turning point (the coordinate runs "
+                                       "away or goes round)")
             lo, hi = (inside, c) if direction > 0 else (c, inside)
             for _ in range(DPS * 4):  # bisection: robust where V_eff is steep or singular
                 mid = (lo + hi) / 2
