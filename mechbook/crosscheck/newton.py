@@ -260,6 +260,10 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
         what.append("particles")
     if spec.get("rigid_bodies"):
         what.append("rigid bodies (Euler)")
+    if spec.get("torques"):
+        what.append("torques")
+    if spec.get("attractors"):
+        what.append("attracting masses (force and gravity-gradient torque)")
     other = [k for k in ("kinetic", "potential", "lagrangian", "velocity_potential", "forces")
              if k in spec]
     if any("length" in s for s in spec.get("springs") or []):
