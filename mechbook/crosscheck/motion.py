@@ -88,14 +88,14 @@ def steady_crosscheck(analysis, part) -> CrossCheck:
 
 def trajectory_crosscheck(analysis, part) -> CrossCheck:
     from mechbook.verify.context import Context
-    from mechbook.verify.quantities.trajectory import _Motion
+    from mechbook.verify.quantities.trajectory import Motion
 
     start = time.perf_counter()
     x = CrossCheck(f"measured:{part.name}", "trajectory", part.system or "", "error",
                    parts=[part.name])
     try:
         ctx = Context(analysis, part)
-        motion = _Motion(ctx)
+        motion = Motion(ctx)
         if motion.level is None:
             raise UnsupportedError("the part is itself measured by integration")
         values = ctx.sampler.default()

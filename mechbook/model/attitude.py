@@ -62,19 +62,3 @@ def body_rates(chain: Sequence[tuple[str, sp.Expr]], dt: Callable) -> sp.Matrix:
 def euler_chain(angles: Sequence[sp.Expr]) -> list[tuple[str, sp.Expr]]:
     """Symon's z-x-z Euler angles (phi, theta, psi) as a chain."""
     return list(zip(EULER_ZXZ, angles, strict=True))
-
-
-def singular_rates(chain: Sequence[tuple[str, sp.Expr]], coords: Sequence[sp.Symbol],
-                   rates: Sequence[sp.Symbol], point: dict) -> bool:
-    """Is the map from the chain's angle rates to ω rank-deficient at `point` (a chart
-    singularity, like z-x-z Euler angles at theta = 0)? Decided on the Jacobian ∂ω/∂q̇ of
-    the angles that are coordinates."""
-    def dt(e):
-        return sum((sp.diff(e, q) * v for q, v in zip(coords, rates, strict=True)), sp.S.Zero)
-
-    w = body_rates(chain, dt)
-    used = [v for v in rates if any(w_i.has(v) for w_i in w)]
-    if not used:
-        return False
-    J = w.jacobian(used).subs(point)
-    return J.rank(simplify=True) < min(3, len(used))

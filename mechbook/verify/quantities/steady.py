@@ -14,7 +14,7 @@ from mechbook.core.numeval import holds
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
 from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.quantities.oscillations import _asymptotic
+from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registry import ESTIMATE, LIMIT, quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}
@@ -77,7 +77,7 @@ def check_steady_rates(ctx: Context, val) -> Verdict:
                     return float("inf")
                 worst = max(worst, min(abs(e - b) for e in engine) / max(abs(b), 1e-300))
             return worst
-        return _asymptotic(ctx, error)
+        return asymptotic(ctx, error)
     if "estimate" in ctx.part.data:  # the book's numbers: each near an engine rate
         pt = ctx.sampler.draw()
         engine = fam.real_rates(pt)

@@ -25,7 +25,7 @@ from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal
 from mechbook.numerics.model import build_model
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.quantities.oscillations import _asymptotic
+from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registry import ESTIMATE, EXPR, LIMIT, POINT, quantity
 
 LEVEL_RTOL = 1e-10
@@ -34,7 +34,7 @@ MEASURED_POINTS = 3
 START = {"initial": POINT, "coordinate": {"type": "string"}}
 
 
-class _Motion:
+class Motion:
     """What a trajectory part refers to: its start, coordinate and how it is computed."""
 
     def __init__(self, ctx: Context):
@@ -120,7 +120,7 @@ def _book_values(ctx: Context, val) -> list:
             for i, v in enumerate(vals)]
 
 
-def _compare(ctx: Context, motion: _Motion, book: list, engine_of, what: str,
+def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
              partial: bool = False) -> Verdict:
     """Book values against engine values (a function of the parameter point), at random
     points; with `limit:` the relative error must fall by decades."""
@@ -136,7 +136,7 @@ def _compare(ctx: Context, motion: _Motion, book: list, engine_of, what: str,
                 worst = max(worst, min(abs(e - b) for e in eng) / max(abs(b), 1e-300))
             return worst
 
-        return _asymptotic(ctx, error)
+        return asymptotic(ctx, error)
     how = "level set" if motion.level else "measured"
     for n in range(1, motion.points() + 1):
         pt = ctx.sampler.draw()
@@ -154,7 +154,7 @@ def _at_start(start: dict, book: list, pt: dict) -> list[float]:
     return numbers([sp.S(b).subs(state) for b in book], pt)
 
 
-def _extremes(motion: _Motion, pt: dict) -> list[float]:
+def _extremes(motion: Motion, pt: dict) -> list[float]:
     if motion.level is not None and motion.of is None:
         lo, hi = motion.orbit(pt).turning_points
         return [float(lo), float(hi)]
@@ -174,7 +174,7 @@ KEYS = {**START, "partial": {"type": "boolean"}, "limit": LIMIT, "estimate": EST
                '`partial: true`'),
           keys={**KEYS, "signal": EXPR})
 def check_turning_points(ctx: Context, val) -> Verdict:
-    motion = _Motion(ctx)
+    motion = Motion(ctx)
     return _compare(ctx, motion, _book_values(ctx, val), lambda pt: _extremes(motion, pt),
                     "turning points", bool(ctx.part.data.get("partial")))
 
@@ -184,7 +184,7 @@ def check_turning_points(ctx: Context, val) -> Verdict:
           how='as `turning_points`, the difference of the two (its own relative error)',
           keys={**KEYS, "signal": EXPR})
 def check_excursion(ctx: Context, val) -> Verdict:
-    motion = _Motion(ctx)
+    motion = Motion(ctx)
 
     def engine(pt):
         if motion.level is not None and motion.of is None:
@@ -202,7 +202,7 @@ def check_excursion(ctx: Context, val) -> Verdict:
                '`initial:` (level-set quadrature, or measured by integration)'),
           keys=KEYS)
 def check_motion_frequency(ctx: Context, val) -> Verdict:
-    motion = _Motion(ctx)
+    motion = Motion(ctx)
 
     def engine(pt):
         if motion.level is not None:
@@ -219,7 +219,7 @@ def check_motion_frequency(ctx: Context, val) -> Verdict:
                'integration)'),
           keys={**KEYS, "rate": {"type": "string"}})
 def check_mean_rate(ctx: Context, val) -> Verdict:
-    motion = _Motion(ctx)
+    motion = Motion(ctx)
     name = ctx.part.data.get("rate")
     if name not in ctx.system.coord_names:
         raise ctx.part.error(("rate",), "`rate:` names the coordinate whose mean rate is given")
