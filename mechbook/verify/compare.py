@@ -74,10 +74,12 @@ class Sampler:
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
     def default(self) -> dict[sp.Symbol, sp.Float]:
+        """The default values (when they satisfy the conditions on the parameters alone;
+        a condition on a state variable, such as r > 0, is for the states drawn later)."""
         point = {k: sp.Float(v, DIGITS) for k, v in self.base.items()}
-        if all(holds(c, point) for c in self.conditions):
+        if all(holds(c, point) for c in self.conditions if c.free_symbols <= set(point)):
             return point
-        return self.draw()
+        return {k: v for k, v in self.draw().items() if k in self.base}
 
 
 def value(expr: sp.Basic, point: dict) -> complex:
