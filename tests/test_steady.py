@@ -131,3 +131,11 @@ def test_numeric_estimate(analysis, tmp_path, book, rtol, status):
     got, detail = check(analysis, tmp_path, **STEADY, partial=True,
                         estimate={"values": {"theta0": 2.3}, "rtol": rtol}, book=book)
     assert got == status, detail
+
+
+def test_no_steady_motion_anywhere_cannot_pass(analysis, tmp_path):
+    """Above the horizontal there is no conical motion; an equation without real roots
+    there agrees with the engine vacuously, so the check refuses to call it a pass."""
+    got, detail = check(analysis, tmp_path, **STEADY, assume=["theta0 < pi/2"],
+                        book="phidot**2 + g/R = 0")
+    assert got == "fail" and "cannot discriminate" in detail

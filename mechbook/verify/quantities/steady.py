@@ -111,12 +111,13 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
     if free:  # e.g. a cyclic coordinate's value, which a steady motion leaves arbitrary
         return Verdict(False, "exact", "the equation depends on " + ", ".join(
             sorted(map(str, free))) + ", which the steady motion does not fix")
-    n = 0
+    n = seen = 0
     for _ in range(6):
         pt = ctx.sampler.draw()
         engine = fam.real_rates(pt)
         book = polynomial_roots(eq, fam.x, pt)
         n += 1
+        seen += bool(engine)
         ok = len(engine) == len(book) and all(
             abs(a - b) <= ROOT_RTOL * max(1.0, abs(a)) for a, b in zip(engine, book,
                                                                        strict=True))
@@ -124,6 +125,9 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
             return Verdict(False, f"numeric({n} points)",
                            f"book's roots {[f'{b:.10g}' for b in book]}, engine's steady rates "
                            f"{[f'{e:.10g}' for e in engine]}")
+    if not seen:  # two equations without real roots agree without saying anything
+        return Verdict(False, f"numeric({n} points)", "no steady motion exists at any sampled "
+                       "point: the check cannot discriminate (`assume:` a region where one does)")
     return Verdict(True, f"numeric({n} points, polynomial roots)")
 
 
