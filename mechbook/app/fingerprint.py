@@ -9,8 +9,9 @@ from pathlib import Path
 
 @cache
 def engine_sha256() -> str:
-    """Hash of the engine's own source and schemas: any change invalidates every result."""
-    here = Path(__file__).parent
+    """Hash of mechbook's own source and schemas (the whole package, every stage): any
+    change invalidates every result."""
+    here = Path(__file__).parents[1]
     h = hashlib.sha256()
     for path in sorted([*here.rglob("*.py"), *here.rglob("*.json")]):
         h.update(str(path.relative_to(here)).encode())
