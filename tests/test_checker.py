@@ -223,6 +223,10 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     elif q == "mode_node":
         for k in val:
             yield Slot(root + (k,), "value")
+    elif q == "stability":
+        yield Slot(root, "verdict")
+    elif q == "effective_potential":
+        yield Slot(root, "potential")
     elif q == "expression":
         of = part.data.get("of")
         if of == "momenta":
@@ -319,6 +323,9 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
     if slot.kind == "flag":
         yield "flip stable", not value
         return
+    if slot.kind == "verdict":
+        yield "flip verdict", "unstable" if value == "stable" else "stable"
+        return
     s = str(value)
     if slot.kind in ("lagrangian", "value", "potential"):
         yield from expression_mutants(s, names)
@@ -411,8 +418,14 @@ def _free_of(expr, symbols) -> bool:
 def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     if str(old) == str(new):
         return True
-    if slot.kind in ("count", "flag", "relation"):
+    if slot.kind in ("count", "flag", "verdict"):
         return False
+    if slot.kind == "relation":  # the same condition once parsed (factors reordered)
+        try:
+            return ctx.parse(old, slot.path, relation=True) == \
+                ctx.parse(new, slot.path, relation=True)
+        except Exception:  # noqa: BLE001 - a mutant that does not parse is not the same
+            return False
     sys = ctx.system
     motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}
     sub = slot.path

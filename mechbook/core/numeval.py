@@ -41,6 +41,15 @@ def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, fl
         return complex(v), float(m)
 
 
+def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
+    """expr at `point` as an mpmath number of `digits` digits (call inside a context of at
+    least that precision to keep them); errors as for `evaluate`."""
+    with mpmath.workdps(digits):
+        pt = {k: _number(v) for k, v in point.items()}
+        v, _ = _walk(expr, pt, {})
+        return v
+
+
 def _number(v):
     """A point's value (a SymPy number or a Python number; never text) as an mpmath number."""
     if isinstance(v, (int, float)) and not isinstance(v, bool):

@@ -4,9 +4,9 @@ The engine (mechbook.model.bodies) writes a body's angular velocity with the clo
 for z-x-z Euler angles and takes inertia tensors from a table of standard shapes. Here both
 are obtained another way, so that an error in either cannot pass the cross-check:
 
-* the angular velocity from the rotation itself: R = Rz(φ)·Rx(θ)·Rz(ψ) carries body axes
-  into space axes, and the body components of ω are read off the antisymmetric matrix
-  Rᵀ·dR/dt;
+* the angular velocity from the rotation itself: R = Rz(φ)·Rx(θ)·Rz(ψ) (or the product of
+  a body's chain of elementary rotations) carries body axes into space axes, and the body
+  components of ω are read off the antisymmetric matrix Rᵀ·dR/dt;
 * an inertia tensor by integrating ρ(|r|²·1 − r rᵀ) over the shape with uniform density
   (line, surface or volume integrals in the shape's own parametrization).
 """
@@ -29,6 +29,28 @@ def _rz(a: sp.Expr) -> sp.Matrix:
 
 def _rx(a: sp.Expr) -> sp.Matrix:
     return sp.Matrix([[1, 0, 0], [0, sp.cos(a), -sp.sin(a)], [0, sp.sin(a), sp.cos(a)]])
+
+
+def _ry(a: sp.Expr) -> sp.Matrix:
+    return sp.Matrix([[sp.cos(a), 0, sp.sin(a)], [0, 1, 0], [-sp.sin(a), 0, sp.cos(a)]])
+
+
+_ELEMENTARY = {"x": _rx, "y": _ry, "z": _rz}
+
+
+def chain_matrix(chain: list[tuple[str, sp.Expr]]) -> sp.Matrix:
+    """R = R_1·R_2·… of a chain of (axis, angle) rotations about body axes."""
+    R = sp.eye(3)
+    for axis, angle in chain:
+        R = R * _ELEMENTARY[axis](angle)
+    return R
+
+
+def chain_angular_velocity(chain: list[tuple[str, sp.Expr]], dt: Callable) -> sp.Matrix:
+    """Body-axis components of ω for a chain of rotations: vee(Rᵀ Ṙ)."""
+    R = chain_matrix(chain)
+    W = R.T * R.applyfunc(dt)
+    return sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
 
 
 def body_angular_velocity(angles: list[sp.Expr], dt: Callable) -> sp.Matrix:

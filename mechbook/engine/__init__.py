@@ -5,6 +5,8 @@ reader asks (mechbook solve).
     equilibria  static equilibria, and the linearization about a point
     linear      the linear system about a point: frequencies, modes, stability
     routh       Routh's reduction about a steady motion
+    steady      steady motions: conditions, real rates, existence, effective potential
+    levelset    the motion on a level set of the first integrals, reduced to one coordinate
     phase       the phase-space flow in (q, p)
     analysis    one problem's results, cached per system and point (what checks pull from)
     sweep       a linear system over a grid of parameters: compiled once, stacked

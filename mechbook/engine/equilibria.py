@@ -129,9 +129,49 @@ class Equilibria:
     def residual(self, point: dict) -> list[sp.Expr]:
         return [c.subs(point) for c in self.conditions]
 
+    def _conservative(self) -> bool:
+        """L alone decides the motion: no forces, constraints, small parameters or time."""
+        sys = self.sys
+        return (not sys.constraints and not sys.small_params and not sys.free_driven
+                and all(f == 0 for f in sys.forces) and not self.dyn.L.has(sys.t))
+
+    def _linearize_lagrangian(self, point: dict) -> LinearSystem:
+        """The linear system from L's second derivatives at (point, q̇ = 0): with
+        A = ∂²L/∂q̇∂q̇, B = ∂²L/∂q̇∂q, C = ∂²L/∂q∂q there, Lagrange's equations of the
+        quadratic part of L are A·δq̈ + (B − Bᵀ)·δq̇ − C·δq = ∂L/∂q (which must vanish: an
+        equilibrium or steady motion). Far cheaper than expanding the equations of motion
+        when L is large (Routh's reduced Lagrangian of an unsymmetrical body)."""
+        dyn = self.dyn
+        n = len(dyn.q)
+        at = dict(point)
+        at.update({q: at.get(q, sp.S.Zero) for q in dyn.q})
+        rest = {v: sp.S.Zero for v in dyn.qd}
+        # each second derivative from the smallest expression that still holds it:
+        # A from L at the point (a function of q̇), C and the force from L at rest,
+        # B from ∂L/∂q̇ at rest
+        held = getattr(self.sys, "deferred", {})  # Routh's held momenta: symbols until now
+        L_at, L_rest = dyn.L.subs(at), dyn.L.subs(rest)
+        b = [sp.diff(dyn.L, v).subs(rest) for v in dyn.qd]
+        dq = [sp.diff(L_rest, q) for q in dyn.q]
+        force = [g.subs(at).subs(held) for g in dq]
+        bad = [g for g in force if not _is_zero(g, self.sys.numeric_values())]
+        if bad:
+            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
+                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
+                                      "is left there")
+        simp = (lambda x: try_simplify(x, 5)) if dyn.simplify else (lambda x: x)
+        dv = [sp.diff(L_at, v) for v in dyn.qd]
+        A = sp.Matrix(n, n, lambda i, j: simp(sp.diff(dv[i], dyn.qd[j]).subs(rest).subs(held)))
+        B = sp.Matrix(n, n, lambda i, j: sp.diff(b[i], dyn.q[j]).subs(at).subs(held))
+        C = sp.Matrix(n, n, lambda i, j: sp.diff(dq[i], dyn.q[j]).subs(at).subs(held))
+        return LinearSystem(dyn, dict(point), A, (B - B.T).applyfunc(simp),
+                            (-C).applyfunc(simp), sp.zeros(n, 1))
+
     def linearize(self, point: dict) -> LinearSystem:
         """First-order expansion of the equations of motion about `point` (q̇ = 0)."""
         dyn = self.dyn
+        if self._conservative():
+            return self._linearize_lagrangian(point)
         sub = {}
         for q in dyn.q:
             sub[q] = point.get(q, sp.S.Zero) + EPS * q
@@ -139,8 +179,9 @@ class Equilibria:
         sub.update({s: EPS * s for s in self.sys.small_params})
         lin = []
         zeroth = []
+        held = getattr(self.sys, "deferred", {})  # Routh's held momenta (see routh.py)
         for e in dyn.residuals:
-            e_sub = e.subs(sub, simultaneous=True)
+            e_sub = e.subs(sub, simultaneous=True).subs(held)
             zeroth.append(e_sub.subs(EPS, 0))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
         bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]

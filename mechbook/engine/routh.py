@@ -55,18 +55,14 @@ class ReducedSystem:
         at_steady.update({base.qd[i]: rates[c] for i, c in zip(idx, cyc, strict=True)})
         simp = sp.simplify if simplify else (lambda e: e)  # for a reader only
         p_values = [simp(p.subs(at_steady)) for p in momenta]
-        try:
-            with time_limit(30):
-                sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
-                               cyc_rates, dict=True)
-        except Timeout:
-            sol = []
-        if len(sol) != 1:
-            raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
-                                   "their momenta")
-        rate_of = sol[0]
-        routh = sum((pv * v for pv, v in zip(p_values, cyc_rates, strict=True)), sp.S.Zero)
+        # the held momenta stay symbols P until the linear system is formed: their values
+        # (large expressions for a rate given as a root of a quadratic) are put into the
+        # small matrices M, C, K, not into L' and its derivatives (Equilibria.linearize)
+        held = [sp.Symbol(f"P_held_{c}", real=True) for c in cyc]
+        rate_of = _solve_rates(momenta, held, cyc_rates, point, base.numeric_values())
+        routh = sum((P * v for P, v in zip(held, cyc_rates, strict=True)), sp.S.Zero)
         self.lagrangian = simp((L - routh).subs(rate_of))
+        self.deferred = dict(zip(held, p_values, strict=True))
         self.momenta = dict(zip(cyc, p_values, strict=True))
 
     def dt(self, expr):
@@ -77,3 +73,37 @@ class ReducedSystem:
 
     def numeric_values(self) -> dict:
         return self.problem.values()
+
+
+def _solve_rates(momenta: list, values: list, rates: list, point: dict,
+                 numeric: dict) -> dict:
+    """The cyclic rates as functions of the state from p = p_values. Momenta linear in the
+    rates (L quadratic in the velocities) are solved as a linear system, without
+    sp.solve's search; a Jacobian that is singular at the steady point is a chart
+    singularity (z-x-z Euler angles at theta = 0) and is said so."""
+    J = sp.Matrix([[sp.diff(p, v) for v in rates] for p in momenta])
+    if not any(e.has(*rates) for e in J):
+        at = J.subs(point).subs({k: v for k, v in numeric.items()})
+        try:
+            singular = abs(complex(sp.N(at.det()))) < 1e-12 * max(
+                1.0, max(abs(complex(sp.N(x))) for x in at) ** len(rates))
+        except (TypeError, ValueError):
+            singular = False
+        if singular:
+            raise UnsupportedError("steady motion: the cyclic rates are not determined by "
+                                   "their momenta at this point (a singular point of the "
+                                   "coordinates, such as z-x-z Euler angles at theta = 0: "
+                                   "use a chart regular there, e.g. `rotation:` x-y-z)")
+        rest = [p.subs({v: 0 for v in rates}) for p in momenta]  # p = J·rates + rest
+        sol = J.LUsolve(sp.Matrix([pv - r for pv, r in zip(values, rest, strict=True)]))
+        return dict(zip(rates, sol, strict=True))
+    try:
+        with time_limit(30):
+            sol = sp.solve([p - pv for p, pv in zip(momenta, values, strict=True)], rates,
+                           dict=True)
+    except Timeout:
+        sol = []
+    if len(sol) != 1:
+        raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
+                               "their momenta")
+    return sol[0]

@@ -8,6 +8,8 @@
     problem   a problem file: parameters, conditions, its systems as data
     system    one system built: coordinates, T, V, L, forces, constraints
     bodies    rigid bodies: standard shapes' inertia, kinetic energy, Euler-angle rates
+    attitude  attitude charts: chains of elementary rotations, rotation matrix, body rates
+    loads     torques as generalized forces, attracting point masses, averaging over an angle
 
 May import: mechbook.core, mechbook.errors, mechbook.records.
 """

@@ -2,7 +2,8 @@
 
 Shapes have their symmetry axis along the body z axis. A planar body (2-D position) uses the
 moment about the axis normal to the plane; a 3-D body uses the full tensor in body axes with
-its angular velocity given in body axes or through z-x-z Euler angles (phi, theta, psi).
+its angular velocity given in body axes or through its attitude: z-x-z Euler angles (phi,
+theta, psi) or any chain of elementary rotations (mechbook.model.attitude).
 """
 
 from __future__ import annotations
@@ -10,6 +11,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import sympy as sp
+
+from mechbook.model.attitude import body_rates, euler_chain
 
 SHAPES = ("point", "rod", "ring", "disk", "solid_cylinder", "solid_sphere", "spherical_shell",
           "rectangular_plate", "block")
@@ -54,17 +57,12 @@ def shape_inertia(shape: str, m: sp.Expr, dims: dict) -> sp.Matrix:
 
 def euler_body_rates(angles: list[sp.Expr], dt: Callable) -> sp.Matrix:
     """Body-axis angular velocity for z-x-z Euler angles (phi, theta, psi)."""
-    phi, theta, psi = angles
-    dphi, dtheta, dpsi = dt(phi), dt(theta), dt(psi)
-    return sp.Matrix([
-        dphi * sp.sin(theta) * sp.sin(psi) + dtheta * sp.cos(psi),
-        dphi * sp.sin(theta) * sp.cos(psi) - dtheta * sp.sin(psi),
-        dphi * sp.cos(theta) + dpsi,
-    ])
+    return body_rates(euler_chain(angles), dt)
 
 
-def body_kinetic(m: sp.Expr, v: sp.Matrix, inertia, omega, euler, dt: Callable) -> sp.Expr:
-    """T = m v²/2 + ω·I·ω/2 (centre-of-mass velocity v; ω in body axes)."""
+def body_kinetic(m: sp.Expr, v: sp.Matrix, inertia, omega, chain, dt: Callable) -> sp.Expr:
+    """T = m v²/2 + ω·I·ω/2 (centre-of-mass velocity v; ω in body axes, given or from the
+    attitude `chain` of elementary rotations)."""
     translational = m * v.dot(v) / 2
     planar = v.rows == 2
     if isinstance(inertia, sp.MatrixBase):
@@ -73,15 +71,17 @@ def body_kinetic(m: sp.Expr, v: sp.Matrix, inertia, omega, euler, dt: Callable) 
     elif not planar:
         raise ValueError("a 3-D body needs a 3x3 inertia tensor or a shape")
     if planar:
-        if euler is not None:
-            raise ValueError("a planar body takes a scalar angular_velocity, not Euler angles")
+        if chain is not None:
+            raise ValueError("a planar body takes a scalar angular_velocity, not an attitude")
         if omega is None or isinstance(omega, sp.MatrixBase):
             raise ValueError("a planar body needs a scalar 'angular_velocity'")
         return translational + inertia * omega**2 / 2
-    if euler is not None and omega is not None:
-        raise ValueError("give either 'angular_velocity' or 'euler_angles', not both")
-    if euler is not None:
-        omega = euler_body_rates(euler, dt)
+    if chain is not None and omega is not None:
+        raise ValueError("give either 'angular_velocity' or an attitude ('euler_angles' or "
+                         "'rotation'), not both")
+    if chain is not None:
+        omega = body_rates(chain, dt)
     if omega is None or not isinstance(omega, sp.MatrixBase) or omega.rows != 3:
-        raise ValueError("a 3-D body needs a 3-vector 'angular_velocity' or 'euler_angles'")
+        raise ValueError("a 3-D body needs a 3-vector 'angular_velocity', 'euler_angles' or "
+                         "'rotation'")
     return translational + (omega.T * inertia * omega)[0, 0] / 2

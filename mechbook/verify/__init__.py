@@ -8,6 +8,6 @@
     quantities  the checks, one module per family of quantities
     checker     running a key: outcomes pass / fail / erratum / unsupported / error
 
-May import: mechbook.engine, mechbook.model, mechbook.core, mechbook.errors,
-mechbook.records.
+May import: mechbook.numerics (trajectory quantities measured by integration),
+mechbook.engine, mechbook.model, mechbook.core, mechbook.errors, mechbook.records.
 """

@@ -46,6 +46,10 @@ class Part:
 
     def names(self, system) -> dict[str, sp.Basic]:
         names = dict(system.names)
+        for sym in self.key.symbols:
+            if sym in names:
+                raise self.key.doc.error(("symbols", sym), f"{sym!r} is already a name of the "
+                                         "problem (a parameter, coordinate or rate)")
         names.update(self.key.symbols)
         for abbr, text in (self.key.doc.data.get("abbreviations") or {}).items():
             if abbr in names:

@@ -48,7 +48,21 @@ class Context:
                   for i, c in enumerate(self.part.data.get("assume", []))]
         base = dict(self.analysis.problem.values())
         base.update(self.part.key.symbol_values)
-        self.sampler = Sampler(base, conds, policy=self.policy)
+        if "estimate" in self.part.data:  # a number the book computed: one point, its rtol
+            est = self.part.data["estimate"]
+            for k, v in (est.get("values") or {}).items():
+                sym = self.names.get(k)
+                if not isinstance(sym, sp.Symbol) or sym not in base:
+                    raise self.part.error(("estimate", "values", k), f"{k!r} is not a "
+                                          "parameter or answer symbol")
+                val = self.parse(v, ("estimate", "values", k))
+                if not val.is_number:
+                    raise self.part.error(("estimate", "values", k), "a number is expected")
+                base[sym] = float(val)
+            self.sampler = Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
+                                   fixed=list(base))
+        else:
+            self.sampler = Sampler(base, conds, policy=self.policy)
 
     @property
     def dyn(self):

@@ -30,6 +30,10 @@ POINT = {"$ref": "#/$defs/point"}
 LIMIT = {"type": "object", "required": ["parameter", "to"], "additionalProperties": False,
          "properties": {"parameter": {"type": "string"}, "to": {"enum": ["0", "oo", 0]},
                         "order": {"type": "integer", "minimum": 0, "maximum": 3}}}
+ESTIMATE = {"type": "object", "required": ["rtol"], "additionalProperties": False,
+            "properties": {"values": {"type": "object",
+                                      "additionalProperties": {"$ref": "#/$defs/expr"}},
+                           "rtol": {"type": "number", "exclusiveMinimum": 0, "maximum": 0.5}}}
 REGION = {"type": "object", "minProperties": 1,
           "additionalProperties": {"type": "array", "minItems": 2, "maxItems": 2,
                                    "items": EXPR}}

@@ -8,5 +8,8 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     motion,
     oscillations,
     phase,
+    rotation,
+    steady,
+    trajectory,
     words,
 )

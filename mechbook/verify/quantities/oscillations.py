@@ -107,6 +107,9 @@ def _asymptotic(ctx: Context, error) -> Verdict:
     return Verdict(ok, "numeric(asymptotic)", detail)
 
 
+asymptotic = _asymptotic  # the same decades test for steady rates and trajectory formulas
+
+
 @quantity('period',
           book='expression',
           how="2π/ω for one of the engine's nonzero frequencies")
