@@ -5,6 +5,8 @@ None of them looks at the book's answers:
     newton       the engine's equations against Newton's and Euler's laws, with kinematics
                  computed here independently (kinematics.py)
     conserved    the book's first integrals constant along a simulated trajectory
+    inertia      each declared body's inertia: the engine's table and parallel axes against
+                 integration over its parts (assembly.py)
 
 May import: mechbook.verify (how an answer part names its point: `about:`, `steady:`,
 `assume:`), mechbook.numerics, mechbook.engine (the results under test), mechbook.core,
@@ -21,6 +23,7 @@ import traceback
 import sympy as sp
 
 from mechbook.crosscheck.frequencies import frequency_crosscheck
+from mechbook.crosscheck.inertia import inertia_crosschecks
 from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
@@ -129,6 +132,8 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                 freq[tag] = _guarded_frequency(analysis, lin, values, f"modes:{name}@{label}",
                                                models)
     out += list(newton.values()) + list(freq.values())
+    stage("cross-check: declared bodies")
+    out += inertia_crosschecks(analysis, key)
     return out
 
 

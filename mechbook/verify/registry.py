@@ -42,17 +42,21 @@ class Quantity:
     book: str  # what `book:` holds
     how: str  # how it is checked
     keys: dict = field(default_factory=dict)  # extra part keys -> JSON-Schema fragments
+    needs_system: bool = True  # False: tensors and bodies, checked without a system
 
 
 QUANTITIES: dict[str, Quantity] = {}
 
 
-def quantity(name: str, *, book: str, how: str, keys: dict | None = None):
-    """Register the decorated function as the check of quantity `name`."""
+def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
+             needs_system: bool = True):
+    """Register the decorated function as the check of quantity `name` (`needs_system`:
+    False for quantities of declared tensors and bodies, which a problem without a system
+    can have)."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
-        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}))
+        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), needs_system)
         return fn
 
     return register
@@ -100,4 +104,7 @@ def markdown_table() -> str:
 
 
 if __name__ == "__main__":  # python -m mechbook.verify.registry: the table for the docs
-    print(markdown_table())
+    # the registry that the quantities fill is the imported module, not this __main__
+    from mechbook.verify.registry import markdown_table as table
+
+    print(table())
