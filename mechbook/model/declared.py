@@ -20,9 +20,9 @@ from mechbook.errors import ExpressionError
 from mechbook.model.bodies import AXISYMMETRIC, CompositeBody, Piece, apex_offset
 from mechbook.model.bodies.composite import rotation_matrix
 from mechbook.model.problem import RESERVED, Problem
-from mechbook.model.tensorexpr import BODY_FUNCTIONS, TENSOR_FUNCTIONS, kind, parse_tensor
+from mechbook.model.tensorexpr import kind, parse_tensor
 
-TAKEN = RESERVED | set(TENSOR_FUNCTIONS) | set(BODY_FUNCTIONS)
+TAKEN = RESERVED
 CACHE_KEY = "_declared"  # never a system name (those start with a letter)
 
 
@@ -51,8 +51,8 @@ def _build(problem: Problem) -> Declared:
     def claim(section: str, name: str) -> None:
         if name in taken:
             raise problem.doc.error((section, name), f"name {name!r} is already taken "
-                                    "(parameter, reserved word, function, or another "
-                                    "vector, tensor or body)")
+                                    "(parameter, reserved word, or another vector, tensor "
+                                    "or body)")
         taken.add(name)
 
     for name, spec in (data.get("vectors") or {}).items():

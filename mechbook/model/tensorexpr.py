@@ -68,6 +68,11 @@ def _dot(a, b):
 
 
 def _cross(a, b):
+    """u × v; with a tensor, the dyadic rule: w × (AB) = (w × A)B, (AB) × w = A(B × w)."""
+    if _vector(a) and _tensor(b):
+        return _im(_skew(a) * b)
+    if _tensor(a) and _vector(b):
+        return _im(a * _skew(b))
     _need("vector", _vector, a, b)
     return _im(a.cross(b))
 
@@ -140,6 +145,25 @@ def _entry(t, i, j=None):
     return t[_index(i), _index(j)]
 
 
+def _row(t, i):
+    """Row i (1-based) of a tensor's matrix, as a vector (e'_i for a transformation a)."""
+    _need("tensor", _tensor, t)
+    return _im(t[_index(i), :].T)
+
+
+def _col(t, j):
+    _need("tensor", _tensor, t)
+    return _im(t[:, _index(j)])
+
+
+def _diff(x, s):
+    """d/ds of a scalar, vector or tensor; s a parameter or a generic scalar."""
+    if not isinstance(s, sp.Symbol):
+        raise TypeError("differentiate with respect to a plain symbol (a parameter, or a "
+                        "`for_all` scalar)")
+    return _im(x.diff(s)) if isinstance(x, sp.MatrixBase) else sp.diff(x, s)
+
+
 def _norm(v):
     _need("vector", _vector, v)
     return sp.sqrt(v.dot(v))
@@ -156,11 +180,13 @@ TENSOR_FUNCTIONS: dict[str, Callable] = {
     "dyad": _dyad, "dot": _dot, "cross": _cross, "transpose": _transpose, "det": _det,
     "trace": _trace, "second_invariant": _second_invariant, "inverse": _inverse,
     "unit": _unit, "rotation": _rotation, "skew": _skew, "entry": _entry, "norm": _norm,
-    "expi": _scalar_fn(lambda x: sp.exp(sp.I * x)), "re": _scalar_fn(sp.re),
-    "im": _scalar_fn(sp.im), "conj": _scalar_fn(sp.conjugate),
+    "row": _row, "col": _col, "diff": _diff,
+    "i": lambda: sp.I, "expi": _scalar_fn(lambda x: sp.exp(sp.I * x)),
+    "re": _scalar_fn(sp.re), "im": _scalar_fn(sp.im), "conj": _scalar_fn(sp.conjugate),
 }
 TENSOR_ARITY = {"dyad": (2, 2), "dot": (2, 2), "cross": (2, 2), "unit": (0, 0),
-                "rotation": (2, 2), "entry": (2, 3)}
+                "rotation": (2, 2), "entry": (2, 3), "row": (2, 2), "col": (2, 2),
+                "diff": (2, 2), "i": (0, 0)}
 
 
 def _point(obj, p):

@@ -17,7 +17,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.tensorexpr import kind, parse_tensor, parse_tensor_equation
-from mechbook.verify.compare import Verdict, all_vanish, combine, value
+from mechbook.verify.compare import Verdict, all_vanish, value
 from mechbook.verify.context import Context
 from mechbook.verify.instances import KINDS, branches, vanish_on_instances
 from mechbook.verify.registry import quantity
@@ -146,6 +146,16 @@ def book_value(ctx: Context, val, sub: tuple, names: dict, like):
             for i in range(like.rows) for j in range(like.cols)]
 
 
+def combine(verdicts: list[Verdict]) -> Verdict:
+    """One verdict for the branches of `for_all`: the first failure, else the weakest
+    method (numeric < exact < symbolic), its count of instances kept."""
+    for v in verdicts:
+        if not v.ok:
+            return v
+    rank = {"numeric": 0, "exact": 1, "symbolic": 2}
+    return min(verdicts, key=lambda v: rank.get(v.method.split("(")[0], 0))
+
+
 def _vanish(ctx: Context, exprs: list, labels: list[str]) -> Verdict:
     """All vanish: on for_all instances (exact where rational) or at random points."""
     return vanish_on_instances(exprs, ctx.sampler, labels)
@@ -251,7 +261,8 @@ def check_principal_axes(ctx: Context, val) -> Verdict:
                        for k in range(len(residual))]
         verdict = _vanish(ctx, exprs, labels)
         if verdict.ok:
-            verdict = combine([verdict, _nonzero_and_independent(ctx, vectors, normals)])
+            shape = _nonzero_and_independent(ctx, vectors, normals)
+            verdict = verdict if shape.ok else shape
         out.append(verdict)
     return combine(out)
 
@@ -314,6 +325,49 @@ def check_identity(ctx: Context, val) -> Verdict:
     return combine(out)
 
 
+@quantity('solves',
+          book='the value (scalar, vector or tensor) of the unknown `unknown:`',
+          how=('the book\'s value, put for the unknown in the equations `equations:` '
+               '(tensor equations, e.g. a constitutive law), satisfies every one of them, '
+               'decided as for `identity` (uniqueness is the equations\' business: say so '
+               'in the note)'),
+          keys={"unknown": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
+                "equations": {"type": "array", "minItems": 1, "items": {"type": "string"}},
+                "for_all": FOR_ALL}, needs_system=False)
+def check_solves(ctx: Context, val) -> Verdict:
+    unknown = ctx.part.data.get("unknown")
+    equations = ctx.part.data.get("equations")
+    if not unknown or not equations:
+        raise ctx.part.error((), "a 'solves' part names `unknown:` and `equations:`")
+    out = []
+    for names in instances(ctx):
+        if unknown in names:
+            raise ctx.part.error(("unknown",), f"{unknown!r} is already a name")
+        if isinstance(val, list) and val and isinstance(val[0], list):
+            book = sp.ImmutableMatrix([[tparse(ctx, x, ("book", i, j), names)
+                                        for j, x in enumerate(row)]
+                                       for i, row in enumerate(val)])
+        elif isinstance(val, list):
+            book = sp.ImmutableMatrix([tparse(ctx, x, ("book", i), names)
+                                       for i, x in enumerate(val)])
+        else:
+            book = tparse(ctx, val, ("book",), names)
+        if kind(book) not in ("scalar", "vector", "tensor"):
+            raise ctx.part.error(("book",), "the value is a scalar, a vector or a tensor")
+        names = dict(names)
+        names[unknown] = book
+        exprs, labels = [], []
+        for i, text in enumerate(equations):
+            lhs, rhs = tequation(ctx, text, ("equations", i), names)
+            diff = lhs - rhs
+            flat = list(diff) if isinstance(diff, sp.MatrixBase) else [diff]
+            exprs += flat
+            labels += [f"equation {i + 1}" + (f", component {k + 1}" if len(flat) > 1 else "")
+                       for k in range(len(flat))]
+        out.append(_vanish(ctx, exprs, labels))
+    return combine(out)
+
+
 XYZ = ("x", "y", "z")
 
 
@@ -350,3 +404,28 @@ def check_inertia_ellipsoid(ctx: Context, val) -> Verdict:
     if abs(value(c, point)) == 0:
         return Verdict(False, "numeric", "the equation has no constant term: not r·T·r = 1")
     return verdict
+
+
+def validate_part(ctx: Context) -> None:
+    """Parse every expression of a tensor part (for `mechbook validate`), nothing derived."""
+    names = dict(instances(ctx)[0])
+    if ctx.part.quantity == "inertia_ellipsoid":
+        names.update({c: sp.Symbol(c, real=True) for c in XYZ if c not in names})
+
+    def walk(v, sub):
+        if isinstance(v, dict):
+            for k, x in v.items():
+                walk(x, sub + (k,))
+        elif isinstance(v, list):
+            for i, x in enumerate(v):
+                walk(x, sub + (i,))
+        elif isinstance(v, str) and "=" in v.replace("==", ""):
+            tequation(ctx, v, sub, names)
+        elif isinstance(v, (str, int, float)) and not isinstance(v, bool):
+            tparse(ctx, v, sub, names)
+
+    for key in ("tensor", "axes", "book"):
+        if key in ctx.part.data:
+            walk(ctx.part.data[key], (key,))
+    if "erratum" in ctx.part.data:
+        walk(ctx.part.data["erratum"]["corrected"], ("erratum", "corrected"))
