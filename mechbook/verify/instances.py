@@ -171,6 +171,14 @@ def _constants(exprs: Sequence[sp.Basic], labels: Sequence[str]) -> Verdict:
         v, scale = value_and_scale(e, {})
         if not np.isfinite(abs(v)) or abs(v) > RTOL * max(scale, 1.0):
             return Verdict(False, "numeric(30 digits)", f"{label} is {_num(v)}, not 0")
+    try:
+        with time_limit(CANCEL_SECONDS):
+            if all(sp.expand(e) == 0 or sp.radsimp(sp.expand(e)) == 0 for e in exprs):
+                return Verdict(True, "symbolic", "numbers only, zero exactly")
+    except Timeout:
+        pass
+    except Exception:  # noqa: BLE001 - the 30-digit values have decided
+        pass
     return Verdict(True, "numeric(30 digits)", "numbers only, equal to 30 digits")
 
 
