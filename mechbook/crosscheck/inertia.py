@@ -25,7 +25,13 @@ POINTS = 6
 
 
 def _mentions(part, body: str) -> bool:
-    text = " ".join(str(v) for k, v in part.data.items() if k in ("tensor", "book", "define"))
+    """Does the part's object or statement name the body (directly or through one of the
+    key's abbreviations)?"""
+    text = " ".join(str(v) for k, v in part.data.items()
+                    if k in ("tensor", "book", "define", "equations"))
+    for abbr, value in (part.key.doc.data.get("abbreviations") or {}).items():
+        if re.search(rf"\b{re.escape(abbr)}\b", text):
+            text += " " + str(value)
     return re.search(rf"\b{re.escape(body)}\b", text) is not None
 
 

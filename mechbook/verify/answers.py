@@ -45,17 +45,19 @@ class Part:
     def error(self, sub: tuple, message: str):
         return self.key.doc.error(self.path + sub, message)
 
-    def names(self, base: dict, tensor: bool = False) -> dict[str, sp.Basic]:
+    def names(self, base: dict, tensor: bool = False,
+              bodies: dict | None = None) -> dict[str, sp.Basic]:
         """The names this part may use: `base` (a system's, or the problem's declared
-        ones), the key's symbols and its abbreviations (tensor expressions if `tensor`)."""
+        ones), the key's symbols and its abbreviations (tensor expressions, which may name
+        the problem's `bodies`, if `tensor`)."""
         names = dict(base)
         names.update(self.key.symbols)
-        reader = parse_tensor if tensor else parse
         for abbr, text in (self.key.doc.data.get("abbreviations") or {}).items():
             if abbr in names:
                 raise self.key.doc.error(("abbreviations", abbr), f"{abbr!r} is already a name")
             try:
-                names[abbr] = reader(text, names)
+                names[abbr] = parse_tensor(text, names, bodies or {}) if tensor \
+                    else parse(text, names)
             except ExpressionError as exc:
                 # An abbreviation may belong to another of the problem's systems (it names
                 # that system's coordinates): it is simply not available in this one, and a

@@ -34,7 +34,8 @@ class Context:
         self.tensor_mode = not quantities()[self.part.quantity].needs_system
         if self.part.system is None and (self.tensor_mode or not problem.systems):
             self.system = None  # a tensor or body quantity, or a problem without a system
-            self.names = self.part.names(declared(problem).names, tensor=True)
+            decl = declared(problem)
+            self.names = self.part.names(decl.names, tensor=True, bodies=decl.bodies)
         else:
             try:
                 self.system = self.analysis.system(self.part.system)
@@ -42,9 +43,12 @@ class Context:
                 raise self.part.error(("system",) if self.part.system else (),
                                       str(exc.args[0]) + "; name it with `system:`") from None
             names = dict(self.system.names)
+            bodies = None
             if self.tensor_mode:
-                _merge_declared(names, declared(problem).names, self.part)
-            self.names = self.part.names(names, tensor=self.tensor_mode)
+                decl = declared(problem)
+                _merge_declared(names, decl.names, self.part)
+                bodies = decl.bodies
+            self.names = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
             for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
                 self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
         if self.system is not None and not self.tensor_mode:
