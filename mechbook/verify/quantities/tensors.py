@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import sympy as sp
 
 from mechbook.errors import ExpressionError
@@ -277,22 +278,23 @@ def _vec(ctx: Context, spec, sub: tuple, names: dict) -> sp.Matrix:
 
 def _nonzero_and_independent(ctx: Context, vectors: list, normals: list) -> Verdict:
     """At a random point: no axis or plane normal is zero, and three directions (a plane
-    counting two) are independent."""
-    point = ctx.sampler.draw(set().union(*(e.free_symbols for v in vectors + normals
-                                           for e in v)) - set(ctx.sampler.base))
-    for v in vectors + normals:
-        if all(abs(value(e, point)) < 1e-20 for e in v):
-            return Verdict(False, "numeric", "an axis (or a plane's normal) is zero")
-    dims = len(vectors) + 2 * len(normals)
-    if dims == 3:
-        if normals:
-            independent = abs(value(vectors[0].dot(normals[0]), point))
-            scale = value(vectors[0].norm() * normals[0].norm(), point)
+    counting two) are independent (judged on the numbers, never on symbolic determinants)."""
+    free = set().union(*(e.free_symbols for v in vectors + normals for e in v))
+    point = ctx.sampler.draw(free - set(ctx.sampler.base))
+    vecs = [np.array([value(e, point) for e in v]) for v in vectors]
+    norms = [np.array([value(e, point) for e in v]) for v in normals]
+    for v in vecs + norms:
+        if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
+            return Verdict(False, "numeric", "an axis (or a plane's normal) is zero or "
+                           "does not evaluate")
+    if len(vecs) + 2 * len(norms) == 3:
+        if norms:
+            independent = abs(np.dot(vecs[0], norms[0]))
+            scale = np.linalg.norm(vecs[0]) * np.linalg.norm(norms[0])
         else:
-            m = sp.Matrix.hstack(*vectors)
-            independent = abs(value(m.det(), point))
-            scale = abs(value(sp.prod([v.norm() for v in vectors]), point))
-        if independent <= 1e-12 * abs(scale):
+            independent = abs(np.linalg.det(np.array(vecs)))
+            scale = float(np.prod([np.linalg.norm(v) for v in vecs]))
+        if independent <= 1e-9 * scale:
             return Verdict(False, "numeric", "the principal axes given are not independent")
     return Verdict(True, "numeric", "")
 
