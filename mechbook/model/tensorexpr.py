@@ -164,6 +164,54 @@ def _diff(x, s):
     return _im(x.diff(s)) if isinstance(x, sp.MatrixBase) else sp.diff(x, s)
 
 
+def _coordinates(r) -> list[sp.Symbol]:
+    _need("vector", _vector, r)
+    if not all(isinstance(c, sp.Symbol) for c in r):
+        raise TypeError("the position must be a vector of three plain symbols [x, y, z]")
+    return list(r)
+
+
+def _grad(x, r):
+    """∇f (a vector) of a scalar field, or the dyad ∇v, (∇v)_ij = ∂v_j/∂x_i (Symon Eq.
+    10-175), of a vector field; `r` = [x, y, z], Cartesian."""
+    xs = _coordinates(r)
+    if _scalar(x):
+        return _im(sp.Matrix([sp.diff(x, c) for c in xs]))
+    _need("vector", _vector, x)
+    return _im(sp.Matrix(3, 3, lambda i, j: sp.diff(x[j], xs[i])))
+
+
+def _div(x, r):
+    """∇·v of a vector field (a scalar), or ∇·P, (∇·P)_j = Σ_i ∂P_ij/∂x_i, of a tensor."""
+    xs = _coordinates(r)
+    if _vector(x):
+        return sum((sp.diff(x[i], xs[i]) for i in range(3)), sp.S.Zero)
+    _need("tensor", _tensor, x)
+    return _im(sp.Matrix([sum((sp.diff(x[i, j], xs[i]) for i in range(3)), sp.S.Zero)
+                          for j in range(3)]))
+
+
+def _subs(x, s, v):
+    """x with the symbol s replaced by the scalar v (a boundary value, a change of
+    variables)."""
+    if not isinstance(s, sp.Symbol):
+        raise TypeError("substitute for a plain symbol")
+    _need("scalar", _scalar, v)
+    return _im(x.xreplace({s: v})) if isinstance(x, sp.MatrixBase) else x.xreplace({s: v})
+
+
+def _integral(f, s, lo, hi):
+    """The definite integral of a scalar over s from lo to hi (SymPy's integrate; an
+    integral it cannot do in closed form is an error)."""
+    if not isinstance(s, sp.Symbol):
+        raise TypeError("integrate over a plain symbol")
+    _need("scalar", _scalar, f, lo, hi)
+    out = sp.integrate(f, (s, lo, hi))
+    if out.has(sp.Integral):
+        raise ValueError("SymPy finds no closed form for this integral")
+    return out
+
+
 def _norm(v):
     _need("vector", _vector, v)
     return sp.sqrt(v.dot(v))
@@ -180,13 +228,15 @@ TENSOR_FUNCTIONS: dict[str, Callable] = {
     "dyad": _dyad, "dot": _dot, "cross": _cross, "transpose": _transpose, "det": _det,
     "trace": _trace, "second_invariant": _second_invariant, "inverse": _inverse,
     "unit": _unit, "rotation": _rotation, "skew": _skew, "entry": _entry, "norm": _norm,
-    "row": _row, "col": _col, "diff": _diff,
+    "row": _row, "col": _col, "diff": _diff, "grad": _grad, "div": _div, "subs": _subs,
+    "integral": _integral,
     "i": lambda: sp.I, "expi": _scalar_fn(lambda x: sp.exp(sp.I * x)),
     "re": _scalar_fn(sp.re), "im": _scalar_fn(sp.im), "conj": _scalar_fn(sp.conjugate),
 }
 TENSOR_ARITY = {"dyad": (2, 2), "dot": (2, 2), "cross": (2, 2), "unit": (0, 0),
                 "rotation": (2, 2), "entry": (2, 3), "row": (2, 2), "col": (2, 2),
-                "diff": (2, 2), "i": (0, 0)}
+                "diff": (2, 2), "i": (0, 0), "grad": (2, 2), "div": (2, 2), "subs": (3, 3),
+                "integral": (4, 4)}
 
 
 def _point(obj, p):
