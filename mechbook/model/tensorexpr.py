@@ -67,6 +67,12 @@ def _dot(a, b):
     raise TypeError(f"dot of a {_kind(a)} and a {_kind(b)}")
 
 
+def _ddot(a, b):
+    """The double dot product A:B = Σ A_ij B_ij of two tensors."""
+    _need("tensor", _tensor, a, b)
+    return sum((a[i, j] * b[i, j] for i in range(3) for j in range(3)), sp.S.Zero)
+
+
 def _cross(a, b):
     """u × v; with a tensor, the dyadic rule: w × (AB) = (w × A)B, (AB) × w = A(B × w)."""
     if _vector(a) and _tensor(b):
@@ -225,7 +231,7 @@ def _scalar_fn(fn):
 
 
 TENSOR_FUNCTIONS: dict[str, Callable] = {
-    "dyad": _dyad, "dot": _dot, "cross": _cross, "transpose": _transpose, "det": _det,
+    "dyad": _dyad, "dot": _dot, "ddot": _ddot, "cross": _cross, "transpose": _transpose, "det": _det,
     "trace": _trace, "second_invariant": _second_invariant, "inverse": _inverse,
     "unit": _unit, "rotation": _rotation, "skew": _skew, "entry": _entry, "norm": _norm,
     "row": _row, "col": _col, "diff": _diff, "grad": _grad, "div": _div, "subs": _subs,
@@ -233,7 +239,7 @@ TENSOR_FUNCTIONS: dict[str, Callable] = {
     "i": lambda: sp.I, "expi": _scalar_fn(lambda x: sp.exp(sp.I * x)),
     "re": _scalar_fn(sp.re), "im": _scalar_fn(sp.im), "conj": _scalar_fn(sp.conjugate),
 }
-TENSOR_ARITY = {"dyad": (2, 2), "dot": (2, 2), "cross": (2, 2), "unit": (0, 0),
+TENSOR_ARITY = {"dyad": (2, 2), "dot": (2, 2), "ddot": (2, 2), "cross": (2, 2), "unit": (0, 0),
                 "rotation": (2, 2), "entry": (2, 3), "row": (2, 2), "col": (2, 2),
                 "diff": (2, 2), "i": (0, 0), "grad": (2, 2), "div": (2, 2), "subs": (3, 3),
                 "integral": (4, 4)}
