@@ -456,7 +456,7 @@ def tensor_slots(part: Part, val, root: tuple) -> Iterator[Slot]:
     and statements (identities, an ellipsoid's equation) of a tensor part."""
     q = part.quantity
     if q in ("identity", "inertia_ellipsoid"):
-        for i, text in enumerate(val if isinstance(val, list) else [val]):
+        for i, _ in enumerate(val if isinstance(val, list) else [val]):
             yield Slot(root + ((i,) if isinstance(val, list) else ()), "tequation")
     elif q == "principal_axes":
         for i, entry in enumerate(val):
@@ -561,10 +561,14 @@ def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
     if slot.kind == "tequation":
         from mechbook.model.tensorexpr import parse_tensor_equation
 
-        a = [x - y for x, y in zip(*map(_flat, parse_tensor_equation(str(old), table,
+        b = [x - y for x, y in zip(*map(_flat, parse_tensor_equation(str(new), table,
                                                                      ctx.bodies)),
                                    strict=True)]
-        b = [x - y for x, y in zip(*map(_flat, parse_tensor_equation(str(new), table,
+        if ctx.part.quantity == "identity":  # the original holds identically: so must this
+            if any(_numerically_nonzero(y) for y in b):  # cheap, and settles most mutants
+                return False
+            return all(_zero(y) for y in b)
+        a = [x - y for x, y in zip(*map(_flat, parse_tensor_equation(str(old), table,
                                                                      ctx.bodies)),
                                    strict=True)]
         if all(_zero(x - y) for x, y in zip(a, b, strict=True)):
@@ -582,6 +586,9 @@ def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
         v = [_tparse(ctx, new if j == slot.path[-1] else x, table) for j, x in enumerate(entry)]
         return all(_zero(u[i] * v[j] - u[j] * v[i]) for i in range(3) for j in range(i + 1, 3))
     a, b = _flat(_tparse(ctx, old, table)), _flat(_tparse(ctx, new, table))
+    if any(_numerically_nonzero(y - x) for x, y in zip(a, b, strict=True)) and \
+            slot.kind != "tdirection":
+        return False
     if slot.kind == "tdirection":
         return all(_zero(a[i] * b[j] - a[j] * b[i]) for i in range(3) for j in range(i + 1, 3))
     return all(_zero(y - x) for x, y in zip(a, b, strict=True))

@@ -29,9 +29,9 @@ def _mentions(part, body: str) -> bool:
     key's abbreviations)?"""
     text = " ".join(str(v) for k, v in part.data.items()
                     if k in ("tensor", "book", "define", "equations"))
-    for abbr, value in (part.key.doc.data.get("abbreviations") or {}).items():
+    for abbr, meaning in (part.key.doc.data.get("abbreviations") or {}).items():
         if re.search(rf"\b{re.escape(abbr)}\b", text):
-            text += " " + str(value)
+            text += " " + str(meaning)
     return re.search(rf"\b{re.escape(body)}\b", text) is not None
 
 

@@ -231,7 +231,8 @@ def _scalar_fn(fn):
 
 
 TENSOR_FUNCTIONS: dict[str, Callable] = {
-    "dyad": _dyad, "dot": _dot, "ddot": _ddot, "cross": _cross, "transpose": _transpose, "det": _det,
+    "dyad": _dyad, "dot": _dot, "ddot": _ddot, "cross": _cross, "transpose": _transpose,
+    "det": _det,
     "trace": _trace, "second_invariant": _second_invariant, "inverse": _inverse,
     "unit": _unit, "rotation": _rotation, "skew": _skew, "entry": _entry, "norm": _norm,
     "row": _row, "col": _col, "diff": _diff, "grad": _grad, "div": _div, "subs": _subs,

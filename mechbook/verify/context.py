@@ -28,6 +28,7 @@ class Context:
     analysis: Analysis
     part: Part
     policy: ProofPolicy = NUMERIC
+    validate_only: bool = False  # tensor parts: build the statement once, judge nothing
 
     def __post_init__(self):
         problem = self.analysis.problem

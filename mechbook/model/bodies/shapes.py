@@ -33,7 +33,9 @@ def shape_inertia(shape: str, m: sp.Expr, dims: dict) -> sp.Matrix:
     if shape in COUNTS:
         key, count = COUNTS[shape]
         if len(dims[key]) != count:
-            raise ValueError(f"a {shape.replace('_', ' ')} has {count} {key.replace('_', ' ')}")
+            words = {2: "two", 3: "three"}
+            raise ValueError(f"a {shape.replace('_', ' ')} has {words[count]} "
+                             f"{key.replace('_', ' ')}")
     r = dims.get("radius")
     length = dims.get("length", sp.S.Zero)
     if shape == "point":

@@ -11,17 +11,22 @@ them (e.g. the angle of a rotation). Agreement is decided at random admissible p
 
 from __future__ import annotations
 
-import re
-
-import numpy as np
 import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.tensorexpr import kind, parse_tensor, parse_tensor_equation
-from mechbook.verify.compare import Verdict, all_vanish, value
+from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
-from mechbook.verify.instances import KINDS, branches, vanish_on_instances
-from mechbook.verify.registry import quantity
+from mechbook.verify.instances import (
+    KINDS,
+    Statement,
+    branches,
+    decide,
+    generic_symbols,
+    is_variable,
+    rational_point,
+)
+from mechbook.verify.registry import quantities, quantity
 
 TENSOR = {"type": "string"}
 FOR_ALL = {"type": "object", "minProperties": 1,
@@ -36,22 +41,48 @@ INDEX = {"1": 0, "2": 1, "3": 2, "x": 0, "y": 1, "z": 2}
 
 
 # ---- names, objects, parsing -------------------------------------------------------------
-def instances(ctx: Context) -> list[dict]:
-    """The names of each branch of `for_all` (one branch without it), `define:` included."""
+def check(ctx: Context, build) -> Verdict:
+    """Decide the part's statement, `build(names) -> Statement`, on every branch of
+    `for_all` (mechbook/verify/instances.py): built at random instances, then tried for
+    the generic objects."""
     spec = ctx.part.data.get("for_all") or {}
     for name in spec:
         if name in ctx.names:
             raise ctx.part.error(("for_all", name), f"{name!r} is already a name")
+    if ctx.validate_only:  # `mechbook validate`: build once, judge nothing
+        branch = branches(spec)[0]
+        build(_names(ctx, branch, rational_point(ctx.sampler, generic_symbols(branch))))
+        return Verdict(True, "validated")
     out = []
+    memo: dict = {}
     for branch in branches(spec):
-        names = dict(ctx.names)
-        names.update(branch)
-        for k, v in (ctx.part.data.get("define") or {}).items():
-            if k in names:
-                raise ctx.part.error(("define", k), f"{k!r} is already a name")
-            names[k] = tparse(ctx, v, ("define", k), names)
-        out.append(names)
-    return out
+        def names_at(point, branch=branch):
+            return _names(ctx, branch, point)
+
+        out.append(decide(names_at, build, generic_symbols(branch), ctx.sampler, memo))
+    return combine(out)
+
+
+def _names(ctx: Context, branch: dict, point: dict | None) -> dict:
+    """The part's names with the branch's generic objects and `define:`, everything at
+    `point` (numbers for the symbols) unless None."""
+    names = dict(ctx.names)
+    names.update(branch)
+    if point is not None:  # numbers for every symbol but the `variable`s, which stay
+        early = {k: v for k, v in point.items() if not is_variable(k)}  # until the end
+        names = {k: v.xreplace(early) if isinstance(v, sp.Basic) else v
+                 for k, v in names.items()}
+    for k, v in (ctx.part.data.get("define") or {}).items():
+        if k in names:
+            raise ctx.part.error(("define", k), f"{k!r} is already a name")
+        names[k] = tparse(ctx, v, ("define", k), names)
+    return names
+
+
+def first_names(ctx: Context) -> dict:
+    """The names of the first branch, generic (for validation and the mutation test)."""
+    spec = ctx.part.data.get("for_all") or {}
+    return _names(ctx, branches(spec)[0], None)
 
 
 def tparse(ctx: Context, text, sub: tuple, names: dict):
@@ -102,10 +133,12 @@ def axes_matrix(ctx: Context, names: dict) -> sp.Matrix:
             rows.append(list(v))
         a = sp.Matrix(rows)
     a = sp.Matrix(a)
-    residual = all_vanish(list(a * a.T - sp.eye(3)), ctx.sampler, symbolic=False)
-    if not residual.ok:
-        raise ctx.part.error(("axes",), "the new axes are not orthonormal (a·aᵀ ≠ 1): "
-                             + residual.detail)
+    residual = a * a.T - sp.eye(3)
+    if not residual.free_symbols:  # at an instance (numbers): checked there
+        worst = max(abs(complex(sp.N(e, 30))) for e in residual)
+        if worst > 1e-20:
+            raise ctx.part.error(("axes",), "the new axes are not orthonormal (a·aᵀ ≠ 1; "
+                                 f"off by {worst:.2g})")
     return a
 
 
@@ -157,11 +190,6 @@ def combine(verdicts: list[Verdict]) -> Verdict:
     return min(verdicts, key=lambda v: rank.get(v.method.split("(")[0], 0))
 
 
-def _vanish(ctx: Context, exprs: list, labels: list[str]) -> Verdict:
-    """All vanish: on for_all instances (exact where rational) or at random points."""
-    return vanish_on_instances(exprs, ctx.sampler, labels)
-
-
 # ---- quantities --------------------------------------------------------------------------
 @quantity('components',
           book='expression, `[x, y, z]`, `[[..], [..], [..]]`, or `{"12": T12, …}` (some '
@@ -173,13 +201,13 @@ def _vanish(ctx: Context, exprs: list, labels: list[str]) -> Verdict:
                'points; with `for_all:`, for every instance'),
           keys={"tensor": TENSOR, "axes": AXES, "for_all": FOR_ALL}, needs_system=False)
 def check_components(ctx: Context, val) -> Verdict:
-    out = []
-    for names in instances(ctx):
+    def build(names):
         obj = subject(ctx, names)
         pairs = book_value(ctx, val, ("book",), names, obj)
-        out.append(_vanish(ctx, [b - e for _, b, e in pairs],
-                           [f"component {p[0]}, book − value," for p in pairs]))
-    return combine(out)
+        return Statement([b - e for _, b, e in pairs],
+                         [f"component {p[0]}, book − value," for p in pairs])
+
+    return check(ctx, build)
 
 
 def _characteristic(t: sp.Matrix) -> tuple:
@@ -212,21 +240,20 @@ def check_eigenvalues(ctx: Context, val) -> Verdict:
     if not partial and len(values) != 3:
         raise ctx.part.error(("book",), "give all three eigenvalues (with repeats), or "
                              "`partial: true`")
-    out = []
-    for names in instances(ctx):
+
+    def build(names):
         t = _tensor_subject(ctx, names)
         lams = [tparse(ctx, v, ("book", i), names) for i, v in enumerate(values)]
         if partial:
-            exprs = [(lam * sp.eye(3) - t).det(method="berkowitz") for lam in lams]
-            labels = [f"det(λ1 − T) at λ = {v}" for v in values]
-        else:
-            a, b, c = lams
-            exprs = [x - y for x, y in zip((a + b + c, a * b + b * c + a * c, a * b * c),
-                                           _characteristic(t), strict=True)]
-            labels = ["sum of the eigenvalues − tr T", "sum of their pair products − M(T)",
-                      "their product − det T"]
-        out.append(_vanish(ctx, exprs, labels))
-    return combine(out)
+            return Statement([(lam * sp.eye(3) - t).det(method="berkowitz") for lam in lams],
+                             [f"det(λ1 − T) at λ = {v}" for v in values])
+        a, b, c = lams
+        return Statement([x - y for x, y in zip((a + b + c, a * b + b * c + a * c, a * b * c),
+                                                _characteristic(t), strict=True)],
+                         ["sum of the eigenvalues − tr T",
+                          "sum of their pair products − M(T)", "their product − det T"])
+
+    return check(ctx, build)
 
 
 @quantity('principal_axes',
@@ -238,16 +265,17 @@ def check_eigenvalues(ctx: Context, val) -> Verdict:
           keys={"tensor": TENSOR, "for_all": FOR_ALL, "axes": AXES}, needs_system=False)
 def check_principal_axes(ctx: Context, val) -> Verdict:
     entries = ctx.as_list(val, ("book",))
-    out = []
-    for names in instances(ctx):
+    for i, entry in enumerate(entries):
+        entry = ctx.as_map(entry, ("book", i))
+        if "value" not in entry or len(set(entry) & {"axis", "plane"}) != 1 \
+                or set(entry) - {"value", "axis", "plane"}:
+            raise ctx.part.error(("book", i), "an entry is {value: λ, axis: v} or "
+                                 "{value: λ, plane: n}")
+
+    def build(names):
         t = _tensor_subject(ctx, names)
         exprs, labels, vectors, normals = [], [], [], []
         for i, entry in enumerate(entries):
-            entry = ctx.as_map(entry, ("book", i))
-            if "value" not in entry or len(set(entry) & {"axis", "plane"}) != 1 \
-                    or set(entry) - {"value", "axis", "plane"}:
-                raise ctx.part.error(("book", i), "an entry is {value: λ, axis: v} or "
-                                     "{value: λ, plane: n}")
             lam = tparse(ctx, entry["value"], ("book", i, "value"), names)
             key = "axis" if "axis" in entry else "plane"
             v = _vec(ctx, entry[key], ("book", i, key), names)
@@ -258,14 +286,19 @@ def check_principal_axes(ctx: Context, val) -> Verdict:
                 residual = (t - lam * sp.eye(3)) * (v.dot(v) * sp.eye(3) - v * v.T)
                 normals.append(v)
             exprs += list(residual)
-            labels += [f"entry {i + 1} ({key}), component {k + 1}"
+            labels += [f"entry {i + 1} ({key}), component {k + 1} of (T − λ1)·v"
                        for k in range(len(residual))]
-        verdict = _vanish(ctx, exprs, labels)
-        if verdict.ok:
-            shape = _nonzero_and_independent(ctx, vectors, normals)
-            verdict = verdict if shape.ok else shape
-        out.append(verdict)
-    return combine(out)
+        nonzero = [(f"entry {i + 1}'s direction", v.dot(v))
+                   for i, v in enumerate(vectors + normals)]
+        if len(vectors) + 2 * len(normals) == 3:  # the directions must be independent
+            if normals:
+                nonzero.append(("the axis along the plane's normal", vectors[0].dot(normals[0])))
+            else:
+                nonzero.append(("the determinant of the three axes",
+                                sp.Matrix.hstack(*vectors).det(method="berkowitz")))
+        return Statement(exprs, labels, nonzero)
+
+    return check(ctx, build)
 
 
 def _vec(ctx: Context, spec, sub: tuple, names: dict) -> sp.Matrix:
@@ -274,29 +307,6 @@ def _vec(ctx: Context, spec, sub: tuple, names: dict) -> sp.Matrix:
     if kind(v) != "vector":
         raise ctx.part.error(sub, f"expected a vector, got a {kind(v)}")
     return sp.Matrix(v)
-
-
-def _nonzero_and_independent(ctx: Context, vectors: list, normals: list) -> Verdict:
-    """At a random point: no axis or plane normal is zero, and three directions (a plane
-    counting two) are independent (judged on the numbers, never on symbolic determinants)."""
-    free = set().union(*(e.free_symbols for v in vectors + normals for e in v))
-    point = ctx.sampler.draw(free - set(ctx.sampler.base))
-    vecs = [np.array([value(e, point) for e in v]) for v in vectors]
-    norms = [np.array([value(e, point) for e in v]) for v in normals]
-    for v in vecs + norms:
-        if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
-            return Verdict(False, "numeric", "an axis (or a plane's normal) is zero or "
-                           "does not evaluate")
-    if len(vecs) + 2 * len(norms) == 3:
-        if norms:
-            independent = abs(np.dot(vecs[0], norms[0]))
-            scale = np.linalg.norm(vecs[0]) * np.linalg.norm(norms[0])
-        else:
-            independent = abs(np.linalg.det(np.array(vecs)))
-            scale = float(np.prod([np.linalg.norm(v) for v in vecs]))
-        if independent <= 1e-9 * scale:
-            return Verdict(False, "numeric", "the principal axes given are not independent")
-    return Verdict(True, "numeric", "")
 
 
 @quantity('identity',
@@ -312,19 +322,23 @@ def _nonzero_and_independent(ctx: Context, vectors: list, normals: list) -> Verd
           keys={"for_all": FOR_ALL}, needs_system=False)
 def check_identity(ctx: Context, val) -> Verdict:
     statements = val if isinstance(val, list) else [val]
-    out = []
-    for names in instances(ctx):
+
+    def build(names):
         exprs, labels = [], []
         for i, text in enumerate(statements):
             sub = ("book", i) if isinstance(val, list) else ("book",)
             lhs, rhs = tequation(ctx, text, sub, names)
-            diff = lhs - rhs
-            flat = list(diff) if isinstance(diff, sp.MatrixBase) else [diff]
+            flat = _flat(lhs - rhs)
             exprs += flat
             labels += [f"{text!r}" + (f", component {k + 1}" if len(flat) > 1 else "")
                        for k in range(len(flat))]
-        out.append(_vanish(ctx, exprs, labels))
-    return combine(out)
+        return Statement(exprs, labels)
+
+    return check(ctx, build)
+
+
+def _flat(value) -> list:
+    return list(value) if isinstance(value, sp.MatrixBase) else [value]
 
 
 @quantity('solves',
@@ -341,33 +355,33 @@ def check_solves(ctx: Context, val) -> Verdict:
     equations = ctx.part.data.get("equations")
     if not unknown or not equations:
         raise ctx.part.error((), "a 'solves' part names `unknown:` and `equations:`")
-    out = []
-    for names in instances(ctx):
-        if unknown in names:
-            raise ctx.part.error(("unknown",), f"{unknown!r} is already a name")
-        if isinstance(val, list) and val and isinstance(val[0], list):
-            book = sp.ImmutableMatrix([[tparse(ctx, x, ("book", i, j), names)
-                                        for j, x in enumerate(row)]
-                                       for i, row in enumerate(val)])
-        elif isinstance(val, list):
-            book = sp.ImmutableMatrix([tparse(ctx, x, ("book", i), names)
-                                       for i, x in enumerate(val)])
-        else:
-            book = tparse(ctx, val, ("book",), names)
-        if kind(book) not in ("scalar", "vector", "tensor"):
-            raise ctx.part.error(("book",), "the value is a scalar, a vector or a tensor")
+    if unknown in ctx.names:
+        raise ctx.part.error(("unknown",), f"{unknown!r} is already a name")
+
+    def build(names):
         names = dict(names)
-        names[unknown] = book
+        names[unknown] = _book_object(ctx, val, names)
         exprs, labels = [], []
         for i, text in enumerate(equations):
             lhs, rhs = tequation(ctx, text, ("equations", i), names)
-            diff = lhs - rhs
-            flat = list(diff) if isinstance(diff, sp.MatrixBase) else [diff]
+            flat = _flat(lhs - rhs)
             exprs += flat
             labels += [f"equation {i + 1}" + (f", component {k + 1}" if len(flat) > 1 else "")
                        for k in range(len(flat))]
-        out.append(_vanish(ctx, exprs, labels))
-    return combine(out)
+        return Statement(exprs, labels)
+
+    return check(ctx, build)
+
+
+def _book_object(ctx: Context, val, names: dict):
+    """A scalar, vector ([x, y, z]) or tensor (three rows) written in the key."""
+    if isinstance(val, list) and val and isinstance(val[0], list):
+        return sp.ImmutableMatrix([[tparse(ctx, x, ("book", i, j), names)
+                                    for j, x in enumerate(row)] for i, row in enumerate(val)])
+    if isinstance(val, list):
+        return sp.ImmutableMatrix([tparse(ctx, x, ("book", i), names)
+                                   for i, x in enumerate(val)])
+    return tparse(ctx, val, ("book",), names)
 
 
 XYZ = ("x", "y", "z")
@@ -381,53 +395,41 @@ XYZ = ("x", "y", "z")
                'and random x, y, z'),
           keys={"tensor": TENSOR}, needs_system=False)
 def check_inertia_ellipsoid(ctx: Context, val) -> Verdict:
-    names = dict(ctx.names)
-    r = []
-    for c in XYZ:
-        if c in names:
-            raise ctx.part.error(("book",), f"{c!r} is already a name; the ellipsoid's "
-                                 "coordinates are x, y, z")
-        names[c] = sp.Symbol(c, real=True)
-        r.append(names[c])
-    t = _tensor_subject(ctx, names)
-    if not re.search(r"=", str(val)):
+    if not isinstance(val, str) or "=" not in val:
         raise ctx.part.error(("book",), "the ellipsoid is an equation: '... = 1'")
-    lhs, rhs = tequation(ctx, val, ("book",), names)
-    if kind(lhs) != "scalar":
-        raise ctx.part.error(("book",), "the ellipsoid's equation is between scalars")
-    f = lhs - rhs
-    rv = sp.Matrix(r)
-    quadric = (rv.T * t * rv)[0, 0] - 1
-    c = -f.xreplace(dict.fromkeys(r, 0))
-    verdict = _vanish(ctx, [f - c * quadric], ["f − c·(r·T·r − 1)"])
-    if not verdict.ok:
-        return verdict
-    point = ctx.sampler.draw(c.free_symbols - set(ctx.sampler.base))
-    if abs(value(c, point)) == 0:
-        return Verdict(False, "numeric", "the equation has no constant term: not r·T·r = 1")
-    return verdict
+    r = [sp.Symbol(c, real=True) for c in XYZ]
+
+    def build(names):
+        names = dict(names)
+        for c, sym in zip(XYZ, r, strict=True):
+            if c in names:
+                raise ctx.part.error(("book",), f"{c!r} is already a name; the ellipsoid's "
+                                     "coordinates are x, y, z")
+            names[c] = sym
+        t = _tensor_subject(ctx, names)
+        lhs, rhs = tequation(ctx, val, ("book",), names)
+        if kind(lhs) != "scalar":
+            raise ctx.part.error(("book",), "the ellipsoid's equation is between scalars")
+        f = sp.expand(lhs - rhs)
+        rv = sp.Matrix(r)
+        quadric = sp.expand((rv.T * t * rv)[0, 0] - 1)
+        c = -f.xreplace(dict.fromkeys(r, 0))
+        residual = sp.Poly(f - c * quadric, *r)  # every coefficient in x, y, z must vanish
+        coeffs = residual.coeffs() if not residual.is_zero else [sp.S.Zero]
+        return Statement(coeffs, [f"coefficient {k + 1} of f − c·(r·T·r − 1)"
+                                  for k in range(len(coeffs))],
+                         [("the constant term of the book's equation", c)])
+
+    return check(ctx, build)
 
 
 def validate_part(ctx: Context) -> None:
-    """Parse every expression of a tensor part (for `mechbook validate`), nothing derived."""
-    names = dict(instances(ctx)[0])
-    if ctx.part.quantity == "inertia_ellipsoid":
-        names.update({c: sp.Symbol(c, real=True) for c in XYZ if c not in names})
-
-    def walk(v, sub):
-        if isinstance(v, dict):
-            for k, x in v.items():
-                walk(x, sub + (k,))
-        elif isinstance(v, list):
-            for i, x in enumerate(v):
-                walk(x, sub + (i,))
-        elif isinstance(v, str) and "=" in v.replace("==", ""):
-            tequation(ctx, v, sub, names)
-        elif isinstance(v, (str, int, float)) and not isinstance(v, bool):
-            tparse(ctx, v, sub, names)
-
-    for key in ("tensor", "axes", "book"):
-        if key in ctx.part.data:
-            walk(ctx.part.data[key], (key,))
-    if "erratum" in ctx.part.data:
-        walk(ctx.part.data["erratum"]["corrected"], ("erratum", "corrected"))
+    """Parse every expression of a tensor part (for `mechbook validate`): the statement is
+    built once, at a random instance, and not judged."""
+    ctx.validate_only = True
+    try:
+        quantities()[ctx.part.quantity].check(ctx, ctx.part.data.get("book"))
+        if "erratum" in ctx.part.data:
+            quantities()[ctx.part.quantity].check(ctx, ctx.part.data["erratum"]["corrected"])
+    finally:
+        ctx.validate_only = False
