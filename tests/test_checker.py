@@ -474,9 +474,16 @@ def tensor_slots(part: Part, val, root: tuple) -> Iterator[Slot]:
 
 
 def _tensor_names(ctx: Context) -> dict:
-    from mechbook.verify.quantities.tensors import instances
+    """The part's names at one random rational instance (numbers: building a statement
+    from the generic objects can take minutes), cached on the context."""
+    if not hasattr(ctx, "_mutation_names"):
+        from mechbook.verify.instances import branches, generic_symbols, rational_point
+        from mechbook.verify.quantities.tensors import _names
 
-    return instances(ctx)[0]
+        branch = branches(ctx.part.data.get("for_all") or {})[0]
+        point = rational_point(ctx.sampler, generic_symbols(branch))
+        ctx._mutation_names = _names(ctx, branch, point)
+    return ctx._mutation_names
 
 
 def _tparse(ctx: Context, text, names: dict):

@@ -4,6 +4,7 @@
     schema    JSON-Schema validation with file:line errors (schemas/*.json)
     expr      the safe expression parser (never eval)
     tensorexpr  the same parser for vectors and tensors (and bodies' functions)
+    tensorfuncs the whitelisted functions of tensor expressions
     catalog   where problem and answer files live, problem ids
     problem   a problem file: parameters, conditions, its systems as data
     system    one system built: coordinates, T, V, L, forces, constraints

@@ -79,12 +79,6 @@ def _names(ctx: Context, branch: dict, point: dict | None) -> dict:
     return names
 
 
-def first_names(ctx: Context) -> dict:
-    """The names of the first branch, generic (for validation and the mutation test)."""
-    spec = ctx.part.data.get("for_all") or {}
-    return _names(ctx, branches(spec)[0], None)
-
-
 def tparse(ctx: Context, text, sub: tuple, names: dict):
     try:
         return parse_tensor(text, names, ctx.bodies)
