@@ -104,7 +104,8 @@ def markdown_table() -> str:
 
 
 if __name__ == "__main__":  # python -m mechbook.verify.registry: the table for the docs
-    # the registry that the quantities fill is the imported module, not this __main__
-    from mechbook.verify.registry import markdown_table as table
+    # run as __main__, this module is a second copy: the quantities register in the one
+    # imported by name, so the table comes from there (this copy's registry stays empty)
+    from mechbook.verify.registry import markdown_table as _table
 
-    print(table())
+    print(_table())
