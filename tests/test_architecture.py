@@ -68,7 +68,8 @@ def test_each_module_imports_only_what_its_stage_may(module):
     bad = sorted(m for m in imports(path) if stage(m) != own and stage(m) not in ALLOWED[own]
                  and m != "mechbook")
     assert not bad, f"{module} ({own}) may not import {bad}"
-    forbidden = sorted(imports(path) & FORBIDDEN.get(own, set()))
+    forbidden = sorted(m for m in imports(path) for f in FORBIDDEN.get(own, set())
+                       if m == f or m.startswith(f + "."))  # a package and its modules
     assert not forbidden, f"{module} must not import {forbidden}"
 
 

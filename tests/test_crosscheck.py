@@ -214,7 +214,8 @@ def test_independent_kinematics_agree_with_the_engine_and_catch_a_wrong_one():
     dims = {"point": {}, "rod": {"length": length}, "ring": {"radius": r},
             "disk": {"radius": r}, "solid_cylinder": {"radius": r, "length": length},
             "solid_sphere": {"radius": r}, "spherical_shell": {"radius": r},
-            "rectangular_plate": {"sides": [a, b]}, "block": {"sides": [a, b, c]}}
+            "rectangular_plate": {"sides": [a, b]}, "block": {"sides": [a, b, c]},
+            "cone": {"radius": r, "height": length}, "solid_ellipsoid": {"semi_axes": [a, b, c]}}
     assert set(dims) == set(SHAPES)
     for shape, d in dims.items():
         diff = sp.simplify(inertia_of_shape(shape, m, d) - shape_inertia(shape, m, d))

@@ -98,7 +98,8 @@ def list_cmd(ctx: click.Context) -> None:
 def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: bool) -> None:
     """Derive and print a problem's results (what its `compute:` asks for), simplified."""
     from mechbook.app.api import load
-    from mechbook.engine.derive import derive
+    from mechbook.engine.derive import declared_results, derive
+    from mechbook.model.declared import declared
 
     base = _resolve_root(ctx)
     try:
@@ -115,6 +116,13 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
                 click.echo(f"{key} (numeric, default parameters):\n    {arr.tolist()}")
             for key, text in res.notes.items():
                 click.echo(f"{key}: {text}")
+        if not names or any(k in problem.model.doc.data for k in ("vectors", "tensors",
+                                                                 "bodies")):
+            declared(problem.model)  # a problem's own vectors, tensors and bodies
+            res = declared_results(problem.analysis)
+            click.echo("\n== declared vectors, tensors and bodies")
+            for key, text in res.text.items():
+                click.echo(f"{key}:\n    {text}")
     except (MechbookError, KeyError) as exc:
         raise click.ClickException(str(exc)) from None
 

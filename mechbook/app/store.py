@@ -7,6 +7,9 @@ Layout (one group per problem, replaced whole on each run of that problem):
     /problems/<id>/systems/<s>/symbolic/<key>   UTF-8 string datasets
     /problems/<id>/systems/<s>/numeric/<key>    float arrays (default parameter values)
     /problems/<id>/systems/<s>/notes/<key>      why a result is missing
+    /problems/<id>/systems/_declared/...        the problem's declared vectors, tensors and
+                                                bodies (mass, centre of mass, inertia), if
+                                                a part used them
     /problems/<id>/checks/<part>   attrs: quantity, cite, status, method, detail, seconds
     /problems/<id>/crosschecks/<n> attrs: name, kind, system, status, error, detail, parts,
                                           seconds, modes (JSON); see mechbook/crosscheck.py

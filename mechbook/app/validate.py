@@ -8,11 +8,13 @@ from pathlib import Path
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import problem_path, root
+from mechbook.model.declared import declared
 from mechbook.model.problem import load_problem
 from mechbook.model.system import system_of
 from mechbook.model.yamlio import load
 from mechbook.verify.answers import load_answers
 from mechbook.verify.context import Context, strip_const
+from mechbook.verify.quantities.tensors import validate_part
 
 
 def validate_file(path: str | Path) -> str:
@@ -24,7 +26,10 @@ def validate_file(path: str | Path) -> str:
     problem = load_problem(path)
     for name in problem.systems:
         system_of(problem, name)
-    return f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s))"
+    decl = declared(problem)
+    return (f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s), "
+            f"{len(decl.vectors)} vector(s), {len(decl.tensors)} tensor(s), "
+            f"{len(decl.bodies)} body(ies))")
 
 
 def _validate_answers(path: Path) -> str:
@@ -37,6 +42,9 @@ def _validate_answers(path: Path) -> str:
     analysis = Analysis(problem)
     for part in key.parts:
         ctx = Context(analysis, part)
+        if ctx.tensor_mode:
+            validate_part(ctx)
+            continue
         for field in ("book", "about", "initial", "released", "region", "time", "hold",
                       "signal", "event"):
             if field in part.data and not (field == "book" and part.quantity == "stability"):

@@ -9,6 +9,8 @@ None of them looks at the book's answers:
                  --quantity drift`: where the linear answer stops being good)
     motion       steady motions kept by a simulation; trajectory quantities of the level
                  set measured by integration
+    inertia      each declared body's inertia: the engine's table and parallel axes against
+                 integration over its parts (assembly.py)
 
 May import: mechbook.verify (how an answer part names its point: `about:`, `steady:`,
 `assume:`), mechbook.numerics, mechbook.engine (the results under test), mechbook.core,
@@ -25,6 +27,7 @@ import traceback
 import sympy as sp
 
 from mechbook.crosscheck.frequencies import frequency_crosscheck
+from mechbook.crosscheck.inertia import inertia_crosschecks
 from mechbook.crosscheck.motion import (
     STEADY_QUANTITIES,
     TRAJECTORY_QUANTITIES,
@@ -40,7 +43,8 @@ from mechbook.verify.context import Context  # how a part names its point
 
 FREQUENCY_QUANTITIES = ("frequencies", "period", "normal_modes", "normal_coordinates",
                         "mode_node", "stability_condition", "stability")
-EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "identity", "solution",
+EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "state_identity",
+                       "solution",
                        "precession_rate", "rotation_matrix")
 LOOSE_BUDGET = 3.0  # seconds for the engine's own closed-form equilibria (no part asks)
 
@@ -160,6 +164,8 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                 freq[tag] = _guarded_frequency(analysis, lin, values, f"modes:{name}@{label}",
                                                models)
     out += list(newton.values()) + list(freq.values())
+    stage("cross-check: declared bodies")
+    out += inertia_crosschecks(analysis, key)
     return out
 
 

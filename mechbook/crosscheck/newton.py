@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
+from mechbook.crosscheck.assembly import composite_inertia
 from mechbook.crosscheck.kinematics import (
     body_angular_velocity,
     chain_angular_velocity,
@@ -136,12 +137,15 @@ def _body_frame(sys, name: str, b: dict, m, parse):
     sub = ("rigid_bodies", name)
     planar = len(b["position"]) == 2
     inertia = b["inertia"]
-    if isinstance(inertia, dict):
+    if isinstance(inertia, dict) and "body" in inertia:  # a body made of parts
+        tensor = composite_inertia(sys.problem, inertia["body"])[2]
+    elif isinstance(inertia, dict):
         dims = {k: parse(v, sub + ("inertia", k)) for k, v in inertia.items()
-                if k in ("radius", "length")}
-        if "sides" in inertia:
-            dims["sides"] = [parse(v, sub + ("inertia", "sides", i))
-                             for i, v in enumerate(inertia["sides"])]
+                if k in ("radius", "length", "height")}
+        for key in ("sides", "semi_axes"):
+            if key in inertia:
+                dims[key] = [parse(v, sub + ("inertia", key, i))
+                             for i, v in enumerate(inertia[key])]
         tensor = inertia_of_shape(inertia["shape"], m, dims)
     elif isinstance(inertia, list):
         tensor = sp.Matrix([[parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]

@@ -1,8 +1,9 @@
 """Problem files: load, validate, and turn declarations into SymPy symbols and expressions.
 
 A problem holds shared parameters and one or more systems (a problem whose parts use
-different physical set-ups, say a free and a driven chain, declares `systems:`). Everything
-a system says is parsed with the safe parser; an error names the file and line.
+different physical set-ups, say a free and a driven chain, declares `systems:`), or none: a
+problem about tensors and bodies declares only those (mechbook/model/declared.py).
+Everything a system says is parsed with the safe parser; an error names the file and line.
 """
 
 from __future__ import annotations
@@ -112,10 +113,14 @@ def load_problem(path: str | Path) -> Problem:
         if inline:
             raise doc.error((inline[0],), "with 'systems:' every system key goes inside a system")
         systems = {n: SystemSpec(n, s, ("systems", n)) for n, s in data["systems"].items()}
-    else:
-        if "coordinates" not in data:
-            raise doc.error((), "'coordinates' is required (or a 'systems' mapping)")
+    elif "coordinates" in data:
         systems = {"main": SystemSpec("main", {k: data[k] for k in SYSTEM_KEYS if k in data}, ())}
+    else:  # no system: a problem about declared vectors, tensors and bodies only
+        stray = [k for k in SYSTEM_KEYS if k in data and k != "doc"]
+        if stray:
+            raise doc.error((stray[0],), "'coordinates' is required (or a 'systems' mapping) "
+                            f"for a system; {stray[0]!r} belongs to one")
+        systems = {}
     why = file_id_error(data["id"], path)
     if why:
         raise doc.error(("id",), why)

@@ -13,10 +13,11 @@ from __future__ import annotations
 import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
-from mechbook.core.numeval import without_absent
+from mechbook.core.numeval import is_zero, without_absent
 from mechbook.errors import UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
+from mechbook.model.declared import declared
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
 
@@ -142,16 +143,32 @@ class System:
 
     def _rigid_body(self, name: str, b: dict) -> sp.Expr:
         sub = ("rigid_bodies", name)
-        m = self._parse(b["mass"], sub + ("mass",))
+        inertia = b["inertia"]
+        composite = None
+        if isinstance(inertia, dict) and "body" in inertia:
+            composite = self._composite(inertia["body"], sub + ("inertia", "body"))
+        if "mass" in b:
+            m = self._parse(b["mass"], sub + ("mass",))
+            if composite is not None and not is_zero(m - composite.mass):
+                raise self._error(sub + ("mass",), f"the mass differs from body "
+                                  f"{inertia['body']!r}'s ({composite.mass}); leave it out")
+        elif composite is not None:
+            m = composite.mass
+        else:
+            raise self._error(sub, "a rigid body needs 'mass' (unless its inertia names a body)")
         r = sp.Matrix([self._parse(x, sub + ("position", i)) for i, x in enumerate(b["position"])])
         self.positions[name], self.masses[name] = r, m
-        inertia = b["inertia"]
-        if isinstance(inertia, dict):
+        if composite is not None:
+            if r.rows != 3:
+                raise self._error(sub + ("position",), "a body made of parts moves in 3-D")
+            tensor = composite.inertia()  # about its centre of mass, in its own axes
+        elif isinstance(inertia, dict):
             dims = {k: self._parse(v, sub + ("inertia", k)) for k, v in inertia.items()
-                    if k in ("radius", "length")}
-            if "sides" in inertia:
-                dims["sides"] = [self._parse(v, sub + ("inertia", "sides", i))
-                                 for i, v in enumerate(inertia["sides"])]
+                    if k in ("radius", "length", "height")}
+            for key in ("sides", "semi_axes"):
+                if key in inertia:
+                    dims[key] = [self._parse(v, sub + ("inertia", key, i))
+                                 for i, v in enumerate(inertia[key])]
             try:
                 tensor = shape_inertia(inertia["shape"], m, dims)
             except ValueError as exc:
@@ -214,6 +231,14 @@ class System:
                         raise self._error(sub + (key, i), f"name {n!r} is already taken")
                 self.names[rname] = omega[i]
                 self.names[rname + "dot"] = self.dt(omega[i])
+
+    def _composite(self, body: str, sub: tuple):
+        """A body declared under the problem's `bodies:` (made of parts)."""
+        bodies = declared(self.problem).bodies
+        if body not in bodies:
+            known = ", ".join(sorted(bodies)) or "none declared"
+            raise self._error(sub, f"no body {body!r} under 'bodies:' ({known})")
+        return bodies[body]
 
     def _gravity(self) -> sp.Expr:
         if "gravity" not in self.spec:

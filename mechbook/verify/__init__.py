@@ -5,6 +5,8 @@
                 on request (ProofPolicy)
     context     what a part is checked in: system, names, sampler, point
     registry    every answer quantity: name -> check, schema fragment, doc line
+    instances   generic tensors for statements "for all", and deciding identities on
+                random instances (exact or 30-digit) with a symbolic attempt
     quantities  the checks, one module per family of quantities
     checker     running a key: outcomes pass / fail / erratum / unsupported / error
 

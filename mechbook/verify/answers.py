@@ -15,6 +15,7 @@ import sympy as sp
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import parse, parse_equation
 from mechbook.model.schema import validate
+from mechbook.model.tensorexpr import parse_tensor
 from mechbook.model.yamlio import Document, load
 
 
@@ -44,8 +45,12 @@ class Part:
     def error(self, sub: tuple, message: str):
         return self.key.doc.error(self.path + sub, message)
 
-    def names(self, system) -> dict[str, sp.Basic]:
-        names = dict(system.names)
+    def names(self, base: dict, tensor: bool = False,
+              bodies: dict | None = None) -> dict[str, sp.Basic]:
+        """The names this part may use: `base` (a system's, or the problem's declared
+        ones), the key's symbols and its abbreviations (tensor expressions, which may name
+        the problem's `bodies`, if `tensor`)."""
+        names = dict(base)
         for sym in self.key.symbols:
             if sym in names:
                 raise self.key.doc.error(("symbols", sym), f"{sym!r} is already a name of the "
@@ -55,7 +60,8 @@ class Part:
             if abbr in names:
                 raise self.key.doc.error(("abbreviations", abbr), f"{abbr!r} is already a name")
             try:
-                names[abbr] = parse(text, names)
+                names[abbr] = parse_tensor(text, names, bodies or {}) if tensor \
+                    else parse(text, names)
             except ExpressionError as exc:
                 # An abbreviation may belong to another of the problem's systems (it names
                 # that system's coordinates): it is simply not available in this one, and a

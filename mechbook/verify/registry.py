@@ -27,6 +27,7 @@ COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", 
 # schema fragments shared by several quantities' keys
 EXPR = {"$ref": "#/$defs/expr"}
 POINT = {"$ref": "#/$defs/point"}
+NAME = {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"}  # a coordinate or symbol
 LIMIT = {"type": "object", "required": ["parameter", "to"], "additionalProperties": False,
          "properties": {"parameter": {"type": "string"}, "to": {"enum": ["0", "oo", 0]},
                         "order": {"type": "integer", "minimum": 0, "maximum": 3}}}
@@ -46,17 +47,21 @@ class Quantity:
     book: str  # what `book:` holds
     how: str  # how it is checked
     keys: dict = field(default_factory=dict)  # extra part keys -> JSON-Schema fragments
+    needs_system: bool = True  # False: tensors and bodies, checked without a system
 
 
 QUANTITIES: dict[str, Quantity] = {}
 
 
-def quantity(name: str, *, book: str, how: str, keys: dict | None = None):
-    """Register the decorated function as the check of quantity `name`."""
+def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
+             needs_system: bool = True):
+    """Register the decorated function as the check of quantity `name` (`needs_system`:
+    False for quantities of declared tensors and bodies, which a problem without a system
+    can have)."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
-        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}))
+        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), needs_system)
         return fn
 
     return register

@@ -10,6 +10,7 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     phase,
     rotation,
     steady,
+    tensors,
     trajectory,
     words,
 )

@@ -108,13 +108,13 @@ def check_precession_rate(ctx: Context, val) -> Verdict:
     return equal(book, engine, ctx.sampler)
 
 
-@quantity('identity',
+@quantity('state_identity',
           book='equation or list of equations between functions of the state',
           how=('each holds at random states (momenta `p_<q>` are ∂L/∂q̇, accelerations the '
                "engine's): kinematic relations such as a polhode's projection, or the rate "
                'names of a body'),
           keys={})
-def check_identity(ctx: Context, val) -> Verdict:
+def check_state_identity(ctx: Context, val) -> Verdict:
     vals = val if isinstance(val, list) else [val]
     out = []
     for i, v in enumerate(vals):

@@ -15,10 +15,9 @@ from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial
 from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
-from mechbook.verify.registry import ESTIMATE, LIMIT, quantity
+from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}
-NAME = {"type": "string"}
 ROOT_RTOL = 1e-9
 STEADY_KEYS = {"hold": HOLD, "unknown": NAME}
 
