@@ -98,7 +98,7 @@ def test_solution_in_body_rates(body, tmp_path, book, status):
     ("I1*w1*w1dot + I1*w2*w2dot + I3*w3*w3dot = N3*w3", "pass"),  # dT/dt = N.omega
     ("I1*w1*w1dot + I1*w2*w2dot + I3*w3*w3dot = N3*w1", "fail")])
 def test_identity(body, tmp_path, book, status):
-    got, detail = check(body, tmp_path, quantity="identity", book=book)
+    got, detail = check(body, tmp_path, quantity="state_identity", book=book)
     assert got == status, detail
 
 
