@@ -42,25 +42,33 @@ def _resolve_root(ctx: click.Context) -> Path:
 @main.command("list")
 @click.pass_context
 def list_cmd(ctx: click.Context) -> None:
-    """List every problem with its title and number of answer parts."""
+    """List every problem with its title and number of answer parts; an invalid file is
+    marked INVALID with the reason (and the exit status is 1)."""
     from mechbook.model.problem import load_problem
 
+    from mechbook.verify.answers import load_answers
+
     base = _resolve_root(ctx)
+    invalid = 0
     for pid in all_ids(base):
         try:
             p = load_problem(problem_path(pid, base))
             title = p.title
         except MechbookError as exc:
             title = f"INVALID: {exc}"
-        apath = answer_path(pid, base)
+            invalid += 1
         parts = "no answer key"
-        if apath.exists():
-            from mechbook.verify.answers import load_answers
-            try:
+        try:
+            apath = answer_path(pid, base)
+            if apath.exists():
                 parts = f"{len(load_answers(apath).parts)} parts"
-            except MechbookError:
-                parts = "INVALID answer key"
+        except MechbookError:
+            parts = "INVALID answer key"
+            invalid += 1
         click.echo(f"{pid:<22} {parts:<16} {title}")
+    if invalid:
+        click.echo(f"{invalid} invalid file(s)", err=True)
+        sys.exit(1)
 
 
 @main.command()
@@ -138,19 +146,26 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     from mechbook.app.store import durations, write
     from mechbook.records import ProofPolicy
 
+    from mechbook.app.run import ProblemRun
+
     base = _resolve_root(ctx)
     ids = list(problem_ids) or all_ids(base)
     if not ids:
         raise click.ClickException(f"no problems under {base / 'problems'}")
+    refused: dict[str, ProblemRun] = {}  # files found under problems/ with unusable names
     for pid in ids:
         try:
             if not problem_path(pid, base).exists():
                 raise click.ClickException(f"no problem {pid} (no file "
                                            f"{problem_path(pid, base)})")
         except MechbookError as exc:
-            raise click.ClickException(str(exc)) from None
+            if problem_ids:
+                raise click.ClickException(str(exc)) from None
+            refused[pid] = ProblemRun(pid, error=str(exc))
     store_file = store_path if store_path.is_absolute() else base / store_path
-    runs = {} if (fresh or no_store) else cached_runs(ids, base, store_file, not no_crosscheck)
+    good = [pid for pid in ids if pid not in refused]
+    runs = {} if (fresh or no_store) else cached_runs(good, base, store_file, not no_crosscheck)
+    runs.update(refused)
     progress = Progress(len(ids), 0)
     for pid in ids:
         if pid in runs:
@@ -210,10 +225,14 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     """Print a problem's stored results and checks, read back from the HDF5 store."""
     from mechbook.app.store import read
 
+    from mechbook.model.catalog import check_id
+
     base = _resolve_root(ctx)
     path = store_path if store_path.is_absolute() else base / store_path
     try:
-        rec = read(problem_id, path)
+        rec = read(check_id(problem_id), path)
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
     except (FileNotFoundError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
     a = rec["attrs"]

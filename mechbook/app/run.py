@@ -110,9 +110,12 @@ def cached_runs(ids: list[str], base: Path, store: Path,
     engine unchanged): answered from the store without loading the engine."""
     wanted = {}
     for pid in ids:
-        ppath, apath = problem_path(pid, base), answer_path(pid, base)
-        if ppath.exists() and apath.exists():
-            wanted[pid] = (file_sha256(ppath), file_sha256(apath))
+        try:
+            ppath, apath = problem_path(pid, base), answer_path(pid, base)
+            if ppath.exists() and apath.exists():
+                wanted[pid] = (file_sha256(ppath), file_sha256(apath))
+        except MechbookError:
+            continue  # not a cache hit: the check itself reports what is wrong
     out = {}
     for pid, hit in cached(wanted, store, crosscheck).items():
         out[pid] = ProblemRun(pid, hit.outcomes, seconds=hit.duration, cached=True,

@@ -4,6 +4,13 @@
 could run arbitrary code through them. Here the text is parsed by `ast.parse` (which only
 parses) and the tree is walked with a whitelist of node types, operators, functions and
 names; anything else is rejected with a message that says what and where.
+
+Two checks guard what the text means rather than how it reads: every constant a node
+produces must be finite and real (`1/0` is SymPy's complex infinity, `sqrt(-1)` the
+imaginary unit: neither belongs in a Lagrangian or a book's answer), and names that stand
+for expressions (abbreviations, `define:` forms, driven coordinates) count with the size of
+what they stand for, so a chain of abbreviations cannot build an expression that doubles at
+every step.
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ MAX_AST_DEPTH = 400  # nesting of the parsed tree (a flat sum of n terms is n de
 MAX_DIGITS = 1000  # largest number of digits a numeric power may produce
 MAX_EXPONENT = 64  # largest |numeric exponent| accepted
 MAX_INTEGER = 10**30  # largest integer literal accepted
+MAX_SUBSTITUTED = 20_000  # tree size of one expression with its names' expressions put in
 
 FUNCTIONS: dict[str, object] = {
     "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "cot": sp.cot, "sec": sp.sec, "csc": sp.csc,
@@ -57,6 +65,41 @@ def _depth(text: str) -> int:
     return best
 
 
+_NOT_FINITE = (sp.zoo, sp.oo, -sp.oo, sp.nan)
+
+
+def tree_size(expr: sp.Basic, memo: dict | None = None) -> int:
+    """Nodes of `expr` written out as a tree (shared subexpressions counted each time they
+    occur), computed over the DAG in time proportional to its distinct nodes."""
+    memo = {} if memo is None else memo
+    stack = [expr]
+    while stack:
+        node = stack[-1]
+        if node in memo:
+            stack.pop()
+            continue
+        pending = [a for a in node.args if a not in memo]
+        if pending:
+            stack.extend(pending)
+            continue
+        stack.pop()
+        memo[node] = 1 + sum(memo[a] for a in node.args)
+    return memo[expr]
+
+
+def bad_constant(expr: sp.Basic) -> str | None:
+    """Why a symbol-free expression is not a finite real constant (None if it is)."""
+    if not isinstance(expr, sp.Expr) or not expr.is_number:
+        return None
+    if expr.is_Rational:
+        return None
+    if expr.has(*_NOT_FINITE) or expr.is_finite is False:
+        return "is not finite"
+    if expr.is_extended_real is False:
+        return "is not real"
+    return None
+
+
 class _Builder:
     def __init__(self, text: str, names: Mapping[str, sp.Basic], allow_relations: bool):
         self.text = text
@@ -64,6 +107,8 @@ class _Builder:
         self.names = names
         self.allow_relations = allow_relations
         self.nodes = 0
+        self.substituted = 0
+        self.sizes: dict = {}
 
     def fail(self, node: ast.AST | None, what: str) -> ExpressionError:
         col = getattr(node, "col_offset", None)
@@ -79,7 +124,19 @@ class _Builder:
         method = getattr(self, "_" + type(node).__name__, None)
         if method is None:
             raise self.fail(node, f"{type(node).__name__} is not allowed")
-        return method(node, depth + 1)
+        result = method(node, depth + 1)
+        if isinstance(node, ast.BinOp | ast.UnaryOp | ast.Call):
+            self._check_constant(node, result)
+        return result
+
+    def _check_constant(self, node: ast.AST, result: sp.Basic) -> None:
+        """The node's value, and the constants directly in it (x/0 is zoo*x), must be finite
+        and real; nodes are built bottom-up, so a bad constant is caught where it arises."""
+        for part in (result, *result.args):
+            why = bad_constant(part)
+            if why:
+                segment = ast.get_source_segment(self.source, node) or self.text
+                raise self.fail(node, f"{segment!r} {why} (its value is {part})")
 
     def _Expression(self, node: ast.Expression, depth: int) -> sp.Basic:
         return self.build(node.body, depth)
@@ -107,7 +164,13 @@ class _Builder:
         if name.startswith("_"):
             raise self.fail(node, f"name {name!r} is not allowed (leading underscore)")
         if name in self.names:
-            return self.names[name]
+            value = self.names[name]
+            if value.args:  # a name standing for an expression: count what it brings
+                self.substituted += tree_size(value, self.sizes)
+                if self.substituted > MAX_SUBSTITUTED:
+                    raise self.fail(node, "expression too large once its names are "
+                                    f"substituted (more than {MAX_SUBSTITUTED} nodes)")
+            return value
         if name in CONSTANTS:
             return CONSTANTS[name]
         if name in FUNCTIONS:
@@ -202,7 +265,11 @@ def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
                               text) from None
     except (RecursionError, MemoryError, ValueError):
         raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
-    return _Builder(text, names, allow_relations).build(tree)
+    result = _Builder(text, names, allow_relations).build(tree)
+    if isinstance(result, sp.Basic) and (result.has(*_NOT_FINITE) or result.has(sp.I)):
+        raise ExpressionError(f"expression {text!r} holds a constant that is not finite "
+                              f"and real: {result}", text)
+    return result
 
 
 def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None) -> sp.Expr:

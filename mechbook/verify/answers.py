@@ -14,6 +14,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import parse, parse_equation
+from mechbook.model.limits import check_answer_counts
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, load
 
@@ -100,4 +101,5 @@ def load_answers(path: str | Path) -> AnswerKey:
 
     doc = load(path)
     validate(doc, answers_schema())
+    check_answer_counts(doc)
     return AnswerKey(doc)
