@@ -45,7 +45,6 @@ def list_cmd(ctx: click.Context) -> None:
     """List every problem with its title and number of answer parts; an invalid file is
     marked INVALID with the reason (and the exit status is 1)."""
     from mechbook.model.problem import load_problem
-
     from mechbook.verify.answers import load_answers
 
     base = _resolve_root(ctx)
@@ -142,11 +141,9 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     every mode, and each system's Lagrange equations against Newton's law
     (docs/numerics.md); a cross-check fail also exits 1."""
     from mechbook.app.batch import Batch, BatchOptions
-    from mechbook.app.run import RunOptions, cached_runs
+    from mechbook.app.run import ProblemRun, RunOptions, cached_runs
     from mechbook.app.store import durations, write
     from mechbook.records import ProofPolicy
-
-    from mechbook.app.run import ProblemRun
 
     base = _resolve_root(ctx)
     ids = list(problem_ids) or all_ids(base)
@@ -224,7 +221,6 @@ def validate(files: tuple[Path, ...]) -> None:
 def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     """Print a problem's stored results and checks, read back from the HDF5 store."""
     from mechbook.app.store import read
-
     from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
