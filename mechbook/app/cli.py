@@ -296,58 +296,50 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to store the run in.")
 @click.option("--no-store", is_flag=True, help="Do not store the run.")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
+              default=DEFAULT_TIMEOUT, show_default=True,
+              help="Wall-clock seconds allowed for the run (loading, deriving, integrating, "
+                   "plotting); past it the run is stopped and reported with its stage.")
+@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+              show_default=True, help="Resident memory (MB) allowed for the run (0: no bound).")
+@click.option("--serial", is_flag=True,
+              help="Run in this process, without time or memory limits (for a debugger).")
 @click.pass_context
 def simulate(ctx: click.Context, problem_id: str, system: str | None, method: str | None,
              accuracy: float | None, params: tuple[str, ...], rtol: float | None,
              atol: float | None, max_step: float | None,
              step: float | None, t_end: float, points: int, init: tuple[str, ...],
              backend: str | None, plot_path: Path | None, name: str | None,
-             store_path: Path, no_store: bool) -> None:
+             store_path: Path, no_store: bool, timeout: float, memory_mb: float,
+             serial: bool) -> None:
     """Integrate a problem's full nonlinear equations of motion; report the drift of every
-    conserved quantity the engine found; store the trajectory (and plot it)."""
+    conserved quantity the engine found; store the trajectory (and plot it). The run has a
+    time limit and a memory bound (a worker process stopped from outside when it exceeds
+    either); exceeding one is reported with the stage the run was in, exit status 1."""
+    from mechbook.app.simrun import SimRequest, run_simulation
     from mechbook.app.store import write_simulation
-    from mechbook.core.compile import DEFAULT_BACKEND
-    from mechbook.engine.analysis import Analysis
-    from mechbook.model.problem import load_problem
-    from mechbook.numerics.simulate import parse_assignments
-    from mechbook.numerics.simulate import simulate as run_simulation
+    from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
     try:
-        problem = load_problem(problem_path(problem_id, base))
-        analysis = Analysis(problem)
-        sim = run_simulation(analysis, system, init=parse_assignments(init),
-                             t_span=(0.0, t_end), method=method, points=points,
-                             backend=backend or DEFAULT_BACKEND, accuracy=accuracy,
-                             parameters=parse_assignments(params), rtol=rtol, atol=atol,
-                             max_step=max_step, step=step)
-    except (MechbookError, KeyError) as exc:
-        raise click.ClickException(str(exc).strip("'\"")) from None
-    traj = sim.trajectory
-    click.echo(f"{problem.id} [{sim.system}]: {problem.title}")
-    click.echo("initial: " + ", ".join(f"{k}={v:.6g}" for k, v in sim.initial.items())
-               + f"  ({sim.initial_source})")
-    if sim.choice:
-        click.echo(f"accuracy: {sim.choice}")
-    click.echo("method: " + ", ".join(f"{k}={v}" for k, v in traj.settings.items())
-               + f"; {traj.nfev} evaluations, {len(traj.t)} samples, {sim.seconds:.2f} s "
-               f"(RHS: {sim.model.backend}, generated in {sim.model.generation_seconds:.3f} s)")
-    for note in sim.notes:
-        click.echo(f"note: {note}")
-    if sim.drifts:
-        for d in sim.drifts:
-            click.echo("drift of " + d.summary())
-    else:
-        click.echo("no conserved quantity found by the engine: nothing to monitor")
+        check_id(problem_id)
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
+    request = SimRequest(problem_id, system, method, accuracy, tuple(params), rtol, atol,
+                         max_step, step, t_end, points, tuple(init), backend,
+                         str(plot_path) if plot_path is not None else None)
+    report = run_simulation(request, base, timeout, memory_mb, serial)
+    if report.error:
+        raise click.ClickException(report.error)
+    for line in report.lines:
+        click.echo(line)
     if not no_store:
         path = store_path if store_path.is_absolute() else base / store_path
-        run_name = name or f"{sim.system}-{traj.method}"
-        write_simulation(problem.id, run_name, sim.arrays(), sim.settings(),
-                         {f"monitors/{d.name}": d.attrs() for d in sim.drifts}, path)
-        click.echo(f"stored as /problems/{problem.id}/simulations/{run_name} in {path}")
-    if plot_path is not None:
-        from mechbook.numerics.plot import plot_simulation
-
-        click.echo(f"plot written to {plot_simulation(sim, plot_path)}")
-    if not traj.success:
+        run_name = name or f"{report.system}-{report.method}"
+        write_simulation(report.problem_id, run_name, report.arrays, report.settings,
+                         report.array_attrs, path)
+        click.echo(f"stored as /problems/{report.problem_id}/simulations/{run_name} in {path}")
+    if report.plot is not None:
+        click.echo(f"plot written to {report.plot}")
+    if not report.success:
         sys.exit(1)

@@ -22,7 +22,7 @@ import sympy as sp
 from mechbook.core.numeval import is_zero
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
-from mechbook.errors import UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError
 
 ZERO_TOL = 1e-9
 
@@ -108,7 +108,16 @@ class LinearSystem:
     # ---- numeric -------------------------------------------------------------------------
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         def num(A):
-            return np.array(A.evalf(30, subs=values).tolist(), dtype=complex).real.astype(float)
+            A = A.evalf(30, subs=values)
+            left = sorted(map(str, A.free_symbols))
+            if left:  # e.g. a point that names a symbol the system gives no value
+                raise MechbookError(f"the linearized system keeps {', '.join(left)} without a "
+                                    "numeric value")
+            try:
+                return np.array(A.tolist(), dtype=complex).real.astype(float)
+            except TypeError:  # zoo, nan: not a number at this point
+                raise MechbookError("the linearized system has no finite value at this "
+                                    "point") from None
 
         return num(self.M), num(self.C), num(self.K)
 
