@@ -124,7 +124,11 @@ class _Builder:
         method = getattr(self, "_" + type(node).__name__, None)
         if method is None:
             raise self.fail(node, f"{type(node).__name__} is not allowed")
-        result = method(node, depth + 1)
+        try:
+            result = method(node, depth + 1)
+        except (TypeError, ValueError, ArithmeticError, AttributeError) as exc:
+            # SymPy refused to build it (the operand checks below catch the usual causes)
+            raise self.fail(node, f"invalid operation ({exc})") from None
         if isinstance(node, ast.BinOp | ast.UnaryOp | ast.Call):
             self._check_constant(node, result)
         return result
@@ -177,8 +181,16 @@ class _Builder:
             raise self.fail(node, f"function {name!r} used without a call")
         raise self.fail(node, f"unknown name {name!r} (declare it as a parameter or coordinate)")
 
+    def value(self, node: ast.AST, depth: int) -> sp.Expr:
+        """An operand of arithmetic or of a function: a value, not a comparison."""
+        out = self.build(node, depth)
+        if not isinstance(out, sp.Expr):
+            raise self.fail(node, "a comparison (or and/or) cannot be an operand; it is "
+                                  "allowed only as the whole expression")
+        return out
+
     def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Basic:
-        operand = self.build(node.operand, depth)
+        operand = self.value(node.operand, depth)
         if isinstance(node.op, ast.USub):
             return -operand
         if isinstance(node.op, ast.UAdd):
@@ -189,8 +201,8 @@ class _Builder:
         op = type(node.op)
         if op not in _BINOPS:
             raise self.fail(node, f"operator {op.__name__} is not allowed")
-        left = self.build(node.left, depth)
-        right = self.build(node.right, depth)
+        left = self.value(node.left, depth)
+        right = self.value(node.right, depth)
         if op is ast.Pow:
             if right.is_Number and abs(right) > MAX_EXPONENT:
                 raise self.fail(node, f"exponent {right} too large (at most {MAX_EXPONENT})")
@@ -220,13 +232,13 @@ class _Builder:
         if not lo <= len(node.args) <= hi:
             raise self.fail(node, f"{name}() takes {lo if lo == hi else f'{lo} to {hi}'} "
                                   f"argument(s), got {len(node.args)}")
-        args = [self.build(a, depth) for a in node.args]
+        args = [self.value(a, depth) for a in node.args]
         return FUNCTIONS[name](*args)
 
     def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:
         if not self.allow_relations:
             raise self.fail(node, "a comparison is not allowed here")
-        terms = [self.build(node.left, depth)] + [self.build(c, depth) for c in node.comparators]
+        terms = [self.value(node.left, depth)] + [self.value(c, depth) for c in node.comparators]
         rels = []
         for op, a, b in zip(node.ops, terms, terms[1:], strict=False):
             if type(op) not in _COMPARE:
@@ -238,6 +250,9 @@ class _Builder:
         if not self.allow_relations:
             raise self.fail(node, "and/or is not allowed here")
         parts = [self.build(v, depth) for v in node.values]
+        for v, part in zip(node.values, parts, strict=True):
+            if not isinstance(part, sp.logic.boolalg.Boolean):
+                raise self.fail(v, "and/or joins comparisons, not values")
         return sp.And(*parts) if isinstance(node.op, ast.And) else sp.Or(*parts)
 
 

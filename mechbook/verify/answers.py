@@ -7,6 +7,7 @@ the names of normal coordinates) and abbreviations (`abbreviations: {omega0: sqr
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -56,8 +57,11 @@ class Part:
             except ExpressionError as exc:
                 # An abbreviation may belong to another of the problem's systems (it names
                 # that system's coordinates): it is simply not available in this one, and a
-                # part that uses it here is told why.
-                self._unavailable[abbr] = str(exc)
+                # part that uses it here is told why (the first abbreviation of a chain that
+                # failed, with its own reason).
+                used = re.search(r"unknown name '(\w+)'", str(exc))
+                self._unavailable[abbr] = self._unavailable.get(used.group(1) if used else "",
+                                                                str(exc))
         return names
 
     def parse(self, text, sub: tuple, names: dict, equation: bool = False,
