@@ -22,6 +22,7 @@ from collections.abc import Mapping
 import sympy as sp
 
 from mechbook.errors import ExpressionError
+from mechbook.model.constants import bad_constant
 
 MAX_LENGTH = 20_000  # characters in one expression
 MAX_NODES = 5_000  # AST nodes in one expression
@@ -87,19 +88,6 @@ def tree_size(expr: sp.Basic, memo: dict | None = None) -> int:
     return memo[expr]
 
 
-def bad_constant(expr: sp.Basic) -> str | None:
-    """Why a symbol-free expression is not a finite real constant (None if it is)."""
-    if not isinstance(expr, sp.Expr) or not expr.is_number:
-        return None
-    if expr.is_Rational:
-        return None
-    if expr.has(*_NOT_FINITE) or expr.is_finite is False:
-        return "is not finite"
-    if expr.is_extended_real is False:
-        return "is not real"
-    return None
-
-
 class _Builder:
     def __init__(self, text: str, names: Mapping[str, sp.Basic], allow_relations: bool):
         self.text = text
@@ -109,13 +97,16 @@ class _Builder:
         self.nodes = 0
         self.substituted = 0
         self.sizes: dict = {}
+        self.values: dict = {}  # float values of constants (mechbook.model.constants)
 
     def fail(self, node: ast.AST | None, what: str) -> ExpressionError:
         col = getattr(node, "col_offset", None)
         where = f" at column {col + 1}" if col is not None else ""
         return ExpressionError(f"{what}{where} in expression {self.text!r}", self.text)
 
-    def build(self, node: ast.AST, depth: int = 0) -> sp.Basic:
+    def build(self, node: ast.AST, depth: int = 0, operand: bool = False) -> sp.Basic:
+        """The SymPy value of `node`; with `operand`, it must be a value, not a comparison
+        (an operand of arithmetic or a function's argument)."""
         self.nodes += 1
         if self.nodes > MAX_NODES:
             raise self.fail(None, f"expression too large (more than {MAX_NODES} nodes)")
@@ -126,18 +117,22 @@ class _Builder:
             raise self.fail(node, f"{type(node).__name__} is not allowed")
         try:
             result = method(node, depth + 1)
+            if isinstance(node, ast.BinOp | ast.UnaryOp | ast.Call):
+                self._check_constant(node, result)
         except (TypeError, ValueError, ArithmeticError, AttributeError) as exc:
-            # SymPy refused to build it (the operand checks below catch the usual causes)
-            raise self.fail(node, f"invalid operation ({exc})") from None
-        if isinstance(node, ast.BinOp | ast.UnaryOp | ast.Call):
-            self._check_constant(node, result)
+            # SymPy refused to build or to evaluate it (mpmath overflows on exp(exp(...)))
+            raise self.fail(node, f"invalid operation ({type(exc).__name__}: {exc})") \
+                from None
+        if operand and not isinstance(result, sp.Expr):
+            raise self.fail(node, "a comparison (or and/or) cannot be an operand; it is "
+                                  "allowed only as the whole expression")
         return result
 
     def _check_constant(self, node: ast.AST, result: sp.Basic) -> None:
         """The node's value, and the constants directly in it (x/0 is zoo*x), must be finite
         and real; nodes are built bottom-up, so a bad constant is caught where it arises."""
         for part in (result, *result.args):
-            why = bad_constant(part)
+            why = bad_constant(part, self.values)
             if why:
                 segment = ast.get_source_segment(self.source, node) or self.text
                 raise self.fail(node, f"{segment!r} {why} (its value is {part})")
@@ -181,16 +176,8 @@ class _Builder:
             raise self.fail(node, f"function {name!r} used without a call")
         raise self.fail(node, f"unknown name {name!r} (declare it as a parameter or coordinate)")
 
-    def value(self, node: ast.AST, depth: int) -> sp.Expr:
-        """An operand of arithmetic or of a function: a value, not a comparison."""
-        out = self.build(node, depth)
-        if not isinstance(out, sp.Expr):
-            raise self.fail(node, "a comparison (or and/or) cannot be an operand; it is "
-                                  "allowed only as the whole expression")
-        return out
-
     def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Basic:
-        operand = self.value(node.operand, depth)
+        operand = self.build(node.operand, depth, True)
         if isinstance(node.op, ast.USub):
             return -operand
         if isinstance(node.op, ast.UAdd):
@@ -201,8 +188,8 @@ class _Builder:
         op = type(node.op)
         if op not in _BINOPS:
             raise self.fail(node, f"operator {op.__name__} is not allowed")
-        left = self.value(node.left, depth)
-        right = self.value(node.right, depth)
+        left = self.build(node.left, depth, True)
+        right = self.build(node.right, depth, True)
         if op is ast.Pow:
             if right.is_Number and abs(right) > MAX_EXPONENT:
                 raise self.fail(node, f"exponent {right} too large (at most {MAX_EXPONENT})")
@@ -232,13 +219,14 @@ class _Builder:
         if not lo <= len(node.args) <= hi:
             raise self.fail(node, f"{name}() takes {lo if lo == hi else f'{lo} to {hi}'} "
                                   f"argument(s), got {len(node.args)}")
-        args = [self.value(a, depth) for a in node.args]
+        args = [self.build(a, depth, True) for a in node.args]
         return FUNCTIONS[name](*args)
 
     def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:
         if not self.allow_relations:
             raise self.fail(node, "a comparison is not allowed here")
-        terms = [self.value(node.left, depth)] + [self.value(c, depth) for c in node.comparators]
+        terms = [self.build(node.left, depth, True)] + [self.build(c, depth, True)
+                                                       for c in node.comparators]
         rels = []
         for op, a, b in zip(node.ops, terms, terms[1:], strict=False):
             if type(op) not in _COMPARE:
@@ -280,7 +268,10 @@ def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
                               text) from None
     except (RecursionError, MemoryError, ValueError):
         raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
-    result = _Builder(text, names, allow_relations).build(tree)
+    try:
+        result = _Builder(text, names, allow_relations).build(tree)
+    except RecursionError:  # MAX_AST_DEPTH keeps clear of it; a deep caller may not
+        raise ExpressionError(f"expression {text[:60]!r} nested too deeply", text) from None
     if isinstance(result, sp.Basic) and (result.has(*_NOT_FINITE) or result.has(sp.I)):
         raise ExpressionError(f"expression {text!r} holds a constant that is not finite "
                               f"and real: {result}", text)
