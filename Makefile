@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test lint bench bench-check clean
+.PHONY: check test lint fuzz bench bench-check clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -17,6 +17,10 @@ check: $(STAMP)  ## check every problem against the book's answer key (one worke
 
 test: $(STAMP)   ## run the test suite
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
+
+fuzz: $(STAMP)   ## 10,000 mutated and hostile problem/answer files under time and memory limits (~30 min)
+	$(BIN)/python tests/fuzz.py --cases 10000 --seed 1 --keep results/fuzz \
+		--json results/fuzz/results.json
 
 bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -> results/ (~15 min)
 	mkdir -p results/bench
