@@ -444,3 +444,36 @@ def test_constants_textbooks_use_pass():
     for text in ["exp(700)", "sin(10**30)", "acosh(2) + asinh(1)", "log(2, 3)", "cbrt(8)",
                  "sqrt(2)**-64", "6.67e-11*5.97e24", "atan2(1, 0) - pi/2"]:
         assert parse(text).is_number, text
+
+
+# ---- simulate under limits -------------------------------------------------------------------
+
+@pytest.mark.parametrize("option, value, why", [("--timeout", "0.3", "time limit of 0.3 s"),
+                                                 ("--memory", "30", "memory bound of 30 MB")])
+def test_simulate_past_its_limits_is_stopped_and_reported(tmp_path, option, value, why):
+    h5 = tmp_path / "m.h5"
+    start = time.perf_counter()
+    res = run("--root", str(ROOT), "simulate", "lim-2031", "--t-end", "1000",
+              option, value, "--store", str(h5))
+    assert time.perf_counter() - start < 60
+    assert res.exit_code == 1
+    assert f"simulate lim-2031: exceeded the {why} while in stage:" in res.output
+    assert not h5.exists()
+
+
+def test_simulate_within_its_limits_stores_the_run(tmp_path):
+    h5 = tmp_path / "m.h5"
+    res = run("--root", str(ROOT), "simulate", "lim-2031", "--t-end", "1", "--timeout", "300",
+              "--memory", "4000", "--store", str(h5))
+    assert res.exit_code == 0, res.output
+    assert "drift of energy_function" in res.output
+    with h5py.File(h5) as f:
+        assert "problems/lim-2031/simulations/main-DOP853" in f
+
+
+def test_simulate_refuses_a_hostile_problem(tmp_path):
+    tree(tmp_path, PENDULUM + 'potential: "sqrt(-1)*theta**2"\n')
+    res = run("--root", str(tmp_path), "simulate", "lim-2099", "--store",
+              str(tmp_path / "m.h5"))
+    assert res.exit_code == 1 and "not real" in res.output
+    assert not (tmp_path / "m.h5").exists()

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ast
 import math
+import warnings
 from collections.abc import Mapping
 
 import sympy as sp
@@ -261,7 +262,9 @@ def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
     if _depth(text) > MAX_DEPTH:
         raise ExpressionError(f"expression nested too deeply (more than {MAX_DEPTH})", text)
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        with warnings.catch_warnings():  # '\ ' in a string literal warns; it is refused anyway
+            warnings.simplefilter("ignore")
+            tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
         col = f" at column {exc.offset}" if exc.offset else ""
         raise ExpressionError(f"syntax error{col} in expression {text!r}: {exc.msg}",
