@@ -477,3 +477,19 @@ def test_simulate_refuses_a_hostile_problem(tmp_path):
               str(tmp_path / "m.h5"))
     assert res.exit_code == 1 and "not real" in res.output
     assert not (tmp_path / "m.h5").exists()
+
+
+def test_zero_to_a_symbolic_power_does_not_crash_the_numeric_zero_test(tmp_path):
+    """Fuzz case (make fuzz, case 666): a position holding 0**theta; its derivative holds
+    log(0) = zoo, and the engine's numeric zero test raised AttributeError on it."""
+    import sympy as sp
+
+    from mechbook.core.numeval import evaluate, is_zero
+
+    x = sp.Symbol("x", real=True)
+    with pytest.raises(ValueError):
+        evaluate(sp.diff(0**x, x), {x: 0.5})
+    assert is_zero(sp.diff(0**x, x)) is False
+    path = tree(tmp_path, PENDULUM.replace("-l*cos(theta)]", "-l*cos(theta) + 0**theta]"))
+    res = run("validate", str(path))
+    assert "Traceback" not in res.output and res.exit_code in (0, 1)

@@ -29,6 +29,9 @@ class NotNumeric(ValueError):
     """The expression has a part this evaluator cannot give a number for."""
 
 
+_NOT_FINITE = (sp.zoo, sp.nan, sp.oo, -sp.oo)
+
+
 def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, float]:
     """(value, magnitude) of expr at `point`: magnitude bounds what cancelled in sums.
 
@@ -71,6 +74,8 @@ def _node(e: sp.Basic, pt: dict, memo: dict):
             raise NotNumeric(f"no value for {e}")
         v = pt[e]
         return v, abs(v)
+    if e in _NOT_FINITE:  # zoo, nan, oo (d/dx 0**x = 0**x*log(0)): singular here
+        raise ValueError(f"{e} in the expression")
     if e.is_Number or e.is_NumberSymbol or e is sp.I:
         v = mpmath.mpmathify(complex(e)) if e is sp.I else mpmath.mpf(sp.Float(e, mpmath.mp.dps)
                                                                       ._mpf_)
