@@ -44,7 +44,9 @@ SYSTEM_COUNTS = {
 ANSWER_COUNTS = {"parts": 64, "abbreviations": 64, "symbols": 64}
 PART_COUNTS = {"assume": 32, "define": 32}
 
-_NUMBERISH = re.compile(r"^[-+]?[.0-9]")
+# what YAML may read as a number (decimal, with '_', '.', an exponent); an expression such
+# as 2*(m*l**2) is text and may be long
+_NUMBERISH = re.compile(r"[-+]?[0-9_]*\.?[0-9_]*(?:[eE][-+]?[0-9_]+)?")
 
 
 def read_text(path: str | Path) -> str:
@@ -122,7 +124,7 @@ def check_events(events, file: str) -> None:
                 raise SpecError(f"YAML nested too deeply (more than {MAX_YAML_DEPTH} levels)",
                                 file, line)
         elif kind == "ScalarEvent" and ev.style is None and len(ev.value) > MAX_NUMBER_CHARS \
-                and _NUMBERISH.match(ev.value):
+                and _NUMBERISH.fullmatch(ev.value):
             raise SpecError(f"unquoted value of {len(ev.value)} characters starting "
                             f"{ev.value[:20]!r} (a number that long is refused; quote text)",
                             file, line)
