@@ -114,14 +114,18 @@ def test_billion_laughs_from_a_fresh_process(tmp_path):
     import subprocess
     import sys
 
+    import resource
+
     path = tmp_path / "laughs.yaml"
     path.write_text(LAUGHS)
-    start = time.perf_counter()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     res = subprocess.run([sys.executable, "-m", "mechbook", "validate", str(path)],
-                         capture_output=True, text=True, timeout=60)
+                         capture_output=True, text=True, timeout=120)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     assert res.returncode == 1
     assert "anchor" in res.stderr and "Traceback" not in res.stderr
-    assert time.perf_counter() - start < 10
+    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+    assert cpu < 5, f"{cpu:.1f} s of CPU"  # about 1 s: interpreter start and imports
 
 
 def test_billion_laughs_inside_a_problem_is_refused(tmp_path):
