@@ -111,10 +111,9 @@ def test_billion_laughs_is_refused_in_well_under_two_seconds(tmp_path):
 def test_billion_laughs_from_a_fresh_process(tmp_path):
     """The whole command, interpreter start and imports included (the unfixed loader ran
     until killed)."""
+    import resource
     import subprocess
     import sys
-
-    import resource
 
     path = tmp_path / "laughs.yaml"
     path.write_text(LAUGHS)
