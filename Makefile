@@ -20,7 +20,7 @@ test: $(STAMP)   ## run the test suite
 
 fuzz: $(STAMP)   ## 10,000 mutated and hostile problem/answer files under time and memory limits (~30 min)
 	$(BIN)/python tests/fuzz.py --cases 10000 --seed 1 --keep results/fuzz \
-		--json results/fuzz/results.json
+		--json results/fuzz/results.jsonl
 
 bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -> results/ (~15 min)
 	mkdir -p results/bench

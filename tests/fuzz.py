@@ -279,7 +279,7 @@ def _structure(rng: random.Random, tree, other, names: list[str]):
                                            "springs", "book", "about", "value", "x", "1"])] = value
             elif r < 0.5 and other is not None:  # graft a subtree of another file
                 graft = rng.choice([v for _, v in _paths(other)])
-                parent[path[-1]] = graft
+                parent[path[-1]] = json.loads(json.dumps(graft))  # a copy: never the pool's
             elif r < 0.6 and isinstance(parent, list):  # duplicate an entry
                 parent.append(parent[path[-1]])
             else:
@@ -565,16 +565,23 @@ def run_cases(cases: list[Case], workdir: Path, jobs: int = 2, keep: Path | None
 
 
 def fuzz(cases: int, seed: int = 1, jobs: int = 2, kinds: list[str] | None = None,
-         keep: Path | None = None, chunk: int = 500, verbose: bool = False) -> list[Result]:
-    """Generate and run `cases` inputs, `chunk` at a time (a fresh temporary tree each)."""
+         keep: Path | None = None, chunk: int = 500, verbose: bool = False,
+         log: Path | None = None) -> list[Result]:
+    """Generate and run `cases` inputs, `chunk` at a time (a fresh temporary tree each);
+    each chunk's results are appended to `log` (JSON lines) as it finishes."""
     pool = seeds()
+    frozen = json.dumps([(s.data, s.key) for s in pool])
     kinds = kinds or list(KINDS)
     out: list[Result] = []
     for start in range(0, cases, chunk):
         batch = [generate(i, seed, pool, kinds) for i in range(start, min(cases, start + chunk))]
+        assert json.dumps([(s.data, s.key) for s in pool]) == frozen, "the pool was mutated"
         with tempfile.TemporaryDirectory(prefix="mechbook-fuzz-") as tmp:
             res = run_cases(batch, Path(tmp), jobs, keep)
         out += res
+        if log is not None:  # as the run goes, so an interrupted run keeps its numbers
+            with open(log, "a", encoding="utf-8") as fh:
+                fh.writelines(json.dumps(r.__dict__) + "\n" for r in res)
         if verbose:
             counts = Counter(r.status for r in out)
             print(f"[{len(out)}/{cases}] " + ", ".join(f"{k} {v}" for k, v in
@@ -607,19 +614,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--kinds", nargs="*", choices=list(KINDS), default=None)
     ap.add_argument("--keep", type=Path, default=ROOT / "results" / "fuzz",
                     help="where the files of failing cases are kept")
-    ap.add_argument("--json", type=Path, default=None, help="write every result here")
+    ap.add_argument("--json", type=Path, default=None,
+                    help="append every result here (JSON lines), chunk by chunk")
     args = ap.parse_args(argv)
     start = time.monotonic()
-    results = fuzz(args.cases, args.seed, args.jobs, args.kinds, args.keep, verbose=True)
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text("")
+    results = fuzz(args.cases, args.seed, args.jobs, args.kinds, args.keep, verbose=True,
+                   log=args.json)
     print(summary(results))
     bad = [r for r in results if r.status in BAD]
     for r in bad[:20]:
         print(f"case {r.index} ({r.kind}): {r.status}: {r.message[:400]}")
     print(f"{len(results)} cases in {time.monotonic() - start:.0f} s; {len(bad)} failures "
           f"(files kept under {args.keep})")
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps([r.__dict__ for r in results]))
     return 1 if bad else 0
 
 
