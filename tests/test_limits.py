@@ -497,3 +497,27 @@ def test_zero_to_a_symbolic_power_does_not_crash_the_numeric_zero_test(tmp_path)
     path = tree(tmp_path, PENDULUM.replace("-l*cos(theta)]", "-l*cos(theta) + 0**theta]"))
     res = run("validate", str(path))
     assert "Traceback" not in res.output and res.exit_code in (0, 1)
+
+
+def test_a_recursion_error_in_the_numeric_zero_test_is_not_a_crash(tmp_path, monkeypatch):
+    """make fuzz, cases 9216 and 9482: positions such as
+    -acosh(Abs(exp(exp(1/2))/(k/s1 + 2 - t))) made mpmath/SymPy recurse past Python's
+    limit inside the numeric zero test while the system was built. A point that cannot be
+    evaluated is redrawn, and none evaluating means 'not known to be zero'."""
+    import sympy as sp
+
+    from mechbook.core import numeval
+
+    x = sp.Symbol("x", real=True)
+
+    def deep(*args, **kwargs):
+        raise RecursionError("maximum recursion depth exceeded")
+
+    monkeypatch.setattr(numeval, "evaluate", deep)
+    assert numeval.is_zero(sp.sin(x)) is False
+    monkeypatch.undo()
+    for position in ["[sign(acosh(tanh(theta)) + cot(sin(m)) - l), -l*cos(theta)]",
+                     "[-acosh(Abs(exp(exp(1/2))/(m/l + 2 - t))), -l*cos(theta)]"]:
+        path = tree(tmp_path, PENDULUM.replace("[l*sin(theta), -l*cos(theta)]", position))
+        res = run("validate", str(path))
+        assert "Traceback" not in res.output and res.exit_code in (0, 1), res.output

@@ -163,8 +163,8 @@ def is_zero(expr: sp.Basic, points: int = 3, digits: int = 30, seed: int = 20261
             v, m = evaluate(expr, point, digits)
         except NotNumeric:
             return False
-        except (ZeroDivisionError, ValueError, TypeError, OverflowError):
-            continue
+        except (ZeroDivisionError, ValueError, TypeError, OverflowError, RecursionError):
+            continue  # RecursionError: mpmath/SymPy on a hostile tower of functions
         if not (abs(v) == abs(v) and m == m):  # NaN
             continue
         if abs(v) > 1e-20 * max(m, 1e-300):
