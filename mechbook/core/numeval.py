@@ -161,10 +161,10 @@ def is_zero(expr: sp.Basic, points: int = 3, digits: int = 30, seed: int = 20261
         point = {s: sp.Float(rng.uniform(0.3, 1.3), digits) for s in symbols}
         try:
             v, m = evaluate(expr, point, digits)
-        except NotNumeric:
-            return False
-        except (ZeroDivisionError, ValueError, TypeError, OverflowError, RecursionError):
-            continue  # RecursionError: mpmath/SymPy on a hostile tower of functions
+        except (NotNumeric, RecursionError):  # RecursionError: mpmath/SymPy on a hostile
+            return False  # tower of functions; every point would be as deep and as slow
+        except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+            continue
         if not (abs(v) == abs(v) and m == m):  # NaN
             continue
         if abs(v) > 1e-20 * max(m, 1e-300):
