@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test lint report bench bench-check bench-sweep clean
+.PHONY: check test lint fuzz report bench bench-check bench-sweep clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -21,6 +21,10 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 
 test: $(STAMP)   ## run the test suite
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
+
+fuzz: $(STAMP)   ## 10,000 mutated and hostile problem/answer files under time and memory limits (~30 min)
+	$(BIN)/python tests/fuzz.py --cases 10000 --seed 1 --keep results/fuzz \
+		--json results/fuzz/results.jsonl
 
 bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -> results/ (~15 min)
 	mkdir -p results/bench

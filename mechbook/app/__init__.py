@@ -1,7 +1,8 @@
 """The application on top: checking problems in batches, the HDF5 store, the command line.
 
     run          checking one problem (what a worker does), plain data out
-    batch        a pool of worker processes with time and memory limits
+    batch        a pool of worker processes with time and memory limits (any task)
+    simrun       `mechbook simulate` in a worker, under the same limits
     distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
     sweep        `mechbook sweep`: a result over a grid of parameters (sweep_accuracy:
                  float64 against 30 digits; sweep_book: the book's answer on the grid;

@@ -59,15 +59,17 @@ def _resolve_root(ctx: click.Context) -> Path:
 @main.command("list")
 @click.pass_context
 def list_cmd(ctx: click.Context) -> None:
-    """List every problem with its title and number of answer parts.
+    """List every problem with its title and number of answer parts; an invalid file is
+    marked INVALID with the reason (and the exit status is 1).
 
-    Reads the files' YAML and the problem schema only (fast, no engine): `mechbook validate`
-    checks every expression."""
+    Reads the files' YAML (under the input limits) and the problem schema only (fast, no
+    engine): `mechbook validate` checks every expression."""
     from mechbook.model.books import file_id_error
     from mechbook.model.schema import validate
     from mechbook.model.yamlio import load
 
     base = _resolve_root(ctx)
+    invalid = 0
     for pid in all_ids(base):
         try:
             doc = load(problem_path(pid, base))
@@ -78,16 +80,24 @@ def list_cmd(ctx: click.Context) -> None:
             title = doc.data["title"]
         except MechbookError as exc:
             title = f"INVALID: {exc}"
+            invalid += 1
         parts = "no answer key"
         try:
             apath = answer_path(pid, base)
             if apath.exists():
                 found = load(apath).data.get("parts")
-                parts = f"{len(found)} parts" if isinstance(found, list) else \
-                    "INVALID answer key"
+                if isinstance(found, list):
+                    parts = f"{len(found)} parts"
+                else:
+                    parts = "INVALID answer key"
+                    invalid += 1
         except MechbookError:
             parts = "INVALID answer key"
+            invalid += 1
         click.echo(f"{pid:<22} {parts:<16} {title}")
+    if invalid:
+        click.echo(f"{invalid} invalid file(s)", err=True)
+        sys.exit(1)
 
 
 @main.command()
@@ -182,7 +192,7 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     from mechbook.app.batch import Batch, BatchOptions
     from mechbook.app.console import Progress, print_table
     from mechbook.app.formats import failures, to_json, write_junit
-    from mechbook.app.run import RunOptions, cached_runs
+    from mechbook.app.run import ProblemRun, RunOptions, cached_runs
     from mechbook.app.store import durations, write
     from mechbook.records import ProofPolicy
 
@@ -190,15 +200,20 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     ids = list(problem_ids) or all_ids(base)
     if not ids:
         raise click.ClickException(f"no problems under {base / 'problems'}")
+    refused: dict[str, ProblemRun] = {}  # files found under problems/ with unusable names
     for pid in ids:
         try:
             if not problem_path(pid, base).exists():
                 raise click.ClickException(f"no problem {pid} (no file "
                                            f"{problem_path(pid, base)})")
         except MechbookError as exc:
-            raise click.ClickException(str(exc)) from None
+            if problem_ids:
+                raise click.ClickException(str(exc)) from None
+            refused[pid] = ProblemRun(pid, error=str(exc))
     store_file = store_path if store_path.is_absolute() else base / store_path
-    runs = {} if (fresh or no_store) else cached_runs(ids, base, store_file, not no_crosscheck)
+    good = [pid for pid in ids if pid not in refused]
+    runs = {} if (fresh or no_store) else cached_runs(good, base, store_file, not no_crosscheck)
+    runs.update(refused)
     progress = Progress(len(ids), 0)
     for pid in ids:
         if pid in runs:
@@ -269,11 +284,14 @@ def validate(files: tuple[Path, ...]) -> None:
 def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     """Print a problem's stored results and checks, read back from the HDF5 store."""
     from mechbook.app.store import read
+    from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
     path = store_path if store_path.is_absolute() else base / store_path
     try:
-        rec = read(problem_id, path)
+        rec = read(check_id(problem_id), path)
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
     except (FileNotFoundError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
     a = rec["attrs"]
@@ -345,51 +363,52 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to store the run in.")
 @click.option("--no-store", is_flag=True, help="Do not store the run.")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
+              default=DEFAULT_TIMEOUT, show_default=True,
+              help="Wall-clock seconds allowed for the run (loading, deriving, integrating, "
+                   "plotting); past it the run is stopped and reported with its stage.")
+@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+              show_default=True, help="Resident memory (MB) allowed for the run (0: no bound).")
+@click.option("--serial", is_flag=True,
+              help="Run in this process, without time or memory limits (for a debugger).")
 @click.pass_context
 def simulate(ctx: click.Context, problem_id: str, system: str | None, method: str | None,
              accuracy: float | None, params: tuple[str, ...], rtol: float | None,
              atol: float | None, max_step: float | None,
              step: float | None, t_end: float, points: int, init: tuple[str, ...],
              backend: str | None, plot_path: Path | None, name: str | None,
-             store_path: Path, no_store: bool) -> None:
+             store_path: Path, no_store: bool, timeout: float, memory_mb: float,
+             serial: bool) -> None:
     """Integrate a problem's full nonlinear equations of motion; report the drift of every
-    conserved quantity the engine found; store the trajectory (and plot it)."""
-    from mechbook.app.api import load
-    from mechbook.core.compile import DEFAULT_BACKEND
-    from mechbook.numerics.simulate import parse_assignments
+    conserved quantity the engine found; store the trajectory (and plot it). The run has a
+    time limit and a memory bound (a worker process stopped from outside when it exceeds
+    either); exceeding one is reported with the stage the run was in, exit status 1."""
+    from mechbook.app.simrun import SimRequest, run_simulation
+    from mechbook.app.store import write_simulation
+    from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
     try:
-        problem = load(problem_id, base, simplify=False)
-        run = problem.simulate(t_end, system, init=parse_assignments(init), method=method,
-                               points=points, backend=backend or DEFAULT_BACKEND,
-                               accuracy=accuracy, parameters=parse_assignments(params),
-                               rtol=rtol, atol=atol, max_step=max_step, step=step)
-    except (MechbookError, KeyError) as exc:
-        raise click.ClickException(str(exc).strip("'\"")) from None
-    sim = run.run
-    traj = sim.trajectory
-    click.echo(f"{problem.id} [{sim.system}]: {problem.title}")
-    click.echo("initial: " + ", ".join(f"{k}={v:.6g}" for k, v in sim.initial.items())
-               + f"  ({sim.initial_source})")
-    if sim.choice:
-        click.echo(f"accuracy: {sim.choice}")
-    click.echo("method: " + ", ".join(f"{k}={v}" for k, v in traj.settings.items())
-               + f"; {traj.nfev} evaluations, {len(traj.t)} samples, {sim.seconds:.2f} s "
-               f"(RHS: {sim.model.backend}, generated in {sim.model.generation_seconds:.3f} s)")
-    for note in sim.notes:
-        click.echo(f"note: {note}")
-    if sim.drifts:
-        for d in sim.drifts:
-            click.echo("drift of " + d.summary())
-    else:
-        click.echo("no conserved quantity found by the engine: nothing to monitor")
+        check_id(problem_id)
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
+    request = SimRequest(problem_id, system, method, accuracy, tuple(params), rtol, atol,
+                         max_step, step, t_end, points, tuple(init), backend,
+                         str(plot_path) if plot_path is not None else None)
+    report = run_simulation(request, base, timeout, memory_mb, serial)
+    if report.error:
+        raise click.ClickException(report.error)
+    for line in report.lines:
+        click.echo(line)
     if not no_store:
         path = store_path if store_path.is_absolute() else base / store_path
-        click.echo(f"stored as {run.store(path, name)} in {path}")
-    if plot_path is not None:
-        click.echo(f"plot written to {run.plot(plot_path)}")
-    if not traj.success:
+        run_name = name or f"{report.system}-{report.method}"
+        write_simulation(report.problem_id, run_name, report.arrays, report.settings,
+                         report.array_attrs, path)
+        click.echo(f"stored as /problems/{report.problem_id}/simulations/{run_name} in {path}")
+    if report.plot is not None:
+        click.echo(f"plot written to {report.plot}")
+    if not report.success:
         sys.exit(1)
 
 

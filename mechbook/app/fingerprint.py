@@ -6,6 +6,8 @@ import hashlib
 from functools import cache
 from pathlib import Path
 
+from mechbook.model.limits import read_bytes
+
 
 @cache
 def engine_sha256() -> str:
@@ -20,4 +22,6 @@ def engine_sha256() -> str:
 
 
 def file_sha256(path: str | Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """Hash of a problem or answer file, read within the input limits (a FIFO or an
+    oversized file raises SpecError instead of hanging or filling memory)."""
+    return hashlib.sha256(read_bytes(path)).hexdigest()

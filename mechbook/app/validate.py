@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, SpecError
 from mechbook.model.catalog import problem_path, root
 from mechbook.model.declared import declared
 from mechbook.model.problem import load_problem
@@ -24,8 +24,7 @@ def validate_file(path: str | Path) -> str:
     if isinstance(doc.data, dict) and "parts" in doc.data:
         return _validate_answers(path)
     problem = load_problem(path)
-    for name in problem.systems:
-        system_of(problem, name)
+    build_systems(problem)
     decl = declared(problem)
     return (f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s), "
             f"{len(decl.vectors)} vector(s), {len(decl.tensors)} tensor(s), "
@@ -38,20 +37,51 @@ def _validate_answers(path: Path) -> str:
         base = root(path.parent)
     except MechbookError:
         base = path.resolve().parents[2]
-    problem = load_problem(problem_path(key.problem_id, base))
-    analysis = Analysis(problem)
-    for part in key.parts:
-        ctx = Context(analysis, part)
-        if ctx.tensor_mode:
-            validate_part(ctx)
-            continue
-        for field in ("book", "about", "initial", "released", "region", "time", "hold",
-                      "signal", "event"):
-            if field in part.data and not (field == "book" and part.quantity == "stability"):
-                _walk(ctx, part.data[field], (field,))
-        if "erratum" in part.data:
-            _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"))
+    try:
+        ppath = problem_path(key.problem_id, base)
+    except MechbookError as exc:
+        raise key.doc.error(("problem",), str(exc)) from None
+    problem = load_problem(ppath)
+    check_expressions(key, Analysis(problem))
     return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
+
+
+def build_systems(problem) -> None:
+    """Build every system of a problem (each expression parsed); SpecError on the first
+    fault."""
+    for name in problem.systems:
+        system_of(problem, name)
+
+
+def check_expressions(key, analysis: Analysis) -> None:
+    """Parse every expression of an answer key in its part's context; SpecError on the
+    first fault (file:line), before any part is checked."""
+    for part in key.parts:
+        check_part_expressions(part, analysis)
+
+
+def part_faults(key, analysis: Analysis) -> dict[str, str]:
+    """{part name: what is malformed} for every part whose expressions do not parse."""
+    faults = {}
+    for part in key.parts:
+        try:
+            check_part_expressions(part, analysis)
+        except SpecError as exc:
+            faults[part.name] = str(exc)
+    return faults
+
+
+def check_part_expressions(part, analysis: Analysis) -> None:
+    ctx = Context(analysis, part)
+    if ctx.tensor_mode:  # vectors, tensors, bodies: built once, nothing judged
+        validate_part(ctx)
+        return
+    for field in ("book", "about", "initial", "released", "region", "time", "hold", "signal",
+                  "event"):
+        if field in part.data and not (field == "book" and part.quantity == "stability"):
+            _walk(ctx, part.data[field], (field,))
+    if "erratum" in part.data:
+        _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"))
 
 
 def _walk(ctx: Context, value, sub: tuple) -> None:

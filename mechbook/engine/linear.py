@@ -22,7 +22,7 @@ import sympy as sp
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, is_zero
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
-from mechbook.errors import UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError
 
 ZERO_TOL = 1e-9
 
@@ -111,8 +111,16 @@ class LinearSystem:
         one memoized pass over the expression, so a large entry — Routh's reduction with a
         steady rate given as a root — costs milliseconds, not minutes of evalf)."""
         def num(A):
-            return np.array([[_entry(x, values, 30).real for x in row] for row in A.tolist()],
-                            dtype=float).reshape(A.shape)
+            left = sorted(map(str, A.free_symbols - set(values)))
+            if left:  # e.g. a point that names a symbol the system gives no value
+                raise MechbookError(f"the linearized system keeps {', '.join(left)} without a "
+                                    "numeric value")
+            try:
+                return np.array([[_entry(x, values, 30).real for x in row]
+                                 for row in A.tolist()], dtype=float).reshape(A.shape)
+            except TypeError:  # zoo, nan: not a number at this point
+                raise MechbookError("the linearized system has no finite value at this "
+                                    "point") from None
 
         return num(self.M), num(self.C), num(self.K)
 

@@ -17,8 +17,9 @@ import sympy as sp
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
 from mechbook.model.expr import CONSTANTS, FUNCTIONS, parse
+from mechbook.model.limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
-from mechbook.model.yamlio import Document, load
+from mechbook.model.yamlio import Document, loads
 
 T = sp.Symbol("t", real=True)
 RESERVED = {"t"} | set(CONSTANTS) | set(FUNCTIONS)
@@ -104,8 +105,10 @@ def _parameter(doc: Document, name: str, spec: dict | None) -> Parameter:
 
 def load_problem(path: str | Path) -> Problem:
     """Load and validate a problem file; raise SpecError naming file and line on any fault."""
-    doc = load(path)
+    raw = read_bytes(path)
+    doc = loads(decode(raw, str(path)), str(path))
     validate(doc, "problem")
+    check_problem_counts(doc)
     data = doc.data
     params = {n: _parameter(doc, n, s) for n, s in data["parameters"].items()}
     if "systems" in data:
@@ -124,7 +127,7 @@ def load_problem(path: str | Path) -> Problem:
     why = file_id_error(data["id"], path)
     if why:
         raise doc.error(("id",), why)
-    sha = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    sha = hashlib.sha256(raw).hexdigest()
     problem = Problem(data["id"], data["title"], data["source"], str(path), doc, params, systems,
                       sha, data.get("description", ""))
     problem.conditions = [problem.parse(c, ("conditions", i), relation=True)

@@ -32,6 +32,8 @@ from mechbook.model.tensorfuncs import (  # noqa: F401 - `kind` is this module's
 
 
 class _TensorBuilder(_Builder):
+    complex_ok = True  # eigenvalues of rotations: i(), expi(theta)
+
     def __init__(self, text: str, names: Mapping, objects: Mapping):
         super().__init__(text, names, False)
         self.objects = objects

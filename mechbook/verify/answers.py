@@ -7,6 +7,7 @@ the names of normal coordinates) and abbreviations (`abbreviations: {omega0: sqr
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import parse, parse_equation
+from mechbook.model.limits import check_answer_counts
 from mechbook.model.schema import validate
 from mechbook.model.tensorexpr import parse_tensor
 from mechbook.model.yamlio import Document, load
@@ -65,8 +67,11 @@ class Part:
             except ExpressionError as exc:
                 # An abbreviation may belong to another of the problem's systems (it names
                 # that system's coordinates): it is simply not available in this one, and a
-                # part that uses it here is told why.
-                self._unavailable[abbr] = str(exc)
+                # part that uses it here is told why (the first abbreviation of a chain that
+                # failed, with its own reason).
+                used = re.search(r"unknown name '(\w+)'", str(exc))
+                self._unavailable[abbr] = self._unavailable.get(used.group(1) if used else "",
+                                                                str(exc))
         return names
 
     def parse(self, text, sub: tuple, names: dict, equation: bool = False,
@@ -110,4 +115,5 @@ def load_answers(path: str | Path) -> AnswerKey:
 
     doc = load(path)
     validate(doc, answers_schema())
+    check_answer_counts(doc)
     return AnswerKey(doc)

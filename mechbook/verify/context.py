@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from mechbook.engine.analysis import Analysis
+from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.model.declared import declared
 from mechbook.records import NUMERIC, ProofPolicy
@@ -157,7 +158,7 @@ def linear_accelerations(lin: LinearSystem) -> dict:
     """q̈ solved from the linear equations M·q̈ + C·q̇ + K·δq = F."""
     n = len(lin.q)
     rhs = lin.F - lin.C * sp.Matrix(lin.dyn.qd) - lin.K * lin.displacement()
-    sol = lin.M.LUsolve(rhs)
+    sol = solve_accelerations(lin.M, rhs, list(lin.dyn.qdd))
     return {lin.dyn.qdd[i]: sol[i] for i in range(n)}
 
 
