@@ -426,3 +426,18 @@ def test_a_composite_body_with_a_wrong_mass_is_refused(tmp_path):
     text = SPINNING.replace("    inertia: {body: thing}", "    mass: M\n    inertia: {body: thing}")
     with pytest.raises(SpecError, match="mass differs"):
         system_of(load_problem(tree(tmp_path, "10-98", text)))
+
+
+def test_vectors_and_tensors_are_operands_and_comparisons_are_not():
+    """The parser refuses a comparison as an operand, `(a < b)**2`; a vector or a tensor is
+    an operand like any number (the merge of the input limits once refused `-l*u/2`)."""
+    import pytest as _pytest
+
+    from mechbook.errors import ExpressionError
+    from mechbook.model.tensorexpr import parse_tensor
+
+    l_ = sp.Symbol("l", positive=True)
+    u = sp.Matrix([1, 2, 3])
+    assert sp.Matrix(parse_tensor("-l*u/2", {"l": l_, "u": u})) == -l_ * u / 2
+    with _pytest.raises(ExpressionError, match="comparison"):
+        parse_tensor("(l < 1)*u", {"l": l_, "u": u})

@@ -35,6 +35,8 @@ MAX_INTEGER = 10**30  # largest integer literal accepted
 MAX_LITERAL = 1e100  # largest |decimal literal| (SI constants: the sun's mass 2e30 kg ...)
 MIN_LITERAL = 1e-100  # smallest nonzero |decimal literal| (... Planck's constant 6.6e-34)
 MAX_SUBSTITUTED = 20_000  # tree size of one expression with its names' expressions put in
+MAX_SUBSTITUTED_TENSOR = 500_000  # the same for a tensor expression (nine entries of products
+# of generic rotations are large; a chain of abbreviations doubling each time still is not)
 
 FUNCTIONS: dict[str, object] = {
     "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "cot": sp.cot, "sec": sp.sec, "csc": sp.csc,
@@ -46,6 +48,10 @@ FUNCTIONS: dict[str, object] = {
 }
 ARITY = {"atan2": (2, 2), "log": (1, 2)}
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
+
+# values that are statements, not numbers (a Symbol is also a SymPy Boolean, so not that)
+_TRUTHS = (sp.core.relational.Relational, sp.logic.boolalg.BooleanFunction,
+           sp.logic.boolalg.BooleanAtom)
 
 _BINOPS = {
     ast.Add: lambda a, b: a + b,
@@ -126,12 +132,13 @@ class _Builder:
             # SymPy refused to build or to evaluate it (mpmath overflows on exp(exp(...)))
             raise self.fail(node, f"invalid operation ({type(exc).__name__}: {exc})") \
                 from None
-        if operand and not isinstance(result, sp.Expr):
+        if operand and isinstance(result, _TRUTHS):  # a relation, and/or, true/false
             raise self.fail(node, "a comparison (or and/or) cannot be an operand; it is "
                                   "allowed only as the whole expression")
         return result
 
     complex_ok = False  # tensor expressions build complex numbers on purpose (i(), expi())
+    max_substituted = MAX_SUBSTITUTED
 
     def _check_constant(self, node: ast.AST, result: sp.Basic) -> None:
         """The node's value, and the constants directly in it (x/0 is zoo*x), must be finite
@@ -176,9 +183,9 @@ class _Builder:
             if any(e.args for e in entries):  # a name standing for an expression (or a
                 # vector or tensor of them): count what it brings
                 self.substituted += sum(tree_size(e, self.sizes) for e in entries)
-                if self.substituted > MAX_SUBSTITUTED:
+                if self.substituted > self.max_substituted:
                     raise self.fail(node, "expression too large once its names are "
-                                    f"substituted (more than {MAX_SUBSTITUTED} nodes)")
+                                    f"substituted (more than {self.max_substituted} nodes)")
             return value
         if name in CONSTANTS:
             return CONSTANTS[name]

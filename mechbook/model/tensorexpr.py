@@ -17,7 +17,7 @@ from collections.abc import Mapping
 import sympy as sp
 
 from mechbook.errors import ExpressionError
-from mechbook.model.expr import MAX_DEPTH, MAX_LENGTH, _Builder, _depth
+from mechbook.model.expr import MAX_DEPTH, MAX_LENGTH, MAX_SUBSTITUTED_TENSOR, _Builder, _depth
 from mechbook.model.tensorfuncs import (  # noqa: F401 - `kind` is this module's API too
     BODY_FUNCTIONS,
     TENSOR_ARITY,
@@ -33,6 +33,7 @@ from mechbook.model.tensorfuncs import (  # noqa: F401 - `kind` is this module's
 
 class _TensorBuilder(_Builder):
     complex_ok = True  # eigenvalues of rotations: i(), expi(theta)
+    max_substituted = MAX_SUBSTITUTED_TENSOR
 
     def __init__(self, text: str, names: Mapping, objects: Mapping):
         super().__init__(text, names, False)
