@@ -531,3 +531,55 @@ def test_physical_constants_in_si_units_are_accepted(tmp_path, value):
 
     path = tree(tmp_path, PENDULUM.replace("m: {value: 1.5}", f"m: {{value: {value}}}"))
     assert load_problem(path).parameters["m"].value == float(value)
+
+
+def _ringed_planet_off_its_circle(tmp_path: Path) -> Path:
+    """Symon 11-18 with the planet's x moved off the circle (fuzz case 92 of seed 20260101):
+    the averaged potential holds 1/sqrt(a + b*sin(alpha)), not a trigonometric polynomial."""
+    for sub in ("problems/symon", "answers/symon"):
+        (tmp_path / sub).mkdir(parents=True)
+    text = (ROOT / "problems/symon/11-18.yaml").read_text()
+    assert "[r*cos(alpha), r*sin(alpha), 0]" in text
+    path = tmp_path / "problems/symon/11-18.yaml"
+    path.write_text(text.replace("[r*cos(alpha), r*sin(alpha), 0]",
+                                 "[tanh(pi), r*sin(alpha), 0]"))
+    return path
+
+
+def test_an_average_that_is_not_a_trig_polynomial_is_refused_within_seconds(tmp_path):
+    from mechbook.app.validate import validate_file
+
+    path = _ringed_planet_off_its_circle(tmp_path)
+    start = time.process_time()
+    with pytest.raises(SpecError, match="could not average over alpha") as err:
+        validate_file(path)
+    assert err.value.file == str(path) and err.value.line is not None
+    assert time.process_time() - start < 15  # was 63 s before the polynomial test
+
+
+def test_validate_bounds_its_own_cpu_time(tmp_path, monkeypatch):
+    from mechbook.app import validate
+
+    path = _ringed_planet_off_its_circle(tmp_path)
+    monkeypatch.setattr(validate, "BUILD_SECONDS", 0.5)
+    start = time.process_time()
+    # the limit's alarm ends the build; if it lands in the averaging's own integral, that
+    # search gives up and says so instead
+    with pytest.raises(SpecError, match="took more than 0.5 s of CPU|could not average") as err:
+        validate.validate_file(path)
+    assert err.value.file == str(path)
+    assert time.process_time() - start < 3
+
+
+def test_an_orbit_on_a_circle_averages_as_a_trig_polynomial(monkeypatch):
+    """sqrt(r²cos²α + r²sin²α) is r: the ringed planet's averages need no integral."""
+    from mechbook.model import loads
+
+    def no_integral(*args, **kwargs):
+        raise AssertionError("the average fell back on sympy.integrate")
+
+    monkeypatch.setattr(loads.sp, "integrate", no_integral)
+    for pid in ("11-18", "11-19"):
+        problem = load_problem(ROOT / f"problems/symon/{pid}.yaml")
+        system = system_of(problem, next(iter(problem.systems)))
+        assert not any(s.name.startswith("alpha") for s in system.lagrangian.free_symbols)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, SpecError
 from mechbook.model.catalog import problem_path, root
@@ -16,6 +17,8 @@ from mechbook.verify.answers import load_answers
 from mechbook.verify.context import Context, strip_const
 from mechbook.verify.quantities.tensors import validate_part
 
+BUILD_SECONDS = 15.0  # CPU; `validate` runs in the caller's process, so it bounds itself
+
 
 def validate_file(path: str | Path) -> str:
     """Validate a problem or an answer file; return a one-line summary or raise SpecError."""
@@ -24,7 +27,13 @@ def validate_file(path: str | Path) -> str:
     if isinstance(doc.data, dict) and "parts" in doc.data:
         return _validate_answers(path)
     problem = load_problem(path)
-    build_systems(problem)
+    try:
+        with hard_time_limit(BUILD_SECONDS):
+            build_systems(problem)
+    except Timeout:
+        raise SpecError(f"building the problem's systems took more than {BUILD_SECONDS:g} s "
+                        "of CPU time (the book's problems take under 1 s): an expression is "
+                        "too large or too deep for the engine", str(path)) from None
     decl = declared(problem)
     return (f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s), "
             f"{len(decl.vectors)} vector(s), {len(decl.tensors)} tensor(s), "

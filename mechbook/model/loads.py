@@ -82,6 +82,9 @@ def attractor_potential(sys, attractors: dict) -> sp.Expr:
     return total
 
 
+INTEGRAL_SECONDS = 5.0  # CPU; an average SymPy can do at all it does in about a second
+
+
 def average_over(sys, expr: sp.Expr, spec: dict) -> sp.Expr:
     """`expr` averaged over each parameter of `spec` ({alpha: [lo, hi]})."""
     for name, bounds in spec.items():
@@ -105,7 +108,7 @@ def _average(expr: sp.Expr, x: sp.Symbol, lo: sp.Expr, hi: sp.Expr) -> sp.Expr |
         if out is not None:
             return out
     try:
-        with time_limit(30):
+        with time_limit(INTEGRAL_SECONDS):
             out = sp.integrate(expr, (x, lo, hi)) / (hi - lo)
     except Timeout:
         return None
@@ -122,9 +125,12 @@ def _fourier_constant(expr: sp.Expr, x: sp.Symbol) -> sp.Expr | None:
         k = arg.coeff(x)
         if arg.has(x) and (not k.is_integer or (arg - k * x).has(x)):
             return None
-    stripped = expr.subs({f: sp.Dummy() for f in trig})
-    if stripped.has(x):
-        return None
+    expr = _pythagoras_in_roots(expr, x)
+    trig = [f for f in expr.atoms(sp.sin, sp.cos) if f.has(x)]
+    dummies = {f: sp.Dummy() for f in trig}
+    stripped = expr.subs(dummies)
+    if stripped.has(x) or not stripped.is_polynomial(*dummies.values()):
+        return None  # e.g. 1/sqrt(a + b*cos(x)): expanding it would run for minutes
     wave = sp.expand(expr.rewrite(sp.exp), power_exp=True, mul=True, multinomial=True)
     keep = sp.S.Zero
     for term in sp.Add.make_args(wave):
@@ -144,3 +150,20 @@ def _fourier_constant(expr: sp.Expr, x: sp.Symbol) -> sp.Expr | None:
         if freq == 0:
             keep += term.subs(x, 0)
     return sp.expand(keep.rewrite(sp.cos))
+
+
+def _pythagoras_in_roots(expr: sp.Expr, x: sp.Symbol) -> sp.Expr:
+    """expr with each root or other non-integer power of a base in x replaced by its value
+    where sin² + cos² = 1 removes x from the base: the distance sqrt(r²cos²x + r²sin²x) of
+    a body on a circle is r, and the rest is then a trigonometric polynomial."""
+    reps = {}
+    for p in expr.atoms(sp.Pow):
+        if not p.base.has(x) or p.exp.is_Integer:
+            continue
+        base = sp.expand(p.base)
+        for f in base.atoms(sp.sin):
+            if f.has(x):
+                base = sp.expand(base.subs(f**2, 1 - sp.cos(f.args[0])**2))
+        if not base.has(x):
+            reps[p] = sp.Pow(base, p.exp)
+    return expr.xreplace(reps) if reps else expr

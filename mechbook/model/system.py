@@ -119,8 +119,10 @@ class System:
         if lag == 0:
             raise self._error(("coordinates",), "the system has no kinetic or potential energy")
         if "average" in s:  # averaged over a fast angle, e.g. a planet's orbital position
-            kinetic, potential, lag = (average_over(self, e, s["average"])
-                                       for e in (kinetic, potential, lag))
+            rest = lag - (kinetic - potential)  # the average is linear: T and V once each
+            kinetic, potential, rest = (average_over(self, e, s["average"])
+                                        for e in (kinetic, potential, rest))
+            lag = kinetic - potential + rest
         if "approximation" in s:  # the approximation the problem makes, e.g. small angles
             approx = s["approximation"]
             point = self.point(approx["about"], ("approximation", "about"))
