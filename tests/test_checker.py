@@ -658,6 +658,8 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict)
                     break
                 if "limit" in part.data and label == "add one" and str(old) != "0":
                     continue  # a lower-order term does not change an asymptotic formula
+                if "estimate" in part.data and label in ("add one", "add the unit tensor"):
+                    continue  # below the book's precision at its scale (moments ~ 1e37)
                 if (tensor_same_meaning(ctx, slot, old, new) if ctx.tensor_mode else
                         same_meaning(ctx, slot, part.data, old, new)):
                     continue

@@ -26,7 +26,7 @@ from mechbook.verify.instances import (
     is_variable,
     rational_point,
 )
-from mechbook.verify.registry import NAME, quantities, quantity
+from mechbook.verify.registry import ESTIMATE, NAME, quantities, quantity
 
 TENSOR = {"type": "string"}
 FOR_ALL = {"type": "object", "minProperties": 1,
@@ -192,9 +192,14 @@ def combine(verdicts: list[Verdict]) -> Verdict:
                'declared vectors, tensors and bodies), in the axes `axes:` (three unit '
                'vectors e′ᵢ, or a tensor whose rows they are: T′ = a·T·aᵀ, a_ij = '
                'e′ᵢ·e_j) if given, equals the book\'s component by component, at random '
-               'points; with `for_all:`, for every instance'),
-          keys={"tensor": TENSOR, "axes": AXES, "for_all": FOR_ALL}, needs_system=False)
+               'points; with `for_all:`, for every instance; with `estimate:`, at the '
+               'book\'s numbers, each component to its precision'),
+          keys={"tensor": TENSOR, "axes": AXES, "for_all": FOR_ALL, "estimate": ESTIMATE},
+          needs_system=False)
 def check_components(ctx: Context, val) -> Verdict:
+    if "estimate" in ctx.part.data and not ctx.validate_only:
+        return _estimate_components(ctx, val)
+
     def build(names):
         obj = subject(ctx, names)
         pairs = book_value(ctx, val, ("book",), names, obj)
@@ -202,6 +207,36 @@ def check_components(ctx: Context, val) -> Verdict:
                          [f"component {p[0]}, book − value," for p in pairs])
 
     return check(ctx, build)
+
+
+def _estimate_components(ctx: Context, val) -> Verdict:
+    """The book's numbers (the problem's values with the estimate's put in): each component
+    of the book's value within the estimate's rtol of the object's, relative to the
+    larger of the two (a component both give as zero must be zero to 1e-12 of the
+    largest)."""
+    if ctx.part.data.get("for_all"):
+        raise ctx.part.error(("estimate",), "an estimate is at one point: no `for_all:`")
+    point = {k: sp.Float(v, 30) for k, v in ctx.sampler.base.items()}
+    names = _names(ctx, {}, point)
+    pairs = book_value(ctx, val, ("book",), names, subject(ctx, names))
+    rtol = ctx.sampler.rtol
+    values = []
+    for label, b, e in pairs:
+        b, e = (complex(sp.N(sp.sympify(x).xreplace(point), 30)) for x in (b, e))
+        values.append((label, b, e))
+    scale = max(max(abs(b), abs(e)) for _, b, e in values)
+    method = f"estimate(rtol {rtol:g})"
+    for label, b, e in values:
+        size = max(abs(b), abs(e))
+        tol = rtol * size if size > 1e-12 * scale else 1e-12 * scale
+        if not abs(b - e) <= tol:
+            return Verdict(False, method, f"component {label}: book {b.real:.6g}, value "
+                           f"{e.real:.6g} (relative difference "
+                           f"{abs(b - e) / max(size, 1e-300):.3g} > {rtol:g})")
+    worst = max(abs(b - e) / max(abs(b), abs(e)) for _, b, e in values
+                if max(abs(b), abs(e)) > 1e-12 * scale)
+    return Verdict(True, method, f"{len(values)} component(s) at the book's numbers, "
+                   f"largest relative difference {worst:.2g}")
 
 
 def _characteristic(t: sp.Matrix) -> tuple:
