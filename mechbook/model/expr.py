@@ -261,10 +261,9 @@ class _Builder:
         return sp.And(*parts) if isinstance(node.op, ast.And) else sp.Or(*parts)
 
 
-def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
-          allow_relations: bool = False) -> sp.Basic:
-    """Parse one expression (or, with allow_relations, a condition such as ``a < b``)."""
-    names = names or {}
+def syntax_tree(text: str | int | float) -> tuple[str, ast.Expression]:
+    """The text (a number's repr) and its Python syntax tree, after the limits on length
+    and nesting; ExpressionError for anything else, a syntax error with its column."""
     if isinstance(text, bool):
         raise ExpressionError(f"expected an expression, got {text!r}")
     if isinstance(text, int | float):
@@ -287,6 +286,14 @@ def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
                               text) from None
     except (RecursionError, MemoryError, ValueError):
         raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
+    return text, tree
+
+
+def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
+          allow_relations: bool = False) -> sp.Basic:
+    """Parse one expression (or, with allow_relations, a condition such as ``a < b``)."""
+    names = names or {}
+    text, tree = syntax_tree(text)
     try:
         result = _Builder(text, names, allow_relations).build(tree)
     except RecursionError:  # MAX_AST_DEPTH keeps clear of it; a deep caller may not

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 import sympy as sp
 
 from mechbook.errors import ExpressionError
-from mechbook.model.expr import MAX_DEPTH, MAX_LENGTH, MAX_SUBSTITUTED_TENSOR, _Builder, _depth
+from mechbook.model.expr import MAX_SUBSTITUTED_TENSOR, _Builder, syntax_tree
 from mechbook.model.tensorfuncs import (  # noqa: F401 - `kind` is this module's API too
     BODY_FUNCTIONS,
     TENSOR_ARITY,
@@ -126,26 +126,7 @@ def parse_tensor(text, names: Mapping[str, sp.Basic] | None = None,
                  objects: Mapping[str, object] | None = None):
     """Parse a scalar, vector or tensor expression (bodies named in `objects`)."""
     names = names or {}
-    if isinstance(text, bool):
-        raise ExpressionError(f"expected an expression, got {text!r}")
-    if isinstance(text, int | float):
-        text = repr(text)
-    if not isinstance(text, str):
-        raise ExpressionError(f"expected an expression string, got {type(text).__name__}")
-    if len(text) > MAX_LENGTH:
-        raise ExpressionError(f"expression longer than {MAX_LENGTH} characters")
-    if not text.strip():
-        raise ExpressionError("empty expression")
-    if _depth(text) > MAX_DEPTH:
-        raise ExpressionError(f"expression nested too deeply (more than {MAX_DEPTH})", text)
-    try:
-        tree = ast.parse(text.strip(), mode="eval")
-    except SyntaxError as exc:
-        col = f" at column {exc.offset}" if exc.offset else ""
-        raise ExpressionError(f"syntax error{col} in expression {text!r}: {exc.msg}",
-                              text) from None
-    except (RecursionError, MemoryError, ValueError):
-        raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
+    text, tree = syntax_tree(text)
     return _TensorBuilder(text, names, objects or {}).build(tree)
 
 
