@@ -19,6 +19,10 @@ from mechbook.core.timeout import Timeout, time_limit
 from mechbook.records import NUMERIC, ProofPolicy
 
 RTOL = 1e-10  # relative tolerance of a numeric comparison
+# What an exact expression (no numbers below 30 digits in it) may leave at a 30-digit point,
+# relative to its cancellation scale: rounding leaves ~1e-30 of it; 1e-10 would let an O(1)
+# error through where 1e10-sized terms cancel (Symon 11-5: a wrong solution passed so)
+EXACT_RTOL = 1e-20
 POINTS = 6  # random points per numeric comparison
 DIGITS = 30
 
@@ -125,6 +129,7 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
     """Is `expr` identically zero (under the sampler's assumptions)? A symbolic proof is
     attempted after the numeric pass when `symbolic` (default: the sampler's policy)."""
     variables = _free_variables([expr], sampler.base)
+    rtol = _residual_rtol(expr, sampler)
     worst = 0.0
     valid = 0
     for _ in range(POINTS * 3):
@@ -137,15 +142,26 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
         valid += 1
         rel = abs(v) / scale if scale > 0 else abs(v)
         worst = max(worst, rel)
-        if rel > sampler.rtol:
+        if rel > rtol:
             return Verdict(False, f"numeric({valid} points)",
                            f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
         return Verdict(True, "symbolic")
-    return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
+    return Verdict(True, f"numeric({valid} points, rtol {rtol:g})",
                    f"worst relative {worst:.2g}")
+
+
+def _residual_rtol(expr: sp.Basic, sampler: Sampler) -> float:
+    """The bound on a residual relative to its scale: the sampler's for an estimate or an
+    expression holding numbers of double precision (the engine's numeric roots), else
+    EXACT_RTOL."""
+    if sampler.rtol > RTOL:
+        return sampler.rtol
+    if isinstance(expr, sp.Basic) and any(f._prec < 90 for f in expr.atoms(sp.Float)):
+        return sampler.rtol
+    return min(sampler.rtol, EXACT_RTOL)
 
 
 def _prove(sampler: Sampler, symbolic: bool | None) -> bool:
