@@ -48,16 +48,23 @@ class Analysis:
             self._lin[key] = self.equilibria(name).linearize(point)
         return self._lin[key]
 
-    def steady_linear(self, name: str | None, rates: dict, point: dict) -> LinearSystem:
-        """Linearization about a steady motion: cyclic coordinates turning at `rates`, the
-        others at `point`, by Routh's reduction (momenta of the cyclic coordinates fixed)."""
+    def steady_linear(self, name: str | None, rates: dict, point: dict,
+                      reduce: bool = True) -> LinearSystem:
+        """Linearization about a steady motion: coordinates turning at `rates`, the others
+        at `point`. By Routh's reduction (momenta of the cyclic coordinates fixed) unless
+        `reduce` is false: then every coordinate is kept, the turning ones as deviations
+        from the uniform turn (their zero roots stay in the secular equation)."""
         sys = self.system(name)
-        key = (sys.name, "steady",
-               tuple(sorted((str(k), sp.srepr(v)) for k, v in {**rates, **point}.items())))
+        key = (sys.name, "steady" if reduce else "steady-full",
+               tuple(sorted((str(k), sp.srepr(v)) for k, v in rates.items())),
+               tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())))
         if key not in self._lin:
-            reduced = ReducedSystem(sys, rates, point, self.simplify)
-            dyn = Dynamics(reduced, self.simplify)
-            self._lin[key] = Equilibria(dyn).linearize(point)
+            if reduce:
+                reduced = ReducedSystem(sys, rates, point, self.simplify)
+                dyn = Dynamics(reduced, self.simplify)
+                self._lin[key] = Equilibria(dyn).linearize(point)
+            else:
+                self._lin[key] = self.equilibria(name).linearize(point, rates)
         return self._lin[key]
 
     def stable_equilibria(self, name: str | None = None,

@@ -130,13 +130,20 @@ class Equilibria:
     def residual(self, point: dict) -> list[sp.Expr]:
         return [c.subs(point) for c in self.conditions]
 
-    def linearize(self, point: dict) -> LinearSystem:
-        """First-order expansion of the equations of motion about `point` (q̇ = 0)."""
+    def linearize(self, point: dict, velocity: dict | None = None) -> LinearSystem:
+        """First-order expansion of the equations of motion about `point` (q̇ = 0), or, with
+        `velocity`, about the uniform motion q*(t) = point + velocity·t (a steady motion
+        kept in all its coordinates: δq of a uniformly turning coordinate is its deviation
+        from the uniform turn). The coefficients must then be free of t (the motion is a
+        symmetry orbit, e.g. a cyclic coordinate or a rotation of the whole system)."""
         dyn = self.dyn
+        velocity = dict(velocity or {})
+        t = self.sys.t
         sub = {}
-        for q in dyn.q:
-            sub[q] = point.get(q, sp.S.Zero) + EPS * q
-        sub.update({v: EPS * v for v in dyn.qd + dyn.qdd})
+        for q, v in zip(dyn.q, dyn.qd, strict=True):
+            sub[q] = point.get(q, sp.S.Zero) + velocity.get(q, sp.S.Zero) * t + EPS * q
+            sub[v] = velocity.get(q, sp.S.Zero) + EPS * v
+        sub.update({v: EPS * v for v in dyn.qdd})
         sub.update({s: EPS * s for s in self.sys.small_params})
         lin = []
         zeroth = []
@@ -144,6 +151,9 @@ class Equilibria:
             e_sub = e.subs(sub, simultaneous=True)
             zeroth.append(e_sub.subs(EPS, 0))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
+        if velocity:  # zeroth order must vanish along the whole uniform motion
+            zeroth = [z.subs(t, sp.Rational(7, 5)) for z in zeroth] + \
+                     [z.subs(t, sp.Rational(-3, 7)) for z in zeroth]
         bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
@@ -168,7 +178,10 @@ class Equilibria:
         bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
-        return LinearSystem(dyn, dict(point), M, C, K, F)
+        if velocity and any(x.has(t) for A in (M, C, K) for x in A):
+            raise UnsupportedError("linearization about a uniform motion whose linear "
+                                   "equations have time-dependent coefficients")
+        return LinearSystem(dyn, dict(point), M, C, K, F, velocity)
 
 
 def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:

@@ -12,7 +12,7 @@ parts of the state-space eigenvalues.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
@@ -37,6 +37,8 @@ class LinearSystem:
     C: sp.Matrix
     K: sp.Matrix
     F: sp.Matrix
+    velocity: dict = field(default_factory=dict)  # uniform rates of a steady motion kept
+    # in full (mechbook.engine.equilibria.Equilibria.linearize); empty about a rest point
 
     @property
     def q(self):

@@ -223,6 +223,9 @@ class System:
         if unknown:
             raise self._error(("forces", sorted(unknown)[0]), "generalized forces are keyed by "
                               "coordinate; no coordinate of that name")
+        if "dissipation" in self.spec:  # Rayleigh's function R(q, q̇): Q_k = −∂R/∂q̇_k
+            rayleigh = self._parse(self.spec["dissipation"], ("dissipation",))
+            out = [f - sp.diff(rayleigh, v) for f, v in zip(out, self.qd, strict=True)]
         return out
 
     # ---- calculus ------------------------------------------------------------------------

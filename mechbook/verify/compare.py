@@ -34,12 +34,30 @@ class Sampler:
     """Random admissible values for symbols: parameters, answer symbols and free variables."""
 
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
-                 seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC):
+                 seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
+                 derived: dict[sp.Symbol, sp.Expr] | None = None):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
         self.spread = spread
         self.policy = policy  # carried with the sampler to every comparison it serves
+        # symbols fixed by the others (a part's `restrict:`, a surface in parameter space):
+        # computed after each draw, in order, so a later one may use an earlier one
+        self.derived = dict(derived or {})
+
+    def _complete(self, point: dict) -> dict | None:
+        """The point with its derived symbols computed (None where one is not real)."""
+        for sym, expr in self.derived.items():
+            try:
+                v, _ = evaluate(expr, point, DIGITS)
+            except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+                return None
+            if not (math.isfinite(v.real) and abs(v.imag) <= 1e-20 * max(1.0, abs(v))):
+                return None
+            if sym.is_positive and v.real <= 0:
+                return None
+            point[sym] = sp.Float(v.real, DIGITS)
+        return point
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
              tries: int = 2000) -> dict[sp.Symbol, sp.Float]:
@@ -60,14 +78,19 @@ class Sampler:
                 if v not in point:
                     point[v] = self.rng.uniform(0.1, 1.0) if v.is_positive \
                         else self.rng.uniform(-1.0, 1.0)
-            point = {k: sp.Float(v, DIGITS) for k, v in point.items()}
-            if all(holds(c, point) for c in self.conditions):
+            point = self._complete({k: sp.Float(v, DIGITS) for k, v in point.items()})
+            if point is not None and all(holds(c, point) for c in self.conditions):
                 return point
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
+    def widened(self, spread: float) -> Sampler:
+        """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
+        return Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
+                       derived=self.derived)
+
     def default(self) -> dict[sp.Symbol, sp.Float]:
-        point = {k: sp.Float(v, DIGITS) for k, v in self.base.items()}
-        if all(holds(c, point) for c in self.conditions):
+        point = self._complete({k: sp.Float(v, DIGITS) for k, v in self.base.items()})
+        if point is not None and all(holds(c, point) for c in self.conditions):
             return point
         return self.draw()
 

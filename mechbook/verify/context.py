@@ -48,7 +48,17 @@ class Context:
                   for i, c in enumerate(self.part.data.get("assume", []))]
         base = dict(self.analysis.problem.values())
         base.update(self.part.key.symbol_values)
-        self.sampler = Sampler(base, conds, policy=self.policy)
+        derived = {}
+        for k, v in (self.part.data.get("restrict") or {}).items():
+            sym = self.names.get(k)
+            if not isinstance(sym, sp.Symbol) or sym not in base:
+                raise self.part.error(("restrict", k), f"{k!r} is not a parameter or symbol")
+            expr = self.parse(v, ("restrict", k))
+            if expr.free_symbols & ({sym} | set(derived)):
+                raise self.part.error(("restrict", k), "a restricted symbol is given by the "
+                                      "others, not by itself or another restricted one")
+            derived[sym] = expr
+        self.sampler = Sampler(base, conds, policy=self.policy, derived=derived)
 
     @property
     def dyn(self):
@@ -68,18 +78,25 @@ class Context:
             point[self.system.q[self.system.coord_names.index(k)]] = self.parse(v, ("about", k))
         return point
 
+    def rates(self) -> dict:
+        """The rates of a steady motion (`steady:`), by coordinate symbol."""
+        rates = {}
+        for k, v in (self.part.data.get("steady") or {}).items():
+            if k not in self.system.coord_names:
+                raise self.part.error(("steady", k), f"{k!r} is not a coordinate")
+            rates[self.system.q[self.system.coord_names.index(k)]] = \
+                self.parse(v, ("steady", k))
+        return rates
+
     def linear(self) -> LinearSystem:
         if "steady" in self.part.data:
             if "about" not in self.part.data:
                 raise self.part.error(("steady",), "a steady motion needs `about:` for the "
                                       "coordinates that stay put")
-            rates = {}
-            for k, v in self.part.data["steady"].items():
-                if k not in self.system.coord_names:
-                    raise self.part.error(("steady", k), f"{k!r} is not a coordinate")
-                rates[self.system.q[self.system.coord_names.index(k)]] = \
-                    self.parse(v, ("steady", k))
-            return self.analysis.steady_linear(self.part.system, rates, self.point())
+            return self.analysis.steady_linear(self.part.system, self.rates(), self.point(),
+                                               self.part.data.get("reduce", True))
+        if "reduce" in self.part.data:
+            raise self.part.error(("reduce",), "`reduce:` applies to a steady motion")
         return self.analysis.linear(self.part.system, self.point())
 
     def as_list(self, val, sub) -> list:

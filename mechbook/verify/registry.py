@@ -20,8 +20,9 @@ from functools import cache
 from mechbook.model.schema import bundled
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
-COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "assume",
-               "define", "note", "verdict", "erratum", "unsupported", "origin")
+COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
+               "assume", "restrict", "define", "note", "verdict", "erratum", "unsupported",
+               "origin")
 
 
 # schema fragments shared by several quantities' keys

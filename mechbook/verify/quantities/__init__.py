@@ -8,5 +8,6 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     motion,
     oscillations,
     phase,
+    response,
     words,
 )
