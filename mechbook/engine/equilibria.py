@@ -130,12 +130,16 @@ class Equilibria:
     def residual(self, point: dict) -> list[sp.Expr]:
         return [c.subs(point) for c in self.conditions]
 
-    def linearize(self, point: dict, velocity: dict | None = None) -> LinearSystem:
+    def linearize(self, point: dict, velocity: dict | None = None,
+                  given: dict | None = None) -> LinearSystem:
         """First-order expansion of the equations of motion about `point` (q̇ = 0), or, with
         `velocity`, about the uniform motion q*(t) = point + velocity·t (a steady motion
         kept in all its coordinates: δq of a uniformly turning coordinate is its deviation
         from the uniform turn). The coefficients must then be free of t (the motion is a
-        symmetry orbit, e.g. a cyclic coordinate or a rotation of the whole system)."""
+        symmetry orbit, e.g. a cyclic coordinate or a rotation of the whole system).
+        `given` ({parameter: expression}) restricts the parameters to a surface on which
+        the point is an equilibrium (an answer's `restrict:`): the zeroth order must vanish
+        there; M, C, K and F stay in the original parameters."""
         dyn = self.dyn
         velocity = dict(velocity or {})
         t = self.sys.t
@@ -154,6 +158,8 @@ class Equilibria:
         if velocity:  # zeroth order must vanish along the whole uniform motion
             zeroth = [z.subs(t, sp.Rational(7, 5)) for z in zeroth] + \
                      [z.subs(t, sp.Rational(-3, 7)) for z in zeroth]
+        if given:
+            zeroth = [z.subs(given) for z in zeroth]
         bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "

@@ -24,7 +24,11 @@ class ReducedSystem:
     """
 
     def __init__(self, base: System, rates: dict[sp.Symbol, sp.Expr], point: dict,
-                 simplify: bool = False):
+                 simplify: bool = False, momenta: dict[sp.Symbol, sp.Expr] | None = None):
+        """`rates` names the cyclic coordinates and their steady rates at `point`, which
+        fix the momenta; or `momenta` gives the momenta directly (then only the keys of
+        `rates` are used: steady motions at a fixed momentum, wherever they are)."""
+        momenta_given = momenta
         self.base = base
         self.problem = base.problem
         self.t = base.t
@@ -54,7 +58,10 @@ class ReducedSystem:
         at_steady.update(point)
         at_steady.update({base.qd[i]: rates[c] for i, c in zip(idx, cyc, strict=True)})
         simp = sp.simplify if simplify else (lambda e: e)  # for a reader only
-        p_values = [simp(p.subs(at_steady)) for p in momenta]
+        if momenta_given is not None:
+            p_values = [sp.S(momenta_given[c]) for c in cyc]
+        else:
+            p_values = [simp(p.subs(at_steady)) for p in momenta]
         try:
             with time_limit(30):
                 sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],

@@ -94,10 +94,11 @@ class Context:
                 raise self.part.error(("steady",), "a steady motion needs `about:` for the "
                                       "coordinates that stay put")
             return self.analysis.steady_linear(self.part.system, self.rates(), self.point(),
-                                               self.part.data.get("reduce", True))
+                                               self.part.data.get("reduce", True),
+                                               self.sampler.derived)
         if "reduce" in self.part.data:
             raise self.part.error(("reduce",), "`reduce:` applies to a steady motion")
-        return self.analysis.linear(self.part.system, self.point())
+        return self.analysis.linear(self.part.system, self.point(), self.sampler.derived)
 
     def as_list(self, val, sub) -> list:
         if isinstance(val, list):

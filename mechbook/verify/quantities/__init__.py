@@ -9,5 +9,6 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     oscillations,
     phase,
     response,
+    steady,
     words,
 )

@@ -51,7 +51,7 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
     if "stable" in ctx.part.data:
         want = ctx.part.data["stable"]
         for pt in candidates:
-            lin = ctx.analysis.linear(ctx.part.system, pt)
+            lin = ctx.analysis.linear(ctx.part.system, pt, ctx.sampler.derived)
             for _ in range(4):
                 got = lin.numeric_stability(ctx.sampler.draw())
                 if (got == "stable") != want:

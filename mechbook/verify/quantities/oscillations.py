@@ -223,7 +223,8 @@ def _shape(ctx: Context, shape, sub) -> sp.Matrix:
 
 @quantity('normal_coordinates',
           book='list of `{coordinate: linear form, frequency?}`',
-          how='c·q is a normal coordinate iff M⁻¹c is a mode')
+          how=('c·q is a normal coordinate iff M⁻¹c is a mode (with velocity terms C, also '
+               'an eigenvector of M⁻¹C: then C does not couple it)'))
 def check_normal_coordinates(ctx: Context, val) -> Verdict:
     """A linear form c·q is a normal coordinate iff u = M⁻¹c is a mode: (K − ω²M)u = 0."""
     lin = ctx.linear()
@@ -247,6 +248,9 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
             if _eig_residual(K, M, w2, u) > 1e-8:
                 return Verdict(False, "numeric", f"{item['coordinate']} is not a normal "
                                "coordinate (M^-1 c is not a mode)")
+            if np.any(C) and _eig_residual(C, M, float(u @ C @ u / (u @ M @ u)), u) > 1e-8:
+                return Verdict(False, "numeric", f"{item['coordinate']} is not a normal "
+                               "coordinate: the velocity terms C couple it to the others")
             if "frequency" in item:
                 w = numbers([ctx.parse(item["frequency"], ("book", i, "frequency"))], pt)[0]
                 if abs(np.sqrt(max(w2, 0)) - w) > 1e-8 * max(1, w):

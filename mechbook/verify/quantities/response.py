@@ -226,6 +226,22 @@ def check_complex_modes(ctx: Context, val) -> Verdict:
     return Verdict(True, f"numeric({POINTS} points)")
 
 
+def _linear_forms(ctx: Context, keys: list[str], lin) -> dict[str, list]:
+    """Each key (a coordinate or a `define:` name) as the gradient of its linear form in the
+    displacements, at the point: a coordinate's own unit row, a defined form's derivatives."""
+    define = ctx.part.data.get("define") or {}
+    out = {}
+    for k in keys:
+        if k in ctx.system.coord_names:
+            out[k] = [sp.S(int(c == k)) for c in ctx.system.coord_names]
+        elif k in define:
+            form = ctx.names[k]
+            out[k] = [sp.diff(form, q).subs(lin.point) for q in ctx.system.q]
+        else:
+            raise ctx.part.error(("book", k), "neither a coordinate nor a `define:` name")
+    return out
+
+
 def _driving(ctx: Context, pt: dict) -> float:
     if "frequency" not in ctx.part.data:
         raise ctx.part.error((), "give the driving frequency as `frequency:`")
@@ -237,19 +253,18 @@ def _driving(ctx: Context, pt: dict) -> float:
 
 @quantity('steady_amplitude',
           book='`{q: A}` (A complex where the response lags)',
-          how=('the steady response to a force harmonic at `frequency:` is '
-               'δq = Re(A·e^{i(ωt + φ₀)}), φ₀ the phase of the force (its first nonzero '
+          how=('the steady response to a force harmonic at `frequency:` is (for a '
+               'coordinate or a linear `define:` form) δq = Re(A·e^{i(ωt + φ₀)}), φ₀ the '
+               'phase of the force (its first nonzero '
                'generalized component as Re(F̂ e^{iωt})): A = X_q e^{−iφ₀} with '
                'X = (K − ω²M + iωC)⁻¹F̂, at 5 points (so a real A is the signed amplitude '
                'in phase with the force)'),
           keys={"frequency": EXPR})
 def check_steady_amplitude(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
-    unknown = set(val) - set(ctx.system.coord_names)
-    if unknown:
-        raise ctx.part.error(("book", sorted(unknown)[0]), "not a coordinate")
     book = {c: ctx.parse(v, ("book", c)) for c, v in val.items()}
     lin = ctx.linear()
+    rows = _linear_forms(ctx, list(val), lin)
     if not lin.driven:
         return Verdict(False, "exact", "the linearized system has no driving force")
     for k in range(POINTS):
@@ -261,7 +276,8 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
         X = response.harmonic_response(lin, pt, w) * np.exp(-1j * np.angle(ref))
         scale = float(np.max(np.abs(X)))
         for c, e in book.items():
-            got, want = value(e, pt), X[ctx.system.coord_names.index(c)]
+            got = value(e, pt)
+            want = complex(np.array(complex_numbers(rows[c], pt)) @ X)
             if not abs(got - want) <= 1e-9 * max(abs(want), 1e-6 * scale):
                 return Verdict(False, f"numeric({k + 1} points)",
                                f"{c}: book {_c(got)}, engine {_c(want)} (ω = {w:.6g})")
@@ -270,9 +286,10 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
 
 @quantity('resonances',
           book='list of driving frequencies',
-          how=('multiset equality with the normal frequencies ω_j (no damping) whose mode '
-               'the force excites (u_jᵀF̂ ≠ 0, F̂ evaluated with the driving-frequency '
-               'parameter `driving:` set to ω_j): where the steady amplitude is unbounded'),
+          how=('set equality with the distinct normal frequencies ω (no damping) whose '
+               'eigenspace the force reaches (F̂, evaluated with the driving-frequency '
+               'parameter `driving:` set to ω, has a component along a mode of ω in the '
+               'mass metric): where the steady amplitude is unbounded'),
           keys={"driving": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"}})
 def check_resonances(ctx: Context, val) -> Verdict:
     book = _book_list(ctx, val)
@@ -285,18 +302,27 @@ def check_resonances(ctx: Context, val) -> Verdict:
         raise UnsupportedError("resonances of a damped or gyroscopic system (peak frequencies)")
     for k in range(POINTS):
         pt = ctx.sampler.draw()
-        w2, U = lin.numeric_modes(pt)
-        excited = []
-        for j, x in enumerate(w2):
-            if x <= 0:
+        w2, U = lin.numeric_modes(pt)  # M-orthonormal columns
+        scale = max(1e-300, float(np.max(np.abs(w2))))
+        groups: list[list[int]] = []
+        for j in np.argsort(w2):
+            if w2[j] <= 1e-9 * scale:
                 continue
+            if groups and abs(w2[j] - w2[groups[-1][0]]) <= 1e-7 * scale:
+                groups[-1].append(j)
+            else:
+                groups.append([j])
+        excited = []
+        for group in groups:
+            w = float(np.sqrt(np.mean(w2[group])))
             at = dict(pt)
-            at[sym] = sp.Float(float(np.sqrt(x)), 30)
-            phasor = response.forcing_phasor(lin, at, float(np.sqrt(x)))
-            M = lin.matrices(at)[0]
-            size = np.linalg.norm(phasor) * np.sqrt(U[:, j] @ M @ U[:, j])
-            if abs(U[:, j] @ phasor) > 1e-9 * max(size, 1e-300):
-                excited.append(complex(np.sqrt(x)))
+            at[sym] = sp.Float(w, 30)
+            phasor = response.forcing_phasor(lin, at, w)
+            Minv = np.linalg.inv(lin.matrices(at)[0])
+            size = np.sqrt(abs(np.conj(phasor) @ Minv @ phasor))  # |F| in the dual metric
+            along = np.sqrt(sum(abs(U[:, j] @ phasor) ** 2 for j in group))
+            if along > 1e-9 * max(size, 1e-300):
+                excited.append(complex(w))
         ok, why = match_complex(complex_numbers(book, pt), excited, partial=False)
         if not ok:
             return Verdict(False, f"numeric({k + 1} points)", why)
@@ -321,3 +347,52 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
     ok = yes == val
     return Verdict(ok, "numeric(6 points)",
                    f"K M^-1 C - C M^-1 K relative residual up to {max(residuals):.1e}")
+
+
+@quantity('normal_transformation',
+          book='`{q: linear form in normal coordinates}` (every coordinate)',
+          how=('x = A·η (the normal coordinates η are answer symbols): AᵀMA = 1 and AᵀKA '
+               'diagonal (T = Σ η̇²/2, V = Σ ω²η²/2), entrywise to 1e-9 at 5 points; '
+               '`frequencies: {η: ω}` also checks the diagonal'),
+          keys={"frequencies": {"type": "object", "additionalProperties": EXPR}})
+def check_normal_transformation(ctx: Context, val) -> Verdict:
+    val = ctx.as_map(val, ("book",))
+    names = ctx.system.coord_names
+    if set(val) != set(names):
+        raise ctx.part.error(("book",), "give every coordinate as a form in the normal "
+                             "coordinates")
+    forms = [ctx.parse(val[c], ("book", c)) for c in names]
+    etas = sorted(set().union(*(f.free_symbols for f in forms))
+                  & set(ctx.part.key.symbols.values()), key=lambda s: s.name)
+    if len(etas) != len(names):
+        raise ctx.part.error(("book",), f"expected {len(names)} normal coordinates (answer "
+                             f"symbols), found {[s.name for s in etas]}")
+    A = sp.Matrix([[sp.diff(f, e) for e in etas] for f in forms])
+    if any(x.free_symbols & set(etas) for x in A):
+        raise ctx.part.error(("book",), "the transformation is not linear")
+    freqs = {}
+    for k, v in (ctx.part.data.get("frequencies") or {}).items():
+        sym = ctx.part.key.symbols.get(k)
+        if sym not in etas:
+            raise ctx.part.error(("frequencies", k), "not one of the normal coordinates")
+        freqs[etas.index(sym)] = ctx.parse(v, ("frequencies", k))
+    lin = ctx.linear()
+    for k in range(POINTS):
+        pt = ctx.sampler.draw()
+        M, C, K = lin.matrices(pt)
+        An = np.array([[value(x, pt).real for x in row] for row in A.tolist()])
+        T, V = An.T @ M @ An, An.T @ K @ An
+        off = V - np.diag(np.diag(V))
+        scale = max(1e-300, float(np.max(np.abs(V))))
+        if np.max(np.abs(T - np.eye(len(names)))) > 1e-9:
+            return Verdict(False, f"numeric({k + 1} points)",
+                           f"A^T M A is not the unit matrix: {np.round(T, 6).tolist()}")
+        if np.max(np.abs(off)) > 1e-9 * scale:
+            return Verdict(False, f"numeric({k + 1} points)",
+                           f"A^T K A is not diagonal: {np.round(V / scale, 6).tolist()}")
+        for j, w in freqs.items():
+            wv = value(w, pt)
+            if abs(wv**2 - V[j, j]) > 1e-9 * scale:
+                return Verdict(False, f"numeric({k + 1} points)",
+                               f"{etas[j]}: omega**2 = {_c(wv**2)}, engine {V[j, j]:.10g}")
+    return Verdict(True, f"numeric({POINTS} points)")
