@@ -13,6 +13,7 @@ from mechbook.model.system import system_of
 from mechbook.model.yamlio import load
 from mechbook.verify.answers import load_answers
 from mechbook.verify.context import Context, strip_const
+from mechbook.verify.registry import quantities
 
 
 def validate_file(path: str | Path) -> str:
@@ -37,24 +38,26 @@ def _validate_answers(path: Path) -> str:
     analysis = Analysis(problem)
     for part in key.parts:
         ctx = Context(analysis, part)
+        extra = quantities()[part.quantity].names
+        names = extra(ctx) if extra else ctx.names
         for field in ("book", "about", "initial", "released", "region", "time"):
             if field in part.data:
-                _walk(ctx, part.data[field], (field,))
+                _walk(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
         if "erratum" in part.data:
-            _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"))
+            _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
     return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
 
 
-def _walk(ctx: Context, value, sub: tuple) -> None:
+def _walk(ctx: Context, value, sub: tuple, names: dict) -> None:
     if isinstance(value, dict):
         for k, v in value.items():
-            _walk(ctx, v, sub + (k,))
+            _walk(ctx, v, sub + (k,), names)
     elif isinstance(value, list):
         for i, v in enumerate(value):
-            _walk(ctx, v, sub + (i,))
+            _walk(ctx, v, sub + (i,), names)
     elif isinstance(value, str):
         value = strip_const(value)  # a first integral may be written "... = constant"
         if "<" in value or ">" in value:
-            ctx.parse(value, sub, relation=True)
+            ctx.part.parse(value, sub, names, relation=True)
         else:
-            ctx.parse(value, sub, equation=True)
+            ctx.part.parse(value, sub, names, equation=True)

@@ -35,6 +35,18 @@ FUNCTIONS: dict[str, object] = {
 ARITY = {"atan2": (2, 2), "log": (1, 2)}
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
 
+class Operator:
+    """A function a quantity offers to the expressions of its own parts (e.g. a perturbation
+    coefficient W0(j), or sum(expr, r)): called by name with the parsed arguments. The
+    safe parser knows only this class; what it computes is the quantity's business."""
+
+    def __init__(self, name: str, fn, arity: tuple[int, int]):
+        self.name, self.fn, self.arity = name, fn, arity
+
+    def __call__(self, *args):
+        return self.fn(*args)
+
+
 _BINOPS = {
     ast.Add: lambda a, b: a + b,
     ast.Sub: lambda a, b: a - b,
@@ -107,6 +119,8 @@ class _Builder:
         if name.startswith("_"):
             raise self.fail(node, f"name {name!r} is not allowed (leading underscore)")
         if name in self.names:
+            if isinstance(self.names[name], Operator):
+                raise self.fail(node, f"function {name!r} used without a call")
             return self.names[name]
         if name in CONSTANTS:
             return CONSTANTS[name]
@@ -149,15 +163,21 @@ class _Builder:
         if not isinstance(node.func, ast.Name):
             raise self.fail(node, "only calls of whitelisted functions by name are allowed")
         name = node.func.id
-        if name not in FUNCTIONS:
+        op = self.names.get(name)
+        if name not in FUNCTIONS and not isinstance(op, Operator):
             raise self.fail(node, f"call of unknown function {name!r}")
         if node.keywords:
             raise self.fail(node, f"keyword arguments are not allowed in {name}()")
-        lo, hi = ARITY.get(name, (1, 1))
+        lo, hi = op.arity if isinstance(op, Operator) else ARITY.get(name, (1, 1))
         if not lo <= len(node.args) <= hi:
             raise self.fail(node, f"{name}() takes {lo if lo == hi else f'{lo} to {hi}'} "
                                   f"argument(s), got {len(node.args)}")
         args = [self.build(a, depth) for a in node.args]
+        if isinstance(op, Operator):
+            try:
+                return op(*args)
+            except (TypeError, ValueError) as exc:
+                raise self.fail(node, f"{name}(): {exc}") from None
         return FUNCTIONS[name](*args)
 
     def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:

@@ -83,6 +83,11 @@ class Sampler:
                 return point
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
+    def complete(self, point: dict) -> dict | None:
+        """`point` with its derived (restricted) symbols recomputed, or None if one is not
+        real there (for a caller that moved a parameter itself, e.g. towards a limit)."""
+        return self._complete({k: v for k, v in point.items() if k not in self.derived})
+
     def widened(self, spread: float) -> Sampler:
         """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
         return Sampler(self.base, self.conditions, spread=spread, policy=self.policy,

@@ -43,17 +43,21 @@ class Quantity:
     book: str  # what `book:` holds
     how: str  # how it is checked
     keys: dict = field(default_factory=dict)  # extra part keys -> JSON-Schema fragments
+    names: Callable | None = None  # ctx -> the names its `book:` may use beyond ctx.names
 
 
 QUANTITIES: dict[str, Quantity] = {}
 
 
-def quantity(name: str, *, book: str, how: str, keys: dict | None = None):
-    """Register the decorated function as the check of quantity `name`."""
+def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
+             names: Callable | None = None):
+    """Register the decorated function as the check of quantity `name` (`names`: a function
+    of the part's context giving the names its book value may use beyond the usual ones,
+    e.g. a polynomial's variable; `mechbook validate` parses with them)."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
-        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}))
+        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names)
         return fn
 
     return register

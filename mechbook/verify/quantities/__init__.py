@@ -7,6 +7,7 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     expressions,
     motion,
     oscillations,
+    perturbation,
     phase,
     response,
     steady,

@@ -109,7 +109,8 @@ def _exponent_map(ctx: Context):
                'eigenvalues at 40 digits, at 5 points); write a secular equation in ω as a '
                'polynomial in ω with `exponent: sqrt(-1)*omega`'),
           keys={"variable": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
-                "exponent": EXPR})
+                "exponent": EXPR},
+          names=lambda ctx: _exponent_map(ctx)[1])
 def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
     var, names, exponent = _exponent_map(ctx)
     poly_expr = ctx.part.parse(val, ("book",), names)
