@@ -38,9 +38,11 @@ def _validate_answers(path: Path) -> str:
     analysis = Analysis(problem)
     for part in key.parts:
         ctx = Context(analysis, part)
-        extra = quantities()[part.quantity].names
-        names = extra(ctx) if extra else ctx.names
+        q = quantities()[part.quantity]
+        names = q.names(ctx) if q.names else ctx.names
         for field in ("book", "about", "initial", "released", "region", "time"):
+            if field == "book" and part.data.get("book") in q.literals:
+                continue
             if field in part.data:
                 _walk(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
         if "erratum" in part.data:

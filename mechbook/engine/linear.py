@@ -19,6 +19,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
+from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import is_zero
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
@@ -39,6 +40,7 @@ class LinearSystem:
     F: sp.Matrix
     velocity: dict = field(default_factory=dict)  # uniform rates of a steady motion kept
     # in full (mechbook.engine.equilibria.Equilibria.linearize); empty about a rest point
+    _compiled: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def q(self):
@@ -190,9 +192,33 @@ class LinearSystem:
             lam = mpmath.eig(A, left=False, right=False)
             return np.array([complex(x) for x in lam])
 
+    def fast_matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """M, C, K at `values` in double precision through the compile layer (compiled once):
+        for sweeps over many parameter points (stability over a parameter space), where
+        `matrices`' 30-digit evaluation would dominate."""
+        if self._compiled is None:
+            syms = sorted(set().union(*(A.free_symbols for A in (self.M, self.C, self.K))),
+                          key=lambda x: x.name)
+            entries = [x for A in (self.M, self.C, self.K) for x in A]
+            try:
+                fn, _ = compile_exprs(syms, entries)
+            except UnsupportedError:
+                fn = None
+            self._compiled = (syms, fn)
+        syms, fn = self._compiled
+        if fn is None or any(x not in values for x in syms):
+            return self.matrices(values)
+        with np.errstate(all="ignore"):
+            out = np.asarray(fn(np.array([float(values[x]) for x in syms])), dtype=float)
+        if not np.all(np.isfinite(out)):
+            return self.matrices(values)
+        n = self.M.rows
+        return (out[: n * n].reshape(n, n), out[n * n: 2 * n * n].reshape(n, n),
+                out[2 * n * n:].reshape(n, n))
+
     def numeric_stability(self, values: dict) -> str:
         """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
-        M, C, K = self.matrices(values)
+        M, C, K = self.fast_matrices(values)
         n = M.shape[0]
         if not np.any(C):
             w2 = scipy.linalg.eigh(K, M, eigvals_only=True)

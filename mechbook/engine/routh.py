@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechbook.core.expansion import trig_canonical
 from mechbook.core.numeval import is_zero
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.errors import UnsupportedError
@@ -50,7 +51,7 @@ class ReducedSystem:
         self.coord_names = [base.coord_names[i] for i in keep]
         self.forces = [base.forces[i] for i in keep]
         self.names = base.names
-        L = base.lagrangian
+        L = trig_canonical(base.lagrangian)  # exact; keeps the reduction small
         cyc_rates = [base.qd[i] for i in idx]
         momenta = [sp.diff(L, v) for v in cyc_rates]
         # the momenta's values at the steady motion: rates given, others at rest at `point`

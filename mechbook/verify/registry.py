@@ -44,20 +44,23 @@ class Quantity:
     how: str  # how it is checked
     keys: dict = field(default_factory=dict)  # extra part keys -> JSON-Schema fragments
     names: Callable | None = None  # ctx -> the names its `book:` may use beyond ctx.names
+    literals: tuple = ()  # words a `book:` value may be instead of an expression
 
 
 QUANTITIES: dict[str, Quantity] = {}
 
 
 def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
-             names: Callable | None = None):
+             names: Callable | None = None, literals: tuple = ()):
     """Register the decorated function as the check of quantity `name` (`names`: a function
     of the part's context giving the names its book value may use beyond the usual ones,
-    e.g. a polynomial's variable; `mechbook validate` parses with them)."""
+    e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`: words
+    the book value may be instead, e.g. "stable")."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
-        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names)
+        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names,
+                                    tuple(literals))
         return fn
 
     return register

@@ -235,12 +235,15 @@ def _near(values, x, rtol=1e-8):
 
 
 def _shape(ctx: Context, shape, sub) -> sp.Matrix:
+    """A mode shape over the linear system's coordinates (a steady motion reduced by Routh
+    has lost its cyclic ones)."""
     shape = ctx.as_map(shape, sub)
-    unknown = set(shape) - set(ctx.system.coord_names)
+    names = ctx.linear().dyn.sys.coord_names
+    unknown = set(shape) - set(names)
     if unknown:
-        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate")
-    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0
-                      for c in ctx.system.coord_names])
+        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the linear "
+                             "system")
+    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0 for c in names])
 
 
 @quantity('normal_coordinates',

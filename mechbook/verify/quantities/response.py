@@ -54,7 +54,7 @@ def _fmt(xs) -> str:
 
 
 def _matrix(ctx: Context, rows, sub) -> sp.Matrix:
-    n = len(ctx.system.q)
+    n = len(ctx.linear().q)
     rows = ctx.as_list(rows, sub)
     if len(rows) != n or any(not isinstance(r, list) or len(r) != n for r in rows):
         raise ctx.part.error(sub, f"expected a {n}x{n} matrix (rows and columns in the order "
@@ -180,12 +180,15 @@ def check_decay_rates(ctx: Context, val) -> Verdict:
 
 
 def _shape(ctx: Context, shape, sub) -> sp.Matrix:
+    """A mode shape over the linear system's coordinates (a steady motion reduced by Routh
+    has lost its cyclic ones)."""
     shape = ctx.as_map(shape, sub)
-    unknown = set(shape) - set(ctx.system.coord_names)
+    names = ctx.linear().dyn.sys.coord_names
+    unknown = set(shape) - set(names)
     if unknown:
-        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate")
-    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0
-                      for c in ctx.system.coord_names])
+        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the linear "
+                             "system")
+    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0 for c in names])
 
 
 def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
@@ -233,11 +236,12 @@ def _linear_forms(ctx: Context, keys: list[str], lin) -> dict[str, list]:
     define = ctx.part.data.get("define") or {}
     out = {}
     for k in keys:
-        if k in ctx.system.coord_names:
-            out[k] = [sp.S(int(c == k)) for c in ctx.system.coord_names]
+        names = lin.dyn.sys.coord_names
+        if k in names:
+            out[k] = [sp.S(int(c == k)) for c in names]
         elif k in define:
             form = ctx.names[k]
-            out[k] = [sp.diff(form, q).subs(lin.point) for q in ctx.system.q]
+            out[k] = [sp.diff(form, q).subs(lin.point) for q in lin.q]
         else:
             raise ctx.part.error(("book", k), "neither a coordinate nor a `define:` name")
     return out
@@ -358,7 +362,7 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
           keys={"frequencies": {"type": "object", "additionalProperties": EXPR}})
 def check_normal_transformation(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
-    names = ctx.system.coord_names
+    names = ctx.linear().dyn.sys.coord_names
     if set(val) != set(names):
         raise ctx.part.error(("book",), "give every coordinate as a form in the normal "
                              "coordinates")

@@ -5,10 +5,13 @@
 from __future__ import annotations
 
 import numpy as np
+import sympy as sp
 
+from mechbook.core.numeval import holds
 from mechbook.engine import response, steady
 from mechbook.verify.compare import Verdict, all_vanish, value
 from mechbook.verify.context import Context
+from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.registry import EXPR, POINT, REGION, quantity
 
 
@@ -41,14 +44,17 @@ def check_steady_motion(ctx: Context, val) -> Verdict:
 
 
 @quantity('stability',
-          book='stable, unstable or marginal',
+          book='stable, unstable or marginal (or a relation: stable exactly where it holds)',
           how=('the linearized system about the part\'s point or steady motion has that '
                'verdict at every one of ≥ 60 parameter points drawn widely (spread x4, '
                '`assume:` honoured): "always stable / always unstable" claims'),
-          keys={})
+          literals=("stable", "unstable", "marginal"))
 def check_stability(ctx: Context, val) -> Verdict:
+    if isinstance(val, str) and ("<" in val or ">" in val):  # a condition after all
+        return check_stability_condition(ctx, val)
     if val not in ("stable", "unstable", "marginal"):
-        raise ctx.part.error(("book",), "expected stable, unstable or marginal")
+        raise ctx.part.error(("book",), "expected stable, unstable or marginal (or a "
+                             "relation: where it is stable)")
     lin = ctx.linear()
     wide = ctx.sampler.widened(2.0)
     seen: dict[str, int] = {}
@@ -152,3 +158,64 @@ def _clusters(lam: np.ndarray) -> list[complex]:
             out.append(complex(x))
     return out
 
+
+
+@quantity('steady_exists',
+          book='relation (where a steady motion exists)',
+          how=('at ≥ 60 parameter points drawn widely, the relation holds exactly where some '
+               'real rate of the coordinate `turning:` makes the configuration `at:` (every '
+               'other coordinate) a steady motion: the residuals, polynomials in the rate, '
+               'have a common real root (numpy roots, checked on every residual)'),
+          keys={"turning": {"type": "string"}, "at": POINT})
+def check_steady_exists(ctx: Context, val) -> Verdict:
+    cond = ctx.parse(val, ("book",), relation=True)
+    name = ctx.part.data.get("turning")
+    if name not in ctx.system.coord_names:
+        raise ctx.part.error(("turning",), "name the coordinate that turns at a steady rate")
+    q = ctx.system.q[ctx.system.coord_names.index(name)]
+    point = _coordinate_map(ctx, ctx.part.data.get("at") or {}, ("at",))
+    if set(point) | {q} != set(ctx.system.q):
+        raise ctx.part.error(("at",), "give every coordinate but the turning one")
+    w = sp.Symbol("w_rate", real=True)
+    residuals = [e for e in steady.steady_residuals(ctx.dyn, {q: w}, point) if e != 0]
+    wide = ctx.sampler.widened(2.0)
+    seen = {True: 0, False: 0}
+    n = 0
+    for _ in range(400):
+        pt = wide.draw()
+        exists = _common_real_root(residuals, w, pt)
+        claim = holds(cond, pt)
+        if claim != exists:
+            shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
+                pt.items(), key=lambda kv: kv[0].name)[:8])
+            return Verdict(False, f"numeric({n + 1} points)",
+                           f"book says {'a' if claim else 'no'} steady motion, engine finds "
+                           f"{'one' if exists else 'none'} at {{{shown}}}")
+        seen[claim] += 1
+        n += 1
+        if n >= 60 and min(seen.values()) >= 10:
+            break
+    if min(seen.values()) == 0:
+        return Verdict(False, "numeric", "sampling never crossed the boundary; the check "
+                       "cannot discriminate")
+    return Verdict(True, f"numeric({n} points: {seen[True]} with, {seen[False]} without)")
+
+
+def _common_real_root(residuals: list, w: sp.Symbol, pt: dict) -> bool:
+    polys = []
+    for e in residuals:
+        p = sp.Poly(sp.expand(e.subs(pt)), w)
+        coeffs = [complex(sp.N(c, 30)) for c in p.all_coeffs()]
+        scale = max(abs(c) for c in coeffs) if coeffs else 0.0
+        if scale == 0 or all(abs(c) <= 1e-20 * scale for c in coeffs):
+            continue
+        polys.append((p, np.array(coeffs) / scale))
+    if not polys:
+        return True
+    if any(len(c) == 1 for _, c in polys):  # a nonzero constant residual: never steady
+        return False
+    roots = [r.real for r in np.roots(polys[0][1]) if abs(r.imag) <= 1e-9 * max(1, abs(r))]
+    for r in roots:
+        if all(abs(np.polyval(c, r)) <= 1e-9 * np.polyval(np.abs(c), abs(r)) for _, c in polys):
+            return True
+    return False
