@@ -42,7 +42,9 @@ class Equilibria:
             raise UnsupportedError("equilibria of a system with multiplier constraints")
         zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
         zero.update({s: 0 for s in self.sys.small_params})
-        conds = [without_absent(e.subs(zero), [self.sys.t]) for e in self.dyn.residuals]
+        held = getattr(self.sys, "held", {})  # a reduced system's momenta, put back
+        conds = [without_absent(e.subs(zero).xreplace(held), [self.sys.t])
+                 for e in self.dyn.residuals]
         if any(c.has(self.sys.t) for c in conds):
             raise UnsupportedError("static equilibria of a non-autonomous system")
         free = {s for syms in self.sys.free_driven for s in syms}
@@ -143,10 +145,25 @@ class Equilibria:
         dyn = self.dyn
         velocity = dict(velocity or {})
         t = self.sys.t
+        # a point or rate given by a long expression (an orbit parametrized by an answer's
+        # symbol) stands in as a plain symbol while differentiating, and is put back at the
+        # end: differentiating through it would multiply its size many times over
+        holders: dict[sp.Symbol, sp.Expr] = dict(getattr(self.sys, "held", {}))
+
+        def held(value, tag: str) -> sp.Expr:
+            value = sp.S(value)
+            if value.is_Atom or sp.count_ops(value) <= 4:
+                return value
+            sym = sp.Symbol(f"held_{tag}_{len(holders)}", real=True)
+            holders[sym] = value
+            return sym
+
         sub = {}
         for q, v in zip(dyn.q, dyn.qd, strict=True):
-            sub[q] = point.get(q, sp.S.Zero) + velocity.get(q, sp.S.Zero) * t + EPS * q
-            sub[v] = velocity.get(q, sp.S.Zero) + EPS * v
+            sub[q] = (held(point.get(q, 0), q.name) + held(velocity.get(q, 0), v.name) * t
+                      + EPS * q)
+            sub[v] = held(velocity.get(q, 0), v.name) if q in velocity else sp.S.Zero
+            sub[v] += EPS * v
         sub.update({v: EPS * v for v in dyn.qdd})
         sub.update({s: EPS * s for s in self.sys.small_params})
         lin = []
@@ -155,6 +172,7 @@ class Equilibria:
             e_sub = e.subs(sub, simultaneous=True)
             zeroth.append(e_sub.subs(EPS, 0))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
+        zeroth = [z.xreplace(holders) for z in zeroth]
         if velocity:  # zeroth order must vanish along the whole uniform motion
             zeroth = [z.subs(t, sp.Rational(7, 5)) for z in zeroth] + \
                      [z.subs(t, sp.Rational(-3, 7)) for z in zeroth]
@@ -179,8 +197,8 @@ class Equilibria:
         else:
             def simp(x, absent=t):
                 return without_absent(x, absent)
-        M, C, K = (raw[k].applyfunc(simp) for k in ("M", "C", "K"))
-        F = (-rest).applyfunc(lambda x: simp(sp.expand(x), state))
+        M, C, K = (raw[k].applyfunc(simp).xreplace(holders) for k in ("M", "C", "K"))
+        F = (-rest).applyfunc(lambda x: simp(sp.expand(x), state)).xreplace(holders)
         bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover

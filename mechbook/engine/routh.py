@@ -63,6 +63,20 @@ class ReducedSystem:
             p_values = [sp.S(momenta_given[c]) for c in cyc]
         else:
             p_values = [simp(p.subs(at_steady)) for p in momenta]
+        # a momentum value that is a long expression (the steady motion's point and rate
+        # substituted) stands in as a symbol in the reduced Lagrangian; `held` maps it back
+        # (Equilibria puts the values in after differentiating)
+        self.held: dict[sp.Symbol, sp.Expr] = {}
+        self.momenta = dict(zip(cyc, p_values, strict=True))
+        symbols = []
+        for c, pv in zip(cyc, p_values, strict=True):
+            if pv.is_Atom or sp.count_ops(pv) <= 4:
+                symbols.append(pv)
+            else:
+                held = sp.Symbol(f"held_p_{c}", real=True)
+                self.held[held] = pv
+                symbols.append(held)
+        p_values = symbols
         try:
             with time_limit(30):
                 sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
@@ -75,7 +89,6 @@ class ReducedSystem:
         rate_of = sol[0]
         routh = sum((pv * v for pv, v in zip(p_values, cyc_rates, strict=True)), sp.S.Zero)
         self.lagrangian = simp((L - routh).subs(rate_of))
-        self.momenta = dict(zip(cyc, p_values, strict=True))
 
     def dt(self, expr):
         out = sp.diff(expr, self.t)

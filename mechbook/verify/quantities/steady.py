@@ -9,7 +9,7 @@ import sympy as sp
 
 from mechbook.core.numeval import holds
 from mechbook.engine import response, steady
-from mechbook.verify.compare import Verdict, all_vanish, value
+from mechbook.verify.compare import Verdict, all_vanish, value, value_and_scale
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.registry import EXPR, POINT, REGION, quantity
@@ -177,13 +177,16 @@ def check_steady_exists(ctx: Context, val) -> Verdict:
     if set(point) | {q} != set(ctx.system.q):
         raise ctx.part.error(("at",), "give every coordinate but the turning one")
     w = sp.Symbol("w_rate", real=True)
-    residuals = [e for e in steady.steady_residuals(ctx.dyn, {q: w}, point) if e != 0]
+    coefficients = []  # each residual as a polynomial in the rate: its coefficients
+    for e in steady.steady_residuals(ctx.dyn, {q: w}, point):
+        if e != 0:
+            coefficients.append(sp.Poly(sp.expand(e), w).all_coeffs())
     wide = ctx.sampler.widened(2.0)
     seen = {True: 0, False: 0}
     n = 0
     for _ in range(400):
         pt = wide.draw()
-        exists = _common_real_root(residuals, w, pt)
+        exists = _common_real_root(coefficients, pt)
         claim = holds(cond, pt)
         if claim != exists:
             shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
@@ -201,21 +204,26 @@ def check_steady_exists(ctx: Context, val) -> Verdict:
     return Verdict(True, f"numeric({n} points: {seen[True]} with, {seen[False]} without)")
 
 
-def _common_real_root(residuals: list, w: sp.Symbol, pt: dict) -> bool:
+def _common_real_root(coefficients: list[list], pt: dict) -> bool:
+    """Do the polynomials (coefficient lists, highest first) have a common real root at
+    `pt`? A coefficient counts as zero when it cancels to 1e-20 of its terms."""
     polys = []
-    for e in residuals:
-        p = sp.Poly(sp.expand(e.subs(pt)), w)
-        coeffs = [complex(sp.N(c, 30)) for c in p.all_coeffs()]
-        scale = max(abs(c) for c in coeffs) if coeffs else 0.0
-        if scale == 0 or all(abs(c) <= 1e-20 * scale for c in coeffs):
-            continue
-        polys.append((p, np.array(coeffs) / scale))
+    for coeffs in coefficients:
+        vals = []
+        for c in coeffs:
+            v, size = value_and_scale(c, pt)
+            vals.append(0.0 if abs(v) <= 1e-20 * max(size, 1e-300) else v.real)
+        while vals and vals[0] == 0.0:
+            vals.pop(0)
+        if not vals:
+            continue  # vanishes identically here
+        if len(vals) == 1:
+            return False  # a nonzero constant: no rate makes this residual vanish
+        polys.append(np.array(vals))
     if not polys:
         return True
-    if any(len(c) == 1 for _, c in polys):  # a nonzero constant residual: never steady
-        return False
-    roots = [r.real for r in np.roots(polys[0][1]) if abs(r.imag) <= 1e-9 * max(1, abs(r))]
+    roots = [r.real for r in np.roots(polys[0]) if abs(r.imag) <= 1e-9 * max(1, abs(r))]
     for r in roots:
-        if all(abs(np.polyval(c, r)) <= 1e-9 * np.polyval(np.abs(c), abs(r)) for _, c in polys):
+        if all(abs(np.polyval(c, r)) <= 1e-9 * np.polyval(np.abs(c), abs(r)) for c in polys):
             return True
     return False
