@@ -51,7 +51,7 @@ class ReducedSystem:
         self.coord_names = [base.coord_names[i] for i in keep]
         self.forces = [base.forces[i] for i in keep]
         self.names = base.names
-        L = trig_canonical(base.lagrangian)  # exact; keeps the reduction small
+        L = trig_canonical(base.lagrangian, base.qd)  # exact; keeps the reduction small
         cyc_rates = [base.qd[i] for i in idx]
         momenta = [sp.diff(L, v) for v in cyc_rates]
         # the momenta's values at the steady motion: rates given, others at rest at `point`
@@ -77,12 +77,14 @@ class ReducedSystem:
                 self.held[held] = pv
                 symbols.append(held)
         p_values = symbols
-        try:
-            with time_limit(30):
-                sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
-                               cyc_rates, dict=True)
-        except Timeout:
-            sol = []
+        sol = _linear_rates(momenta, p_values, cyc_rates)
+        if sol is None:
+            try:
+                with time_limit(30):
+                    sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
+                                   cyc_rates, dict=True)
+            except Timeout:
+                sol = []
         if len(sol) != 1:
             raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
                                    "their momenta")
@@ -98,3 +100,17 @@ class ReducedSystem:
 
     def numeric_values(self) -> dict:
         return self.problem.values()
+
+
+def _linear_rates(momenta: list, values: list, rates: list) -> list[dict] | None:
+    """The rates from p = A·rates + b when the momenta are linear in them (T quadratic in
+    the velocities): one LU solve keeps the result compact (None: not linear)."""
+    A = sp.Matrix([[sp.diff(p, v) for v in rates] for p in momenta])
+    if any(x.has(*rates) for x in A):
+        return None
+    b = sp.Matrix([p.subs({v: 0 for v in rates}) for p in momenta])
+    try:
+        sol = A.LUsolve(sp.Matrix(values) - b)
+    except (ValueError, ZeroDivisionError):
+        return None
+    return [dict(zip(rates, sol, strict=True))]
