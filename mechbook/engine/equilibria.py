@@ -154,6 +154,9 @@ class Equilibria:
             value = sp.S(value)
             if value.is_Atom or sp.count_ops(value) <= 4:
                 return value
+            for sym, v in holders.items():  # equal rates stay equal (a rigid rotation)
+                if v == value:
+                    return sym
             sym = sp.Symbol(f"held_{tag}_{len(holders)}", real=True)
             holders[sym] = value
             return sym

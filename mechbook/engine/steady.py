@@ -54,15 +54,16 @@ def reduced_at(sys, momenta: dict) -> ReducedSystem:
     return ReducedSystem(sys, {c: sp.S.Zero for c in momenta}, {}, momenta=momenta)
 
 
-def steady_conditions(sys, rates: dict | None = None,
-                      momenta: dict | None = None) -> tuple[list[sp.Expr], list[sp.Symbol]]:
-    """The conditions on the non-turning coordinates for a steady motion, and those
-    coordinates: at fixed `rates` (E_i with q̇ = rates), at fixed cyclic `momenta` (the
-    equilibrium conditions of Routh's reduced system), or neither (static equilibria)."""
+def steady_conditions(sys, rates: dict | None = None, momenta: dict | None = None
+                      ) -> tuple[list[sp.Expr], list[sp.Symbol], Equilibria]:
+    """The conditions on the non-turning coordinates for a steady motion, those
+    coordinates, and the Equilibria object that linearizes about one: at fixed `rates`
+    (E_i with q̇ = rates), at fixed cyclic `momenta` (the equilibrium conditions of Routh's
+    reduced system), or neither (static equilibria)."""
     if momenta:
         reduced = reduced_at(sys, momenta)
         eq = Equilibria(Dynamics(reduced))
-        return eq.conditions, list(reduced.q)
+        return eq.conditions, list(reduced.q), eq
     dyn = Dynamics(sys)
     rates = rates or {}
     free = [q for q in dyn.q if q not in rates]
@@ -72,7 +73,15 @@ def steady_conditions(sys, rates: dict | None = None,
             raise UnsupportedError("steady motions of a non-autonomous system")
         if e != 0:
             conds.append(e)
-    return conds, free
+    return conds, free, Equilibria(dyn)
+
+
+def classify_at(eq: Equilibria, root: dict, values: dict, rates: dict | None = None) -> str:
+    """The stability of the steady motion found numerically at `root` ({q: float}), at
+    fixed `rates` of the turning coordinates (or at rest in a reduced system)."""
+    point = {q: sp.Float(x, 30) for q, x in root.items()}
+    velocity = {q: sp.S(r).subs(values) for q, r in (rates or {}).items()}
+    return eq.linearize(point, velocity or None).numeric_stability(values)
 
 
 def roots_in(conds: list[sp.Expr], unknowns: list[sp.Symbol], values: dict,

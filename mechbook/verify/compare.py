@@ -48,15 +48,18 @@ class Sampler:
     def _complete(self, point: dict) -> dict | None:
         """The point with its derived symbols computed (None where one is not real)."""
         for sym, expr in self.derived.items():
-            try:
-                v, _ = evaluate(expr, point, DIGITS)
-            except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+            try:  # all 30 digits: a point exactly on a surface (a double root) stays on it
+                v = sp.N(expr.subs(point), DIGITS)
+                re, im = v.as_real_imag()
+                if not (re.is_number and im.is_number):
+                    return None
+            except (ZeroDivisionError, ValueError, TypeError, OverflowError):
                 return None
-            if not (math.isfinite(v.real) and abs(v.imag) <= 1e-20 * max(1.0, abs(v))):
+            if not (math.isfinite(float(re)) and abs(im) <= 1e-20 * max(1.0, abs(re))):
                 return None
-            if sym.is_positive and v.real <= 0:
+            if sym.is_positive and re <= 0:
                 return None
-            point[sym] = sp.Float(v.real, DIGITS)
+            point[sym] = sp.Float(re, DIGITS)
         return point
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,

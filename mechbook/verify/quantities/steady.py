@@ -97,10 +97,11 @@ def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:
                'fixed cyclic `momenta:` (equilibria of Routh\'s reduced system), inside '
                '`search:` (a box or a list of boxes over the other coordinates), found by '
                'multistart root finding at 3 points (a count the search can miss is a lower '
-               'bound: say so in the note)'),
+               'bound: say so in the note); `stable: true/false` also checks each one\'s '
+               'stability'),
           keys={"search": {"oneOf": [REGION, {"type": "array", "minItems": 1,
                                                "items": REGION}]},
-                "rates": POINT, "momenta": POINT})
+                "rates": POINT, "momenta": POINT, "stable": {"type": "boolean"}})
 def check_equilibrium_count(ctx: Context, val) -> Verdict:
     if not isinstance(val, int) or isinstance(val, bool):
         raise ctx.part.error(("book",), "expected an integer")
@@ -110,17 +111,25 @@ def check_equilibrium_count(ctx: Context, val) -> Verdict:
     momenta = _coordinate_map(ctx, ctx.part.data.get("momenta") or {}, ("momenta",))
     if rates and momenta:
         raise ctx.part.error(("momenta",), "fix either rates or momenta")
-    conds, unknowns = steady.steady_conditions(ctx.system, rates, momenta)
+    conds, unknowns, eq = steady.steady_conditions(ctx.system, rates, momenta)
+    want = ctx.part.data.get("stable")
     counts = []
     for _ in range(3):
         pt = ctx.sampler.draw()
         roots = steady.roots_in(conds, unknowns, pt, _boxes(ctx, pt, unknowns))
         counts.append(len(roots))
+        where = "; ".join("(" + ", ".join(f"{x:.5g}" for x in r) + ")" for r in roots[:6])
         if len(roots) != val:
-            where = "; ".join("(" + ", ".join(f"{x:.5g}" for x in r) + ")" for r in roots[:6])
             return Verdict(False, "numeric(root search)",
                            f"found {len(roots)} in the region: {where}")
-    return Verdict(True, "numeric(root search, 3 points)", f"counts {counts}")
+        if want is not None:
+            for r in roots:
+                got = steady.classify_at(eq, dict(zip(unknowns, r, strict=True)), pt, rates)
+                if (got == "stable") != want:
+                    at = ", ".join(f"{x:.5g}" for x in r)
+                    return Verdict(False, "numeric(root search)", f"the one at ({at}) is {got}")
+    how = "" if want is None else f", each {'stable' if want else 'unstable'}"
+    return Verdict(True, f"numeric(root search, 3 points{how})", f"counts {counts}")
 
 
 @quantity('secular_growth',
