@@ -219,26 +219,7 @@ class LinearSystem:
 
     def numeric_stability(self, values: dict) -> str:
         """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
-        M, C, K = self.fast_matrices(values)
-        n = M.shape[0]
-        if not np.any(C):
-            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
-            scale = max(1.0, float(np.max(np.abs(w2))))
-            if np.any(w2 < -ZERO_TOL * scale):
-                return "unstable"
-            return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
-        A = np.block([[np.zeros((n, n)), np.eye(n)],
-                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-        lam = np.linalg.eigvals(A)
-        scale = max(1.0, float(np.max(np.abs(lam))))
-        # exponents at zero (a symmetry: an ignorable coordinate kept in the linearization,
-        # a family of steady motions) split by rounding into a tiny cluster whose real parts
-        # mean nothing; they are neutral here (their polynomial growth is `secular_growth`'s
-        # question), and the verdict rests on the others
-        live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
-        if np.any(live.real > 1e-8 * scale):
-            return "unstable"
-        return "stable"
+        return classify_matrices(*self.fast_matrices(values))
 
     @cached_property
     def stability_condition(self) -> sp.Basic:
@@ -248,6 +229,29 @@ class LinearSystem:
         K = self.K
         minors = [try_simplify(K[:k, :k].det(), 5) for k in range(1, K.rows + 1)]
         return sp.And(*[mi > 0 for mi in minors])
+
+
+def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
+    """'stable', 'unstable' or 'marginal' for M·q̈ + C·q̇ + K·q = 0 (numbers)."""
+    n = M.shape[0]
+    if not np.any(C):
+        w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+        scale = max(1.0, float(np.max(np.abs(w2))))
+        if np.any(w2 < -ZERO_TOL * scale):
+            return "unstable"
+        return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    lam = np.linalg.eigvals(A)
+    scale = max(1.0, float(np.max(np.abs(lam))))
+    # exponents at zero (a symmetry: an ignorable coordinate kept in the linearization, a
+    # family of steady motions) split by rounding into a tiny cluster whose real parts mean
+    # nothing; they are neutral here (their polynomial growth is `secular_growth`'s
+    # question), and the verdict rests on the others
+    live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
+    if np.any(live.real > 1e-8 * scale):
+        return "unstable"
+    return "stable"
 
 
 def _ill_conditioned(M: np.ndarray, w2: np.ndarray) -> bool:

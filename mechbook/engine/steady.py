@@ -25,7 +25,7 @@ import sympy as sp
 from mechbook.core.compile import compile_exprs
 from mechbook.engine.equilibria import Equilibria
 from mechbook.engine.lagrange import Dynamics
-from mechbook.engine.linear import LinearSystem
+from mechbook.engine.linear import LinearSystem, classify_matrices
 from mechbook.engine.routh import ReducedSystem
 from mechbook.errors import UnsupportedError
 
@@ -78,10 +78,26 @@ def steady_conditions(sys, rates: dict | None = None, momenta: dict | None = Non
 
 def classify_at(eq: Equilibria, root: dict, values: dict, rates: dict | None = None) -> str:
     """The stability of the steady motion found numerically at `root` ({q: float}), at
-    fixed `rates` of the turning coordinates (or at rest in a reduced system)."""
-    point = {q: sp.Float(x, 30) for q, x in root.items()}
-    velocity = {q: sp.S(r).subs(values) for q, r in (rates or {}).items()}
-    return eq.linearize(point, velocity or None).numeric_stability(values)
+    fixed `rates` of the turning coordinates (or at rest in a reduced system): M, C, K are
+    the derivatives of the equations of motion there, taken symbolically once and
+    evaluated at the numbers (a numeric root is no exact equilibrium for `linearize`)."""
+    dyn = eq.dyn
+    held = getattr(dyn.sys, "held", {})
+    rates = rates or {}
+    sub = {v: sp.S(rates.get(q, 0)) for q, v in zip(dyn.q, dyn.qd, strict=True)}
+    sub.update({a: 0 for a in dyn.qdd})
+    sub.update({s: 0 for s in dyn.sys.small_params})
+    key = ("jacobians", tuple(sorted(map(str, rates))))
+    cache = eq.__dict__.setdefault("_jacobians", {})
+    if key not in cache:
+        res = [e.xreplace(held) for e in dyn.residuals]
+        cache[key] = [sp.Matrix([[sp.diff(e, v) for v in vs] for e in res]).subs(sub)
+                      for vs in (dyn.qdd, dyn.qd, dyn.q)]
+    at = dict(values)
+    at.update({q: sp.Float(x, 30) for q, x in root.items()})
+    M, C, K = (np.array(A.subs(at).evalf(30).tolist(), dtype=complex).real.astype(float)
+               for A in cache[key])
+    return classify_matrices(M, C, K)
 
 
 def roots_in(conds: list[sp.Expr], unknowns: list[sp.Symbol], values: dict,
@@ -99,7 +115,9 @@ def roots_in(conds: list[sp.Expr], unknowns: list[sp.Symbol], values: dict,
     rng = np.random.default_rng(11)
     for box in boxes:
         ranges = [box.get(q, (-np.pi, np.pi)) for q in unknowns]
-        grids = [np.linspace(lo, hi, starts + 2)[1:-1] for lo, hi in ranges]
+        # a positive range over decades (a distance) is searched on a geometric grid
+        grids = [np.geomspace(lo, hi, starts + 2)[1:-1] if lo > 0 and hi > 100 * lo
+                 else np.linspace(lo, hi, starts + 2)[1:-1] for lo, hi in ranges]
         mesh = np.array(np.meshgrid(*grids, indexing="ij")).reshape(n, -1).T
         if len(mesh) > 3000:
             mesh = mesh[rng.choice(len(mesh), 3000, replace=False)]
