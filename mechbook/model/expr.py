@@ -32,7 +32,17 @@ FUNCTIONS: dict[str, object] = {
     "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt, "Abs": sp.Abs, "abs": sp.Abs,
     "sign": sp.sign, "cbrt": sp.cbrt,
 }
-ARITY = {"atan2": (2, 2), "log": (1, 2)}
+def _diff(expr, var, times=1):
+    """diff(expr, x[, n]): the derivative with respect to a declared name (at most 6th)."""
+    if not isinstance(var, sp.Symbol):
+        raise ValueError("differentiate with respect to a declared name")
+    if not (isinstance(times, int | sp.Integer) and 1 <= int(times) <= 6):
+        raise ValueError("the order is a whole number from 1 to 6")
+    return sp.diff(expr, var, int(times))
+
+
+FUNCTIONS["diff"] = _diff
+ARITY = {"atan2": (2, 2), "log": (1, 2), "diff": (2, 3)}
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
 
 class Operator:
@@ -178,7 +188,10 @@ class _Builder:
                 return op(*args)
             except (TypeError, ValueError) as exc:
                 raise self.fail(node, f"{name}(): {exc}") from None
-        return FUNCTIONS[name](*args)
+        try:
+            return FUNCTIONS[name](*args)
+        except ValueError as exc:
+            raise self.fail(node, f"{name}(): {exc}") from None
 
     def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:
         if not self.allow_relations:
