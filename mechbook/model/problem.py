@@ -23,7 +23,8 @@ T = sp.Symbol("t", real=True)
 RESERVED = {"t"} | set(CONSTANTS) | set(FUNCTIONS)
 SYSTEM_KEYS = ("coordinates", "driven", "particles", "rigid_bodies", "gravity", "springs",
                "kinetic", "potential", "lagrangian", "velocity_potential", "constraints",
-               "forces", "dissipation", "approximation", "equilibria", "initial", "compute", "doc")
+               "forces", "dissipation", "string", "approximation", "equilibria", "initial",
+               "compute", "doc")
 DEFAULT_VALUES = {"g": 9.81}  # documented default for the gravitational acceleration
 DEFAULT_VALUE = 1.0
 
