@@ -88,9 +88,10 @@ class ReducedSystem:
         if len(sol) != 1:
             raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
                                    "their momenta")
-        rate_of = sol[0]
+        rate_of = {v: _smaller(e, _cancel(e)) for v, e in sol[0].items()}
         routh = sum((pv * v for pv, v in zip(p_values, cyc_rates, strict=True)), sp.S.Zero)
-        self.lagrangian = simp((L - routh).subs(rate_of))
+        reduced = (L - routh).subs(rate_of)
+        self.lagrangian = simp(_smaller(reduced, _cancel(reduced)))
 
     def dt(self, expr):
         out = sp.diff(expr, self.t)
@@ -114,3 +115,19 @@ def _linear_rates(momenta: list, values: list, rates: list) -> list[dict] | None
     except (ValueError, ZeroDivisionError):
         return None
     return [dict(zip(rates, sol, strict=True))]
+
+
+def _cancel(expr: sp.Expr, seconds: float = 5.0) -> sp.Expr:
+    """expr as one rational function (common denominator, common factors cancelled): exact
+    polynomial arithmetic, not simplify, and it keeps Routh's function small for the
+    differentiations that follow; given up (expr unchanged) after `seconds`."""
+    try:
+        with time_limit(seconds):
+            return sp.cancel(expr)
+    except (Timeout, sp.PolynomialError):
+        return expr
+
+
+def _smaller(a: sp.Expr, b: sp.Expr) -> sp.Expr:
+    """The one of two equal expressions with fewer operations."""
+    return b if sp.count_ops(b) < sp.count_ops(a) else a
