@@ -5,6 +5,8 @@ None of them looks at the book's answers:
     newton       the engine's equations against Newton's and Euler's laws, with kinematics
                  computed here independently (kinematics.py)
     conserved    the book's first integrals constant along a simulated trajectory
+    response     a steady-state amplitude measured from the driven nonlinear motion
+                 (frequencies.py also measures damped modes' decay rates)
 
 May import: mechbook.verify (how an answer part names its point: `about:`, `steady:`,
 `assume:`), mechbook.numerics, mechbook.engine (the results under test), mechbook.core,

@@ -74,7 +74,7 @@ def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
         eng = [float(w) for w in perturbation.precise_frequencies(lin, pt)]
         worst = 0.0
         for b in numbers(book, pt):  # one-to-one: each engine frequency matches once
-            if not eng:
+            if not eng or not np.isfinite(b):  # a book value that is not real here fails
                 return float("inf")
             nearest = min(range(len(eng)), key=lambda i, b=b: abs(eng[i] - b))
             worst = max(worst, abs(eng.pop(nearest) - b) / max(abs(b), 1e-300))
@@ -109,6 +109,9 @@ def asymptotic(ctx: Context, error) -> Verdict:
         errors.append(float(error(pt)) if pt is not None else float("nan"))
     tail = errors[-3:]
     shown = ", ".join(f"{e:.2g}" for e in errors)
+    if not all(np.isfinite(tail)):
+        return Verdict(False, "numeric(asymptotic)", f"relative error {shown}: the formula "
+                       "does not evaluate (or match) near the limit")
     if all(e < 1e-30 for e in tail):
         return Verdict(True, "numeric(asymptotic)", f"relative error {shown}: exact in the "
                        "limit's last steps")
@@ -212,7 +215,7 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
         for freq, shape in parsed:
             w = numbers([freq], pt)[0]
             u = np.array(numbers(list(shape), pt))
-            if not free or not np.any(u):
+            if not free or not np.any(u) or not np.isfinite(w) or not np.all(np.isfinite(u)):
                 return float("inf")
             best = float("inf")
             for j in free:
