@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test lint bench bench-check clean
+.PHONY: check test lint fuzz report bench bench-check bench-sweep clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -15,8 +15,16 @@ $(STAMP): pyproject.toml constraints.txt
 check: $(STAMP)  ## check every problem against the book's answer key (one worker per core)
 	$(BIN)/mechbook check
 
+report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/index.html
+	-$(BIN)/mechbook check  # a failing part is shown in the report, not an end to it
+	$(BIN)/mechbook report
+
 test: $(STAMP)   ## run the test suite
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
+
+fuzz: $(STAMP)   ## 10,000 mutated and hostile problem/answer files under time and memory limits (~30 min)
+	$(BIN)/python tests/fuzz.py --cases 10000 --seed 1 --keep results/fuzz \
+		--json results/fuzz/results.jsonl
 
 bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -> results/ (~15 min)
 	mkdir -p results/bench
@@ -33,6 +41,11 @@ bench-check: $(STAMP)  ## cold/warm `mechbook check` before and after, side by s
 		--profile lim-2057 symon-09-07 lim-2034 lim-2042 symon-09-31 symon-09-01 \
 		          lim-2058 lim-2043 symon-09-02 lim-2055 \
 		--out results/bench/check_time.md
+
+bench-sweep: $(STAMP)  ## 10^6-point sweeps: points per second, float64 vs 30 digits (~2 min)
+	mkdir -p results/bench
+	$(BIN)/python bench/sweep.py --csv results/bench/sweep.csv > results/bench/sweep.txt \
+		&& cat results/bench/sweep.txt
 
 lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench

@@ -39,10 +39,20 @@ SUMMARY = re.compile(r"^(\d+) problems, (\d+) parts: (.*)$")
 CROSS = re.compile(r"^cross-checks: (.*)$")
 
 
+# An editable install of mechbook puts a finder on sys.meta_path that serves any mechbook
+# module the tree on sys.path lacks from the installed checkout: a benchmark of another
+# tree would silently mix the two. Every snippet run here drops it first.
+ONLY_THIS_TREE = ("import sys\n"
+                  "sys.meta_path[:] = [f for f in sys.meta_path\n"
+                  "                    if 'editable' not in str(getattr(f, '__module__', ''))]")
+
+
 def launcher(tree: Path) -> list[str]:
-    """A command running the `mechbook` CLI of `tree` (imported from that tree first)."""
-    code = (f"import sys; sys.path.insert(0, {str(tree)!r}); "
-            "from mechbook.app.cli import main; sys.argv[0] = 'mechbook'; main()")
+    """A command running the `mechbook` CLI of `tree` (imported from that tree only)."""
+    code = (f"{ONLY_THIS_TREE}\nsys.path.insert(0, {str(tree)!r})\n"
+            "try:\n    from mechbook.app.cli import main\n"
+            "except ImportError:\n    from mechbook.cli import main\n"
+            "sys.argv[0] = 'mechbook'\nmain()")
     return [sys.executable, "-c", code]
 
 
@@ -74,12 +84,12 @@ sys.path.insert(0, {str(tree)!r})
 from pathlib import Path
 tree = Path({str(tree)!r})
 pr = cProfile.Profile()
+{ONLY_THIS_TREE}
 try:
-    from mechbook.app.run import run_problem, RunOptions
-    call = lambda: run_problem({pid!r}, tree)
+    from mechbook.app.run import run_problem  # the layout of the stages
 except ImportError:
-    from mechbook.app.run import run_problem
-    call = lambda: run_problem({pid!r}, tree)
+    from mechbook.run import run_problem  # the flat layout before it
+call = lambda: run_problem({pid!r}, tree)
 pr.enable(); call(); pr.disable()
 st = pstats.Stats(pr)
 out = {{}}
@@ -120,9 +130,9 @@ print(json.dumps(out))
 
 def time_tests(tree: Path) -> float:
     start = time.perf_counter()
-    env = dict(os.environ, PYTHONPATH=str(tree))
-    subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "auto", "-p", "no:cacheprovider"],
-                   cwd=tree, env=env, capture_output=True)
+    code = (f"{ONLY_THIS_TREE}\nsys.path.insert(0, {str(tree)!r})\nimport pytest\n"
+            "sys.exit(pytest.main(['-q', '-n', 'auto', '-p', 'no:cacheprovider']))")
+    subprocess.run([sys.executable, "-c", code], cwd=tree, capture_output=True)
     return time.perf_counter() - start
 
 

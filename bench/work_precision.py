@@ -59,7 +59,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.core.timeout import Timeout  # noqa: E402
+from mechbook.core.timeout import Timeout, hard_time_limit  # noqa: E402
 from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError, UnsupportedError  # noqa: E402
 from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
@@ -68,7 +68,7 @@ from mechbook.numerics import accuracy  # noqa: E402
 from mechbook.numerics.integrators import IntegratorError, integrate, make_integrator  # noqa: E402
 from mechbook.numerics.model import build_model  # noqa: E402
 from mechbook.numerics.monitors import conserved_quantities, drifts  # noqa: E402
-from mechbook.numerics.simulate import hard_time_limit, initial_state  # noqa: E402
+from mechbook.numerics.simulate import initial_state  # noqa: E402
 from mechbook.numerics.stiffness import IMPLICIT, assess, linear_rates  # noqa: E402
 
 SCIPY = ("RK45", "DOP853", "Radau", "LSODA")

@@ -56,7 +56,7 @@ class CrossCheck:
     """One independent cross-check and the answer parts it vouches for."""
 
     name: str
-    kind: str  # "frequencies", "newton" or "conserved"
+    kind: str  # "frequencies", "newton", "conserved", "inertia" or "none" (n.a.)
     system: str
     status: str = "error"  # pass | fail | n.a. | error
     error: float = float("nan")  # largest relative error measured

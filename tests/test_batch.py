@@ -55,8 +55,10 @@ def test_parallel_run_matches_serial_run_and_keeps_the_given_order(tmp_path):
 
 def test_a_problem_over_the_time_limit_is_an_error_naming_its_stage(tmp_path):
     """An equilibrium search SymPy cannot finish quickly (the plate of Lim 2057 on exact
-    springs, asked for its equilibria by equations) runs past a 2 s limit: the problem is
-    reported as an error that names the part it was in, and the next problem still runs."""
+    springs, asked for its equilibria by equations: simplifying its conditions and solving
+    them take their full time limits, over 10 s) runs past an 8 s limit: the problem is
+    reported as an error that names the part it was in, and the next problem still runs
+    (a fast one, well inside the limit even on a loaded machine)."""
     base = tree(tmp_path, ["lim-2057", "lim-2031"])
     (base / "answers/lim/2057.yaml").write_text("""\
 problem: lim-2057
@@ -69,10 +71,10 @@ parts:
     book: {where: ["X = 0"]}
 """)
     result = CliRunner().invoke(main, ["--root", str(base), "check", "lim-2057", "lim-2031",
-                                       "--timeout", "2", "-j", "1", "--no-store"])
+                                       "--timeout", "8", "-j", "1", "--no-store"])
     assert result.exit_code == 1
     line = next(ln for ln in result.output.splitlines() if ln.startswith("lim-2057"))
-    assert "ERROR" in line and "time limit of 2 s" in line and "part slow (equilibrium)" in line
+    assert "ERROR" in line and "time limit of 8 s" in line and "part slow (equilibrium)" in line
     assert sum(" pass " in ln for ln in result.output.splitlines()
                if ln.startswith("lim-2031")) == 6
 

@@ -36,3 +36,22 @@ def test_second_run_is_cached_and_a_changed_key_is_not(tmp_path):
     assert third.exit_code == 1 and "fail" in third.output
     fresh = runner.invoke(main, [*args, "--fresh"])
     assert "(cached" not in fresh.output
+
+
+def test_the_engine_fingerprint_covers_every_stage(monkeypatch, tmp_path):
+    """A change to any stage's source (not only the app's) invalidates stored results: the
+    fingerprint of a copy of the package changes when an engine module changes."""
+    import mechbook.app.fingerprint as fp
+
+    copy = tmp_path / "mechbook"
+    shutil.copytree(ROOT / "mechbook", copy, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(fp, "__file__", str(copy / "app" / "fingerprint.py"))
+    fp.engine_sha256.cache_clear()
+    before = fp.engine_sha256()
+    lagrange = copy / "engine" / "lagrange.py"
+    lagrange.write_text(lagrange.read_text() + "\n# changed\n")
+    fp.engine_sha256.cache_clear()
+    try:
+        assert fp.engine_sha256() != before
+    finally:
+        fp.engine_sha256.cache_clear()

@@ -27,6 +27,7 @@ from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
 from mechbook.model.catalog import problem_path
 from mechbook.model.problem import load_problem
+from mechbook.model.tensorexpr import kind
 from mechbook.verify.answers import AnswerKey, Part, load_answers
 from mechbook.verify.checker import check_problem
 from mechbook.verify.context import Context
@@ -171,7 +172,9 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     q = part.quantity
     root = ("erratum", "corrected") if "erratum" in part.data else ("book",)
     val = get(part.data, root)
-    if q == "lagrangian":
+    if ctx.tensor_mode:
+        yield from tensor_slots(part, val, root)
+    elif q == "lagrangian":
         yield Slot(root, "lagrangian")
     elif q == "eom":
         for i in range(len(val)):
@@ -224,6 +227,8 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     elif q == "mode_node":
         for k in val:
             yield Slot(root + (k,), "value")
+    elif q == "effective_potential":
+        yield Slot(root, "potential")
     elif q == "expression":
         of = part.data.get("of")
         if of == "momenta":
@@ -462,9 +467,15 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
         return True
     if slot.kind in ("count", "flag", "verdict"):
         return False
-    if slot.kind == "relation":  # the same condition, e.g. a symmetric one with names swapped
-        a = ctx.parse(old, slot.path, relation=True)
-        b = ctx.parse(new, slot.path, relation=True)
+    if slot.kind == "relation":  # the same condition once parsed (factors reordered), or
+        # the same up to moving terms (e.g. a symmetric one with names swapped)
+        try:
+            a = ctx.parse(old, slot.path, relation=True)
+            b = ctx.parse(new, slot.path, relation=True)
+        except Exception:  # noqa: BLE001 - a mutant that does not parse is not the same
+            return False
+        if a == b:
+            return True
         return (isinstance(a, sp.core.relational.Relational) and type(a) is type(b)
                 and _zero((a.lhs - a.rhs) - (b.lhs - b.rhs)))
     if slot.kind == "steady":  # another true steady motion (a symmetry: -rate, -angle, ...)
@@ -526,6 +537,157 @@ def _also_steady(ctx: Context, slot: Slot, part_data: dict, new) -> bool:
     return all(_zero(r) for r in residuals)
 
 
+# ---- tensor and body quantities (mechbook/verify/quantities/tensors.py) ----------------------
+def tensor_slots(part: Part, val, root: tuple) -> Iterator[Slot]:
+    """Values (components, eigenvalues, a solution), principal axes (value and direction)
+    and statements (identities, an ellipsoid's equation) of a tensor part."""
+    q = part.quantity
+    if q in ("identity", "inertia_ellipsoid"):
+        for i, _ in enumerate(val if isinstance(val, list) else [val]):
+            yield Slot(root + ((i,) if isinstance(val, list) else ()), "tequation")
+    elif q == "principal_axes":
+        for i, entry in enumerate(val):
+            yield Slot(root + (i, "value"), "tvalue")
+            key = "axis" if "axis" in entry else "plane"
+            direction = entry[key]
+            if isinstance(direction, list):
+                for j in range(len(direction)):
+                    yield Slot(root + (i, key, j), "tdirection")
+            else:
+                yield Slot(root + (i, key), "tdirection")
+    else:  # components, eigenvalues, solves: every leaf of the value
+        for slot in walk(val, root):
+            yield Slot(slot.path, "tvalue")
+
+
+def _tensor_names(ctx: Context) -> dict:
+    """The part's names at one random rational instance (numbers: building a statement
+    from the generic objects can take minutes), cached on the context."""
+    if not hasattr(ctx, "_mutation_names"):
+        from mechbook.verify.instances import branches, generic_symbols, rational_point
+        from mechbook.verify.quantities.tensors import _names
+
+        branch = branches(ctx.part.data.get("for_all") or {})[0]
+        point = rational_point(ctx.sampler, generic_symbols(branch))
+        ctx._mutation_names = _names(ctx, branch, point)
+    return ctx._mutation_names
+
+
+def _tparse(ctx: Context, text, names: dict):
+    from mechbook.model.tensorexpr import parse_tensor
+
+    return parse_tensor(text, names, ctx.bodies)
+
+
+def _scalar_names(ctx: Context, names: list[str]) -> list[str]:
+    table = _tensor_names(ctx)
+    return [n for n in names if n in table and not isinstance(table[n], sp.MatrixBase)]
+
+
+def tensor_mutants(ctx: Context, slot: Slot, value, names: list[str]) \
+        -> Iterator[tuple[str, object]]:
+    """Wrong versions of a tensor part's value, of the right kind (a scalar stays a
+    scalar, a tensor a tensor), so that a mutant is a wrong statement, never a malformed
+    one."""
+    table = _tensor_names(ctx)
+    scalars = _scalar_names(ctx, names)
+    if slot.kind == "tequation":
+        from mechbook.model.tensorexpr import parse_tensor_equation
+
+        sides = split_equation(str(value))
+        lhs, rhs = sides
+        left, _ = parse_tensor_equation(str(value), _with_xyz(ctx, table), ctx.bodies)
+        zero = {"scalar": "1", "vector": "[1, 2, 3]", "tensor": "unit()"}[kind(left)]
+        for side, build in ((lhs, lambda x: f"{x} = {rhs}"), (rhs, lambda x: f"{lhs} = {x}")):
+            flipped = flip_first_sign(side)
+            if flipped:
+                yield "flip sign of a term", build(flipped)
+                break
+        for side, build in ((lhs, lambda x: f"{x} = {rhs}"), (rhs, lambda x: f"{lhs} = {x}")):
+            doubled = double_first_term(side)
+            if doubled:
+                yield "double a term", build(doubled)
+                break
+        yield "double right side", f"{lhs} = 2*({rhs})"
+        yield "add to the left side", f"{lhs} + {zero} = {rhs}"
+        yield from swap_names(str(value), scalars)
+        return
+    old = _tparse(ctx, value, _with_xyz(ctx, table))
+    what = kind(old)
+    s = str(value)
+    if slot.kind == "tdirection":  # a component of an axis, or a whole axis
+        if what == "scalar":
+            yield "double", f"2*({s})"
+            yield "add one", f"({s}) + 1"
+        else:
+            yield "add a vector", f"({s}) + [1, 2, 3]"
+        return
+    if what == "scalar":
+        yield from expression_mutants(s, scalars)
+    elif what == "vector":
+        yield "negate", f"-({s})"
+        yield "add a vector", f"({s}) + [1, 2, 3]"
+    else:
+        yield "negate", f"-({s})"
+        yield "double", f"2*({s})"
+        yield "add the unit tensor", f"({s}) + unit()"
+
+
+def _with_xyz(ctx: Context, table: dict) -> dict:
+    """An ellipsoid's equation also names x, y, z."""
+    if ctx.part.quantity != "inertia_ellipsoid":
+        return table
+    out = dict(table)
+    out.update({c: sp.Symbol(c, real=True) for c in "xyz" if c not in out})
+    return out
+
+
+def _flat(value) -> list:
+    return list(value) if isinstance(value, sp.MatrixBase) else [value]
+
+
+def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
+    """The mutant says the same thing: the same value; the same direction (an axis given
+    up to scale); the same equation up to a constant factor."""
+    if str(old) == str(new):
+        return True
+    table = _with_xyz(ctx, _tensor_names(ctx))
+    if slot.kind == "tequation":
+        from mechbook.model.tensorexpr import parse_tensor_equation
+
+        b = [x - y for x, y in zip(*map(_flat, parse_tensor_equation(str(new), table,
+                                                                     ctx.bodies)),
+                                   strict=True)]
+        if ctx.part.quantity == "identity":  # the original holds identically: so must this
+            if any(_numerically_nonzero(y) for y in b):  # cheap, and settles most mutants
+                return False
+            return all(_zero(y) for y in b)
+        a = [x - y for x, y in zip(*map(_flat, parse_tensor_equation(str(old), table,
+                                                                     ctx.bodies)),
+                                   strict=True)]
+        if all(_zero(x - y) for x, y in zip(a, b, strict=True)):
+            return True
+        nonzero = [i for i, x in enumerate(a) if not _zero(x)]
+        if not nonzero:
+            return all(_zero(y) for y in b)
+        ratio = b[nonzero[0]] / a[nonzero[0]]
+        every = set().union(*(e.free_symbols for e in a + b))
+        return _free_of(ratio, every) and all(_zero(y - ratio * x)
+                                              for x, y in zip(a, b, strict=True))
+    if slot.kind == "tdirection" and isinstance(slot.path[-1], int):
+        entry = get(ctx.part.data, slot.path[:-1])
+        u = [_tparse(ctx, x, table) for x in entry]
+        v = [_tparse(ctx, new if j == slot.path[-1] else x, table) for j, x in enumerate(entry)]
+        return all(_zero(u[i] * v[j] - u[j] * v[i]) for i in range(3) for j in range(i + 1, 3))
+    a, b = _flat(_tparse(ctx, old, table)), _flat(_tparse(ctx, new, table))
+    if any(_numerically_nonzero(y - x) for x, y in zip(a, b, strict=True)) and \
+            slot.kind != "tdirection":
+        return False
+    if slot.kind == "tdirection":
+        return all(_zero(a[i] * b[j] - a[j] * b[i]) for i in range(3) for j in range(i + 1, 3))
+    return all(_zero(y - x) for x, y in zip(a, b, strict=True))
+
+
 # ---- (b) the mutation test ------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def analyses() -> dict:
@@ -559,16 +721,21 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict)
         except UnsupportedError:
             continue
         checked_parts += 1
-        coordinate = ctx.system.coord_names[0]
+        coordinate = ctx.system.coord_names[0] if ctx.system is not None else ""
         for slot in part_slots:
             old = get(part.data, slot.path)
             count = 0
-            for label, new in mutants(slot, old, names, coordinate):
+            made = (tensor_mutants(ctx, slot, old, names) if ctx.tensor_mode else
+                    mutants(slot, old, names, coordinate))
+            for label, new in made:
                 if count >= MAX_MUTANTS_PER_SLOT:
                     break
                 if "limit" in part.data and label == "add one" and str(old) != "0":
                     continue  # a lower-order term does not change an asymptotic formula
-                if same_meaning(ctx, slot, part.data, old, new):
+                if "estimate" in part.data and label in ("add one", "add the unit tensor"):
+                    continue  # below the book's precision at its scale (moments ~ 1e37)
+                if (tensor_same_meaning(ctx, slot, old, new) if ctx.tensor_mode else
+                        same_meaning(ctx, slot, part.data, old, new)):
                     continue
                 count += 1
                 tried += 1

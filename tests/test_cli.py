@@ -61,7 +61,7 @@ def test_list_marks_invalid_files(tmp_path):
     (tmp_path / "problems" / "lim").mkdir(parents=True)
     (tmp_path / "problems" / "lim" / "2099.yaml").write_text("id: lim-2099\nfoo: [\n")
     result = run("--root", str(tmp_path), "list")
-    assert result.exit_code == 0
+    assert result.exit_code == 1  # listed, marked, and the status says something is wrong
     assert "lim-2099" in result.output
     assert "INVALID" in result.output
     assert "no answer key" in result.output

@@ -1,11 +1,22 @@
 """The application on top: checking problems in batches, the HDF5 store, the command line.
 
     run          checking one problem (what a worker does), plain data out
-    batch        a pool of worker processes with time and memory limits
+    batch        a pool of worker processes with time and memory limits (any task)
+    simrun       `mechbook simulate` in a worker, under the same limits
+    distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
+    sweep        `mechbook sweep`: a result over a grid of parameters (sweep_accuracy:
+                 float64 against 30 digits; sweep_book: the book's answer on the grid;
+                 sweep_io: store and netCDF; sweep_plot; sweep_text: what it prints)
     store        the HDF5 store, written atomically under a lock
     fingerprint  content hashes for the warm-run cache
     validate     `mechbook validate`
+    limits       the batch's default limits (light: the command line's --help shows them)
     cli          the `mechbook` command (imports the engine only inside commands)
+    api          the Python API: mechbook.load(id) -> derived results as SymPy objects
+    mathml       SymPy expressions as MathML (the report, notebooks)
+    formats      check results as JSON (schemas/check-result.json) and JUnit XML
+    frames       the store as pandas DataFrames: mechbook.results(path)
+    report/      `mechbook report`: the static HTML report
 
 May import: everything in mechbook.
 """

@@ -9,6 +9,11 @@ also replaced after `max_tasks` problems, so memory SymPy caches do not grow wit
 Results are handed to `on_done` as each problem finishes (the CLI stores them at once: the
 parent is the store's only writer), and returned in the order the ids were given.
 
+The same machinery runs other work under the same limits: `task` (a module-level function
+of (item, base, options, stage), so workers can import it) replaces the problem check and
+`failed` makes the result of an item stopped from outside; `mechbook simulate` and the fuzz
+harness (tests/fuzz) use it that way.
+
 Why not concurrent.futures or pebble: a per-task kill with the task's last stage, a memory
 bound read from /proc, and stage messages streamed while a task runs are the point of this
 module, and neither offers all three; the loop below is the whole of it.
@@ -19,15 +24,18 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
+from typing import Any
 
-from mechbook.app.run import ProblemRun, RunOptions
+from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.run import ProblemRun, RunOptions, Stage
 
-DEFAULT_TIMEOUT = 600.0  # seconds per problem; the slowest takes well under a minute
-DEFAULT_MEMORY_MB = 8000  # resident memory per worker
+Task = Callable[[Any, Path, Any, Stage], Any]  # (item, base, options, stage) -> result
+Failed = Callable[[Any, str, float, str], Any]  # (item, why, seconds, stage) -> result
+
 MAX_TASKS = 20  # problems per worker before it is replaced
 POLL = 0.25  # seconds between checks of the limits
 
@@ -38,7 +46,7 @@ class BatchOptions:
     timeout: float = DEFAULT_TIMEOUT
     memory_mb: float = DEFAULT_MEMORY_MB
     max_tasks: int = MAX_TASKS
-    run: RunOptions = RunOptions()
+    run: Any = RunOptions()  # handed to the task (RunOptions for the problem check)
     serial: bool = False  # in the calling process, no limits (debugging)
 
     @property
@@ -46,21 +54,31 @@ class BatchOptions:
         return self.jobs if self.jobs > 0 else (os.cpu_count() or 1)
 
 
-def _worker(conn: Connection, base: Path, options: RunOptions) -> None:
-    """A worker's loop: receive an id, check it, send stages and then the result."""
+def check_problem(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
+    """The default task: check one problem (mechbook.app.run)."""
     from mechbook.app.run import run_problem
 
+    return run_problem(pid, base, options, stage=stage)
+
+
+def problem_failed(pid: str, why: str, seconds: float, stage: str) -> ProblemRun:
+    """The default result of a problem stopped from outside."""
+    return ProblemRun(pid, error=why, seconds=seconds, stage=stage)
+
+
+def _worker(conn: Connection, base: Path, options: Any, task: Task) -> None:
+    """A worker's loop: receive an item, run the task on it, send stages and the result."""
     while True:
         try:
-            pid = conn.recv()
+            item = conn.recv()
         except (EOFError, KeyboardInterrupt):
             return
-        if pid is None:
+        if item is None:
             return
         try:
-            run = run_problem(pid, base, options, stage=lambda text, pid=pid:
-                              conn.send(("stage", pid, text)))
-            conn.send(("done", pid, run))
+            result = task(item, base, options, lambda text, item=item:
+                          conn.send(("stage", item, text)))
+            conn.send(("done", item, result))
         except (BrokenPipeError, ConnectionResetError, EOFError):
             return  # the parent is gone (killed): nobody to report to
 
@@ -69,7 +87,7 @@ def _worker(conn: Connection, base: Path, options: RunOptions) -> None:
 class _Slot:
     process: mp.process.BaseProcess
     conn: Connection
-    pid: str | None = None  # the problem it is working on
+    pid: Hashable | None = None  # the item (problem id) it is working on
     started: float = 0.0
     stage: str = ""
     tasks: int = 0
@@ -96,19 +114,22 @@ class Batch:
     """Check many problems on worker processes; see the module docstring."""
 
     def __init__(self, base: Path, options: BatchOptions = BatchOptions(),
-                 on_done: Callable[[ProblemRun], None] | None = None,
-                 on_start: Callable[[str], None] | None = None):
+                 on_done: Callable[[Any], None] | None = None,
+                 on_start: Callable[[Hashable], None] | None = None,
+                 task: Task = check_problem, failed: Failed = problem_failed):
         self.base = base
         self.options = options
         self.on_done = on_done or (lambda run: None)
         self.on_start = on_start or (lambda pid: None)
+        self.task = task
+        self.failed = failed
         self._ctx = _context()
         self._slots: list[_Slot] = []
 
     def _spawn(self) -> _Slot:
         parent, child = self._ctx.Pipe()
-        proc = self._ctx.Process(target=_worker, args=(child, self.base, self.options.run),
-                                 daemon=True)
+        proc = self._ctx.Process(target=_worker, daemon=True,
+                                 args=(child, self.base, self.options.run, self.task))
         proc.start()
         child.close()
         return _Slot(proc, parent)
@@ -127,12 +148,13 @@ class Batch:
             slot.process.join()
         slot.conn.close()
 
-    def run(self, ids: list[str]) -> list[ProblemRun]:
-        """Check `ids` (in the order given: put the longest first); results in that order."""
+    def run(self, ids: list[Hashable]) -> list[Any]:
+        """Run the task on `ids` (distinct; in the order given: put the longest first);
+        results in that order."""
         if self.options.serial:
             return self._serial(ids)
         todo = list(ids)
-        done: dict[str, ProblemRun] = {}
+        done: dict[Hashable, Any] = {}
         try:
             self._slots = [self._spawn() for _ in range(min(self.options.workers, len(todo)))]
             while len(done) < len(ids):
@@ -144,19 +166,17 @@ class Batch:
             self._slots = []
         return [done[pid] for pid in ids]
 
-    def _serial(self, ids: list[str]) -> list[ProblemRun]:
+    def _serial(self, ids: list[Hashable]) -> list[Any]:
         """In this process, one after another: no limits, but a debugger can follow."""
-        from mechbook.app.run import run_problem
-
         out = []
         for pid in ids:
             self.on_start(pid)
-            run = run_problem(pid, self.base, self.options.run)
+            run = self.task(pid, self.base, self.options.run, lambda text: None)
             self.on_done(run)
             out.append(run)
         return out
 
-    def _assign(self, todo: list[str]) -> None:
+    def _assign(self, todo: list[Hashable]) -> None:
         for i, slot in enumerate(self._slots):
             if slot.pid is not None or not todo:
                 continue
@@ -168,7 +188,7 @@ class Batch:
             slot.conn.send(slot.pid)
             self.on_start(slot.pid)
 
-    def _collect(self, done: dict[str, ProblemRun]) -> None:
+    def _collect(self, done: dict[Hashable, Any]) -> None:
         busy = [s for s in self._slots if s.pid is not None]
         ready = wait([s.conn for s in busy] + [s.process.sentinel for s in busy], POLL)
         for slot in busy:
@@ -186,7 +206,7 @@ class Batch:
             if why:
                 self._fail(slot, done, f"{why} while in stage: {slot.stage}")
 
-    def _read(self, slot: _Slot, done: dict[str, ProblemRun]) -> None:
+    def _read(self, slot: _Slot, done: dict[Hashable, Any]) -> None:
         try:
             while slot.conn.poll():
                 kind, pid, payload = slot.conn.recv()
@@ -205,10 +225,9 @@ class Batch:
             self._fail(slot, done, f"the worker process died ({how}) while in stage: "
                        f"{slot.stage}")
 
-    def _fail(self, slot: _Slot, done: dict[str, ProblemRun], why: str) -> None:
+    def _fail(self, slot: _Slot, done: dict[Hashable, Any], why: str) -> None:
         pid = slot.pid
-        run = ProblemRun(pid, error=why, seconds=time.monotonic() - slot.started,
-                         stage=slot.stage)
+        run = self.failed(pid, why, time.monotonic() - slot.started, slot.stage)
         self._retire(slot, kill=True)
         i = self._slots.index(slot)
         self._slots[i] = self._spawn()

@@ -1,4 +1,10 @@
-"""The `mechbook` command line: list, solve, check, validate, show, simulate."""
+"""The `mechbook` command line: list, solve, check, validate, show, simulate, sweep, report,
+completion.
+
+Only click and a few small modules are imported at the top: --help, list, shell completion
+and argument errors answer without loading SymPy, NumPy or the engine, which each command
+imports when it runs (a test keeps it so; docs/performance.md has the timing).
+"""
 
 from __future__ import annotations
 
@@ -8,14 +14,25 @@ from pathlib import Path
 import click
 
 from mechbook import __version__
-from mechbook.app.batch import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
-from mechbook.app.console import Progress, print_table
+from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, answer_path, problem_path, root
 
-# The engine (SymPy, SciPy) is imported inside the commands that need it, so --help, list
-# and argument errors answer at once.
 DEFAULT_PATH = DEFAULT_STORE
+SHELLS = ("bash", "zsh", "fish")
+
+
+def _complete_ids(ctx: click.Context, param: click.Parameter, incomplete: str) -> list:
+    """Shell completion of problem ids: the files under the tree's problems/ (no engine)."""
+    from click.shell_completion import CompletionItem
+
+    try:
+        opt = ctx.find_root().params.get("root_dir")
+        base = Path(opt) if opt else root()
+        ids = all_ids(base)
+    except (MechbookError, OSError):
+        return []
+    return [CompletionItem(pid) for pid in ids if pid.startswith(incomplete)]
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -42,46 +59,65 @@ def _resolve_root(ctx: click.Context) -> Path:
 @main.command("list")
 @click.pass_context
 def list_cmd(ctx: click.Context) -> None:
-    """List every problem with its title and number of answer parts."""
-    from mechbook.model.problem import load_problem
+    """List every problem with its title and number of answer parts; an invalid file is
+    marked INVALID with the reason (and the exit status is 1).
+
+    Reads the files' YAML (under the input limits) and the problem schema only (fast, no
+    engine): `mechbook validate` checks every expression."""
+    from mechbook.model.books import file_id_error
+    from mechbook.model.schema import validate
+    from mechbook.model.yamlio import load
 
     base = _resolve_root(ctx)
+    invalid = 0
     for pid in all_ids(base):
         try:
-            p = load_problem(problem_path(pid, base))
-            title = p.title
+            doc = load(problem_path(pid, base))
+            validate(doc, "problem")
+            why = file_id_error(doc.data["id"], problem_path(pid, base))
+            if why:
+                raise doc.error(("id",), why)
+            title = doc.data["title"]
         except MechbookError as exc:
             title = f"INVALID: {exc}"
-        apath = answer_path(pid, base)
+            invalid += 1
         parts = "no answer key"
-        if apath.exists():
-            from mechbook.verify.answers import load_answers
-            try:
-                parts = f"{len(load_answers(apath).parts)} parts"
-            except MechbookError:
-                parts = "INVALID answer key"
+        try:
+            apath = answer_path(pid, base)
+            if apath.exists():
+                found = load(apath).data.get("parts")
+                if isinstance(found, list):
+                    parts = f"{len(found)} parts"
+                else:
+                    parts = "INVALID answer key"
+                    invalid += 1
+        except MechbookError:
+            parts = "INVALID answer key"
+            invalid += 1
         click.echo(f"{pid:<22} {parts:<16} {title}")
+    if invalid:
+        click.echo(f"{invalid} invalid file(s)", err=True)
+        sys.exit(1)
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--system", default=None, help="Which system of a multi-system problem.")
 @click.option("--no-simplify", is_flag=True, help="Skip SymPy simplification (faster).")
 @click.pass_context
 def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: bool) -> None:
     """Derive and print a problem's results (what its `compute:` asks for), simplified."""
-    from mechbook.engine.analysis import Analysis
-    from mechbook.engine.derive import derive
-    from mechbook.model.problem import load_problem
+    from mechbook.app.api import load
+    from mechbook.engine.derive import declared_results, derive
+    from mechbook.model.declared import declared
 
     base = _resolve_root(ctx)
     try:
-        problem = load_problem(problem_path(problem_id, base))
-        analysis = Analysis(problem, simplify=not no_simplify)
-        names = [system] if system else list(problem.systems)
+        problem = load(problem_id, base, simplify=not no_simplify)
+        names = [system] if system else problem.systems
         click.echo(f"{problem.id}: {problem.title}  [{problem.source}]")
         for name in names:
-            res = derive(analysis, name)
+            res = derive(problem.analysis, name)
             if len(problem.systems) > 1:
                 click.echo(f"\n== system {name}")
             for key, text in res.text.items():
@@ -90,12 +126,19 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
                 click.echo(f"{key} (numeric, default parameters):\n    {arr.tolist()}")
             for key, text in res.notes.items():
                 click.echo(f"{key}: {text}")
+        if not names or any(k in problem.model.doc.data for k in ("vectors", "tensors",
+                                                                 "bodies")):
+            declared(problem.model)  # a problem's own vectors, tensors and bodies
+            res = declared_results(problem.analysis)
+            click.echo("\n== declared vectors, tensors and bodies")
+            for key, text in res.text.items():
+                click.echo(f"{key}:\n    {text}")
     except (MechbookError, KeyError) as exc:
         raise click.ClickException(str(exc)) from None
 
 
 @main.command()
-@click.argument("problem_ids", nargs=-1)
+@click.argument("problem_ids", nargs=-1, shell_complete=_complete_ids)
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to write results to.")
 @click.option("--no-store", is_flag=True, help="Do not write results.")
@@ -121,10 +164,21 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
                    "also try a symbolic proof with SymPy; the method column says which it got.")
 @click.option("--prove-seconds", type=click.FloatRange(min=0, min_open=True), default=10.0,
               show_default=True, help="Time limit of each symbolic proof attempt.")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Run the problems on the Dask cluster whose scheduler is at ADDRESS "
+                   "(tcp://host:8786; default $MECHBOOK_SCHEDULER, else the local pool). "
+                   "The limits hold per problem on the workers.")
+@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
+              show_default=True,
+              help="table: for people; json: one JSON document on stdout (its schema: "
+                   "mechbook/app/schemas/check-result.json), progress stays on stderr.")
+@click.option("--junit-xml", "junit_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Also write the outcomes as JUnit XML here (for CI).")
 @click.pass_context
 def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no_store: bool,
           verbose: bool, fresh: bool, no_crosscheck: bool, jobs: int, timeout: float,
-          memory_mb: float, serial: bool, prove: bool, prove_seconds: float) -> None:
+          memory_mb: float, serial: bool, prove: bool, prove_seconds: float,
+          scheduler: str | None, fmt: str, junit_path: Path | None) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail.
 
     Problems run in parallel worker processes, the longest first; each finished problem is
@@ -133,8 +187,12 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     frequency part's linear system is confirmed by simulating the nonlinear equations along
     every mode, and each system's Lagrange equations against Newton's law
     (docs/numerics.md); a cross-check fail also exits 1."""
+    import json
+
     from mechbook.app.batch import Batch, BatchOptions
-    from mechbook.app.run import RunOptions, cached_runs
+    from mechbook.app.console import Progress, print_table
+    from mechbook.app.formats import failures, to_json, write_junit
+    from mechbook.app.run import ProblemRun, RunOptions, cached_runs
     from mechbook.app.store import durations, write
     from mechbook.records import ProofPolicy
 
@@ -142,15 +200,20 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     ids = list(problem_ids) or all_ids(base)
     if not ids:
         raise click.ClickException(f"no problems under {base / 'problems'}")
+    refused: dict[str, ProblemRun] = {}  # files found under problems/ with unusable names
     for pid in ids:
         try:
             if not problem_path(pid, base).exists():
                 raise click.ClickException(f"no problem {pid} (no file "
                                            f"{problem_path(pid, base)})")
         except MechbookError as exc:
-            raise click.ClickException(str(exc)) from None
+            if problem_ids:
+                raise click.ClickException(str(exc)) from None
+            refused[pid] = ProblemRun(pid, error=str(exc))
     store_file = store_path if store_path.is_absolute() else base / store_path
-    runs = {} if (fresh or no_store) else cached_runs(ids, base, store_file, not no_crosscheck)
+    good = [pid for pid in ids if pid not in refused]
+    runs = {} if (fresh or no_store) else cached_runs(good, base, store_file, not no_crosscheck)
+    runs.update(refused)
     progress = Progress(len(ids), 0)
     for pid in ids:
         if pid in runs:
@@ -166,18 +229,30 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
                   key=lambda pid: -past.get(pid, float("inf")))
     options = BatchOptions(jobs, timeout, memory_mb, serial=serial, run=RunOptions(
         crosscheck=not no_crosscheck, policy=ProofPolicy(prove, prove_seconds)))
+    from mechbook.app.distributed import ClusterBatch, scheduler_address
+
+    address = None if serial else scheduler_address(scheduler)
     try:
-        for run in Batch(base, options, on_done=finished).run(todo):
+        batch = ClusterBatch(address, base, options, on_done=finished) if address and todo \
+            else Batch(base, options, on_done=finished)
+        for run in batch.run(todo):
             runs[run.pid] = run
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
     finally:
         progress.close()
     ordered = [runs[pid] for pid in ids]
-    print_table(ordered, verbose)
-    if not no_store and any(r.record is not None for r in ordered):
-        click.echo(f"results written to {store_file}")
-    bad = sum(1 for r in ordered if r.error) + sum(1 for r in ordered for o in r.outcomes
-                                                   if o.status in ("fail", "error"))
-    bad += sum(1 for r in ordered for x in r.crosschecks if x.failed)
+    stored = not no_store and any(r.record is not None or r.cached for r in ordered)
+    if fmt == "json":
+        doc = to_json(ordered, base, store_file if stored else None)
+        click.echo(json.dumps(doc, indent=1, ensure_ascii=False))
+    else:
+        print_table(ordered, verbose)
+        if not no_store and any(r.record is not None for r in ordered):
+            click.echo(f"results written to {store_file}")
+    if junit_path is not None:
+        click.echo(f"JUnit XML written to {write_junit(ordered, junit_path)}", err=True)
+    bad = failures(ordered)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
         sys.exit(1)
@@ -202,18 +277,21 @@ def validate(files: tuple[Path, ...]) -> None:
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to read.")
 @click.pass_context
 def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     """Print a problem's stored results and checks, read back from the HDF5 store."""
     from mechbook.app.store import read
+    from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
     path = store_path if store_path.is_absolute() else base / store_path
     try:
-        rec = read(problem_id, path)
+        rec = read(check_id(problem_id), path)
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
     except (FileNotFoundError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
     a = rec["attrs"]
@@ -241,10 +319,14 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
                        f"parts: {parts}] {x.get('detail', '')}")
     for name in rec.get("simulations", []):
         click.echo(f"simulation stored: /problems/{problem_id}/simulations/{name}")
+    from mechbook.app.sweep_io import stored_sweeps
+
+    for name, text in stored_sweeps(problem_id, path):
+        click.echo(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")
 
 
 @main.command()
-@click.argument("problem_id")
+@click.argument("problem_id", shell_complete=_complete_ids)
 @click.option("--system", default=None, help="Which system of a multi-system problem.")
 @click.option("--method", default=None,
               type=click.Choice(["RK45", "DOP853", "Radau", "LSODA", "RK4", "leapfrog",
@@ -281,58 +363,215 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to store the run in.")
 @click.option("--no-store", is_flag=True, help="Do not store the run.")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
+              default=DEFAULT_TIMEOUT, show_default=True,
+              help="Wall-clock seconds allowed for the run (loading, deriving, integrating, "
+                   "plotting); past it the run is stopped and reported with its stage.")
+@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+              show_default=True, help="Resident memory (MB) allowed for the run (0: no bound).")
+@click.option("--serial", is_flag=True,
+              help="Run in this process, without time or memory limits (for a debugger).")
 @click.pass_context
 def simulate(ctx: click.Context, problem_id: str, system: str | None, method: str | None,
              accuracy: float | None, params: tuple[str, ...], rtol: float | None,
              atol: float | None, max_step: float | None,
              step: float | None, t_end: float, points: int, init: tuple[str, ...],
              backend: str | None, plot_path: Path | None, name: str | None,
-             store_path: Path, no_store: bool) -> None:
+             store_path: Path, no_store: bool, timeout: float, memory_mb: float,
+             serial: bool) -> None:
     """Integrate a problem's full nonlinear equations of motion; report the drift of every
-    conserved quantity the engine found; store the trajectory (and plot it)."""
+    conserved quantity the engine found; store the trajectory (and plot it). The run has a
+    time limit and a memory bound (a worker process stopped from outside when it exceeds
+    either); exceeding one is reported with the stage the run was in, exit status 1."""
+    from mechbook.app.simrun import SimRequest, run_simulation
     from mechbook.app.store import write_simulation
-    from mechbook.core.compile import DEFAULT_BACKEND
-    from mechbook.engine.analysis import Analysis
-    from mechbook.model.problem import load_problem
-    from mechbook.numerics.simulate import parse_assignments
-    from mechbook.numerics.simulate import simulate as run_simulation
+    from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
     try:
-        problem = load_problem(problem_path(problem_id, base))
-        analysis = Analysis(problem)
-        sim = run_simulation(analysis, system, init=parse_assignments(init),
-                             t_span=(0.0, t_end), method=method, points=points,
-                             backend=backend or DEFAULT_BACKEND, accuracy=accuracy,
-                             parameters=parse_assignments(params), rtol=rtol, atol=atol,
-                             max_step=max_step, step=step)
-    except (MechbookError, KeyError) as exc:
-        raise click.ClickException(str(exc).strip("'\"")) from None
-    traj = sim.trajectory
-    click.echo(f"{problem.id} [{sim.system}]: {problem.title}")
-    click.echo("initial: " + ", ".join(f"{k}={v:.6g}" for k, v in sim.initial.items())
-               + f"  ({sim.initial_source})")
-    if sim.choice:
-        click.echo(f"accuracy: {sim.choice}")
-    click.echo("method: " + ", ".join(f"{k}={v}" for k, v in traj.settings.items())
-               + f"; {traj.nfev} evaluations, {len(traj.t)} samples, {sim.seconds:.2f} s "
-               f"(RHS: {sim.model.backend}, generated in {sim.model.generation_seconds:.3f} s)")
-    for note in sim.notes:
-        click.echo(f"note: {note}")
-    if sim.drifts:
-        for d in sim.drifts:
-            click.echo("drift of " + d.summary())
-    else:
-        click.echo("no conserved quantity found by the engine: nothing to monitor")
+        check_id(problem_id)
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
+    request = SimRequest(problem_id, system, method, accuracy, tuple(params), rtol, atol,
+                         max_step, step, t_end, points, tuple(init), backend,
+                         str(plot_path) if plot_path is not None else None)
+    report = run_simulation(request, base, timeout, memory_mb, serial)
+    if report.error:
+        raise click.ClickException(report.error)
+    for line in report.lines:
+        click.echo(line)
     if not no_store:
         path = store_path if store_path.is_absolute() else base / store_path
-        run_name = name or f"{sim.system}-{traj.method}"
-        write_simulation(problem.id, run_name, sim.arrays(), sim.settings(),
-                         {f"monitors/{d.name}": d.attrs() for d in sim.drifts}, path)
-        click.echo(f"stored as /problems/{problem.id}/simulations/{run_name} in {path}")
-    if plot_path is not None:
-        from mechbook.numerics.plot import plot_simulation
-
-        click.echo(f"plot written to {plot_simulation(sim, plot_path)}")
-    if not traj.success:
+        run_name = name or f"{report.system}-{report.method}"
+        write_simulation(report.problem_id, run_name, report.arrays, report.settings,
+                         report.array_attrs, path)
+        click.echo(f"stored as /problems/{report.problem_id}/simulations/{run_name} in {path}")
+    if report.plot is not None:
+        click.echo(f"plot written to {report.plot}")
+    if not report.success:
         sys.exit(1)
+
+
+@main.command()
+@click.argument("problem_id", shell_complete=_complete_ids)
+@click.option("--param", "params", multiple=True, required=True, metavar="NAME=LO:HI:N[:log]",
+              help="A swept parameter: N values from LO to HI (evenly; ':log' evenly in log). "
+                   "Repeat for a plane or more; the others stay at their values (N=1 fixes "
+                   "one: k=2:2:1). For --quantity drift one must be 'amplitude'.")
+@click.option("--quantity", type=click.Choice(["frequencies", "stability", "drift"]),
+              default="frequencies", show_default=True,
+              help="frequencies: the normal frequencies; stability: stable / marginal / "
+                   "unstable and the growth rate; drift: the frequency measured from the "
+                   "nonlinear motion at each amplitude against the linear one.")
+@click.option("--system", default=None, help="Which system of a multi-system problem.")
+@click.option("--about", multiple=True, metavar="COORD=EXPR",
+              help="The equilibrium to linearize about (theta=pi); default: the stable one.")
+@click.option("--steady", multiple=True, metavar="COORD=RATE",
+              help="A steady motion: a cyclic coordinate turning at RATE (with --about for "
+                   "the others), reduced by Routh's procedure.")
+@click.option("--part", default=None,
+              help="Take the point (and the book's answer drawn over) from this answer part.")
+@click.option("--backend", type=click.Choice(["llvm", "symengine", "sympy"]), default="llvm",
+              show_default=True, help="How M(p), C(p), K(p) are compiled.")
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Local worker processes for the blocks (1: this process).")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Evaluate the blocks on the Dask cluster at ADDRESS (default "
+                   "$MECHBOOK_SCHEDULER, else locally).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
+              default=DEFAULT_TIMEOUT, show_default=True,
+              help="Wall-clock seconds allowed per block on a cluster worker.")
+@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+              show_default=True, help="Resident memory (MB) allowed per cluster worker's block.")
+@click.option("--samples", type=click.IntRange(min=0), default=24, show_default=True,
+              help="Points where the float64 result is checked against 30 digits.")
+@click.option("--name", default=None, help="Name of the stored sweep (default QUANTITY-AXES).")
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 store to add the sweep to.")
+@click.option("--no-store", is_flag=True, help="Do not store the sweep.")
+@click.option("--out", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write the sweep to this netCDF-4 file (named dimensions); a "
+                                 "sweep too large for the store goes to results/sweeps/ anyway.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="Write the figure here (PNG, SVG, PDF by suffix).")
+@click.pass_context
+def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity: str,
+          system: str | None, about: tuple[str, ...], steady: tuple[str, ...],
+          part: str | None, backend: str, jobs: int, scheduler: str | None, timeout: float,
+          memory_mb: float, samples: int, name: str | None, store_path: Path, no_store: bool,
+          out_path: Path | None, plot_path: Path | None) -> None:
+    """Map a problem's frequencies, stability or frequency drift over a grid of parameter
+    values: derived once, M(p), C(p), K(p) compiled once, every point's eigenproblem solved
+    in stacked batches; the float64 result is checked against 30 digits at sampled points
+    and the book's answer at the same point is drawn over (and compared)."""
+    from mechbook.app.distributed import scheduler_address
+    from mechbook.app.sweep import make_spec, run_sweep
+    from mechbook.app.sweep_io import STORE_POINTS, write_netcdf, write_store
+    from mechbook.app.sweep_text import summary
+    from mechbook.engine.sweep import parse_axis
+
+    base = _resolve_root(ctx)
+
+    def pairs(items: tuple[str, ...], what: str) -> dict[str, str]:
+        out = {}
+        for item in items:
+            key, sep, val = item.partition("=")
+            if not sep or not key.strip() or not val.strip():
+                raise click.BadParameter(f"{item!r}: expected NAME=EXPR", param_hint=what)
+            out[key.strip()] = val.strip()
+        return out
+
+    try:
+        axes = [parse_axis(p) for p in params]
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), param_hint="--param") from None
+    if (about or steady) and part:
+        raise click.UsageError("--part takes the point from the answer key: drop --about/"
+                               "--steady, or --part")
+    try:
+        spec = make_spec(problem_id, base, quantity, axes, system=system,
+                         about=pairs(about, "--about"), steady=pairs(steady, "--steady"),
+                         part=part, backend=backend)
+        result = run_sweep(spec, base, jobs=jobs, scheduler=scheduler_address(scheduler),
+                           timeout=timeout, memory_mb=memory_mb, samples=samples)
+    except (MechbookError, KeyError) as exc:
+        raise click.ClickException(str(exc).strip("'\"")) from None
+    for line in summary(result):
+        click.echo(line)
+    run_name = name or "-".join([quantity] + [a.name for a in axes])
+    big = result.attrs["points"] > STORE_POINTS
+    if out_path is None and big and not no_store:
+        out_path = base / "results" / "sweeps" / f"{problem_id}-{run_name}.nc"
+    if out_path is not None:
+        result.attrs["file"] = str(write_netcdf(result, out_path))
+        click.echo(f"written to {out_path} (netCDF-4, dimensions "
+                   f"{', '.join(result.coords)})")
+    if not no_store:
+        path = store_path if store_path.is_absolute() else base / store_path
+        write_store(result, run_name, path)
+        where = "its attributes and the file's path" if big else "stored"
+        click.echo(f"{where} as /sweeps/{problem_id}/{run_name} in {path}")
+    if plot_path is not None:
+        from mechbook.app.sweep_plot import plot_sweep
+
+        click.echo(f"plot written to {plot_sweep(result, plot_path)}")
+
+
+@main.command()
+@click.argument("problem_ids", nargs=-1, shell_complete=_complete_ids)
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=DEFAULT_PATH, show_default=True, help="HDF5 file to read outcomes from.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("results/report"), show_default=True,
+              help="Directory to write the report to (index.html and problems/).")
+@click.option("-j", "--jobs", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Worker processes (0: one per core).")
+@click.option("--serial", is_flag=True, help="Build the pages in this process.")
+@click.option("--seconds", type=click.FloatRange(min=0, min_open=True), default=20.0,
+              show_default=True, help="Time limit of each derivation step of a page.")
+@click.option("--simplify-seconds", type=click.FloatRange(min=0), default=3.0,
+              show_default=True,
+              help="Time limit of simplifying each expression shown (0: show unsimplified).")
+@click.option("--no-simulate", is_flag=True, help="Leave out the simulated trajectories.")
+@click.option("--t-end", type=click.FloatRange(min=0, min_open=True), default=10.0,
+              show_default=True, help="End time of the simulated trajectories.")
+@click.pass_context
+def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, out_dir: Path,
+           jobs: int, serial: bool, seconds: float, simplify_seconds: float,
+           no_simulate: bool, t_end: float) -> None:
+    """Write a static HTML report (all problems by default): an index of every part's
+    outcome with filters, errata and unsupported parts, and one page per problem with the
+    derivation as mathematics, the book's value beside the engine's, cross-checks and
+    figures. Outcomes come from the store (`mechbook check` first); works offline."""
+    from mechbook.app.report.build import ReportOptions, build_report
+    from mechbook.app.report.page import PageOptions
+
+    base = _resolve_root(ctx)
+    ids = list(problem_ids) or all_ids(base)
+    for pid in ids:
+        try:
+            if not problem_path(pid, base).exists():
+                raise click.ClickException(f"no problem {pid}")
+        except MechbookError as exc:
+            raise click.ClickException(str(exc)) from None
+    store = store_path if store_path.is_absolute() else base / store_path
+    out = out_dir if out_dir.is_absolute() else base / out_dir
+    page = PageOptions(seconds=seconds, simplify_seconds=simplify_seconds,
+                       simplify_budget=30.0 if simplify_seconds > 0 else 0.0,
+                       simulate=not no_simulate, t_end=t_end)
+    index = build_report(base, store, out, ids, ReportOptions(jobs, serial, page),
+                         log=lambda text: click.echo(text, err=True))
+    click.echo(f"report written to {index}")
+
+
+@main.command()
+@click.argument("shell", type=click.Choice(SHELLS))
+def completion(shell: str) -> None:
+    """Print the shell completion script (commands, options, problem ids) for SHELL.
+
+    bash: eval "$(mechbook completion bash)" in ~/.bashrc; zsh: the same in ~/.zshrc;
+    fish: mechbook completion fish > ~/.config/fish/completions/mechbook.fish"""
+    from click.shell_completion import get_completion_class
+
+    cls = get_completion_class(shell)
+    click.echo(cls(main, {}, "mechbook", "_MECHBOOK_COMPLETE").source())

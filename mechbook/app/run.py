@@ -58,6 +58,7 @@ class RunOptions:
 def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
                 stage: Stage = _quiet) -> ProblemRun:
     """Check one problem against its answer key (and cross-check it), from scratch."""
+    from mechbook.app.validate import build_systems, part_faults
     from mechbook.crosscheck import crosscheck_problem
     from mechbook.engine.analysis import (
         Analysis,  # the engine: imported only where a problem is checked
@@ -80,6 +81,17 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
             raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem "
                                 f"file is {problem.id!r}")
         analysis = Analysis(problem)
+        stage("validating")  # a malformed file is refused whole: nothing is stored for it
+        build_systems(problem)
+        faults = part_faults(key, analysis)
+        if faults:  # each malformed part says where; the others are not checked
+            run.outcomes = [Outcome(problem.id, p.name, p.quantity, p.data["cite"], "error",
+                                    detail=faults[p.name], origin=p.data.get("origin", "book"))
+                            for p in key.parts if p.name in faults]
+            run.notes.append("the answer key is malformed: its other parts were not checked "
+                             "and nothing was stored")
+            run.seconds = time.perf_counter() - start
+            return run
         for part in key.parts:
             stage(f"part {part.name} ({part.quantity})")
             run.outcomes.append(check_part(analysis, part, options.policy))
@@ -110,9 +122,12 @@ def cached_runs(ids: list[str], base: Path, store: Path,
     engine unchanged): answered from the store without loading the engine."""
     wanted = {}
     for pid in ids:
-        ppath, apath = problem_path(pid, base), answer_path(pid, base)
-        if ppath.exists() and apath.exists():
-            wanted[pid] = (file_sha256(ppath), file_sha256(apath))
+        try:
+            ppath, apath = problem_path(pid, base), answer_path(pid, base)
+            if ppath.exists() and apath.exists():
+                wanted[pid] = (file_sha256(ppath), file_sha256(apath))
+        except MechbookError:
+            continue  # not a cache hit: the check itself reports what is wrong
     out = {}
     for pid, hit in cached(wanted, store, crosscheck).items():
         out[pid] = ProblemRun(pid, hit.outcomes, seconds=hit.duration, cached=True,

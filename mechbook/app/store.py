@@ -7,14 +7,19 @@ Layout (one group per problem, replaced whole on each run of that problem):
     /problems/<id>/systems/<s>/symbolic/<key>   UTF-8 string datasets
     /problems/<id>/systems/<s>/numeric/<key>    float arrays (default parameter values)
     /problems/<id>/systems/<s>/notes/<key>      why a result is missing
+    /problems/<id>/systems/_declared/...        the problem's declared vectors, tensors and
+                                                bodies (mass, centre of mass, inertia), if
+                                                a part used them
     /problems/<id>/checks/<part>   attrs: quantity, cite, status, method, detail, seconds
     /problems/<id>/crosschecks/<n> attrs: name, kind, system, status, error, detail, parts,
                                           seconds, modes (JSON); see mechbook/crosscheck.py
     /problems/<id>/simulations/<name>   attrs: the method's settings, initial conditions,
                                         parameters, RHS backend, drift of each monitor;
-                                        datasets t, q (n×N), qdot (n×N), monitors/<quantity>
-                                        (with attrs initial, max_abs_drift, relative_drift,
-                                        final_drift, drift_rate)
+                                        datasets t, coordinate (names), q (n×N), qdot (n×N),
+                                        monitors/<quantity> (with attrs initial,
+                                        max_abs_drift, relative_drift, final_drift,
+                                        drift_rate); t and coordinate are HDF5 dimension
+                                        scales, so xarray (h5netcdf) opens the group
 
 A run copies the current file, edits the copy and renames it over the original, so an
 interrupted run leaves the previous file whole and readable. Rewriting a problem's checks
@@ -50,6 +55,7 @@ if TYPE_CHECKING:
 DEFAULT_PATH = DEFAULT_STORE
 FORMAT = 1
 _STR = h5py.string_dtype("utf-8")
+_SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
 
 
 @dataclass
@@ -230,7 +236,36 @@ def write_simulation(pid: str, name: str, arrays: dict[str, np.ndarray], attrs: 
             d = s.create_dataset(key, data=np.asarray(arr, dtype=float), compression="gzip")
             for k, v in ((array_attrs or {}).get(key) or {}).items():
                 d.attrs[k] = _attr(v)
+        _dimension_scales(s, str(attrs.get("coordinates") or ""))
     return Path(path)
+
+
+def _dimension_scales(s: h5py.Group, coordinates: str) -> None:
+    """Label the axes of a stored trajectory with HDF5 dimension scales: `t` (the sample
+    times) and `coordinate` (the coordinates' names), so that netCDF readers (xarray with
+    h5netcdf) open the group as a dataset with q(coordinate, t), qdot(coordinate, t) and
+    each monitor(t)."""
+    if "t" not in s or s["t"].ndim != 1:
+        return
+    t = s["t"]
+    t.make_scale("t")
+    n = len(t)
+    names = [c for c in coordinates.split(",") if c]
+    coord = None
+    if names and all(s[k].shape == (len(names), n) for k in ("q", "qdot") if k in s):
+        coord = s.create_dataset("coordinate", data=np.array(names, dtype=object), dtype=_STR)
+        coord.make_scale("coordinate")
+
+    def attach(key: str, obj) -> None:
+        if not isinstance(obj, h5py.Dataset) or obj.name in (t.name, getattr(coord, "name", "")):
+            return
+        if obj.ndim == 1 and obj.shape[0] == n:
+            obj.dims[0].attach_scale(t)
+        elif obj.ndim == 2 and coord is not None and obj.shape == (len(names), n):
+            obj.dims[0].attach_scale(coord)
+            obj.dims[1].attach_scale(t)
+
+    s.visititems(attach)
 
 
 def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dict:
@@ -241,9 +276,10 @@ def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dic
                "array_attrs": {}}
 
         def visit(key, obj):
-            if isinstance(obj, h5py.Dataset):
+            if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
                 out["arrays"][key] = np.array(obj[()])
-                out["array_attrs"][key] = {k: _plain(v) for k, v in obj.attrs.items()}
+                out["array_attrs"][key] = {k: _plain(v) for k, v in obj.attrs.items()
+                                           if k not in _SCALE_ATTRS}
 
         s.visititems(visit)
     return out

@@ -5,15 +5,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, SpecError
 from mechbook.model.catalog import problem_path, root
+from mechbook.model.declared import declared
 from mechbook.model.problem import load_problem
 from mechbook.model.system import system_of
 from mechbook.model.yamlio import load
 from mechbook.verify.answers import load_answers
 from mechbook.verify.context import Context, strip_const
+from mechbook.verify.quantities.tensors import validate_part
 from mechbook.verify.registry import quantities
+
+BUILD_SECONDS = 15.0  # CPU; `validate` runs in the caller's process, so it bounds itself
 
 
 def validate_file(path: str | Path) -> str:
@@ -23,9 +28,17 @@ def validate_file(path: str | Path) -> str:
     if isinstance(doc.data, dict) and "parts" in doc.data:
         return _validate_answers(path)
     problem = load_problem(path)
-    for name in problem.systems:
-        system_of(problem, name)
-    return f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s))"
+    try:
+        with hard_time_limit(BUILD_SECONDS):
+            build_systems(problem)
+    except Timeout:
+        raise SpecError(f"building the problem's systems took more than {BUILD_SECONDS:g} s "
+                        "of CPU time (the book's problems take under 1 s): an expression is "
+                        "too large or too deep for the engine", str(path)) from None
+    decl = declared(problem)
+    return (f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s), "
+            f"{len(decl.vectors)} vector(s), {len(decl.tensors)} tensor(s), "
+            f"{len(decl.bodies)} body(ies))")
 
 
 def _validate_answers(path: Path) -> str:
@@ -34,20 +47,55 @@ def _validate_answers(path: Path) -> str:
         base = root(path.parent)
     except MechbookError:
         base = path.resolve().parents[2]
-    problem = load_problem(problem_path(key.problem_id, base))
-    analysis = Analysis(problem)
-    for part in key.parts:
-        ctx = Context(analysis, part)
-        q = quantities()[part.quantity]
-        names = q.names(ctx) if q.names else ctx.names
-        for field in ("book", "about", "initial", "released", "region", "time"):
-            if field == "book" and part.data.get("book") in q.literals:
-                continue
-            if field in part.data:
-                _walk(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
-        if "erratum" in part.data:
-            _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
+    try:
+        ppath = problem_path(key.problem_id, base)
+    except MechbookError as exc:
+        raise key.doc.error(("problem",), str(exc)) from None
+    problem = load_problem(ppath)
+    check_expressions(key, Analysis(problem))
     return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
+
+
+def build_systems(problem) -> None:
+    """Build every system of a problem (each expression parsed); SpecError on the first
+    fault."""
+    for name in problem.systems:
+        system_of(problem, name)
+
+
+def check_expressions(key, analysis: Analysis) -> None:
+    """Parse every expression of an answer key in its part's context; SpecError on the
+    first fault (file:line), before any part is checked."""
+    for part in key.parts:
+        check_part_expressions(part, analysis)
+
+
+def part_faults(key, analysis: Analysis) -> dict[str, str]:
+    """{part name: what is malformed} for every part whose expressions do not parse."""
+    faults = {}
+    for part in key.parts:
+        try:
+            check_part_expressions(part, analysis)
+        except SpecError as exc:
+            faults[part.name] = str(exc)
+    return faults
+
+
+def check_part_expressions(part, analysis: Analysis) -> None:
+    ctx = Context(analysis, part)
+    if ctx.tensor_mode:  # vectors, tensors, bodies: built once, nothing judged
+        validate_part(ctx)
+        return
+    q = quantities()[part.quantity]
+    names = q.names(ctx) if q.names else ctx.names  # a book value's extra names
+    for field in ("book", "about", "initial", "released", "region", "time", "hold", "signal",
+                  "event"):
+        if field == "book" and part.data.get("book") in q.literals:
+            continue  # a word such as "stable", not an expression
+        if field in part.data:
+            _walk(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
+    if "erratum" in part.data:
+        _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
 
 
 def _walk(ctx: Context, value, sub: tuple, names: dict) -> None:

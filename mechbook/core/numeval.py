@@ -29,6 +29,9 @@ class NotNumeric(ValueError):
     """The expression has a part this evaluator cannot give a number for."""
 
 
+_NOT_FINITE = (sp.zoo, sp.nan, sp.oo, -sp.oo)
+
+
 def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, float]:
     """(value, magnitude) of expr at `point`: magnitude bounds what cancelled in sums.
 
@@ -39,6 +42,15 @@ def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, fl
         pt = {k: _number(v) for k, v in point.items()}
         v, m = _walk(expr, pt, memo)
         return complex(v), float(m)
+
+
+def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
+    """expr at `point` as an mpmath number of `digits` digits (call inside a context of at
+    least that precision to keep them); errors as for `evaluate`."""
+    with mpmath.workdps(digits):
+        pt = {k: _number(v) for k, v in point.items()}
+        v, _ = _walk(expr, pt, {})
+        return v
 
 
 def _number(v):
@@ -71,6 +83,8 @@ def _node(e: sp.Basic, pt: dict, memo: dict):
             raise NotNumeric(f"no value for {e}")
         v = pt[e]
         return v, abs(v)
+    if e in _NOT_FINITE:  # zoo, nan, oo (d/dx 0**x = 0**x*log(0)): singular here
+        raise ValueError(f"{e} in the expression")
     if e.is_Number or e.is_NumberSymbol or e is sp.I:
         v = mpmath.mpmathify(complex(e)) if e is sp.I else mpmath.mpf(sp.Float(e, mpmath.mp.dps)
                                                                       ._mpf_)
@@ -156,8 +170,8 @@ def is_zero(expr: sp.Basic, points: int = 3, digits: int = 30, seed: int = 20261
         point = {s: sp.Float(rng.uniform(0.3, 1.3), digits) for s in symbols}
         try:
             v, m = evaluate(expr, point, digits)
-        except NotNumeric:
-            return False
+        except (NotNumeric, RecursionError):  # RecursionError: mpmath/SymPy on a hostile
+            return False  # tower of functions; every point would be as deep and as slow
         except (ZeroDivisionError, ValueError, TypeError, OverflowError):
             continue
         if not (abs(v) == abs(v) and m == m):  # NaN

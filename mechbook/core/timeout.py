@@ -1,11 +1,27 @@
-"""A wall-clock limit for SymPy calls that can run for ever (simplify, solve)."""
+"""Time limits for SymPy calls that can run for ever (simplify, solve), in CPU seconds.
+
+The limits count the CPU time of this process (ITIMER_VIRTUAL), not the wall clock: a
+search given 3 s gets 3 s of work whether the machine is idle or busy with other jobs, so
+what the engine finds within its limits does not depend on the machine's load (it still
+depends on the machine's speed). The wall-clock limit a user sets (`mechbook check
+--timeout`) is enforced from outside, by the batch.
+"""
 
 from __future__ import annotations
 
 import signal
 import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+
+try:
+    import resource
+except ImportError:  # not POSIX: no limits (see _usable), process_time as the clock
+    resource = None
+
+_TIMER = getattr(signal, "ITIMER_VIRTUAL", None)
+_SIGNAL = getattr(signal, "SIGVTALRM", None)
 
 
 class Timeout(BaseException):
@@ -13,24 +29,85 @@ class Timeout(BaseException):
     `except Exception` clauses cannot swallow it)."""
 
 
+def cpu_time() -> float:
+    """The clock the limits count: user CPU seconds of this process (what ITIMER_VIRTUAL
+    counts; process_time would add system time and run ahead of the timer)."""
+    if resource is None:
+        return time.process_time()
+    return resource.getrusage(resource.RUSAGE_SELF).ru_utime
+
+
+# The limits now running, outermost first: (deadline in CPU seconds, repeat interval).
+_ACTIVE: list[tuple[float, float]] = []
+
+
+def _raise(signum, frame):
+    raise Timeout("gave up: CPU time limit")
+
+
+def _usable() -> bool:
+    """A limit can be set: POSIX, main thread, and the timer not held by someone else."""
+    if _TIMER is None or threading.current_thread() is not threading.main_thread():
+        return False
+    return bool(_ACTIVE) or signal.getitimer(_TIMER)[0] == 0
+
+
+def _arm(deadline: float, interval: float) -> None:
+    signal.setitimer(_TIMER, max(deadline - cpu_time(), 1e-3), interval)
+
+
 @contextmanager
-def time_limit(seconds: float) -> Iterator[None]:
-    """Raise Timeout inside the block after `seconds` (main thread, POSIX; else no limit)."""
-    if seconds <= 0 or threading.current_thread() is not threading.main_thread() \
-            or not hasattr(signal, "setitimer") or signal.getitimer(signal.ITIMER_REAL)[0] > 0:
-        yield  # no timer here, or an outer limit is already running and governs
+def _limit(seconds: float, interval: float) -> Iterator[None]:
+    """Nested limits: the inner one counts while it is the sooner; when it is left, the
+    outer one's timer is set again to what remains of it (at once if it has run out, so
+    an inner `except Timeout` that swallowed the outer's alarm does not outlive it)."""
+    if seconds <= 0 or not _usable():
+        yield
         return
-
-    def _raise(signum, frame):
-        raise Timeout(f"gave up after {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, _raise)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    deadline = cpu_time() + seconds
+    if _ACTIVE and _ACTIVE[-1][0] <= deadline:
+        yield  # an outer limit runs out first and governs
+        return
+    with _quiet():  # the bookkeeping is not interrupted by an outer limit's alarm
+        previous = signal.signal(_SIGNAL, _raise) if not _ACTIVE else None
+        _ACTIVE.append((deadline, interval))
+        _arm(deadline, interval)
     try:
         yield
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
+        with _quiet():
+            _ACTIVE.pop()
+            if _ACTIVE:
+                _arm(*_ACTIVE[-1])
+            else:
+                signal.setitimer(_TIMER, 0)
+                signal.signal(_SIGNAL, previous)
+
+
+@contextmanager
+def _quiet() -> Iterator[None]:
+    """The timer's signal held back (delivered on leaving, if it came meanwhile)."""
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {_SIGNAL})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def time_limit(seconds: float):
+    """Raise Timeout inside the block after `seconds` of CPU time (main thread, POSIX;
+    else no limit). Limits nest: the sooner one governs."""
+    return _limit(seconds, 0.0)
+
+
+def hard_time_limit(seconds: float):
+    """Raise Timeout in the block after `seconds` of CPU time, and again every 0.2 s until
+    it is left.
+
+    `time_limit` fires once, and the engine's searches catch a Timeout as their own limit
+    and go on with the next strategy: the equilibrium search of lim-2057/planar ran for 130 s
+    that way before giving up. The repeated alarm ends such a search within `seconds`."""
+    return _limit(seconds, 0.2)
 
 
 def try_simplify(expr, seconds: float = 5.0):

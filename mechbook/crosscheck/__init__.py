@@ -7,6 +7,12 @@ None of them looks at the book's answers:
     conserved    the book's first integrals constant along a simulated trajectory
     response     a steady-state amplitude measured from the driven nonlinear motion
                  (frequencies.py also measures damped modes' decay rates)
+    amplitude    the frequency measured at a finite amplitude (for `mechbook sweep
+                 --quantity drift`: where the linear answer stops being good)
+    motion       steady motions kept by a simulation; trajectory quantities of the level
+                 set measured by integration
+    inertia      each declared body's inertia: the engine's table and parallel axes against
+                 integration over its parts (assembly.py)
 
 May import: mechbook.verify (how an answer part names its point: `about:`, `steady:`,
 `assume:`), mechbook.numerics, mechbook.engine (the results under test), mechbook.core,
@@ -23,6 +29,13 @@ import traceback
 import sympy as sp
 
 from mechbook.crosscheck.frequencies import frequency_crosscheck
+from mechbook.crosscheck.inertia import inertia_crosschecks
+from mechbook.crosscheck.motion import (
+    STEADY_QUANTITIES,
+    TRAJECTORY_QUANTITIES,
+    steady_crosscheck,
+    trajectory_crosscheck,
+)
 from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
@@ -36,7 +49,9 @@ FREQUENCY_QUANTITIES = ("frequencies", "period", "normal_modes", "normal_coordin
                         "stability_condition", "resonances", "steady_amplitude",
                         "secular_growth")
 RESPONSE_QUANTITIES = ("steady_amplitude",)  # also simulated driven (crosscheck.response)
-EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force")
+EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "state_identity",
+                       "solution",
+                       "precession_rate", "rotation_matrix")
 LOOSE_BUDGET = 3.0  # seconds for the engine's own closed-form equilibria (no part asks)
 
 # ---- one problem -------------------------------------------------------------------------------
@@ -82,6 +97,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
     only = next(iter(problem.systems)) if len(problem.systems) == 1 else None
     freq: dict[tuple, CrossCheck] = {}
     models: dict = {}
+    measured: dict = {}
     params = set(problem.values())
     for part in (key.parts if key else []):
         if "unsupported" in part.data:
@@ -94,6 +110,25 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
             x = _guarded_conserved(analysis, part, models)
             if x is not None:
                 out.append(x)
+        if part.quantity in STEADY_QUANTITIES:
+            tag = (sname, "steady", repr(part.data.get("about")), part.data.get("unknown"),
+                   repr(part.data.get("hold")), repr(part.data.get("assume")),
+                   repr(part.data.get("estimate")))
+            if tag in measured:
+                measured[tag].parts.append(part.name)
+            else:
+                stage(f"cross-check steady:{part.name}")
+                measured[tag] = steady_crosscheck(analysis, part)
+                out.append(measured[tag])
+        if part.quantity in TRAJECTORY_QUANTITIES:
+            tag = (sname, part.quantity, repr(part.data.get("initial")),
+                   part.data.get("coordinate"), part.data.get("rate"))
+            if tag in measured:
+                measured[tag].parts.append(part.name)
+            else:
+                stage(f"cross-check measured:{part.name}")
+                measured[tag] = trajectory_crosscheck(analysis, part)
+                out.append(measured[tag])
         if part.quantity not in FREQUENCY_QUANTITIES:
             continue
         try:
@@ -138,6 +173,8 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                 freq[tag] = _guarded_frequency(analysis, lin, values, f"modes:{name}@{label}",
                                                models)
     out += list(newton.values()) + list(freq.values())
+    stage("cross-check: declared bodies")
+    out += inertia_crosschecks(analysis, key)
     return out
 
 

@@ -149,6 +149,8 @@ def _modes(s: _Setup) -> list[dict]:
         kind = ""
         if abs(lam[j]) <= ZERO_CLUSTER * scale:  # a zero exponent split by rounding
             kind = "zero"
+        elif _defective(lam, V, j, scale):  # before `unstable`: rounding splits the root
+            kind = "defective"
         elif lam[j].real > 1e-8 * scale:
             kind = "unstable"
         elif abs(lam[j].imag) <= 1e-9 * scale:
@@ -156,6 +158,20 @@ def _modes(s: _Setup) -> list[dict]:
         out.append({"omega": float(abs(lam[j].imag)), "kind": kind, "start": start,
                     "weights": np.conj(w), "complex": True, "decay": float(-lam[j].real)})
     return out
+
+
+def _defective(lam: np.ndarray, V: np.ndarray, j: int, scale: float) -> bool:
+    """Is exponent j a multiple root with a single eigenvector (a Jordan block: a stability
+    boundary, where solutions grow like t·e^{pt})? Rounding splits the root by about the
+    square root of the machine precision and leaves the two computed eigenvectors parallel
+    to the same order; an oscillation of fixed amplitude does not exist there to measure."""
+    v = V[:, j] / np.linalg.norm(V[:, j])
+    for i in range(len(lam)):
+        if i != j and abs(lam[i] - lam[j]) <= 1e-6 * scale:
+            u = V[:, i] / np.linalg.norm(V[:, i])
+            if abs(np.vdot(u, v)) >= 1 - 1e-6:
+                return True
+    return False
 
 
 def _signal(s: _Setup, mode: dict):
@@ -291,6 +307,10 @@ def _frequency_crosscheck(analysis, lin, values, out: CrossCheck, models: dict) 
         if mode["kind"] in ("unstable", "overdamped"):
             entry["status"] = "n.a."
             notes.append(f"mode {k}: {mode['kind']}, no oscillation to measure")
+        elif mode["kind"] == "defective":
+            entry["status"] = "n.a."
+            notes.append(f"mode {k}: a double exponent with one mode (secular growth at a "
+                         "stability boundary), no oscillation of fixed amplitude to measure")
         elif mode["kind"] == "zero":
             if mode.get("complex"):
                 entry["status"] = "n.a."

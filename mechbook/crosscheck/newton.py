@@ -22,7 +22,13 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
-from mechbook.crosscheck.kinematics import body_angular_velocity, inertia_of_shape
+from mechbook.crosscheck.assembly import composite_inertia
+from mechbook.crosscheck.kinematics import (
+    body_angular_velocity,
+    chain_angular_velocity,
+    chain_matrix,
+    inertia_of_shape,
+)
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.records import CrossCheck
@@ -50,9 +56,9 @@ def _newton_residual(sys) -> list[sp.Expr]:
     """Σ J·(m r̈ − F) + rigid-body Euler terms + the Lagrange expressions of everything the
     file gives other than particles and bodies − Q."""
     spec = sys.spec
-    if "approximation" in spec:
+    if "approximation" in spec or "average" in spec:
         raise UnsupportedError("Newton cross-check: the Lagrangian is an approximation "
-                               "(Newton's law holds for the exact one)")
+                               "(expanded or averaged; Newton's law holds for the exact one)")
     particles = dict(spec.get("particles") or {})
     bodies = dict(spec.get("rigid_bodies") or {})
     if not particles and not bodies:
@@ -106,26 +112,40 @@ def _newton_residual(sys) -> list[sp.Expr]:
         net = masses[name] * acc - forces[name]
         for i in range(n):
             res[i] += sp.diff(r, q[i]).dot(net)
-    for name, b in bodies.items():
-        rot = _euler_terms(sys, name, b, masses[name], parse)
+    frames = {name: _body_frame(sys, name, b, masses[name], parse) for name, b in bodies.items()}
+    for tensor, omega, _ in frames.values():
+        if omega.rows == 1:  # planar: (∂ω/∂q̇) I ω̇
+            torque = tensor * sys.dt(omega)
+        else:
+            torque = tensor * sys.dt(omega) + omega.cross(tensor * omega)
         for i in range(n):
-            res[i] += rot[i]
+            res[i] += sp.diff(omega, qd[i]).dot(torque)
+    pulls, attractor_q = _attractors(sys, spec, positions, masses, frames, parse)
+    torque_q = _torques(sys, spec, frames, parse)
+    for name, pull in pulls.items():
+        for i in range(n):
+            res[i] -= sp.diff(positions[name], q[i]).dot(pull)
     for i in range(n):
-        res[i] += sys.dt(sp.diff(rest, qd[i])) - sp.diff(rest, q[i]) - sys.forces[i]
+        res[i] += sys.dt(sp.diff(rest, qd[i])) - sp.diff(rest, q[i]) - sys.declared_forces[i]
+        res[i] -= attractor_q[i] + torque_q[i]
     return res
 
 
-def _euler_terms(sys, name: str, b: dict, m, parse) -> list[sp.Expr]:
-    """(∂ω/∂q̇_i)·(I ω̇ + ω × Iω) (3-D, body axes) or (∂ω/∂q̇_i) I ω̇ (planar)."""
+def _body_frame(sys, name: str, b: dict, m, parse):
+    """(inertia, ω in body axes, R body -> space or None) of a body, computed here: ω from
+    Rᵀ·dR/dt of the body's own rotation chain; for a planar body (moment, ω, None)."""
     sub = ("rigid_bodies", name)
     planar = len(b["position"]) == 2
     inertia = b["inertia"]
-    if isinstance(inertia, dict):
+    if isinstance(inertia, dict) and "body" in inertia:  # a body made of parts
+        tensor = composite_inertia(sys.problem, inertia["body"])[2]
+    elif isinstance(inertia, dict):
         dims = {k: parse(v, sub + ("inertia", k)) for k, v in inertia.items()
-                if k in ("radius", "length")}
-        if "sides" in inertia:
-            dims["sides"] = [parse(v, sub + ("inertia", "sides", i))
-                             for i, v in enumerate(inertia["sides"])]
+                if k in ("radius", "length", "height")}
+        for key in ("sides", "semi_axes"):
+            if key in inertia:
+                dims[key] = [parse(v, sub + ("inertia", key, i))
+                             for i, v in enumerate(inertia[key])]
         tensor = inertia_of_shape(inertia["shape"], m, dims)
     elif isinstance(inertia, list):
         tensor = sp.Matrix([[parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]
@@ -135,15 +155,69 @@ def _euler_terms(sys, name: str, b: dict, m, parse) -> list[sp.Expr]:
     if planar:
         moment = tensor[2, 2] if isinstance(tensor, sp.MatrixBase) else tensor
         omega = parse(b["angular_velocity"], sub + ("angular_velocity",))
-        return [sp.diff(omega, v) * moment * sys.dt(omega) for v in sys.qd]
+        return sp.Matrix([[moment]]), sp.Matrix([omega]), None
+    R = None
     if "euler_angles" in b:
         angles = [parse(x, sub + ("euler_angles", i)) for i, x in enumerate(b["euler_angles"])]
         omega = body_angular_velocity(angles, sys.dt)
+        R = chain_matrix(list(zip("zxz", angles, strict=True)))
+    elif "rotation" in b:
+        chain = [(axis, parse(angle, sub + ("rotation", i, 1)))
+                 for i, (axis, angle) in enumerate(b["rotation"])]
+        omega = chain_angular_velocity(chain, sys.dt)
+        R = chain_matrix(chain)
     else:
         omega = sp.Matrix([parse(x, sub + ("angular_velocity", i))
                            for i, x in enumerate(b["angular_velocity"])])
-    torque = tensor * sys.dt(omega) + omega.cross(tensor * omega)
-    return [sp.diff(omega, v).dot(torque) for v in sys.qd]
+    return tensor, omega, R
+
+
+def _torques(sys, spec: dict, frames: dict, parse) -> list[sp.Expr]:
+    """Generalized forces of `torques:`: the torque's power N·ω per unit rate."""
+    out = [sp.S.Zero] * len(sys.q)
+    for i, t in enumerate(spec.get("torques") or []):
+        _, omega, R = frames[t["body"]]
+        N = sp.Matrix([parse(x, ("torques", i, "components", j))
+                       for j, x in enumerate(t["components"])])
+        if t.get("axes", "body") == "space":
+            omega = R * omega
+        out = [o + N.dot(sp.diff(omega, v)) for o, v in zip(out, sys.qd, strict=True)]
+    return out
+
+
+def _attractors(sys, spec, positions, masses, frames, parse) -> tuple[dict, list]:
+    """({body or particle: Cartesian force}, generalized forces of the torques on bodies):
+    the inverse-square pull on every particle and the pull of a point mass on each body's
+    centre (monopole plus the gradient of the quadrupole term, its inertia held fixed),
+    and the gravity-gradient torque 3GM' d × (I_s d)/d⁵ (space axes) on each body."""
+    pulls: dict = {}
+    torque_q = [sp.S.Zero] * len(sys.q)
+    dx = sp.Matrix(sp.symbols("dx_ dy_ dz_", real=True))
+    for name, a in (spec.get("attractors") or {}).items():
+        sub = ("attractors", name)
+        M = parse(a["mass"], sub + ("mass",))
+        G = parse(a["G"], sub + ("G",)) if "G" in a else sys.params["G"].symbol
+        at = sp.Matrix([parse(x, sub + ("position", i))
+                        for i, x in enumerate(a.get("position", [0, 0, 0]))])
+        for obj, r in positions.items():
+            d = r - at
+            dist = sp.sqrt(d.dot(d))
+            pull = -G * M * masses[obj] * d / dist**3
+            frame = frames.get(obj)
+            if frame is not None and frame[2] is not None:
+                tensor, omega, R = frame
+                Is = R * tensor * R.T
+                ddx = dx.dot(dx)
+                quad = -G * M * (Is.trace() * ddx - 3 * (dx.T * Is * dx)[0, 0]) \
+                    / (2 * sp.sqrt(ddx)**5)
+                grad = sp.Matrix([-sp.diff(quad, c) for c in dx])
+                pull += grad.subs(dict(zip(dx, d, strict=True)))
+                torque = 3 * G * M * d.cross(Is * d) / dist**5
+                w_space = R * omega
+                for i, v in enumerate(sys.qd):
+                    torque_q[i] += torque.dot(sp.diff(w_space, v))
+            pulls[obj] = pulls.get(obj, sp.zeros(r.rows, 1)) + pull
+    return pulls, torque_q
 
 
 def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
@@ -190,6 +264,10 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
         what.append("particles")
     if spec.get("rigid_bodies"):
         what.append("rigid bodies (Euler)")
+    if spec.get("torques"):
+        what.append("torques")
+    if spec.get("attractors"):
+        what.append("attracting masses (force and gravity-gradient torque)")
     other = [k for k in ("kinetic", "potential", "lagrangian", "velocity_potential", "forces",
                          "dissipation") if k in spec]
     if any("length" in s for s in spec.get("springs") or []):

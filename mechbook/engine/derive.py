@@ -11,6 +11,7 @@ import sympy as sp
 
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
+from mechbook.model.declared import CACHE_KEY
 from mechbook.records import Results
 
 DEFAULT_COMPUTE = ["lagrangian", "eom", "momenta", "cyclic", "energy", "equilibria",
@@ -137,12 +138,48 @@ _DYNAMICS_TEXT = ("mass_matrix", "forcing", "momenta", "cyclic", "energy_functio
                   "hamiltonian")
 
 
+DECLARED = "_declared"  # the store's name for a problem's declared vectors, tensors, bodies
+
+
+def declared_results(analysis: Analysis) -> Results | None:
+    """A problem's declared vectors and tensors, and each body's mass, centre of mass and
+    inertia about it, if a check touched them (None otherwise)."""
+    problem = analysis.problem
+    decl = problem._cache.get(CACHE_KEY)
+    if decl is None:
+        return None
+    res = Results(DECLARED)
+    values = problem.values()
+    for name in decl.vectors + decl.tensors:
+        obj = decl.names[name]
+        res.text[name] = show(list(obj) if obj.shape == (3, 1) else obj.tolist())
+        res.arrays[name] = _numeric(obj, values)
+    for name, body in decl.bodies.items():
+        res.text[f"{name}/mass"] = show(body.mass)
+        res.text[f"{name}/center_of_mass"] = show(list(body.center_of_mass))
+        inertia = body.inertia()
+        res.text[f"{name}/inertia"] = show(inertia.tolist())
+        res.arrays[f"{name}/inertia"] = _numeric(inertia, values)
+    return res
+
+
+def _numeric(obj, values: dict) -> np.ndarray:
+    try:
+        return np.array(sp.Matrix(obj).subs(values).evalf(), dtype=complex).real
+    except (TypeError, ValueError):
+        return np.full(sp.Matrix(obj).shape, np.nan)
+
+
 def computed(analysis: Analysis) -> list[Results]:
-    """What a check run derived on its way, as text and default-value arrays, per system:
-    nothing is derived or simplified here (a check run stores what its parts needed)."""
+    """What a check run derived on its way, as text and default-value arrays, per system
+    (and the problem's declared objects): nothing is derived or simplified here (a check
+    run stores what its parts needed)."""
     problem = analysis.problem
     values = problem.values()
     out = []
+    extra = declared_results(analysis)
+    if extra is not None:
+        out.append(extra)
     for name in problem.systems:
         sys = problem._cache.get(name)
         if sys is None:  # no part touched this system

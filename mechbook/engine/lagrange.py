@@ -14,8 +14,28 @@ import sympy as sp
 
 from mechbook.core.numeval import is_zero
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
-from mechbook.errors import UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.system import System
+
+
+class SingularMassError(MechbookError):
+    """The equations do not determine every acceleration: M (with the constraint rows) is
+    singular, as when a coordinate carries no kinetic energy."""
+
+
+def solve_accelerations(M: sp.Matrix, rhs: sp.Matrix, unknowns: list) -> sp.Matrix:
+    """M·x = rhs solved for `unknowns`; a singular M is a SingularMassError that names the
+    unknowns whose rows of M vanish (the usual cause), not a SymPy traceback."""
+    try:
+        return M.LUsolve(rhs)
+    except (sp.matrices.exceptions.NonInvertibleMatrixError, ValueError,
+            ZeroDivisionError) as exc:
+        empty = [str(u) for i, u in enumerate(unknowns[: M.rows])
+                 if all(is_zero(M[i, j]) for j in range(M.cols))]
+        why = (f"no inertia for {', '.join(empty)}" if empty else
+               "its rows are dependent")
+        raise SingularMassError(f"the mass matrix is singular ({why}): the Lagrangian does "
+                                f"not determine every acceleration [{exc}]") from None
 
 
 class Dynamics:
@@ -76,7 +96,7 @@ class Dynamics:
         if not self.sys.constraints:
             try:
                 with time_limit(60):
-                    sol = M.LUsolve(f)
+                    sol = solve_accelerations(M, f, list(self.qdd))
             except Timeout:
                 raise UnsupportedError("solving the mass matrix symbolically (too large)") from None
             return {a: self._simp(s) for a, s in zip(self.qdd, sol, strict=True)}
@@ -89,8 +109,8 @@ class Dynamics:
         big[:n, n:] = -A.T
         big[n:, :n] = A
         rhs = sp.Matrix.vstack(f, -b)
-        sol = big.LUsolve(rhs)
         unknowns = list(self.qdd) + self.multipliers
+        sol = solve_accelerations(big, rhs, unknowns)
         return {u: self._simp(s) for u, s in zip(unknowns, sol, strict=True)}
 
     @cached_property

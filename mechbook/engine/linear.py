@@ -20,10 +20,10 @@ import scipy.linalg
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
-from mechbook.core.numeval import is_zero
+from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, is_zero
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
-from mechbook.errors import UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError
 
 ZERO_TOL = 1e-9
 ZERO_CLUSTER = 1e-6  # |p| below this (relative) is a zero exponent split by rounding
@@ -112,8 +112,20 @@ class LinearSystem:
 
     # ---- numeric -------------------------------------------------------------------------
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """M, C, K at `values`, each entry evaluated in 30-digit arithmetic (core.numeval:
+        one memoized pass over the expression, so a large entry — Routh's reduction with a
+        steady rate given as a root — costs milliseconds, not minutes of evalf)."""
         def num(A):
-            return np.array(A.evalf(30, subs=values).tolist(), dtype=complex).real.astype(float)
+            left = sorted(map(str, A.free_symbols - set(values)))
+            if left:  # e.g. a point that names a symbol the system gives no value
+                raise MechbookError(f"the linearized system keeps {', '.join(left)} without a "
+                                    "numeric value")
+            try:
+                return np.array([[_entry(x, values, 30).real for x in row]
+                                 for row in A.tolist()], dtype=float).reshape(A.shape)
+            except TypeError:  # zoo, nan: not a number at this point
+                raise MechbookError("the linearized system has no finite value at this "
+                                    "point") from None
 
         return num(self.M), num(self.C), num(self.K)
 
@@ -157,8 +169,9 @@ class LinearSystem:
         import mpmath
 
         def conv(A):
-            return mpmath.matrix([[mpmath.mpf(str(sp.re(sp.N(x, dps)))) for x in row]
-                                  for row in A.evalf(dps, subs=values).tolist()])
+            with mpmath.workdps(dps):
+                return mpmath.matrix([[mpmath.re(_entry(x, values, dps, exact=True))
+                                       for x in row] for row in A.tolist()])
 
         return conv(self.M), conv(self.C), conv(self.K)
 
@@ -252,6 +265,20 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     if np.any(live.real > 1e-8 * scale):
         return "unstable"
     return "stable"
+
+
+def _entry(x: sp.Expr, values: dict, digits: int, exact: bool = False):
+    """One matrix entry at `values` (numeval's walk; SymPy's evalf where it cannot go).
+    With `exact`, an mpmath number at `digits` instead of a Python complex."""
+    import mpmath
+
+    try:
+        if exact:
+            return mpmath.mpmathify(evaluate_mp(x, values, digits))
+        return evaluate(x, values, digits)[0]
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
+        v = sp.N(sp.S(x).subs(values), digits)
+        return mpmath.mpc(complex(v)) if exact else complex(v)
 
 
 def _ill_conditioned(M: np.ndarray, w2: np.ndarray) -> bool:

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import mpmath
 import sympy as sp
 
+from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
 
@@ -33,16 +34,30 @@ DPS = 50
 
 
 def _mp(A: sp.Matrix, values: dict):
-    rows = A.evalf(DPS + 5, subs=values).tolist()
-    out = mpmath.matrix(len(rows), len(rows[0]) if rows else 0)
-    for i, row in enumerate(rows):
-        for j, x in enumerate(row):
-            if not x.is_number:
-                raise UnsupportedError(f"perturbation: a matrix entry does not evaluate ({x})")
-            re, im = sp.N(x, DPS + 5).as_real_imag()
-            out[i, j] = mpmath.mpf(sp.Float(re, DPS + 5)._mpf_) if im == 0 else mpmath.mpc(
-                mpmath.mpf(sp.Float(re, DPS + 5)._mpf_), mpmath.mpf(sp.Float(im, DPS + 5)._mpf_))
+    """A at `values` as an mpmath matrix of DPS digits: each entry by numeval's memoized
+    walk (milliseconds even for Routh's large reduced matrices), SymPy's evalf where the
+    walk cannot go."""
+    out = mpmath.matrix(A.rows, A.cols)
+    with mpmath.workdps(DPS + 5):
+        for i in range(A.rows):
+            for j in range(A.cols):
+                out[i, j] = _mp_entry(A[i, j], values)
     return out
+
+
+def _mp_entry(x: sp.Expr, values: dict):
+    try:
+        v = evaluate_mp(x, values, DPS + 5)
+        if mpmath.isfinite(v):
+            return mpmath.mpf(v) if mpmath.im(v) == 0 else v
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+        pass
+    x = sp.N(sp.S(x).subs(values), DPS + 5)
+    if not x.is_number:
+        raise UnsupportedError(f"perturbation: a matrix entry does not evaluate ({x})")
+    re, im = x.as_real_imag()
+    real = mpmath.mpf(sp.Float(re, DPS + 5)._mpf_)
+    return real if im == 0 else mpmath.mpc(real, mpmath.mpf(sp.Float(im, DPS + 5)._mpf_))
 
 
 def generalized_eigh(K, M) -> tuple[list, mpmath.matrix]:

@@ -63,35 +63,19 @@ class ReducedSystem:
             p_values = [sp.S(momenta_given[c]) for c in cyc]
         else:
             p_values = [simp(p.subs(at_steady)) for p in momenta]
-        # a momentum value that is a long expression (the steady motion's point and rate
-        # substituted) stands in as a symbol in the reduced Lagrangian; `held` maps it back
-        # (Equilibria puts the values in after differentiating)
-        self.held: dict[sp.Symbol, sp.Expr] = {}
-        self.momenta = dict(zip(cyc, p_values, strict=True))
-        symbols = []
-        for c, pv in zip(cyc, p_values, strict=True):
-            if pv.is_Atom or sp.count_ops(pv) <= 4:
-                symbols.append(pv)
-            else:
-                held = sp.Symbol(f"held_p_{c}", real=True)
-                self.held[held] = pv
-                symbols.append(held)
-        p_values = symbols
-        sol = _linear_rates(momenta, p_values, cyc_rates)
-        if sol is None:
-            try:
-                with time_limit(30):
-                    sol = sp.solve([p - pv for p, pv in zip(momenta, p_values, strict=True)],
-                                   cyc_rates, dict=True)
-            except Timeout:
-                sol = []
-        if len(sol) != 1:
-            raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
-                                   "their momenta")
-        rate_of = {v: _smaller(e, _cancel(e)) for v, e in sol[0].items()}
-        routh = sum((pv * v for pv, v in zip(p_values, cyc_rates, strict=True)), sp.S.Zero)
+        # the held momenta stay symbols P until the linear system is formed: their values
+        # (large expressions for a rate given as a root of a quadratic, or the steady
+        # motion's point and rate substituted) are put into the small matrices M, C, K and
+        # the equilibrium conditions, not into L' and its derivatives (Equilibria puts
+        # them back through `held`)
+        symbols = [sp.Symbol(f"P_held_{c}", real=True) for c in cyc]
+        rate_of = _solve_rates(momenta, symbols, cyc_rates, point, base.numeric_values())
+        rate_of = {v: _smaller(e, _cancel(e)) for v, e in rate_of.items()}
+        routh = sum((P * v for P, v in zip(symbols, cyc_rates, strict=True)), sp.S.Zero)
         reduced = (L - routh).subs(rate_of)
         self.lagrangian = simp(_smaller(reduced, _cancel(reduced)))
+        self.held: dict[sp.Symbol, sp.Expr] = dict(zip(symbols, p_values, strict=True))
+        self.momenta = dict(zip(cyc, p_values, strict=True))
 
     def dt(self, expr):
         out = sp.diff(expr, self.t)
@@ -103,18 +87,38 @@ class ReducedSystem:
         return self.problem.values()
 
 
-def _linear_rates(momenta: list, values: list, rates: list) -> list[dict] | None:
-    """The rates from p = A·rates + b when the momenta are linear in them (T quadratic in
-    the velocities): one LU solve keeps the result compact (None: not linear)."""
-    A = sp.Matrix([[sp.diff(p, v) for v in rates] for p in momenta])
-    if any(x.has(*rates) for x in A):
-        return None
-    b = sp.Matrix([p.subs({v: 0 for v in rates}) for p in momenta])
+def _solve_rates(momenta: list, values: list, rates: list, point: dict,
+                 numeric: dict) -> dict:
+    """The cyclic rates as functions of the state from p = p_values. Momenta linear in the
+    rates (L quadratic in the velocities) are solved as a linear system, without
+    sp.solve's search; a Jacobian that is singular at the steady point is a chart
+    singularity (z-x-z Euler angles at theta = 0) and is said so."""
+    J = sp.Matrix([[sp.diff(p, v) for v in rates] for p in momenta])
+    if not any(e.has(*rates) for e in J):
+        at = J.subs(point).subs({k: v for k, v in numeric.items()})
+        try:
+            singular = abs(complex(sp.N(at.det()))) < 1e-12 * max(
+                1.0, max(abs(complex(sp.N(x))) for x in at) ** len(rates))
+        except (TypeError, ValueError):
+            singular = False
+        if singular:
+            raise UnsupportedError("steady motion: the cyclic rates are not determined by "
+                                   "their momenta at this point (a singular point of the "
+                                   "coordinates, such as z-x-z Euler angles at theta = 0: "
+                                   "use a chart regular there, e.g. `rotation:` x-y-z)")
+        rest = [p.subs({v: 0 for v in rates}) for p in momenta]  # p = J·rates + rest
+        sol = J.LUsolve(sp.Matrix([pv - r for pv, r in zip(values, rest, strict=True)]))
+        return dict(zip(rates, sol, strict=True))
     try:
-        sol = A.LUsolve(sp.Matrix(values) - b)
-    except (ValueError, ZeroDivisionError):
-        return None
-    return [dict(zip(rates, sol, strict=True))]
+        with time_limit(30):
+            sol = sp.solve([p - pv for p, pv in zip(momenta, values, strict=True)], rates,
+                           dict=True)
+    except Timeout:
+        sol = []
+    if len(sol) != 1:
+        raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
+                               "their momenta")
+    return sol[0]
 
 
 def _cancel(expr: sp.Expr, seconds: float = 5.0) -> sp.Expr:

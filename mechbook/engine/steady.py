@@ -1,34 +1,41 @@
-"""Steady motions, in general: where they are, how many, and whether they are stable.
+"""Steady motions: where they are, and at which rates (Symon §11-5, §12-6).
 
-A steady motion turns some coordinates at constant rates while the others stay put
-(Symon §12-6); with no rates it is an equilibrium. Three questions, for any system:
+A steady motion turns some coordinates at constant rates while the others stay put; with no
+rates it is an equilibrium. This module says where steady motions are; counting them in a
+region and judging each one's stability from numbers is mechbook.engine.steady_search, and
+small oscillations about a given one are `Analysis.steady_linear` (Routh's reduction,
+mechbook.engine.routh, or the motion kept in full). Nothing here knows a particular system:
+chapter 11's tops and chapter 12's orbits and three bodies use the same functions.
 
-    steady_residuals  the equations of motion along q*(t) = point + rates·t (q̈ = 0): all
-                      zero, at two times, exactly when the motion is steady
-    count             the distinct steady motions in a region of the non-turning
-                      coordinates, at fixed rates or at fixed momenta of cyclic coordinates
-                      (Routh's reduction), found by multistart root finding
-    classify          stable / unstable / marginal from the linearized equations (Routh
-                      reduced or kept in full), with the size of the largest Jordan block
-                      (secular t^k growth at a multiple root) for the marginal cases
-
-Chapter 11's tops (steady precession) and chapter 12's orbits and three bodies use the same
-functions; nothing here knows a particular system.
+    steady_residuals   the equations of motion along q*(t) = point + rates·t (q̈ = 0): all
+                       zero, at two times, exactly when that uniform motion is steady
+    steady_conditions  the conditions on the non-turning coordinates at fixed rates, or at
+                       fixed cyclic momenta (the equilibria of Routh's reduced system)
+    SteadyFamily       steady motions at a given point with one cyclic rate x unknown (the
+                       others fixed by `hold:` relations such as ω3 = ψ̇ + φ̇ cos θ): the
+                       conditions as functions of x, their real roots at given parameter
+                       values (polynomial in x after clearing denominators), so whether any
+                       exists (the minimum spin of a top)
+    effective_potential  Routh's V_eff(q; p) = [Σ p_φ φ̇ − L] at q̇ = 0 with φ̇ expressed by
+                       the momenta: the energy left for the non-cyclic coordinates when the
+                       cyclic momenta are held (Symon's V'(θ) of the top)
 """
 
 from __future__ import annotations
 
-import numpy as np
-import scipy.optimize
+from dataclasses import dataclass
+
+import mpmath
 import sympy as sp
 
-from mechbook.core.compile import compile_exprs
+from mechbook.core.numeval import is_zero
+from mechbook.core.timeout import Timeout, time_limit
 from mechbook.engine.equilibria import Equilibria
 from mechbook.engine.lagrange import Dynamics
-from mechbook.engine.linear import LinearSystem, classify_matrices
 from mechbook.engine.routh import ReducedSystem
 from mechbook.errors import UnsupportedError
 
+DIGITS = 30
 TIMES = (sp.Rational(7, 5), sp.Rational(-3, 7))  # a steady motion's residual vanishes at all t
 
 
@@ -76,77 +83,168 @@ def steady_conditions(sys, rates: dict | None = None, momenta: dict | None = Non
     return conds, free, Equilibria(dyn)
 
 
-def classify_at(eq: Equilibria, root: dict, values: dict, rates: dict | None = None) -> str:
-    """The stability of the steady motion found numerically at `root` ({q: float}), at
-    fixed `rates` of the turning coordinates (or at rest in a reduced system): M, C, K are
-    the derivatives of the equations of motion there, taken symbolically once and
-    evaluated at the numbers (a numeric root is no exact equilibrium for `linearize`)."""
-    dyn = eq.dyn
-    held = getattr(dyn.sys, "held", {})
-    rates = rates or {}
-    sub = {v: sp.S(rates.get(q, 0)) for q, v in zip(dyn.q, dyn.qd, strict=True)}
-    sub.update({a: 0 for a in dyn.qdd})
-    sub.update({s: 0 for s in dyn.sys.small_params})
-    key = ("jacobians", tuple(sorted(map(str, rates))))
-    cache = eq.__dict__.setdefault("_jacobians", {})
-    if key not in cache:
-        res = [e.xreplace(held) for e in dyn.residuals]
-        cache[key] = [sp.Matrix([[sp.diff(e, v) for v in vs] for e in res]).subs(sub)
-                      for vs in (dyn.qdd, dyn.qd, dyn.q)]
-    at = dict(values)
-    at.update({q: sp.Float(x, 30) for q, x in root.items()})
-    M, C, K = (np.array(A.subs(at).evalf(30).tolist(), dtype=complex).real.astype(float)
-               for A in cache[key])
-    return classify_matrices(M, C, K)
+def cyclic_check(dyn: Dynamics, coords: list[sp.Symbol]) -> None:
+    """Refuse a coordinate that is not cyclic (present in L, or acted on by a force)."""
+    sys = dyn.sys
+    if sys.constraints:
+        raise UnsupportedError("steady motions of a system with multiplier constraints")
+    for c in coords:
+        i = sys.q.index(c)
+        if not is_zero(sp.diff(dyn.L, c)) or sys.forces[i] != 0:
+            raise UnsupportedError(f"steady motion: {c} is not a cyclic coordinate")
 
 
-def roots_in(conds: list[sp.Expr], unknowns: list[sp.Symbol], values: dict,
-             boxes: list[dict], starts: int = 7, tol: float = 1e-10) -> list[np.ndarray]:
-    """The distinct solutions of conds = 0 inside any of `boxes` ({q: (lo, hi)}; a missing
-    coordinate ranges over (−π, π)), by Newton-type root finding from a grid of starting
-    points in each box (`starts` per coordinate, at most 3000 per box). Solutions on a box's
-    edge (within 1e-9 of its width) are not counted: a count is about the interior."""
-    F = [sp.N(c.subs(values), 30) for c in conds]
-    J = sp.Matrix(F).jacobian(unknowns)
-    f_num, _ = compile_exprs(unknowns, F)
-    j_num, _ = compile_exprs(unknowns, list(J))
-    n, m = len(unknowns), len(F)
-    found: list[np.ndarray] = []
-    rng = np.random.default_rng(11)
-    for box in boxes:
-        ranges = [box.get(q, (-np.pi, np.pi)) for q in unknowns]
-        # a positive range over decades (a distance) is searched on a geometric grid
-        grids = [np.geomspace(lo, hi, starts + 2)[1:-1] if lo > 0 and hi > 100 * lo
-                 else np.linspace(lo, hi, starts + 2)[1:-1] for lo, hi in ranges]
-        mesh = np.array(np.meshgrid(*grids, indexing="ij")).reshape(n, -1).T
-        if len(mesh) > 3000:
-            mesh = mesh[rng.choice(len(mesh), 3000, replace=False)]
-        width = np.array([hi - lo for lo, hi in ranges], dtype=float)
-        for x0 in mesh:
-            with np.errstate(all="ignore"):
-                sol = scipy.optimize.root(
-                    lambda x: np.asarray(f_num(x), float), x0, method="lm",
-                    jac=lambda x: np.asarray(j_num(x), float).reshape(m, n))
-            x = sol.x
-            with np.errstate(all="ignore"):
-                resid = np.asarray(f_num(x), float)
-                jac = np.asarray(j_num(x), float).reshape(m, n)
-            if not (np.all(np.isfinite(x)) and np.all(np.isfinite(resid))
-                    and np.all(np.isfinite(jac))):
+@dataclass
+class SteadyFamily:
+    """Steady motions at `point` (non-cyclic coordinates at rest there) whose cyclic rates
+    are fixed by `hold` equations (in the velocities) except one, the `unknown`'s rate x.
+
+    `rates` gives every cyclic rate as a function of x; `conditions` the generalized forces
+    on the non-cyclic coordinates as functions of x (all zero at a steady motion)."""
+
+    dyn: Dynamics
+    point: dict
+    unknown: sp.Symbol  # the coordinate whose rate is x
+    x: sp.Symbol
+    rates: dict  # cyclic velocity symbol -> expression in x
+    conditions: list[sp.Expr]
+    state: dict  # the steady state: point, velocities (at rest or rates in x)
+
+    @classmethod
+    def build(cls, dyn: Dynamics, point: dict, unknown: sp.Symbol,
+              hold: list[sp.Expr]) -> SteadyFamily:
+        sys = dyn.sys
+        if sys.lagrangian.has(sys.t):
+            raise UnsupportedError("steady motions of a non-autonomous system")
+        moving = [q for q in sys.q if q not in point]
+        if unknown not in moving:
+            raise UnsupportedError(f"steady motion: {unknown} is held in `about:`")
+        cyclic_check(dyn, moving)
+        x = sp.Symbol("x_steady", real=True)
+        rate_of = {sys.qd[sys.q.index(unknown)]: x}
+        others = [sys.qd[sys.q.index(q)] for q in moving if q != unknown]
+        at_rest = {sys.qd[sys.q.index(q)]: sp.S.Zero for q in point}
+        eqs = [h.subs(point).subs(at_rest).subs(rate_of) for h in hold]
+        if len(eqs) != len(others):
+            raise UnsupportedError(f"steady motion: {len(others)} other cyclic rate(s) need as "
+                                   f"many `hold:` relations, {len(eqs)} given")
+        if others:
+            try:
+                with time_limit(20):
+                    sol = sp.solve(eqs, others, dict=True)
+            except Timeout:
+                sol = []
+            if len(sol) != 1 or set(sol[0]) != set(others):
+                raise UnsupportedError("steady motion: the `hold:` relations do not fix the "
+                                       "other cyclic rates uniquely")
+            rate_of.update(sol[0])
+        state = dict(point)
+        state.update(at_rest)
+        state.update(rate_of)
+        state.update({a: sp.S.Zero for a in sys.qdd})
+        conds = []
+        for q, e in zip(sys.q, dyn.residuals, strict=True):
+            if q in point:
+                conds.append(e.subs(state))
+        steady = {k: v for k, v in state.items() if k not in sys.qdd}
+        return cls(dyn, dict(point), unknown, x, rate_of, conds, steady)
+
+    def residuals_at(self, rate: sp.Expr) -> list[sp.Expr]:
+        """The conditions with x = rate (zero iff that rate is a steady motion)."""
+        return [c.subs(self.x, rate) for c in self.conditions]
+
+    def polynomials(self, values: dict) -> list[sp.Poly]:
+        """The conditions at numeric `values` as polynomials in x (numerators), dropping
+        those identically zero; UnsupportedError if one is not polynomial in x."""
+        out = []
+        for c in self.conditions:
+            num = sp.together(c.subs(values)).as_numer_denom()[0]
+            num = sp.expand(num)
+            if num == 0:
                 continue
-            # a root, not a place where the conditions are merely small (a potential that
-            # decays far away): the Newton step from it must be negligible
-            step = np.linalg.lstsq(jac, resid, rcond=None)[0]
-            if not np.linalg.norm(step) <= tol * max(1.0, float(np.max(width))):
-                continue
-            inside = all(lo + 1e-9 * w < xi < hi - 1e-9 * w
-                         for xi, (lo, hi), w in zip(x, ranges, width, strict=True))
-            if inside and not any(np.allclose(x, f, rtol=1e-6, atol=1e-7 * np.max(width))
-                                  for f in found):
-                found.append(x)
-    return found
+            try:
+                poly = sp.Poly(num, self.x)
+            except sp.PolynomialError:
+                raise UnsupportedError("steady rates of a condition not polynomial in the "
+                                       "rate") from None
+            if any(not c.is_number for c in poly.all_coeffs()):
+                raise UnsupportedError("steady rates: the condition does not evaluate at the "
+                                       "sampled values")
+            out.append(poly)
+        return out
+
+    def real_rates(self, values: dict) -> list[float]:
+        """The real rates x at `values` that make every condition vanish (sorted)."""
+        polys = self.polynomials(values)
+        if not polys:
+            raise UnsupportedError("steady rates: every rate is a steady motion here")
+        first = min(polys, key=lambda p: p.degree())
+        roots = real_roots(first)
+        keep = []
+        for r in roots:
+            if all(_small(p, r) for p in polys):
+                keep.append(r)
+        return sorted(keep)
 
 
-def classify(lin: LinearSystem, values: dict) -> str:
-    """'stable', 'unstable' or 'marginal' (the linearized system's own verdict)."""
-    return lin.numeric_stability(values)
+def real_roots(poly: sp.Poly) -> list[float]:
+    """Real roots of a numeric polynomial (30-digit arithmetic)."""
+    coeffs = [mpmath.mpf(str(sp.re(sp.N(c, DIGITS)))) for c in poly.all_coeffs()]
+    while coeffs and coeffs[0] == 0:
+        coeffs.pop(0)
+    if len(coeffs) <= 1:
+        return []
+    with mpmath.workdps(DIGITS):
+        try:
+            roots = mpmath.polyroots(coeffs, maxsteps=200, extraprec=60)
+        except mpmath.libmp.NoConvergence:
+            raise UnsupportedError("steady rates: the polynomial roots did not converge") \
+                from None
+        scale = max(abs(r) for r in roots) if roots else 1
+        return [float(mpmath.re(r)) for r in roots
+                if abs(mpmath.im(r)) <= mpmath.mpf(10) ** (-DIGITS // 2) * max(1, scale)]
+
+
+def polynomial_roots(expr: sp.Expr, x: sp.Symbol, values: dict) -> list[float]:
+    """Real roots in x of expr (an equation's left side minus right side) at `values`."""
+    num = sp.expand(sp.together(expr.subs(values)).as_numer_denom()[0])
+    if num == 0:
+        raise UnsupportedError("the equation holds for every rate")
+    if num.free_symbols - {x}:
+        raise ValueError("the equation has symbols other than the rate: "
+                         + ", ".join(sorted(map(str, num.free_symbols - {x}))))
+    try:
+        poly = sp.Poly(num, x)
+    except sp.PolynomialError:
+        raise UnsupportedError("steady rates: the equation is not polynomial in the rate") \
+            from None
+    return sorted(real_roots(poly))
+
+
+def _small(poly: sp.Poly, r: float) -> bool:
+    coeffs = [complex(sp.N(c, DIGITS)) for c in poly.all_coeffs()]
+    deg = len(coeffs) - 1
+    val = sum(c * r ** (deg - i) for i, c in enumerate(coeffs))
+    scale = sum(abs(c) * abs(r) ** (deg - i) for i, c in enumerate(coeffs))
+    return abs(val) <= 1e-9 * max(scale, 1e-300)
+
+
+def effective_potential(dyn: Dynamics, cyclic: list[sp.Symbol],
+                        momenta: list[sp.Symbol]) -> sp.Expr:
+    """V_eff(q; p) = [Σ p φ̇ − L] with the other velocities zero and φ̇ from p = ∂L/∂φ̇."""
+    sys = dyn.sys
+    cyclic_check(dyn, cyclic)
+    rates = [sys.qd[sys.q.index(c)] for c in cyclic]
+    rest = {v: sp.S.Zero for v in sys.qd if v not in rates}
+    L0 = dyn.L.subs(rest)
+    eqs = [p - sp.diff(L0, v) for p, v in zip(momenta, rates, strict=True)]
+    try:
+        with time_limit(30):
+            sol = sp.solve(eqs, rates, dict=True)
+    except Timeout:
+        sol = []
+    if len(sol) != 1:
+        raise UnsupportedError("effective potential: the cyclic rates are not uniquely "
+                               "solvable from their momenta (a chart singularity?)")
+    routh = sum((p * v for p, v in zip(momenta, rates, strict=True)), sp.S.Zero) - L0
+    return routh.subs(sol[0])

@@ -1,12 +1,21 @@
 """The problem model: problem files read safely and turned into symbols and a Lagrangian.
 
     yamlio    YAML with line numbers, duplicate keys refused
+    limits    input limits: file size, no YAML aliases or tags, depth, counts (hostile input)
     schema    JSON-Schema validation with file:line errors (schemas/*.json)
     expr      the safe expression parser (never eval)
-    catalog   where problem and answer files live, problem ids
+    constants is a constant finite and real? (in double precision: cannot hang)
+    tensorexpr  the same parser for vectors and tensors (and bodies' functions)
+    tensorfuncs the whitelisted functions of tensor expressions
+    books     books.yaml: the declared books, problem ids <book>-<number>
+    catalog   where problem and answer files live, problem ids checked (check_id)
     problem   a problem file: parameters, conditions, its systems as data
     system    one system built: coordinates, T, V, L, forces, constraints
-    bodies    rigid bodies: standard shapes' inertia, kinetic energy, Euler-angle rates
+    declared  a problem's named vectors, bodies made of parts, named tensors
+    bodies    rigid bodies: standard shapes' inertia, bodies of parts, kinetic energy
+              (a package)
+    attitude  attitude charts: chains of elementary rotations, rotation matrix, body rates
+    loads     torques as generalized forces, attracting point masses, averaging over an angle
 
 May import: mechbook.core, mechbook.errors, mechbook.records.
 """

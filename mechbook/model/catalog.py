@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from mechbook.errors import MechbookError
+from mechbook.model.books import book_of
+from mechbook.model.books import split_id as _split_id
 
 DEFAULT_STORE = Path("results/mechbook.h5")  # relative to the tree's root
 
@@ -23,22 +26,43 @@ def root(start: str | Path | None = None) -> Path:
                         "or set MECHBOOK_ROOT")
 
 
+# A book's name, a dash, and the problem's name: letters, digits, '.', '_' and '-' only, so
+# an id can never name a path outside the tree (no '/', no '..', nothing absolute).
+_ID = re.compile(r"[a-z][a-z0-9_]{0,39}-[A-Za-z0-9][A-Za-z0-9._-]{0,79}")
+
+
+def check_id(pid: object) -> str:
+    """`pid` if it is a well-formed problem id; MechbookError otherwise. The one place that
+    decides which ids may become file paths (problems/<book>/<rest>.yaml)."""
+    if not isinstance(pid, str) or not _ID.fullmatch(pid) or ".." in pid:
+        raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, e.g. lim-2031 "
+                            "or symon-09-12: letters, digits, '.', '_' and '-' only)")
+    return pid
+
+
 def split_id(pid: str) -> tuple[str, str]:
     """'lim-2031' -> ('lim', '2031'); 'symon-09-12' -> ('symon', '09-12')."""
-    book, _, rest = pid.partition("-")
-    if not rest:
-        raise MechbookError(f"bad problem id {pid!r} (expected e.g. lim-2031 or symon-09-12)")
-    return book, rest
+    return _split_id(check_id(pid))
+
+
+def _inside(base: Path, folder: str, book: str, rest: str) -> Path:
+    path = base / folder / book / f"{rest}.yaml"
+    top = os.path.normpath(base / folder)
+    if os.path.commonpath([top, os.path.normpath(path)]) != top:  # check_id makes it so
+        raise MechbookError(f"problem id {book}-{rest} resolves outside {top}")
+    return path
 
 
 def problem_path(pid: str, base: Path) -> Path:
-    book, rest = split_id(pid)
-    return base / "problems" / book / f"{rest}.yaml"
+    """problems/<book>/<number>.yaml; the id checked (check_id) and against the tree's
+    books.yaml, and the path kept inside the tree."""
+    book_of(check_id(pid), base)
+    return _inside(base, "problems", *split_id(pid))
 
 
 def answer_path(pid: str, base: Path) -> Path:
-    book, rest = split_id(pid)
-    return base / "answers" / book / f"{rest}.yaml"
+    book_of(check_id(pid), base)
+    return _inside(base, "answers", *split_id(pid))
 
 
 def all_ids(base: Path) -> list[str]:

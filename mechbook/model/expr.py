@@ -4,17 +4,26 @@
 could run arbitrary code through them. Here the text is parsed by `ast.parse` (which only
 parses) and the tree is walked with a whitelist of node types, operators, functions and
 names; anything else is rejected with a message that says what and where.
+
+Two checks guard what the text means rather than how it reads: every constant a node
+produces must be finite and real (`1/0` is SymPy's complex infinity, `sqrt(-1)` the
+imaginary unit: neither belongs in a Lagrangian or a book's answer), and names that stand
+for expressions (abbreviations, `define:` forms, driven coordinates) count with the size of
+what they stand for, so a chain of abbreviations cannot build an expression that doubles at
+every step.
 """
 
 from __future__ import annotations
 
 import ast
 import math
+import warnings
 from collections.abc import Mapping
 
 import sympy as sp
 
 from mechbook.errors import ExpressionError
+from mechbook.model.constants import bad_constant
 
 MAX_LENGTH = 20_000  # characters in one expression
 MAX_NODES = 5_000  # AST nodes in one expression
@@ -23,6 +32,11 @@ MAX_AST_DEPTH = 400  # nesting of the parsed tree (a flat sum of n terms is n de
 MAX_DIGITS = 1000  # largest number of digits a numeric power may produce
 MAX_EXPONENT = 64  # largest |numeric exponent| accepted
 MAX_INTEGER = 10**30  # largest integer literal accepted
+MAX_LITERAL = 1e100  # largest |decimal literal| (SI constants: the sun's mass 2e30 kg ...)
+MIN_LITERAL = 1e-100  # smallest nonzero |decimal literal| (... Planck's constant 6.6e-34)
+MAX_SUBSTITUTED = 20_000  # tree size of one expression with its names' expressions put in
+MAX_SUBSTITUTED_TENSOR = 500_000  # the same for a tensor expression (nine entries of products
+# of generic rotations are large; a chain of abbreviations doubling each time still is not)
 
 FUNCTIONS: dict[str, object] = {
     "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "cot": sp.cot, "sec": sp.sec, "csc": sp.csc,
@@ -45,6 +59,7 @@ FUNCTIONS["diff"] = _diff
 ARITY = {"atan2": (2, 2), "log": (1, 2), "diff": (2, 3)}
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
 
+
 class Operator:
     """A function a quantity offers to the expressions of its own parts (e.g. a perturbation
     coefficient W0(j), or sum(expr, r)): called by name with the parsed arguments. The
@@ -56,6 +71,10 @@ class Operator:
     def __call__(self, *args):
         return self.fn(*args)
 
+
+# values that are statements, not numbers (a Symbol is also a SymPy Boolean, so not that)
+_TRUTHS = (sp.core.relational.Relational, sp.logic.boolalg.BooleanFunction,
+           sp.logic.boolalg.BooleanAtom)
 
 _BINOPS = {
     ast.Add: lambda a, b: a + b,
@@ -79,6 +98,28 @@ def _depth(text: str) -> int:
     return best
 
 
+_NOT_FINITE = (sp.zoo, sp.oo, -sp.oo, sp.nan)
+
+
+def tree_size(expr: sp.Basic, memo: dict | None = None) -> int:
+    """Nodes of `expr` written out as a tree (shared subexpressions counted each time they
+    occur), computed over the DAG in time proportional to its distinct nodes."""
+    memo = {} if memo is None else memo
+    stack = [expr]
+    while stack:
+        node = stack[-1]
+        if node in memo:
+            stack.pop()
+            continue
+        pending = [a for a in node.args if a not in memo]
+        if pending:
+            stack.extend(pending)
+            continue
+        stack.pop()
+        memo[node] = 1 + sum(memo[a] for a in node.args)
+    return memo[expr]
+
+
 class _Builder:
     def __init__(self, text: str, names: Mapping[str, sp.Basic], allow_relations: bool):
         self.text = text
@@ -86,13 +127,18 @@ class _Builder:
         self.names = names
         self.allow_relations = allow_relations
         self.nodes = 0
+        self.substituted = 0
+        self.sizes: dict = {}
+        self.values: dict = {}  # float values of constants (mechbook.model.constants)
 
     def fail(self, node: ast.AST | None, what: str) -> ExpressionError:
         col = getattr(node, "col_offset", None)
         where = f" at column {col + 1}" if col is not None else ""
         return ExpressionError(f"{what}{where} in expression {self.text!r}", self.text)
 
-    def build(self, node: ast.AST, depth: int = 0) -> sp.Basic:
+    def build(self, node: ast.AST, depth: int = 0, operand: bool = False) -> sp.Basic:
+        """The SymPy value of `node`; with `operand`, it must be a value, not a comparison
+        (an operand of arithmetic or a function's argument)."""
         self.nodes += 1
         if self.nodes > MAX_NODES:
             raise self.fail(None, f"expression too large (more than {MAX_NODES} nodes)")
@@ -101,7 +147,32 @@ class _Builder:
         method = getattr(self, "_" + type(node).__name__, None)
         if method is None:
             raise self.fail(node, f"{type(node).__name__} is not allowed")
-        return method(node, depth + 1)
+        try:
+            result = method(node, depth + 1)
+            if isinstance(node, ast.BinOp | ast.UnaryOp | ast.Call):
+                self._check_constant(node, result)
+        except (TypeError, ValueError, ArithmeticError, AttributeError) as exc:
+            # SymPy refused to build or to evaluate it (mpmath overflows on exp(exp(...)))
+            raise self.fail(node, f"invalid operation ({type(exc).__name__}: {exc})") \
+                from None
+        if operand and isinstance(result, _TRUTHS):  # a relation, and/or, true/false
+            raise self.fail(node, "a comparison (or and/or) cannot be an operand; it is "
+                                  "allowed only as the whole expression")
+        return result
+
+    complex_ok = False  # tensor expressions build complex numbers on purpose (i(), expi())
+    max_substituted = MAX_SUBSTITUTED
+
+    def _check_constant(self, node: ast.AST, result: sp.Basic) -> None:
+        """The node's value, and the constants directly in it (x/0 is zoo*x), must be finite
+        and real (finite, where complex numbers are allowed); nodes are built bottom-up, so a
+        bad constant is caught where it arises."""
+        parts = list(result) if isinstance(result, sp.MatrixBase) else [result, *result.args]
+        for part in parts:
+            why = bad_constant(part, self.values, self.complex_ok)
+            if why:
+                segment = ast.get_source_segment(self.source, node) or self.text
+                raise self.fail(node, f"{segment!r} {why} (its value is {part})")
 
     def _Expression(self, node: ast.Expression, depth: int) -> sp.Basic:
         return self.build(node.body, depth)
@@ -117,7 +188,8 @@ class _Builder:
         # decimal literals are read exactly from their source text (0.5 -> 1/2, all digits
         # kept) so symbolic checks stay exact
         literal = ast.get_source_segment(self.source, node) or repr(value)
-        if not math.isfinite(value) or (value != 0 and not 1e-30 <= abs(value) <= MAX_INTEGER):
+        if not math.isfinite(value) or (value != 0
+                                        and not MIN_LITERAL <= abs(value) <= MAX_LITERAL):
             raise self.fail(node, f"number {literal} out of range")
         try:
             return sp.Rational(literal.replace("_", ""))
@@ -129,9 +201,17 @@ class _Builder:
         if name.startswith("_"):
             raise self.fail(node, f"name {name!r} is not allowed (leading underscore)")
         if name in self.names:
-            if isinstance(self.names[name], Operator):
+            value = self.names[name]
+            if isinstance(value, Operator):
                 raise self.fail(node, f"function {name!r} used without a call")
-            return self.names[name]
+            entries = list(value) if isinstance(value, sp.MatrixBase) else [value]
+            if any(e.args for e in entries):  # a name standing for an expression (or a
+                # vector or tensor of them): count what it brings
+                self.substituted += sum(tree_size(e, self.sizes) for e in entries)
+                if self.substituted > self.max_substituted:
+                    raise self.fail(node, "expression too large once its names are "
+                                    f"substituted (more than {self.max_substituted} nodes)")
+            return value
         if name in CONSTANTS:
             return CONSTANTS[name]
         if name in FUNCTIONS:
@@ -139,7 +219,7 @@ class _Builder:
         raise self.fail(node, f"unknown name {name!r} (declare it as a parameter or coordinate)")
 
     def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Basic:
-        operand = self.build(node.operand, depth)
+        operand = self.build(node.operand, depth, True)
         if isinstance(node.op, ast.USub):
             return -operand
         if isinstance(node.op, ast.UAdd):
@@ -150,8 +230,8 @@ class _Builder:
         op = type(node.op)
         if op not in _BINOPS:
             raise self.fail(node, f"operator {op.__name__} is not allowed")
-        left = self.build(node.left, depth)
-        right = self.build(node.right, depth)
+        left = self.build(node.left, depth, True)
+        right = self.build(node.right, depth, True)
         if op is ast.Pow:
             if right.is_Number and abs(right) > MAX_EXPONENT:
                 raise self.fail(node, f"exponent {right} too large (at most {MAX_EXPONENT})")
@@ -182,7 +262,7 @@ class _Builder:
         if not lo <= len(node.args) <= hi:
             raise self.fail(node, f"{name}() takes {lo if lo == hi else f'{lo} to {hi}'} "
                                   f"argument(s), got {len(node.args)}")
-        args = [self.build(a, depth) for a in node.args]
+        args = [self.build(a, depth, True) for a in node.args]
         if isinstance(op, Operator):
             try:
                 return op(*args)
@@ -196,7 +276,8 @@ class _Builder:
     def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:
         if not self.allow_relations:
             raise self.fail(node, "a comparison is not allowed here")
-        terms = [self.build(node.left, depth)] + [self.build(c, depth) for c in node.comparators]
+        terms = [self.build(node.left, depth, True)] + [self.build(c, depth, True)
+                                                       for c in node.comparators]
         rels = []
         for op, a, b in zip(node.ops, terms, terms[1:], strict=False):
             if type(op) not in _COMPARE:
@@ -208,13 +289,15 @@ class _Builder:
         if not self.allow_relations:
             raise self.fail(node, "and/or is not allowed here")
         parts = [self.build(v, depth) for v in node.values]
+        for v, part in zip(node.values, parts, strict=True):
+            if not isinstance(part, sp.logic.boolalg.Boolean):
+                raise self.fail(v, "and/or joins comparisons, not values")
         return sp.And(*parts) if isinstance(node.op, ast.And) else sp.Or(*parts)
 
 
-def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
-          allow_relations: bool = False) -> sp.Basic:
-    """Parse one expression (or, with allow_relations, a condition such as ``a < b``)."""
-    names = names or {}
+def syntax_tree(text: str | int | float) -> tuple[str, ast.Expression]:
+    """The text (a number's repr) and its Python syntax tree, after the limits on length
+    and nesting; ExpressionError for anything else, a syntax error with its column."""
     if isinstance(text, bool):
         raise ExpressionError(f"expected an expression, got {text!r}")
     if isinstance(text, int | float):
@@ -228,25 +311,50 @@ def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
     if _depth(text) > MAX_DEPTH:
         raise ExpressionError(f"expression nested too deeply (more than {MAX_DEPTH})", text)
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        with warnings.catch_warnings():  # '\ ' in a string literal warns; it is refused anyway
+            warnings.simplefilter("ignore")
+            tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
         col = f" at column {exc.offset}" if exc.offset else ""
         raise ExpressionError(f"syntax error{col} in expression {text!r}: {exc.msg}",
                               text) from None
     except (RecursionError, MemoryError, ValueError):
         raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
-    return _Builder(text, names, allow_relations).build(tree)
+    return text, tree
 
 
-def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None) -> sp.Expr:
+def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
+          allow_relations: bool = False, complex_ok: bool = False) -> sp.Basic:
+    """Parse one expression (or, with allow_relations, a condition such as ``a < b``).
+    Constants must be finite and real; with `complex_ok` (an answer whose values are complex
+    on purpose: exponents, complex modes) finite complex constants such as sqrt(-1) are
+    allowed."""
+    names = names or {}
+    text, tree = syntax_tree(text)
+    builder = _Builder(text, names, allow_relations)
+    builder.complex_ok = complex_ok
+    try:
+        result = builder.build(tree)
+    except RecursionError:  # MAX_AST_DEPTH keeps clear of it; a deep caller may not
+        raise ExpressionError(f"expression {text[:60]!r} nested too deeply", text) from None
+    if isinstance(result, sp.Basic) and (result.has(*_NOT_FINITE)
+                                         or (result.has(sp.I) and not complex_ok)):
+        raise ExpressionError(f"expression {text!r} holds a constant that is not finite "
+                              f"and real: {result}", text)
+    return result
+
+
+def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None,
+                   complex_ok: bool = False) -> sp.Expr:
     """Parse ``lhs = rhs`` (or a bare ``expr`` meaning ``expr = 0``) into ``lhs - rhs``."""
     if not isinstance(text, str):
-        return parse(text, names)
+        return parse(text, names, complex_ok=complex_ok)
     pieces = _split_single_equals(text)
     if len(pieces) == 1:
-        return parse(pieces[0], names)
+        return parse(pieces[0], names, complex_ok=complex_ok)
     if len(pieces) == 2:
-        return parse(pieces[0], names) - parse(pieces[1], names)
+        return (parse(pieces[0], names, complex_ok=complex_ok)
+                - parse(pieces[1], names, complex_ok=complex_ok))
     raise ExpressionError(f"more than one '=' in equation {text!r}", text)
 
 

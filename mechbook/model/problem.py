@@ -1,8 +1,9 @@
 """Problem files: load, validate, and turn declarations into SymPy symbols and expressions.
 
 A problem holds shared parameters and one or more systems (a problem whose parts use
-different physical set-ups, say a free and a driven chain, declares `systems:`). Everything
-a system says is parsed with the safe parser; an error names the file and line.
+different physical set-ups, say a free and a driven chain, declares `systems:`), or none: a
+problem about tensors and bodies declares only those (mechbook/model/declared.py).
+Everything a system says is parsed with the safe parser; an error names the file and line.
 """
 
 from __future__ import annotations
@@ -15,16 +16,18 @@ from pathlib import Path
 import sympy as sp
 
 from mechbook.errors import ExpressionError
+from mechbook.model.books import file_id_error
 from mechbook.model.expr import CONSTANTS, FUNCTIONS, Operator, parse
+from mechbook.model.limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
-from mechbook.model.yamlio import Document, load
+from mechbook.model.yamlio import Document, loads
 
 T = sp.Symbol("t", real=True)
 RESERVED = {"t"} | set(CONSTANTS) | set(FUNCTIONS)
 SYSTEM_KEYS = ("coordinates", "driven", "particles", "rigid_bodies", "gravity", "springs",
                "kinetic", "potential", "lagrangian", "velocity_potential", "constraints",
-               "forces", "dissipation", "string", "approximation", "equilibria", "initial",
-               "compute", "doc")
+               "forces", "torques", "attractors", "dissipation", "string", "average",
+               "approximation", "equilibria", "initial", "compute", "doc")
 DEFAULT_VALUES = {"g": 9.81}  # documented default for the gravitational acceleration
 DEFAULT_VALUE = 1.0
 
@@ -137,8 +140,10 @@ def _function(doc: Document, name: str, spec: dict, params: dict) -> Operator:
 
 def load_problem(path: str | Path) -> Problem:
     """Load and validate a problem file; raise SpecError naming file and line on any fault."""
-    doc = load(path)
+    raw = read_bytes(path)
+    doc = loads(decode(raw, str(path)), str(path))
     validate(doc, "problem")
+    check_problem_counts(doc)
     data = doc.data
     params = {n: _parameter(doc, n, s) for n, s in data["parameters"].items()}
     functions = {}
@@ -149,14 +154,18 @@ def load_problem(path: str | Path) -> Problem:
         if inline:
             raise doc.error((inline[0],), "with 'systems:' every system key goes inside a system")
         systems = {n: SystemSpec(n, s, ("systems", n)) for n, s in data["systems"].items()}
-    else:
-        if "coordinates" not in data:
-            raise doc.error((), "'coordinates' is required (or a 'systems' mapping)")
+    elif "coordinates" in data:
         systems = {"main": SystemSpec("main", {k: data[k] for k in SYSTEM_KEYS if k in data}, ())}
-    expected = Path(path).stem
-    if not data["id"].endswith(expected):
-        raise doc.error(("id",), f"id {data['id']!r} does not match the file name {expected!r}")
-    sha = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    else:  # no system: a problem about declared vectors, tensors and bodies only
+        stray = [k for k in SYSTEM_KEYS if k in data and k != "doc"]
+        if stray:
+            raise doc.error((stray[0],), "'coordinates' is required (or a 'systems' mapping) "
+                            f"for a system; {stray[0]!r} belongs to one")
+        systems = {}
+    why = file_id_error(data["id"], path)
+    if why:
+        raise doc.error(("id",), why)
+    sha = hashlib.sha256(raw).hexdigest()
     problem = Problem(data["id"], data["title"], data["source"], str(path), doc, params, systems,
                       sha, data.get("description", ""), functions=functions)
     problem.conditions = [problem.parse(c, ("conditions", i), relation=True)

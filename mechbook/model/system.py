@@ -2,8 +2,10 @@
 
 Coordinates are plain real symbols q, with companions `qdot` and `qddot`; driven coordinates
 are replaced by their prescribed functions of t. T, V and L come from whichever the problem
-states: `lagrangian`, or `kinetic`/`potential`, plus particles, rigid bodies, gravity and
-springs, each adding its own term. Nothing else is modelled.
+states: `lagrangian`, or `kinetic`/`potential`, plus particles, rigid bodies, gravity,
+springs and attracting point masses, each adding its own term; torques on bodies become
+generalized forces, and `average:` averages L over a fast angle (mechbook.model.loads).
+Nothing else is modelled.
 """
 
 from __future__ import annotations
@@ -11,9 +13,12 @@ from __future__ import annotations
 import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
-from mechbook.core.numeval import without_absent
+from mechbook.core.numeval import is_zero, without_absent
 from mechbook.errors import UnsupportedError
+from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
+from mechbook.model.declared import declared
+from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
 
 
@@ -88,6 +93,9 @@ class System:
         potential = self._parse(s["potential"], ("potential",)) if "potential" in s else sp.S.Zero
         self.positions: dict[str, sp.Matrix] = {}
         self.masses: dict[str, sp.Expr] = {}
+        self.attitudes: dict[str, list] = {}  # body -> chain of rotations (3-D bodies)
+        self.inertias: dict[str, sp.Matrix] = {}  # body -> inertia tensor in body axes
+        self.body_rates: dict[str, sp.Matrix] = {}  # body -> ω in body axes
         for name, p in (s.get("particles") or {}).items():
             m = self._parse(p["mass"], ("particles", name, "mass"))
             r = sp.Matrix([self._parse(x, ("particles", name, "position", i))
@@ -102,6 +110,8 @@ class System:
             t_string, v_string = self._string()
             kinetic += t_string
             potential += v_string
+        if s.get("attractors"):
+            potential += attractor_potential(self, s["attractors"])
         if "lagrangian" in s:
             lag = self._parse(s["lagrangian"], ("lagrangian",))
             if self.positions or s.get("rigid_bodies"):
@@ -112,6 +122,11 @@ class System:
             lag -= self._parse(s["velocity_potential"], ("velocity_potential",))
         if lag == 0:
             raise self._error(("coordinates",), "the system has no kinetic or potential energy")
+        if "average" in s:  # averaged over a fast angle, e.g. a planet's orbital position
+            rest = lag - (kinetic - potential)  # the average is linear: T and V once each
+            kinetic, potential, rest = (average_over(self, e, s["average"])
+                                        for e in (kinetic, potential, rest))
+            lag = kinetic - potential + rest
         if "approximation" in s:  # the approximation the problem makes, e.g. small angles
             approx = s["approximation"]
             point = self.point(approx["about"], ("approximation", "about"))
@@ -120,7 +135,11 @@ class System:
         self.kinetic = without_absent(kinetic, [T, *self.q])
         self.potential = without_absent(potential, [T, *self.q])
         self.lagrangian = without_absent(lag, [T, *self.q])
-        self.forces = self._forces()
+        self.declared_forces = self._forces()  # `forces:` as the file gives them
+        self.forces = list(self.declared_forces)
+        if s.get("torques"):
+            self.forces = [f + g for f, g in zip(self.forces, torque_forces(self, s["torques"]),
+                                                  strict=True)]
         self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))
                             for i, c in enumerate(s.get("constraints") or [])]
         for i, (cname, f) in enumerate(self.constraints):
@@ -130,16 +149,32 @@ class System:
 
     def _rigid_body(self, name: str, b: dict) -> sp.Expr:
         sub = ("rigid_bodies", name)
-        m = self._parse(b["mass"], sub + ("mass",))
+        inertia = b["inertia"]
+        composite = None
+        if isinstance(inertia, dict) and "body" in inertia:
+            composite = self._composite(inertia["body"], sub + ("inertia", "body"))
+        if "mass" in b:
+            m = self._parse(b["mass"], sub + ("mass",))
+            if composite is not None and not is_zero(m - composite.mass):
+                raise self._error(sub + ("mass",), f"the mass differs from body "
+                                  f"{inertia['body']!r}'s ({composite.mass}); leave it out")
+        elif composite is not None:
+            m = composite.mass
+        else:
+            raise self._error(sub, "a rigid body needs 'mass' (unless its inertia names a body)")
         r = sp.Matrix([self._parse(x, sub + ("position", i)) for i, x in enumerate(b["position"])])
         self.positions[name], self.masses[name] = r, m
-        inertia = b["inertia"]
-        if isinstance(inertia, dict):
+        if composite is not None:
+            if r.rows != 3:
+                raise self._error(sub + ("position",), "a body made of parts moves in 3-D")
+            tensor = composite.inertia()  # about its centre of mass, in its own axes
+        elif isinstance(inertia, dict):
             dims = {k: self._parse(v, sub + ("inertia", k)) for k, v in inertia.items()
-                    if k in ("radius", "length")}
-            if "sides" in inertia:
-                dims["sides"] = [self._parse(v, sub + ("inertia", "sides", i))
-                                 for i, v in enumerate(inertia["sides"])]
+                    if k in ("radius", "length", "height")}
+            for key in ("sides", "semi_axes"):
+                if key in inertia:
+                    dims[key] = [self._parse(v, sub + ("inertia", key, i))
+                                 for i, v in enumerate(inertia[key])]
             try:
                 tensor = shape_inertia(inertia["shape"], m, dims)
             except ValueError as exc:
@@ -157,14 +192,59 @@ class System:
             omega = (sp.Matrix([self._parse(x, sub + ("angular_velocity", i))
                                 for i, x in enumerate(w)]) if isinstance(w, list)
                      else self._parse(w, sub + ("angular_velocity",)))
-        euler = None
-        if "euler_angles" in b:
-            euler = [self._parse(x, sub + ("euler_angles", i))
-                     for i, x in enumerate(b["euler_angles"])]
+        chain = self._attitude(sub, b)
         try:
-            return body_kinetic(m, self.dt(r), tensor, omega, euler, self.dt)
+            kinetic = body_kinetic(m, self.dt(r), tensor, omega, chain, self.dt)
         except ValueError as exc:
             raise self._error(sub, str(exc)) from None
+        if isinstance(tensor, sp.MatrixBase) and r.rows == 3:
+            self.inertias[name] = tensor
+            self.body_rates[name] = body_rates(chain, self.dt) if chain is not None else omega
+            if chain is not None:
+                self.attitudes[name] = chain
+        self._rate_names(name, sub, b)
+        return kinetic
+
+    def _attitude(self, sub: tuple, b: dict) -> list | None:
+        """The body's chain of rotations: `euler_angles` (z-x-z) or `rotation`."""
+        if "euler_angles" in b and "rotation" in b:
+            raise self._error(sub + ("rotation",), "give either 'euler_angles' or 'rotation'")
+        if "euler_angles" in b:
+            return euler_chain([self._parse(x, sub + ("euler_angles", i))
+                                for i, x in enumerate(b["euler_angles"])])
+        if "rotation" in b:
+            return [(axis, self._parse(angle, sub + ("rotation", i, 1)))
+                    for i, (axis, angle) in enumerate(b["rotation"])]
+        return None
+
+    def _rate_names(self, name: str, sub: tuple, b: dict) -> None:
+        """`rates: [w1, w2, w3]` and `space_rates: [wx, wy, wz]`: names for the body-axis
+        and the space-axis components of ω (functions of the state), each with its time
+        derivative `<name>dot` (which holds accelerations)."""
+        for key in ("rates", "space_rates"):
+            if key not in b:
+                continue
+            omega = self.body_rates.get(name)
+            if omega is None or (key == "space_rates" and name not in self.attitudes):
+                raise self._error(sub + (key,), f"'{key}' names the angular velocity of a 3-D "
+                                  "body with an attitude (or, for 'rates', a vector "
+                                  "angular_velocity)")
+            if key == "space_rates":
+                omega = rotation_matrix(self.attitudes[name]) * omega
+            for i, rname in enumerate(b[key]):
+                for n in (rname, rname + "dot"):
+                    if n in self.names or n in RESERVED:
+                        raise self._error(sub + (key, i), f"name {n!r} is already taken")
+                self.names[rname] = omega[i]
+                self.names[rname + "dot"] = self.dt(omega[i])
+
+    def _composite(self, body: str, sub: tuple):
+        """A body declared under the problem's `bodies:` (made of parts)."""
+        bodies = declared(self.problem).bodies
+        if body not in bodies:
+            known = ", ".join(sorted(bodies)) or "none declared"
+            raise self._error(sub, f"no body {body!r} under 'bodies:' ({known})")
+        return bodies[body]
 
     def _gravity(self) -> sp.Expr:
         if "gravity" not in self.spec:

@@ -1,7 +1,10 @@
-"""YAML reading that remembers line numbers and refuses duplicate keys.
+"""YAML reading that remembers line numbers, refuses duplicate keys and stays bounded.
 
 PyYAML silently keeps the last of two equal keys; ruamel.yaml's round-trip loader raises on
-them and records where every node sits, so errors can name the file and the line.
+them and records where every node sits, so errors can name the file and the line. Before
+anything is built, the file's size, its event stream (no anchors, aliases or tags; bounded
+depth and node count) and then every scalar (plain JSON-like values, finite numbers) are
+checked against mechbook.model.limits.
 """
 
 from __future__ import annotations
@@ -12,9 +15,10 @@ from typing import Any
 from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
 from ruamel.yaml.constructor import DuplicateKeyError
-from ruamel.yaml.error import MarkedYAMLError
+from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from mechbook.errors import SpecError
+from mechbook.model.limits import MAX_FILE_BYTES, check_events, check_scalar, read_text
 
 Path_ = tuple[str | int, ...]
 
@@ -25,7 +29,7 @@ class Document:
     def __init__(self, raw: Any, file: str):
         self.raw = raw
         self.file = file
-        self.data = _plain(raw)
+        self.data = self._plain(raw, ())
 
     def line(self, path: Path_) -> int | None:
         """1-based line of the node at `path` (its key's line for mapping entries)."""
@@ -53,35 +57,41 @@ class Document:
         return SpecError(text, self.file, self.line(path))
 
 
+    def _plain(self, node: Any, path: Path_) -> Any:
+        """JSON-like data: str keys; str, bool, None and finite numbers as values."""
+        if isinstance(node, dict):
+            out = {}
+            for k, v in node.items():
+                if isinstance(k, dict | list | tuple):
+                    raise self.error(path, "a mapping key must be a plain name, not a "
+                                     "collection")
+                out[str(k)] = self._plain(v, path + (k,))
+            return out
+        if isinstance(node, list):
+            return [self._plain(v, path + (i,)) for i, v in enumerate(node)]
+        if isinstance(node, str):
+            return str(node)
+        return check_scalar(node, lambda: (self.file, self.line(path)))
+
+
 def _node_line(node: Any) -> int | None:
     lc = getattr(node, "lc", None)
     return lc.line + 1 if lc is not None and lc.line is not None else None
 
 
-def _plain(node: Any) -> Any:
-    if isinstance(node, dict):
-        return {str(k): _plain(v) for k, v in node.items()}
-    if isinstance(node, list):
-        return [_plain(v) for v in node]
-    if isinstance(node, str):
-        return str(node)
-    return node
-
-
 def load(path: str | Path) -> Document:
-    """Load a YAML file; syntax errors and duplicate keys become SpecError with a line."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SpecError(f"cannot read file: {exc.strerror}", str(path)) from None
-    return loads(text, str(path))
+    """Load a YAML file; syntax errors, duplicate keys and anything past the limits
+    (mechbook.model.limits) become SpecError with a line."""
+    return loads(read_text(path), str(path))
 
 
 def loads(text: str, file: str = "<string>") -> Document:
+    if len(text) > MAX_FILE_BYTES:
+        raise SpecError(f"text too large (more than {MAX_FILE_BYTES} characters)", file)
     yaml = YAML(typ="rt")
     yaml.allow_duplicate_keys = False
     try:
+        check_events(YAML(typ="rt").parse(text), file)  # before anything is built
         raw = yaml.load(text)
     except DuplicateKeyError as exc:
         line = exc.problem_mark.line + 1 if exc.problem_mark else None
@@ -90,6 +100,20 @@ def loads(text: str, file: str = "<string>") -> Document:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark else None
         raise SpecError(f"YAML syntax error: {exc.problem or exc.context}", file, line) from None
+    except YAMLError as exc:  # the reader's errors (control characters) carry no mark
+        raise SpecError(f"YAML error: {_first_line(exc)}", file, _position_line(exc, text)) \
+            from None
+    except (ValueError, OverflowError, RecursionError) as exc:  # a constructor's last resort
+        raise SpecError(f"YAML value cannot be read: {_first_line(exc)}", file) from None
     if raw is None:
         raise SpecError("file is empty", file, 1)
     return Document(raw, file)
+
+
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+
+
+def _position_line(exc: BaseException, text: str) -> int | None:
+    position = getattr(exc, "position", None)
+    return text[:position].count("\n") + 1 if isinstance(position, int) else None

@@ -4,6 +4,7 @@
     integrators  SciPy's solve_ivp methods and fixed-step RK4 / symplectic methods, one
                  interface
     monitors     drift of the conserved quantities the engine found
+    measure      turning points, periods, mean rates and event times measured along a run
     stiffness    time scales from the linearized equations; is a run stiff?
     accuracy     method and tolerance for a requested accuracy (a rule measured by
                  bench/work_precision.py)

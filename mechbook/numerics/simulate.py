@@ -17,11 +17,7 @@ bench/work_precision.py (`accuracy.choose`), and the run reports the error it ex
 
 from __future__ import annotations
 
-import signal
-import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 
@@ -29,7 +25,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook import __version__
-from mechbook.core.timeout import Timeout
+from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.accuracy import choose
@@ -40,31 +36,6 @@ from mechbook.numerics.stiffness import IMPLICIT, Stiffness, assess, fixed_step_
 
 FALLBACK_OFFSET = 0.1
 FALLBACK_SEARCH = 20.0  # seconds for finding a stable equilibrium to start near
-
-
-@contextmanager
-def hard_time_limit(seconds: float) -> Iterator[None]:
-    """Raise Timeout in the block after `seconds`, and again every 0.2 s until it is left.
-
-    `timeout.time_limit` fires once, and the engine's searches catch a Timeout as their own
-    limit and go on with the next strategy: the equilibrium search of lim-2057/planar ran for
-    130 s that way before giving up. The repeated alarm ends such a search within
-    `seconds`. An outer limit already running governs (as with time_limit)."""
-    if seconds <= 0 or threading.current_thread() is not threading.main_thread() \
-            or not hasattr(signal, "setitimer") or signal.getitimer(signal.ITIMER_REAL)[0] > 0:
-        yield
-        return
-
-    def _raise(signum, frame):
-        raise Timeout(f"gave up after {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, _raise)
-    signal.setitimer(signal.ITIMER_REAL, seconds, 0.2)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 @dataclass

@@ -5,9 +5,11 @@
                 on request (ProofPolicy)
     context     what a part is checked in: system, names, sampler, point
     registry    every answer quantity: name -> check, schema fragment, doc line
+    instances   generic tensors for statements "for all", and deciding identities on
+                random instances (exact or 30-digit) with a symbolic attempt
     quantities  the checks, one module per family of quantities
     checker     running a key: outcomes pass / fail / erratum / unsupported / error
 
-May import: mechbook.engine, mechbook.model, mechbook.core, mechbook.errors,
-mechbook.records.
+May import: mechbook.numerics (trajectory quantities measured by integration),
+mechbook.engine, mechbook.model, mechbook.core, mechbook.errors, mechbook.records.
 """

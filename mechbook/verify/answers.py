@@ -7,6 +7,7 @@ the names of normal coordinates) and abbreviations (`abbreviations: {omega0: sqr
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -14,7 +15,9 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import parse, parse_equation
+from mechbook.model.limits import check_answer_counts
 from mechbook.model.schema import validate
+from mechbook.model.tensorexpr import parse_tensor
 from mechbook.model.yamlio import Document, load
 
 
@@ -44,27 +47,43 @@ class Part:
     def error(self, sub: tuple, message: str):
         return self.key.doc.error(self.path + sub, message)
 
-    def names(self, system) -> dict[str, sp.Basic]:
-        names = dict(system.names)
+    def names(self, base: dict, tensor: bool = False,
+              bodies: dict | None = None) -> dict[str, sp.Basic]:
+        """The names this part may use: `base` (a system's, or the problem's declared
+        ones), the key's symbols and its abbreviations (tensor expressions, which may name
+        the problem's `bodies`, if `tensor`)."""
+        names = dict(base)
+        for sym in self.key.symbols:
+            if sym in names:
+                raise self.key.doc.error(("symbols", sym), f"{sym!r} is already a name of the "
+                                         "problem (a parameter, coordinate or rate)")
         names.update(self.key.symbols)
         for abbr, text in (self.key.doc.data.get("abbreviations") or {}).items():
             if abbr in names:
                 raise self.key.doc.error(("abbreviations", abbr), f"{abbr!r} is already a name")
             try:
-                names[abbr] = parse(text, names)
+                names[abbr] = parse_tensor(text, names, bodies or {}) if tensor \
+                    else parse(text, names)
             except ExpressionError as exc:
                 # An abbreviation may belong to another of the problem's systems (it names
                 # that system's coordinates): it is simply not available in this one, and a
-                # part that uses it here is told why.
-                self._unavailable[abbr] = str(exc)
+                # part that uses it here is told why (the first abbreviation of a chain that
+                # failed, with its own reason).
+                used = re.search(r"unknown name '(\w+)'", str(exc))
+                self._unavailable[abbr] = self._unavailable.get(used.group(1) if used else "",
+                                                                str(exc))
         return names
 
     def parse(self, text, sub: tuple, names: dict, equation: bool = False,
               relation: bool = False) -> sp.Basic:
+        from mechbook.verify.registry import quantities
+
+        known = quantities().get(self.quantity)
+        complex_ok = bool(known and known.complex_values)  # exponents, complex modes
         try:
             if equation:
-                return parse_equation(text, names)
-            return parse(text, names, relation)
+                return parse_equation(text, names, complex_ok)
+            return parse(text, names, relation, complex_ok)
         except ExpressionError as exc:
             message = str(exc)
             for abbr, why in self._unavailable.items():
@@ -100,4 +119,5 @@ def load_answers(path: str | Path) -> AnswerKey:
 
     doc = load(path)
     validate(doc, answers_schema())
+    check_answer_counts(doc)
     return AnswerKey(doc)

@@ -35,12 +35,15 @@ class Sampler:
 
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
                  seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
+                 rtol: float = RTOL, fixed: Sequence[sp.Symbol] = (),
                  derived: dict[sp.Symbol, sp.Expr] | None = None):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
         self.spread = spread
         self.policy = policy  # carried with the sampler to every comparison it serves
+        self.rtol = rtol  # relative tolerance of `equal` and `vanishes` (a numeric estimate's)
+        self.fixed = set(fixed)  # symbols kept at their base values (a numeric estimate)
         # symbols fixed by the others (a part's `restrict:`, a surface in parameter space):
         # computed after each draw, in order, so a later one may use an earlier one
         self.derived = dict(derived or {})
@@ -68,12 +71,17 @@ class Sampler:
         conditions exclude the neighbourhood of the default values, the spread is widened
         step by step (x4 each time), so an `assume:` far from the defaults still samples."""
         spread = self.spread if spread is None else spread
+        # a condition may bound a state variable (an `assume:` such as r > 0): draw it too
+        extra = set().union(*(c.free_symbols for c in self.conditions)) - set(self.base)
+        variables = list(variables) + sorted(extra - set(variables), key=str)
         for attempt in range(tries):
             if attempt and attempt % (tries // 5) == 0:
                 spread *= 4
             point = {}
             for sym, value in self.base.items():
-                if sym.is_positive:
+                if sym in self.fixed:
+                    point[sym] = value
+                elif sym.is_positive:
                     point[sym] = value * math.exp(self.rng.uniform(-spread, spread))
                 else:
                     point[sym] = value + self.rng.uniform(-1, 1) * max(1.0, abs(value)) * spread
@@ -94,13 +102,17 @@ class Sampler:
     def widened(self, spread: float) -> Sampler:
         """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
         return Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
-                       derived=self.derived)
+                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived)
 
     def default(self) -> dict[sp.Symbol, sp.Float]:
+        """The default values (when they satisfy the conditions on the parameters alone;
+        a condition on a state variable, such as r > 0, is for the states drawn later),
+        with the derived (restricted) symbols computed."""
         point = self._complete({k: sp.Float(v, DIGITS) for k, v in self.base.items()})
-        if point is not None and all(holds(c, point) for c in self.conditions):
+        if point is not None and all(holds(c, point) for c in self.conditions
+                                     if c.free_symbols <= set(point)):
             return point
-        return self.draw()
+        return {k: v for k, v in self.draw().items() if k in self.base}
 
 
 def value(expr: sp.Basic, point: dict) -> complex:
@@ -158,14 +170,15 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
         valid += 1
         rel = abs(v) / scale if scale > 0 else abs(v)
         worst = max(worst, rel)
-        if rel > RTOL:
+        if rel > sampler.rtol:
             return Verdict(False, f"numeric({valid} points)",
                            f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
         return Verdict(True, "symbolic")
-    return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+    return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
+                   f"worst relative {worst:.2g}")
 
 
 def _prove(sampler: Sampler, symbolic: bool | None) -> bool:
@@ -213,14 +226,15 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
         valid += 1
         rel = abs(va - vb) / max(abs(va), abs(vb), 1e-300)
         worst = max(worst, rel)
-        if rel > RTOL and abs(va - vb) > 1e-25:
+        if rel > sampler.rtol and abs(va - vb) > 1e-25:
             return Verdict(False, f"numeric({valid} points)",
                            f"{_num(va)} vs {_num(vb)} at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(a - b, sampler.policy.seconds):
         return Verdict(True, "symbolic")
-    return Verdict(True, f"numeric({valid} points, rtol {RTOL:g})", f"worst relative {worst:.2g}")
+    return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
+                   f"worst relative {worst:.2g}")
 
 
 def _num(z: complex) -> str:

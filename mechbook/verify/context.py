@@ -15,10 +15,13 @@ from dataclasses import dataclass
 import sympy as sp
 
 from mechbook.engine.analysis import Analysis
+from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
+from mechbook.model.declared import declared
 from mechbook.records import NUMERIC, ProofPolicy
 from mechbook.verify.answers import Part
 from mechbook.verify.compare import Sampler, value
+from mechbook.verify.registry import quantities
 
 
 @dataclass
@@ -26,24 +29,42 @@ class Context:
     analysis: Analysis
     part: Part
     policy: ProofPolicy = NUMERIC
+    validate_only: bool = False  # tensor parts: build the statement once, judge nothing
 
     def __post_init__(self):
-        try:
-            self.system = self.analysis.system(self.part.system)
-        except KeyError as exc:  # no `system:` in a multi-system problem, or a wrong one
-            raise self.part.error(("system",) if self.part.system else (),
-                                  str(exc.args[0]) + "; name it with `system:`") from None
-        self.names = self.part.names(self.system)
-        for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
-            self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
-        for k, v in (self.part.data.get("define") or {}).items():  # e.g. alpha = theta - pi
-            if k in self.names:
-                raise self.part.error(("define", k), f"{k!r} is already a name")
-            f = self.parse(v, ("define", k))
-            self.names[k] = f
-            self.names[k + "dot"] = self.system.dt(f)
-            self.names[k + "ddot"] = self.system.dt(self.system.dt(f))
-        conds = list(self.analysis.problem.conditions)
+        problem = self.analysis.problem
+        self.tensor_mode = not quantities()[self.part.quantity].needs_system
+        if self.part.system is None and (self.tensor_mode or not problem.systems):
+            self.system = None  # a tensor or body quantity, or a problem without a system
+            decl = declared(problem)
+            self.names = self.part.names(decl.names, tensor=True, bodies=decl.bodies)
+        else:
+            try:
+                self.system = self.analysis.system(self.part.system)
+            except KeyError as exc:  # no `system:` in a multi-system problem, or a wrong one
+                raise self.part.error(("system",) if self.part.system else (),
+                                      str(exc.args[0]) + "; name it with `system:`") from None
+            names = dict(self.system.names)
+            bodies = None
+            if self.tensor_mode:
+                decl = declared(problem)
+                _merge_declared(names, decl.names, self.part)
+                bodies = decl.bodies
+            self.names = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
+            for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
+                self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
+        if self.system is not None and not self.tensor_mode:
+            for k, v in (self.part.data.get("define") or {}).items():  # e.g. alpha = theta - pi
+                if k in self.names:
+                    raise self.part.error(("define", k), f"{k!r} is already a name")
+                f = self.parse(v, ("define", k))
+                self.names[k] = f
+                self.names[k + "dot"] = self.system.dt(f)
+                self.names[k + "ddot"] = self.system.dt(self.system.dt(f))
+        elif self.part.data.get("define") and not self.tensor_mode:
+            raise self.part.error(("define",), "`define` needs a system (it names "
+                                  "combinations of coordinates)")
+        conds = list(problem.conditions)
         conds += [self.parse(c, ("assume", i), relation=True)
                   for i, c in enumerate(self.part.data.get("assume", []))]
         base = dict(self.analysis.problem.values())
@@ -58,11 +79,33 @@ class Context:
                 raise self.part.error(("restrict", k), "a restricted symbol is given by the "
                                       "others, not by itself or another restricted one")
             derived[sym] = expr
-        self.sampler = Sampler(base, conds, policy=self.policy, derived=derived)
+        if "estimate" in self.part.data:  # a number the book computed: one point, its rtol
+            est = self.part.data["estimate"]
+            for k, v in (est.get("values") or {}).items():
+                sym = self.names.get(k)
+                if not isinstance(sym, sp.Symbol) or sym not in base:
+                    raise self.part.error(("estimate", "values", k), f"{k!r} is not a "
+                                          "parameter or answer symbol")
+                val = self.parse(v, ("estimate", "values", k))
+                if not val.is_number:
+                    raise self.part.error(("estimate", "values", k), "a number is expected")
+                base[sym] = float(val)
+            self.sampler = Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
+                                   fixed=list(base), derived=derived)
+        else:
+            self.sampler = Sampler(base, conds, policy=self.policy, derived=derived)
 
     @property
     def dyn(self):
+        if self.system is None:
+            raise self.part.error(("quantity",), f"{self.part.quantity!r} needs a system "
+                                  "(coordinates and a Lagrangian); this problem has none")
         return self.analysis.dynamics(self.part.system)
+
+    @property
+    def bodies(self) -> dict:
+        """The problem's declared bodies (for the body functions of tensor expressions)."""
+        return declared(self.analysis.problem).bodies
 
     def parse(self, text, sub, equation=False, relation=False):
         return self.part.parse(text, sub, self.names, equation, relation)
@@ -111,6 +154,15 @@ class Context:
         raise self.part.error(sub, "expected a mapping")
 
 
+def _merge_declared(names: dict, extra: dict, part: Part) -> None:
+    """The problem's vectors and tensors beside a system's names (parameters are shared)."""
+    for k, v in extra.items():
+        if k in names and names[k] is not v:
+            raise part.error(("quantity",), f"{k!r} is both a name of the system and a "
+                             "declared vector or tensor")
+        names[k] = v
+
+
 def strip_const(text):
     """A first integral's text without a trailing '= constant' (or '= const')."""
     if isinstance(text, str):
@@ -124,7 +176,7 @@ def linear_accelerations(lin: LinearSystem) -> dict:
     """q̈ solved from the linear equations M·q̈ + C·q̇ + K·δq = F."""
     n = len(lin.q)
     rhs = lin.F - lin.C * sp.Matrix(lin.dyn.qd) - lin.K * lin.displacement()
-    sol = lin.M.LUsolve(rhs)
+    sol = solve_accelerations(lin.M, rhs, list(lin.dyn.qdd))
     return {lin.dyn.qdd[i]: sol[i] for i in range(n)}
 
 

@@ -28,9 +28,14 @@ COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", 
 # schema fragments shared by several quantities' keys
 EXPR = {"$ref": "#/$defs/expr"}
 POINT = {"$ref": "#/$defs/point"}
+NAME = {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"}  # a coordinate or symbol
 LIMIT = {"type": "object", "required": ["parameter", "to"], "additionalProperties": False,
          "properties": {"parameter": {"type": "string"}, "to": {"enum": ["0", "oo", 0]},
                         "order": {"type": "integer", "minimum": 0, "maximum": 3}}}
+ESTIMATE = {"type": "object", "required": ["rtol"], "additionalProperties": False,
+            "properties": {"values": {"type": "object",
+                                      "additionalProperties": {"$ref": "#/$defs/expr"}},
+                           "rtol": {"type": "number", "exclusiveMinimum": 0, "maximum": 0.5}}}
 REGION = {"type": "object", "minProperties": 1,
           "additionalProperties": {"type": "array", "minItems": 2, "maxItems": 2,
                                    "items": EXPR}}
@@ -45,22 +50,28 @@ class Quantity:
     keys: dict = field(default_factory=dict)  # extra part keys -> JSON-Schema fragments
     names: Callable | None = None  # ctx -> the names its `book:` may use beyond ctx.names
     literals: tuple = ()  # words a `book:` value may be instead of an expression
+    needs_system: bool = True  # False: tensors and bodies, checked without a system
+    complex_values: bool = False  # its expressions may hold complex constants (sqrt(-1))
 
 
 QUANTITIES: dict[str, Quantity] = {}
 
 
 def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
-             names: Callable | None = None, literals: tuple = ()):
+             names: Callable | None = None, literals: tuple = (), needs_system: bool = True,
+             complex_values: bool = False):
     """Register the decorated function as the check of quantity `name` (`names`: a function
     of the part's context giving the names its book value may use beyond the usual ones,
     e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`: words
-    the book value may be instead, e.g. "stable")."""
+    the book value may be instead, e.g. "stable"; `needs_system`: False for quantities of
+    declared tensors and bodies, which a problem without a system can have;
+    `complex_values`: its values are complex on purpose, so its expressions may hold
+    constants such as sqrt(-1), which are refused elsewhere)."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
         QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names,
-                                    tuple(literals))
+                                    tuple(literals), needs_system, complex_values)
         return fn
 
     return register
@@ -108,4 +119,8 @@ def markdown_table() -> str:
 
 
 if __name__ == "__main__":  # python -m mechbook.verify.registry: the table for the docs
-    print(markdown_table())
+    # run as __main__, this module is a second copy: the quantities register in the one
+    # imported by name, so the table comes from there (this copy's registry stays empty)
+    from mechbook.verify.registry import markdown_table as _table
+
+    print(_table())

@@ -10,6 +10,10 @@ from mechbook.verify.quantities import (  # noqa: F401 - each module registers i
     perturbation,
     phase,
     response,
+    rotation,
+    stability,
     steady,
+    tensors,
+    trajectory,
     words,
 )

@@ -235,7 +235,8 @@ def _assignments(idx: list, f: int, mode: int, avoid_mode: bool) -> list[dict]:
                 "indices": {"type": "array", "items": {"type": "string"}},
                 "group": {"type": "array", "items": {"type": "integer", "minimum": 1}},
                 "reference": EXPR, "unperturbed": POINT},
-          names=lambda ctx: _names(ctx)[0])
+          names=lambda ctx: _names(ctx)[0],
+          complex_values=True)
 def check_perturbation(ctx: Context, val):
     for key in ("limit", "approximates"):
         if key not in ctx.part.data:

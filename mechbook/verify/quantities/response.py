@@ -110,7 +110,8 @@ def _exponent_map(ctx: Context):
                'polynomial in ω with `exponent: sqrt(-1)*omega`'),
           keys={"variable": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
                 "exponent": EXPR},
-          names=lambda ctx: _exponent_map(ctx)[1])
+          names=lambda ctx: _exponent_map(ctx)[1],
+          complex_values=True)
 def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
     var, names, exponent = _exponent_map(ctx)
     poly_expr = ctx.part.parse(val, ("book",), names)
@@ -146,7 +147,8 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
           book='list of p (complex: sqrt(-1))',
           how=('multiset equality with the 2n exponents p of e^{pt} solutions (roots of '
                'det(Mp² + Cp + K) = 0) at 5 points; `partial: true` for a subset'),
-          keys={"partial": {"type": "boolean"}})
+          keys={"partial": {"type": "boolean"}},
+          complex_values=True)
 def check_exponents(ctx: Context, val) -> Verdict:
     book = _book_list(ctx, val)
     lin = ctx.linear()
@@ -203,7 +205,8 @@ def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
           book='list of `{exponent: p, shape: {q: complex amplitude}}`',
           how=('p is an exponent of the linearized system and (Mp² + Cp + K)u = 0 for the '
                "book's shape u (relative residual 1e-8; any vector of a degenerate "
-               'eigenspace passes), at 5 points'))
+               'eigenspace passes), at 5 points'),
+          complex_values=True)
 def check_complex_modes(ctx: Context, val) -> Verdict:
     lin = ctx.linear()
     modes = []
@@ -264,7 +267,8 @@ def _driving(ctx: Context, pt: dict) -> float:
                'generalized component as Re(F̂ e^{iωt})): A = X_q e^{−iφ₀} with '
                'X = (K − ω²M + iωC)⁻¹F̂, at 5 points (so a real A is the signed amplitude '
                'in phase with the force)'),
-          keys={"frequency": EXPR})
+          keys={"frequency": EXPR},
+          complex_values=True)
 def check_steady_amplitude(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
     book = {c: ctx.parse(v, ("book", c)) for c, v in val.items()}

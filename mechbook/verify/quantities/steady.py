@@ -1,5 +1,11 @@
-"""Steady motions and their stability: `steady_motion`, `stability`, `equilibrium_count`,
-`secular_growth` (the engine's side is mechbook.engine.steady and .response).
+"""Where steady motions are, as answers: `steady_motion`, `steady_rates`, `steady_exists`,
+`effective_potential` (mechbook.engine.steady). Their stability and counts are
+mechbook.verify.quantities.stability.
+
+A part names a family of steady motions by `about:` (the coordinates at rest, e.g. theta:
+theta0), `unknown:` (the cyclic coordinate whose rate the book gives or whose existence it
+states) and `hold:` (relations that fix the other cyclic rates, e.g. "psidot +
+phidot*cos(theta) = omega3").
 """
 
 from __future__ import annotations
@@ -8,14 +14,19 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import holds
-from mechbook.engine import response, steady
-from mechbook.verify.compare import Verdict, all_vanish, value, value_and_scale
-from mechbook.verify.context import Context
-from mechbook.verify.quantities.equilibria import check_stability_condition
-from mechbook.verify.registry import EXPR, POINT, REGION, quantity
+from mechbook.engine import steady
+from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
+from mechbook.verify.compare import Verdict, all_vanish, combine, value_and_scale
+from mechbook.verify.context import Context, numbers
+from mechbook.verify.quantities.oscillations import asymptotic
+from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
+
+HOLD = {"type": "array", "items": {"type": "string"}}
+ROOT_RTOL = 1e-9
+STEADY_KEYS = {"hold": HOLD, "unknown": NAME}
 
 
-def _coordinate_map(ctx: Context, mapping, sub) -> dict:
+def coordinate_map(ctx: Context, mapping, sub) -> dict:
     mapping = ctx.as_map(mapping, sub)
     out = {}
     for k, v in mapping.items():
@@ -33,8 +44,8 @@ def _coordinate_map(ctx: Context, mapping, sub) -> dict:
                'sampled too)'))
 def check_steady_motion(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
-    point = _coordinate_map(ctx, val.get("at") or {}, ("book", "at"))
-    rates = _coordinate_map(ctx, val.get("rates") or {}, ("book", "rates"))
+    point = coordinate_map(ctx, val.get("at") or {}, ("book", "at"))
+    rates = coordinate_map(ctx, val.get("rates") or {}, ("book", "rates"))
     missing = [c for c, q in zip(ctx.system.coord_names, ctx.system.q, strict=True)
                if q not in point and q not in rates]
     if missing:
@@ -43,153 +54,132 @@ def check_steady_motion(ctx: Context, val) -> Verdict:
     return all_vanish(steady.steady_residuals(ctx.dyn, rates, point), ctx.sampler)
 
 
-@quantity('stability',
-          book='stable, unstable or marginal (or a relation: stable exactly where it holds)',
-          how=('the linearized system about the part\'s point or steady motion has that '
-               'verdict at every one of ≥ 60 parameter points drawn widely (spread x4, '
-               '`assume:` honoured): "always stable / always unstable" claims'),
-          literals=("stable", "unstable", "marginal"))
-def check_stability(ctx: Context, val) -> Verdict:
-    if isinstance(val, str) and ("<" in val or ">" in val):  # a condition after all
-        return check_stability_condition(ctx, val)
-    if val not in ("stable", "unstable", "marginal"):
-        raise ctx.part.error(("book",), "expected stable, unstable or marginal (or a "
-                             "relation: where it is stable)")
-    lin = ctx.linear()
-    wide = ctx.sampler.widened(2.0)
-    seen: dict[str, int] = {}
-    for n in range(60):
-        pt = wide.draw()
-        got = steady.classify(lin, pt)
-        seen[got] = seen.get(got, 0) + 1
-        if got != val:
-            shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
-                pt.items(), key=lambda kv: kv[0].name)[:8])
-            return Verdict(False, f"numeric({n + 1} points)",
-                           f"engine finds it {got} at {{{shown}}}")
-    return Verdict(True, f"numeric(60 points, all {val})")
+def family(ctx: Context) -> SteadyFamily:
+    """The steady motions a part names: `about:`, `unknown:`, `hold:`."""
+    data = ctx.part.data
+    if "about" not in data:
+        raise ctx.part.error((), "a steady motion needs `about:` (the coordinates at rest)")
+    name = data.get("unknown")
+    if name not in ctx.system.coord_names:
+        raise ctx.part.error(("unknown",), f"`unknown:` must name a coordinate, not {name!r}")
+    unknown = ctx.system.q[ctx.system.coord_names.index(name)]
+    hold = [ctx.parse(h, ("hold", i), equation=True)
+            for i, h in enumerate(data.get("hold") or [])]
+    key = ("steady-family", ctx.part.system, repr(sorted(data["about"].items())), name,
+           tuple(data.get("hold") or []))
+    cache = ctx.analysis.__dict__.setdefault("_steady_families", {})
+    if key not in cache:
+        cache[key] = SteadyFamily.build(ctx.dyn, ctx.point(), unknown, hold)
+    return cache[key]
 
 
-def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:
-    region = ctx.part.data.get("search")
-    boxes = region if isinstance(region, list) else [region]
-    out = []
-    for i, box in enumerate(boxes):
-        sub = ("search", i) if isinstance(region, list) else ("search",)
-        box = ctx.as_map(box, sub)
-        parsed = {}
-        for k, (lo, hi) in box.items():
-            if k not in ctx.system.coord_names:
-                raise ctx.part.error(sub + (k,), f"{k!r} is not a coordinate")
-            q = ctx.system.q[ctx.system.coord_names.index(k)]
-            if q not in unknowns:
-                raise ctx.part.error(sub + (k,), f"{k!r} turns at a fixed rate or momentum "
-                                     "here; the region is over the other coordinates")
-            parsed[q] = tuple(value(ctx.parse(x, sub + (k, j)), pt).real
-                              for j, x in enumerate((lo, hi)))
-        out.append(parsed)
-    return out
+def _rate_symbol(ctx: Context, fam: SteadyFamily) -> sp.Symbol:
+    return ctx.system.qd[ctx.system.q.index(fam.unknown)]
 
 
-@quantity('equilibrium_count',
-          book='integer',
-          how=('the number of distinct equilibria, or steady motions at fixed `rates:` or at '
-               'fixed cyclic `momenta:` (equilibria of Routh\'s reduced system), inside '
-               '`search:` (a box or a list of boxes over the other coordinates), found by '
-               'multistart root finding at 3 points (a count the search can miss is a lower '
-               'bound: say so in the note); `stable: true/false` also checks each one\'s '
-               'stability'),
-          keys={"search": {"oneOf": [REGION, {"type": "array", "minItems": 1,
-                                               "items": REGION}]},
-                "rates": POINT, "momenta": POINT, "stable": {"type": "boolean"}})
-def check_equilibrium_count(ctx: Context, val) -> Verdict:
-    if not isinstance(val, int) or isinstance(val, bool):
-        raise ctx.part.error(("book",), "expected an integer")
-    if "search" not in ctx.part.data:
-        raise ctx.part.error((), "a count needs `search:` (the region to count in)")
-    rates = _coordinate_map(ctx, ctx.part.data.get("rates") or {}, ("rates",))
-    momenta = _coordinate_map(ctx, ctx.part.data.get("momenta") or {}, ("momenta",))
-    if rates and momenta:
-        raise ctx.part.error(("momenta",), "fix either rates or momenta")
-    conds, unknowns, eq = steady.steady_conditions(ctx.system, rates, momenta)
-    want = ctx.part.data.get("stable")
-    counts = []
-    for _ in range(3):
+@quantity('steady_rates',
+          book=('equation in the unknown rate (e.g. `phidot`), or a list of rates'),
+          how=('an equation: at random parameter points its real roots in the rate are '
+               'exactly the rates at which the generalized forces on the `about:` '
+               'coordinates vanish (polynomial roots, 30 digits). A list: each rate makes '
+               'them vanish and, unless `partial: true`, there are no other real ones; '
+               'with `limit:` each book rate approaches an engine rate (decades, as for '
+               'frequencies). `hold:` fixes the other cyclic rates; `estimate:` compares '
+               'at the book\'s numbers to its precision'),
+          keys={**STEADY_KEYS, "partial": {"type": "boolean"}, "limit": LIMIT,
+                "estimate": ESTIMATE})
+def check_steady_rates(ctx: Context, val) -> Verdict:
+    fam = family(ctx)
+    xdot = _rate_symbol(ctx, fam)
+    if isinstance(val, str) and "=" in val and "<" not in val and ">" not in val:
+        eq = ctx.parse(val, ("book",), equation=True)
+        if not eq.has(xdot):
+            raise ctx.part.error(("book",), f"the equation must contain the rate {xdot}")
+        # at the steady state: coordinates at `about:`, the other rates by `hold:`
+        return _same_roots(ctx, fam, eq.subs(xdot, fam.x).subs(fam.state))
+    book = [ctx.parse(v, ("book", i)) for i, v in
+            enumerate(val if isinstance(val, list) else [val])]
+    if "limit" in ctx.part.data:
+        def error(pt) -> float:
+            engine = fam.real_rates(pt)
+            worst = 0.0
+            for b in numbers(book, pt):
+                if not engine:
+                    return float("inf")
+                worst = max(worst, min(abs(e - b) for e in engine) / max(abs(b), 1e-300))
+            return worst
+        return asymptotic(ctx, error)
+    if "estimate" in ctx.part.data:  # the book's numbers: each near an engine rate
         pt = ctx.sampler.draw()
-        roots = steady.roots_in(conds, unknowns, pt, _boxes(ctx, pt, unknowns))
-        counts.append(len(roots))
-        where = "; ".join("(" + ", ".join(f"{x:.5g}" for x in r) + ")" for r in roots[:6])
-        if len(roots) != val:
-            return Verdict(False, "numeric(root search)",
-                           f"found {len(roots)} in the region: {where}")
-        if want is not None:
-            for r in roots:
-                got = steady.classify_at(eq, dict(zip(unknowns, r, strict=True)), pt, rates)
-                if (got == "stable") != want:
-                    at = ", ".join(f"{x:.5g}" for x in r)
-                    return Verdict(False, "numeric(root search)", f"the one at ({at}) is {got}")
-    how = "" if want is None else f", each {'stable' if want else 'unstable'}"
-    return Verdict(True, f"numeric(root search, 3 points{how})", f"counts {counts}")
-
-
-@quantity('secular_growth',
-          book='integer k (solutions grow like t^k·e^{pt})',
-          how=('the largest Jordan block of the state matrix (at `exponent:`, or over all '
-               'exponents) has size k + 1: k = 0 no secular terms, k = 1 t·cos growth at a '
-               'double root with one mode; ranks of (A − pI)^j in mpmath at 40 digits, 3 '
-               'points'),
-          keys={"exponent": EXPR})
-def check_secular_growth(ctx: Context, val) -> Verdict:
-    if not isinstance(val, int) or isinstance(val, bool) or val < 0:
-        raise ctx.part.error(("book",), "expected a non-negative integer")
-    lin = ctx.linear()
-    sizes = []
-    for _ in range(3):
+        engine = fam.real_rates(pt)
+        rtol = ctx.sampler.rtol
+        for b in numbers(book, pt):
+            if not any(abs(e - b) <= rtol * abs(b) for e in engine):
+                return Verdict(False, f"estimate(rtol {rtol:g})", f"book rate {b:.6g} is not "
+                               f"within {rtol:g} of an engine rate {[f'{e:.6g}' for e in engine]}")
+        if not ctx.part.data.get("partial") and len(engine) != len(book):
+            return Verdict(False, f"estimate(rtol {rtol:g})", f"the engine finds "
+                           f"{len(engine)} steady rates, the book lists {len(book)}")
+        return Verdict(True, f"estimate(rtol {rtol:g})",
+                       f"engine's steady rates {[f'{e:.6g}' for e in engine]}")
+    verdicts = [all_vanish(fam.residuals_at(b), ctx.sampler) for b in book]
+    verdict = combine(verdicts)
+    if not verdict.ok or ctx.part.data.get("partial"):
+        return verdict
+    for _ in range(4):
         pt = ctx.sampler.draw()
-        if "exponent" in ctx.part.data:
-            targets = [value(ctx.parse(ctx.part.data["exponent"], ("exponent",)), pt)]
-        else:
-            targets = _clusters(response.exponents(lin, pt, precise=True))
-        size = max(response.jordan_size(lin, pt, p) for p in targets)
-        sizes.append(size)
-        if size != val + 1:
-            return Verdict(False, "numeric(Jordan blocks, 40 digits)",
-                           f"largest Jordan block {size}: solutions grow like t^{size - 1}")
-    return Verdict(True, "numeric(Jordan blocks, 40 digits, 3 points)")
+        engine = fam.real_rates(pt)
+        if len(engine) != len(book):
+            return Verdict(False, "numeric", f"the engine finds {len(engine)} steady rates "
+                           f"{[f'{e:.8g}' for e in engine]}, the book lists {len(book)}")
+    return verdict
 
 
-def _clusters(lam: np.ndarray) -> list[complex]:
-    """One representative per group of (nearly) equal exponents."""
-    scale = max(1e-300, float(np.max(np.abs(lam))))
-    out: list[complex] = []
-    for x in lam:
-        if not any(abs(x - y) <= 1e-6 * scale for y in out):
-            out.append(complex(x))
-    return out
-
+def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
+    """The book's equation has exactly the engine's real steady rates as real roots."""
+    sys = ctx.system
+    free = eq.free_symbols & set(sys.q + sys.qd + sys.qdd)
+    if free:  # e.g. a cyclic coordinate's value, which a steady motion leaves arbitrary
+        return Verdict(False, "exact", "the equation depends on " + ", ".join(
+            sorted(map(str, free))) + ", which the steady motion does not fix")
+    n = seen = 0
+    for _ in range(6):
+        pt = ctx.sampler.draw()
+        engine = fam.real_rates(pt)
+        book = polynomial_roots(eq, fam.x, pt)
+        n += 1
+        seen += bool(engine)
+        ok = len(engine) == len(book) and all(
+            abs(a - b) <= ROOT_RTOL * max(1.0, abs(a)) for a, b in zip(engine, book,
+                                                                       strict=True))
+        if not ok:
+            return Verdict(False, f"numeric({n} points)",
+                           f"book's roots {[f'{b:.10g}' for b in book]}, engine's steady rates "
+                           f"{[f'{e:.10g}' for e in engine]}")
+    if not seen:  # two equations without real roots agree without saying anything
+        return Verdict(False, f"numeric({n} points)", "no steady motion exists at any sampled "
+                       "point: the check cannot discriminate (`assume:` a region where one does)")
+    return Verdict(True, f"numeric({n} points, polynomial roots)")
 
 
 @quantity('steady_exists',
           book='relation (where a steady motion exists)',
-          how=('at ≥ 60 parameter points drawn widely, the relation holds exactly where some '
-               'real rate of the coordinate `turning:` makes the configuration `at:` (every '
-               'other coordinate) a steady motion: the residuals, polynomials in the rate, '
-               'have a common real root (numpy roots, checked on every residual)'),
-          keys={"turning": {"type": "string"}, "at": POINT})
+          how=('at ≥ 60 parameter points drawn widely (both outcomes must occur, ≥ 10 '
+               'each), the relation holds exactly where some real rate of the `unknown:` '
+               'coordinate makes the configuration `about:` (with the other cyclic rates '
+               'fixed by `hold:`) a steady motion: the conditions, polynomials in the rate, '
+               'have a common real root (a coefficient that cancels to 1e-20 of its terms '
+               'counts as zero; the roots are checked on every condition). The minimum spin '
+               'of a top, the region where circular orbits exist'),
+          keys=STEADY_KEYS)
 def check_steady_exists(ctx: Context, val) -> Verdict:
+    fam = family(ctx)
     cond = ctx.parse(val, ("book",), relation=True)
-    name = ctx.part.data.get("turning")
-    if name not in ctx.system.coord_names:
-        raise ctx.part.error(("turning",), "name the coordinate that turns at a steady rate")
-    q = ctx.system.q[ctx.system.coord_names.index(name)]
-    point = _coordinate_map(ctx, ctx.part.data.get("at") or {}, ("at",))
-    if set(point) | {q} != set(ctx.system.q):
-        raise ctx.part.error(("at",), "give every coordinate but the turning one")
-    w = sp.Symbol("w_rate", real=True)
-    coefficients = []  # each residual as a polynomial in the rate: its coefficients
-    for e in steady.steady_residuals(ctx.dyn, {q: w}, point):
-        if e != 0:
-            coefficients.append(sp.Poly(sp.expand(e), w).all_coeffs())
+    key = ("steady-coefficients", id(fam))
+    cache = ctx.analysis.__dict__.setdefault("_steady_coefficients", {})
+    if key not in cache:
+        cache[key] = (fam, _coefficients(ctx, fam))
+    coefficients = cache[key][1]
     wide = ctx.sampler.widened(2.0)
     seen = {True: 0, False: 0}
     n = 0
@@ -208,9 +198,31 @@ def check_steady_exists(ctx: Context, val) -> Verdict:
         if n >= 60 and min(seen.values()) >= 10:
             break
     if min(seen.values()) == 0:
-        return Verdict(False, "numeric", "sampling never crossed the boundary; the check "
-                       "cannot discriminate")
+        return Verdict(False, "numeric", "sampling never crossed the existence boundary; the "
+                       "check cannot discriminate")
     return Verdict(True, f"numeric({n} points: {seen[True]} with, {seen[False]} without)")
+
+
+def _coefficients(ctx: Context, fam: SteadyFamily) -> list[list]:
+    """Each condition of the family as a polynomial in its rate x: the coefficient lists
+    (highest first) of the numerators."""
+    out = []
+    for c in fam.conditions:
+        if c == 0:
+            continue
+        try:
+            poly = sp.Poly(sp.expand(c), fam.x)
+        except sp.PolynomialError:
+            poly = None
+        if poly is None or any(a.has(fam.x) for a in poly.all_coeffs()):
+            num = sp.together(c).as_numer_denom()[0]
+            try:
+                poly = sp.Poly(sp.expand(num), fam.x)
+            except sp.PolynomialError:
+                raise ctx.part.error(("unknown",), "the steady conditions are not "
+                                     "polynomial in the rate") from None
+        out.append(poly.all_coeffs())
+    return out
 
 
 def _common_real_root(coefficients: list[list], pt: dict) -> bool:
@@ -236,3 +248,28 @@ def _common_real_root(coefficients: list[list], pt: dict) -> bool:
         if all(abs(np.polyval(c, r)) <= 1e-9 * np.polyval(np.abs(c), abs(r)) for c in polys):
             return True
     return False
+
+
+@quantity('effective_potential',
+          book="expression in the other coordinates and the held momenta `p_<q>`",
+          how=("Routh's reduction: with the momenta of the `cyclic:` coordinates held, V_eff"
+               " = [Σ p φ̇ − L] at rest in the other coordinates; equal to the book's up to "
+               "a function of the momenta (its gradient in the coordinates agrees)"),
+          keys={"cyclic": {"type": "array", "minItems": 1, "items": NAME}})
+def check_effective_potential(ctx: Context, val) -> Verdict:
+    names = ctx.part.data.get("cyclic") or []
+    coords = []
+    for i, c in enumerate(names):
+        if c not in ctx.system.coord_names:
+            raise ctx.part.error(("cyclic", i), f"{c!r} is not a coordinate")
+        coords.append(ctx.system.q[ctx.system.coord_names.index(c)])
+    momenta = [ctx.names["p_" + c] for c in names]
+    engine = effective_potential(ctx.dyn, coords, momenta)
+    book = ctx.parse(val, ("book",))
+    rest = [q for q in ctx.system.q if q not in coords]
+    stray = book.free_symbols & set(coords + ctx.system.qd)
+    if stray:
+        raise ctx.part.error(("book",), "an effective potential depends on the other "
+                             "coordinates and the momenta only, not on "
+                             + ", ".join(sorted(map(str, stray))))
+    return all_vanish([sp.diff(book - engine, q) for q in rest], ctx.sampler)

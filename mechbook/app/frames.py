@@ -1,0 +1,70 @@
+"""The store as pandas DataFrames: `mechbook.results(path)` for a notebook or a script.
+
+pandas is an optional dependency (`pip install mechbook[data]`): the command line does not
+need it, and importing this module does not import it until `results` is called.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, NamedTuple
+
+from mechbook.model.catalog import DEFAULT_STORE
+
+
+class Frames(NamedTuple):
+    """checks: one row per answer part; crosschecks: one row per cross-check; timings: one
+    row per problem (duration and the versions that produced it)."""
+
+    checks: Any
+    crosschecks: Any
+    timings: Any
+
+
+def results(store: str | Path = DEFAULT_STORE) -> Frames:
+    """Read a store written by `mechbook check` into three DataFrames."""
+    try:
+        import pandas as pd
+    except ImportError:  # pragma: no cover - depends on the installation
+        raise ImportError("mechbook.results needs pandas: pip install 'mechbook[data]'") \
+            from None
+    from mechbook.app.store import problems, read
+
+    path = Path(store)
+    if not path.exists():
+        raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
+    checks, cross, timings = [], [], []
+    for pid in problems(path):
+        rec = read(pid, path)
+        a = rec["attrs"]
+        book = pid.split("-", 1)[0]
+        for c in rec["checks"]:
+            checks.append({"problem": pid, "book": book, "part": c["part"],
+                           "quantity": c.get("quantity", ""), "origin": c.get("origin", "book"),
+                           "status": c.get("status", ""), "method": c.get("method", ""),
+                           "detail": c.get("detail", ""), "cite": c.get("cite", ""),
+                           "seconds": float(c.get("seconds", 0.0))})
+        for x in rec.get("crosschecks", []):
+            cross.append({"problem": pid, "book": book, "name": x.get("name", ""),
+                          "kind": x.get("kind", ""), "system": x.get("system", ""),
+                          "status": x.get("status", ""), "error": float(x.get("error", "nan")),
+                          "parts": ", ".join(x.get("parts") or []),
+                          "detail": x.get("detail", ""),
+                          "seconds": float(x.get("seconds", 0.0))})
+        timings.append({"problem": pid, "book": book, "title": a.get("title", ""),
+                        "duration_s": float(a.get("duration_s", 0.0)),
+                        "parts": len(rec["checks"]),
+                        "check_s": sum(float(c.get("seconds", 0.0)) for c in rec["checks"]),
+                        "crosscheck_s": sum(float(x.get("seconds", 0.0))
+                                            for x in rec.get("crosschecks", [])),
+                        "date": a.get("date", ""), "mechbook": a.get("mechbook", ""),
+                        "sympy": a.get("sympy", ""), "numpy": a.get("numpy", "")})
+    columns = {"checks": ["problem", "book", "part", "quantity", "origin", "status", "method",
+                          "detail", "cite", "seconds"],
+               "crosschecks": ["problem", "book", "name", "kind", "system", "status", "error",
+                               "parts", "detail", "seconds"],
+               "timings": ["problem", "book", "title", "duration_s", "parts", "check_s",
+                           "crosscheck_s", "date", "mechbook", "sympy", "numpy"]}
+    return Frames(pd.DataFrame(checks, columns=columns["checks"]),
+                  pd.DataFrame(cross, columns=columns["crosschecks"]),
+                  pd.DataFrame(timings, columns=columns["timings"]))

@@ -1,0 +1,11 @@
+"""`mechbook report`: a static HTML report of the store, readable offline in any browser.
+
+    build      the index and one page per problem (pages computed on worker processes)
+    page       one problem's page: the derivation as MathML, book and engine side by side
+    values     the book's value and the engine's counterpart of an answer part
+    figures    mode shapes and the frequency cross-check (PNG)
+    templates/ the pages (Jinja2, autoescaped); assets/ the style sheet and the filter script
+
+Mathematics is SymPy's presentation MathML (mechbook.app.mathml), which browsers render
+natively: the report needs no script from elsewhere and no network.
+"""

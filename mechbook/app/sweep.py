@@ -1,0 +1,365 @@
+"""`mechbook sweep`: one result of a problem mapped over a grid of parameter values.
+
+The problem is derived once and its linear system (about `--about`, a steady motion
+`--steady`, an answer part's point `--part`, or the stable equilibrium) compiled once with
+the parameters as arguments (mechbook.engine.sweep); the grid is cut into blocks, evaluated
+in this process, on a local process pool (`-j`), or on a Dask cluster (`--scheduler`,
+mechbook.app.distributed), and put back together in grid order. Quantities:
+
+    frequencies  the normal angular frequencies at every point (ascending; NaN: unstable)
+    stability    stable / marginal / unstable / undefined at every point, and the largest
+                 growth rate
+    drift        how far the frequency measured from the nonlinear motion at a finite
+                 amplitude drifts from the small-oscillation one: one axis must be the
+                 pseudo-parameter `amplitude` (mechbook.crosscheck.amplitude)
+
+The float64 path is then checked against the 30-digit one at sampled points (random ones
+and, for a stability map, ones beside the boundary) and the largest relative difference is
+reported; the book's answer at the same point (its stability condition, its frequencies),
+evaluated over the same grid, is kept beside the engine's for the plot and for a count of
+where they disagree (mechbook.app.sweep_book).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+
+from mechbook.core.compile import DEFAULT_BACKEND
+from mechbook.engine.sweep import UNDEFINED, Axis, Grid
+from mechbook.errors import MechbookError
+
+QUANTITIES = ("frequencies", "stability", "drift")
+AMPLITUDE = "amplitude"
+BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
+DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
+SAMPLES = 24  # points of the 30-digit accuracy check
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Everything that defines a sweep, as plain data (it travels to cluster workers)."""
+
+    pid: str
+    files: tuple[tuple[str, bytes], ...]  # the problem's and answer key's files
+    quantity: str
+    axes: tuple[Axis, ...]
+    system: str | None = None
+    about: tuple[tuple[str, str], ...] = ()
+    steady: tuple[tuple[str, str], ...] = ()
+    part: str | None = None
+    backend: str = DEFAULT_BACKEND
+
+    @property
+    def key(self) -> str:
+        h = hashlib.sha256(repr((self.pid, self.quantity, self.axes, self.system, self.about,
+                                 self.steady, self.part, self.backend)).encode())
+        for name, data in self.files:
+            h.update(name.encode() + b"\0" + data)
+        return h.hexdigest()
+
+
+def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
+              system: str | None = None, about: dict | None = None,
+              steady: dict | None = None, part: str | None = None,
+              backend: str = DEFAULT_BACKEND) -> SweepSpec:
+    from mechbook.app.distributed import tree_files
+
+    if quantity not in QUANTITIES:
+        raise MechbookError(f"unknown quantity {quantity!r}; known: {', '.join(QUANTITIES)}")
+    files = tree_files(pid, base)
+    if not files:
+        raise MechbookError(f"no problem {pid} under {base}")
+    return SweepSpec(pid, tuple(sorted(files.items())), quantity, tuple(axes), system,
+                     tuple((about or {}).items()), tuple((steady or {}).items()), part,
+                     backend)
+
+
+class Sweeper:
+    """A sweep's derived and compiled state, built once per process."""
+
+    def __init__(self, spec: SweepSpec, base: Path):
+        from mechbook.engine.analysis import Analysis
+        from mechbook.engine.sweep import LinearSweep
+        from mechbook.model.catalog import answer_path, problem_path
+        from mechbook.model.expr import parse
+        from mechbook.model.problem import load_problem
+        from mechbook.verify.answers import load_answers
+
+        self.spec = spec
+        self.problem = load_problem(problem_path(spec.pid, base))
+        self.analysis = Analysis(self.problem)
+        apath = answer_path(spec.pid, base)
+        self.key = load_answers(apath) if apath.exists() else None
+        fixed = dict(self.problem.values())
+        symbols = list(fixed)
+        if spec.part is not None:
+            from mechbook.verify.context import Context
+
+            part = self._part(spec.part)
+            self.context = Context(self.analysis, part)
+            self.system = self.context.system
+            self.lin = self.context.linear()
+            fixed.update(self.key.symbol_values)
+            symbols += [s for s in self.key.symbol_values if s not in symbols]
+        else:
+            self.context = None
+            try:
+                self.system = self.analysis.system(spec.system)
+            except KeyError as exc:
+                raise MechbookError(str(exc.args[0]) + "; name it with --system") from None
+            names = dict(self.system.names)
+
+            def point(pairs, what):
+                out = {}
+                for name, text in pairs:
+                    if name not in self.system.coord_names:
+                        raise MechbookError(f"--{what} {name}=...: {name!r} is not a coordinate "
+                                            f"of {spec.pid} (coordinates: "
+                                            f"{', '.join(self.system.coord_names)})")
+                    q = self.system.q[self.system.coord_names.index(name)]
+                    out[q] = parse(text, names)
+                return out
+
+            about, steady = point(spec.about, "about"), point(spec.steady, "steady")
+            if steady:
+                self.lin = self.analysis.steady_linear(self.system.name, steady, about)
+            elif about:
+                self.lin = self.analysis.linear(self.system.name, about)
+            else:
+                self.lin = self.analysis.linear(self.system.name,
+                                                self.analysis.default_point(self.system.name))
+        self.steady = dict(getattr(self.lin.dyn.sys, "momenta", None) or {})
+        self.amplitude = None
+        names = [str(s) for s in symbols]
+        if spec.quantity == "drift":
+            if AMPLITUDE in names:
+                raise MechbookError(f"{spec.pid} has a parameter named {AMPLITUDE!r}: a drift "
+                                    "sweep cannot tell it from the amplitude")
+            if AMPLITUDE not in [a.name for a in spec.axes]:
+                raise MechbookError(f"a drift sweep needs --param {AMPLITUDE}=LO:HI:N (the "
+                                    "largest coordinate displacement of the start)")
+            self.amplitude = sp.Symbol(AMPLITUDE)
+            symbols.append(self.amplitude)
+        try:
+            self.grid = Grid(list(spec.axes), symbols, fixed)
+        except ValueError as exc:
+            raise MechbookError(str(exc)) from None
+        for a in spec.axes:  # SymPy simplified with these assumptions: honour them
+            sym = symbols[names.index(a.name)] if a.name in names else self.amplitude
+            if (sym.is_positive or sym is self.amplitude) and min(a.lo, a.hi) <= 0:
+                raise MechbookError(f"--param {a.text()}: {a.name} is positive; sweep it over "
+                                    "positive values")
+            if sym.is_nonzero and min(a.lo, a.hi) <= 0 <= max(a.lo, a.hi):
+                raise MechbookError(f"--param {a.text()}: {a.name} is nonzero; keep 0 out of "
+                                    "its range")
+        self.lin_symbols = [s for s in symbols if s is not self.amplitude]
+        self.linear = LinearSweep(self.lin, self.lin_symbols, spec.backend)
+        # the problem's conditions, and a part's `assume:`: points outside are undefined
+        self.conditions = list(self.context.sampler.conditions if self.context
+                               else self.problem.conditions)
+        loose = sorted({str(x) for c in self.conditions for x in c.free_symbols}
+                       - {str(x) for x in self.lin_symbols})
+        if loose:
+            raise MechbookError(f"the conditions use {', '.join(loose)}, which has no value")
+        self._models: dict = {}
+
+    def _part(self, name: str):
+        if self.key is None:
+            raise MechbookError(f"--part {name}: {self.spec.pid} has no answer key")
+        for p in self.key.parts:
+            if p.name == name:
+                return p
+        raise MechbookError(f"--part {name}: no such part (parts: "
+                            f"{', '.join(p.name for p in self.key.parts)})")
+
+    @property
+    def modes(self) -> int:
+        return self.linear.n
+
+    def point_text(self) -> str:
+        pt = ", ".join(f"{k} = {sp.sstr(v)}" for k, v in self.lin.point.items()) or "origin"
+        if self.steady:
+            pt += "; steady, momenta " + ", ".join(f"p_{k} = {sp.sstr(v)}"
+                                                   for k, v in self.steady.items())
+        return pt
+
+    def block_size(self) -> int:
+        if self.spec.quantity == "drift":
+            return DRIFT_BLOCK
+        return max(1, BLOCK_ENTRIES // (3 * self.modes**2 + 2 * self.modes + 1))
+
+    # ---- one block ---------------------------------------------------------------------
+    def block(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        X = self.grid.block(start, stop)
+        if self.spec.quantity == "drift":
+            return self._drift(X)
+        lin_cols = [j for j, s in enumerate(self.grid.symbols) if s is not self.amplitude]
+        got = self.linear.evaluate(X[:, lin_cols], ("frequencies", "stability"))
+        outside = ~self.admissible(X[:, lin_cols])
+        got.stability[outside] = UNDEFINED
+        got.frequencies[outside] = np.nan
+        got.growth[outside] = np.nan
+        out = {"ill": np.array([got.ill]), "precise": np.array([got.precise]),
+               "stability": got.stability, "frequencies": got.frequencies}
+        if self.spec.quantity == "stability":
+            out["growth"] = got.growth
+        return out
+
+    def admissible(self, X: np.ndarray) -> np.ndarray:
+        """Where the conditions hold, at rows of X (columns: `lin_symbols`)."""
+        from mechbook.engine.sweep import condition_mask
+
+        return condition_mask(self.conditions, self.lin_symbols, X, self.spec.backend)
+
+    def _drift(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        from mechbook.crosscheck.amplitude import amplitude_response
+
+        k, n = X.shape[0], self.modes
+        linear = np.full((k, n), np.nan)
+        measured = np.full((k, n), np.nan)
+        a_col = self.grid.symbols.index(self.amplitude)
+        ok = self.admissible(X[:, [j for j in range(X.shape[1]) if j != a_col]])
+        for i, row in enumerate(X):
+            if not ok[i]:
+                continue
+            values = {s: float(x) for s, x in zip(self.grid.symbols, row, strict=True)
+                      if s is not self.amplitude}
+            try:
+                lin, meas = amplitude_response(self.analysis, self.lin, values, [row[a_col]],
+                                               self._models)
+            except (MechbookError, ValueError, np.linalg.LinAlgError, ZeroDivisionError):
+                continue  # no oscillation to measure there: NaN
+            linear[i, : len(lin)], measured[i, : len(lin)] = lin, meas[0]
+        with np.errstate(all="ignore"):
+            rel = (measured - linear) / linear
+        return {"linear": linear, "measured": measured, "relative_error": rel,
+                "ill": np.array([0]), "precise": np.array([0])}
+
+
+# ---- where blocks run ------------------------------------------------------------------------
+_SWEEPERS: dict[str, Sweeper] = {}  # per process: one sweeper per sweep (compiled once)
+
+
+def block_of(spec: SweepSpec, start: int, stop: int) -> dict[str, np.ndarray]:
+    """One block on whatever process runs it: derived and compiled on first use there."""
+    from mechbook.app.distributed import materialize
+
+    if spec.key not in _SWEEPERS:
+        _SWEEPERS[spec.key] = Sweeper(spec, materialize(dict(spec.files)))
+    return _SWEEPERS[spec.key].block(start, stop)
+
+
+def cluster_block(spec: SweepSpec, start: int, stop: int, timeout: float,
+                  memory_mb: float) -> dict[str, np.ndarray]:
+    """A block on a Dask worker, inside that worker's limited child process."""
+    from mechbook.app.distributed import limited
+
+    return limited(block_of, (spec, start, stop), timeout, memory_mb)
+
+
+@dataclass
+class SweepResult:
+    spec: SweepSpec
+    coords: dict[str, np.ndarray]
+    arrays: dict[str, np.ndarray]
+    dims: dict[str, tuple[str, ...]]
+    attrs: dict = field(default_factory=dict)
+    book: dict = field(default_factory=dict)  # mechbook.app.sweep_book.BookOverlay fields
+
+
+def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None = None,
+              timeout: float = 600.0, memory_mb: float = 8000.0, samples: int = SAMPLES,
+              progress: Callable[[int, int], None] | None = None) -> SweepResult:
+    """Build the sweep here (for the accuracy check and the book), evaluate every block
+    where asked, and assemble the result in grid order."""
+    t0 = time.perf_counter()
+    sweeper = Sweeper(spec, base)
+    built = time.perf_counter() - t0
+    size, step = sweeper.grid.size, sweeper.block_size()
+    ranges = [(s, min(s + step, size)) for s in range(0, size, step)]
+    progress = progress or (lambda done, total: None)
+    t1 = time.perf_counter()
+    parts: dict[int, dict] = {}
+    if scheduler:
+        from dask.distributed import as_completed
+
+        from mechbook.app.distributed import connect
+
+        with connect(scheduler) as client:
+            futures = {client.submit(cluster_block, spec, a, b, timeout, memory_mb,
+                                     pure=False): a for a, b in ranges}
+            for fut in as_completed(futures):
+                parts[futures[fut]] = fut.result()
+                progress(len(parts), len(ranges))
+        where = f"Dask cluster at {scheduler}"
+    elif jobs > 1 and len(ranges) > 1:
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        from mechbook.app.batch import _context
+
+        with ProcessPoolExecutor(jobs, mp_context=_context()) as pool:
+            futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
+            for fut in as_completed(futures):
+                parts[futures[fut]] = fut.result()
+                progress(len(parts), len(ranges))
+        where = f"{jobs} local processes"
+    else:
+        for a, b in ranges:
+            parts[a] = sweeper.block(a, b)
+            progress(len(parts), len(ranges))
+        where = "this process"
+    seconds = time.perf_counter() - t1
+    arrays, dims = _assemble(sweeper, [parts[a] for a, _ in ranges])
+    from mechbook.app.sweep_accuracy import sample_accuracy
+
+    t2 = time.perf_counter()
+    accuracy = sample_accuracy(sweeper, arrays, samples)
+    attrs = {
+        "problem": spec.pid, "title": sweeper.problem.title, "quantity": spec.quantity,
+        "system": sweeper.system.name, "point": sweeper.point_text(),
+        "axes": " ".join(a.text() for a in spec.axes), "points": size, "modes": sweeper.modes,
+        "gyroscopic": bool(sweeper.linear.gyroscopic), "backend": spec.backend,
+        "where": where, "blocks": len(ranges), "build_seconds": built,
+        "evaluate_seconds": seconds, "points_per_second": size / max(seconds, 1e-9),
+        "accuracy_seconds": time.perf_counter() - t2,
+        "ill_conditioned": int(sum(int(p["ill"][0]) for p in parts.values())),
+        "precise_50_digits": int(sum(int(p["precise"][0]) for p in parts.values())),
+        "accuracy_samples": accuracy["samples"],
+        "max_rel_diff_float64_vs_30_digits": accuracy["max_rel_diff"],
+        "accuracy_disagreements": accuracy["disagree"], "accuracy": accuracy,
+        "conditions": [sp.sstr(c) for c in sweeper.conditions],
+        "fixed": {str(s): v for s, v in sweeper.grid.fixed.items()
+                  if str(s) not in {a.name for a in spec.axes}},
+        "problem_sha256": sweeper.problem.sha256,
+    }
+    if spec.part:
+        attrs["part"] = spec.part
+    result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
+    from mechbook.app.sweep_book import book_overlay
+
+    result.book = book_overlay(sweeper, result)
+    return result
+
+
+def _assemble(sweeper: Sweeper, parts: list[dict]) -> tuple[dict, dict]:
+    shape = sweeper.grid.shape
+    names = tuple(a.name for a in sweeper.grid.axes)
+    arrays, dims = {}, {}
+    for key in parts[0]:
+        if key in ("ill", "precise"):
+            continue
+        full = np.concatenate([p[key] for p in parts], axis=0)
+        if full.ndim == 2:
+            arrays[key] = full.reshape(*shape, full.shape[1])
+            dims[key] = names + ("mode",)
+        else:
+            arrays[key] = full.reshape(shape)
+            dims[key] = names
+    return arrays, dims

@@ -1,0 +1,91 @@
+"""A sweep's accuracy statement: the float64 results at sampled grid points against the
+30-digit path (the symbolic matrices substituted at 30 digits, not through the compiled
+function; the eigenproblem in mpmath). A stability map samples a third of its points
+beside the boundary, where the classification is most delicate."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mechbook.app.sweep import SAMPLES
+from mechbook.engine.sweep import UNDEFINED
+
+
+def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SAMPLES,
+                    seed: int = 0) -> dict:
+    """The float64 results at sampled points against the 30-digit path (the matrices
+    substituted symbolically, the eigenproblem in mpmath)."""
+    rng = np.random.default_rng(seed)
+    shape = sweeper.grid.shape
+    if sweeper.spec.quantity == "stability":
+        codes = arrays["stability"]
+        defined = np.flatnonzero(codes.reshape(-1) != UNDEFINED)
+        edge = _boundary(codes)
+    elif sweeper.spec.quantity == "frequencies":
+        defined = np.flatnonzero(np.any(np.isfinite(arrays["frequencies"]), axis=-1)
+                                 .reshape(-1))
+        edge = np.zeros(0, dtype=int)
+    else:
+        defined = np.flatnonzero(np.any(np.isfinite(arrays["linear"]), axis=-1)
+                                 .reshape(-1))
+        edge = np.zeros(0, dtype=int)
+    if not len(defined):
+        return {"samples": 0, "max_rel_diff": float("nan"), "disagree": 0}
+    chosen = list(rng.choice(edge, min(len(edge), samples // 3), replace=False)) \
+        if len(edge) else []
+    rest = np.setdiff1d(defined, chosen)
+    chosen += list(rng.choice(rest, min(len(rest), samples - len(chosen)), replace=False))
+    worst, disagree, worst_at = 0.0, [], None
+    for flat in sorted(int(c) for c in chosen):
+        values = {s: v for s, v in sweeper.grid.values_at(flat).items()
+                  if s is not sweeper.amplitude}
+        idx = np.unravel_index(flat, shape)
+        where = {a.name: float(v) for a, v in
+                 zip(sweeper.grid.axes, (sweeper.grid.coords()[a.name][i] for a, i in
+                                      zip(sweeper.grid.axes, idx, strict=True)), strict=True)}
+        try:
+            if sweeper.spec.quantity == "stability":
+                code, ref = sweeper.linear.precise_stability(values)
+                if code != arrays["stability"][idx]:
+                    disagree.append(where)
+                    continue
+                X = np.array([[values[s] for s in sweeper.linear.symbols]])
+                got = sweeper.linear.spectrum(X)[0]
+                scale = float(np.max(np.abs(ref))) or 1.0
+                # each exact eigenvalue against the nearest float64 one
+                rel = float(np.max(np.min(np.abs(ref[:, None] - got[None, :]), axis=1)))
+                if rel / scale >= worst:
+                    worst, worst_at = rel / scale, where
+                continue
+            else:
+                ref = sweeper.linear.precise_frequencies(values)
+                name = "frequencies" if sweeper.spec.quantity == "frequencies" else "linear"
+                got = arrays[name][idx]
+                if not np.array_equal(np.isfinite(ref), np.isfinite(got)):
+                    disagree.append(where)
+                    continue
+                scale = float(np.nanmax(np.abs(ref))) if np.any(np.isfinite(ref)) else 1.0
+        except (ValueError, ZeroDivisionError, TypeError, ArithmeticError) as exc:
+            disagree.append({**where, "error": str(exc)[:80]})
+            continue
+        diff = np.abs(np.nan_to_num(got) - np.nan_to_num(ref))
+        rel = float(np.max(diff)) / scale if scale > 0 and np.any(diff) else 0.0
+        if rel >= worst:
+            worst, worst_at = rel, where
+    return {"samples": len(chosen), "boundary_samples": min(len(edge), samples // 3),
+            "max_rel_diff": worst, "worst_at": worst_at, "disagree": len(disagree),
+            "disagree_at": disagree[:5]}
+
+
+def _boundary(codes: np.ndarray) -> np.ndarray:
+    """Flat indices of grid points whose stability differs from a neighbour's."""
+    mark = np.zeros(codes.shape, dtype=bool)
+    for ax in range(codes.ndim):
+        if codes.shape[ax] < 2:
+            continue
+        a = np.swapaxes(codes, 0, ax)
+        m = np.swapaxes(mark, 0, ax)
+        diff = (a[1:] != a[:-1]) & (a[1:] != UNDEFINED) & (a[:-1] != UNDEFINED)
+        m[1:] |= diff
+        m[:-1] |= diff
+    return np.flatnonzero(mark.reshape(-1))

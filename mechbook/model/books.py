@@ -1,0 +1,148 @@
+"""Books declared in data (`books.yaml` at the tree's root) and problem ids `<book>-<number>`.
+
+A problem id is a book id (lower-case letters and digits) and the book's own problem number
+(letters and digits, with single '.', '-' or '_' between them: never a path), joined by the
+first '-'. `books.yaml` declares each book: title, author, edition, and a regular expression
+its numbers follow (`numbers`, matched in full; `example` is one number that must match, so a
+broken expression is caught when the file is read). Adding a book is an entry there and the
+files under problems/<book>/ and answers/<book>/; no code changes.
+
+With books.yaml present, an id whose book it does not declare, or whose number does not look
+like that book's, is refused with the reason. A tree without books.yaml (a scratch tree in a
+test) accepts any well-formed id.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from mechbook.errors import MechbookError
+
+FILE = "books.yaml"
+ID = re.compile(r"([a-z][a-z0-9]*)-([A-Za-z0-9]+(?:[._-][A-Za-z0-9]+)*)")
+ID_EXAMPLES = "e.g. lim-2031 or symon-09-12"
+
+
+@dataclass(frozen=True)
+class Book:
+    """One declared book (an entry of books.yaml)."""
+
+    id: str
+    title: str
+    author: str
+    numbers: str  # regular expression the book's problem numbers match in full
+    example: str
+    short: str = ""
+    edition: str = ""
+    doc: str = ""
+
+    def matches(self, number: str) -> bool:
+        return re.fullmatch(self.numbers, number) is not None
+
+    @property
+    def label(self) -> str:
+        """How problems of the book are cited: 'Symon' in 'Symon 9-12'."""
+        return self.short or self.id
+
+    def as_dict(self) -> dict:
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+def split_id(pid: str) -> tuple[str, str]:
+    """'lim-2031' -> ('lim', '2031'); 'symon-09-12' -> ('symon', '09-12')."""
+    m = ID.fullmatch(pid) if isinstance(pid, str) else None
+    if m is None:
+        raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, {ID_EXAMPLES})")
+    return m.group(1), m.group(2)
+
+
+_CACHE: dict[Path, tuple[tuple, dict[str, Book]]] = {}
+
+
+def books(base: str | Path) -> dict[str, Book]:
+    """The books declared in `base`/books.yaml ({} when the tree has none), by id."""
+    path = Path(base) / FILE
+    try:
+        st = path.stat()
+    except OSError:
+        return {}
+    stamp = (st.st_mtime_ns, st.st_size)
+    hit = _CACHE.get(path)
+    if hit is None or hit[0] != stamp:
+        hit = (stamp, load_books(path))
+        _CACHE[path] = hit
+    return hit[1]
+
+
+def load_books(path: str | Path) -> dict[str, Book]:
+    """Read and check a books.yaml; a fault is a SpecError naming file and line."""
+    from mechbook.model.schema import validate
+    from mechbook.model.yamlio import load
+
+    doc = load(path)
+    validate(doc, "books")
+    out: dict[str, Book] = {}
+    for i, entry in enumerate(doc.data["books"]):
+        where = ("books", i)
+        if entry["id"] in out:
+            raise doc.error(where + ("id",), f"book {entry['id']!r} is declared twice")
+        try:
+            re.compile(entry["numbers"])
+        except re.error as exc:
+            raise doc.error(where + ("numbers",), f"not a regular expression: {exc}") from None
+        book = Book(**entry)
+        if not book.matches(book.example):
+            raise doc.error(where + ("example",), f"example {book.example!r} does not match "
+                            f"numbers {book.numbers!r}")
+        try:
+            split_id(f"{book.id}-{book.example}")
+        except MechbookError:
+            raise doc.error(where + ("example",), f"example {book.example!r} is not a valid "
+                            "problem number (letters and digits, single '.', '-' or '_' "
+                            "between them)") from None
+        out[book.id] = book
+    return out
+
+
+def book_of(pid: str, base: str | Path) -> Book | None:
+    """The declared book of problem `pid`, checking the id against books.yaml (None when the
+    tree declares no books); MechbookError says what is wrong with the id."""
+    book, number = split_id(pid)
+    declared = books(base)
+    if not declared:
+        return None
+    if book not in declared:
+        raise MechbookError(f"problem id {pid!r}: book {book!r} is not declared in "
+                            f"{Path(base) / FILE} (books: {', '.join(sorted(declared))})")
+    entry = declared[book]
+    if not entry.matches(number):
+        raise MechbookError(f"problem id {pid!r}: {number!r} does not look like a problem "
+                            f"number of {entry.label} (numbers: {entry.numbers}, e.g. "
+                            f"{book}-{entry.example})")
+    return entry
+
+
+def file_id_error(pid: str, path: str | Path) -> str | None:
+    """Why the id written in a problem file does not fit where the file lies, or None.
+
+    In a tree (problems/<book>/<number>.yaml) the id must be <book>-<number> and follow
+    books.yaml; a file elsewhere must at least end with its file name."""
+    path = Path(path)
+    try:
+        split_id(pid)
+    except MechbookError as exc:
+        return str(exc)
+    if path.parent.parent.name == "problems":
+        expected = f"{path.parent.name}-{path.stem}"
+        if pid != expected:
+            return f"id {pid!r} does not match the file's place (expected {expected!r})"
+        try:
+            book_of(pid, path.parent.parent.parent)
+        except MechbookError as exc:
+            return str(exc)
+        return None
+    if not pid.endswith(path.stem):
+        return f"id {pid!r} does not match the file name {path.stem!r}"
+    return None

@@ -1,0 +1,256 @@
+"""The functions of tensor expressions (mechbook/model/tensorexpr.py): the whitelist, each
+a small SymPy computation on scalars, 3-vectors (columns) and 3x3 tensors, refusing a wrong
+kind of argument with a TypeError or ValueError the parser turns into an error naming the
+expression. Body functions take a declared body (mechbook/model/bodies) first.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import sympy as sp
+
+
+def _holds_matrix(expr) -> bool:
+    """A scalar expression with a matrix inside it (sin of a tensor, 2**T): refused."""
+    return isinstance(expr, sp.Basic) and bool(expr.atoms(sp.MatrixBase))
+
+
+def _vector(v) -> bool:
+    return isinstance(v, sp.MatrixBase) and v.shape == (3, 1)
+
+
+def _tensor(v) -> bool:
+    return isinstance(v, sp.MatrixBase) and v.shape == (3, 3)
+
+
+def _scalar(v) -> bool:
+    return not isinstance(v, sp.MatrixBase)
+
+
+def _kind(v) -> str:
+    return "vector" if _vector(v) else "tensor" if _tensor(v) else "scalar" if _scalar(v) \
+        else f"{v.shape[0]}x{v.shape[1]} matrix"
+
+
+def _need(what: str, test: Callable, *args) -> None:
+    for a in args:
+        if not test(a):
+            raise TypeError(f"expected a {what}, got a {_kind(a)}")
+
+
+def _im(m: sp.MatrixBase) -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(m)
+
+
+def _dyad(a, b):
+    _need("vector", _vector, a, b)
+    return _im(a * b.T)
+
+
+def _dot(a, b):
+    if _vector(a) and _vector(b):
+        return a.dot(b)
+    if _vector(a) and _tensor(b):  # v·T
+        return _im(b.T * a)
+    if _tensor(a) and (_tensor(b) or _vector(b)):
+        return _im(a * b)
+    raise TypeError(f"dot of a {_kind(a)} and a {_kind(b)}")
+
+
+def _ddot(a, b):
+    """The double dot product A:B = Σ A_ij B_ij of two tensors."""
+    _need("tensor", _tensor, a, b)
+    return sum((a[i, j] * b[i, j] for i in range(3) for j in range(3)), sp.S.Zero)
+
+
+def _cross(a, b):
+    """u × v; with a tensor, the dyadic rule: w × (AB) = (w × A)B, (AB) × w = A(B × w)."""
+    if _vector(a) and _tensor(b):
+        return _im(_skew(a) * b)
+    if _tensor(a) and _vector(b):
+        return _im(a * _skew(b))
+    _need("vector", _vector, a, b)
+    return _im(a.cross(b))
+
+
+def _transpose(t):
+    _need("tensor", _tensor, t)
+    return _im(t.T)
+
+
+def _det(t):
+    _need("tensor", _tensor, t)
+    return t.det(method="berkowitz")
+
+
+def _trace(t):
+    _need("tensor", _tensor, t)
+    return t.trace()
+
+
+def _second_invariant(t):
+    """Symon's M(T), Eq. (10-139): the sum of the three principal 2×2 minors."""
+    _need("tensor", _tensor, t)
+    return sum((t[i, i] * t[j, j] - t[i, j] * t[j, i] for i, j in ((0, 1), (1, 2), (0, 2))),
+               sp.S.Zero)
+
+
+def _inverse(t):
+    _need("tensor", _tensor, t)
+    d = _det(t)
+    if d == 0:
+        raise ValueError("the tensor is singular (determinant 0)")
+    return _im(t.adjugate() / d)
+
+
+def _unit():
+    return _im(sp.eye(3))
+
+
+def _rotation(axis, angle):
+    """The orthogonal tensor turning vectors through `angle` about `axis` (right hand)."""
+    _need("vector", _vector, axis)
+    _need("scalar", _scalar, angle)
+    n2 = axis.dot(axis)
+    if n2 == 0:
+        raise ValueError("a rotation axis must not be the zero vector")
+    n = axis / sp.sqrt(n2)
+    cross = sp.Matrix([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+    return _im(sp.cos(angle) * sp.eye(3) + sp.sin(angle) * cross
+               + (1 - sp.cos(angle)) * n * n.T)
+
+
+def _skew(w):
+    """The antisymmetric tensor T with T·C = w × C (Symon Eqs. 10-62, 10-63)."""
+    _need("vector", _vector, w)
+    return _im(sp.Matrix([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]))
+
+
+def _index(i) -> int:
+    if not (isinstance(i, sp.Integer) and 1 <= int(i) <= 3):
+        raise ValueError(f"an index is 1, 2 or 3, not {i}")
+    return int(i) - 1
+
+
+def _entry(t, i, j=None):
+    """Component T_ij (1-based) of a tensor, or v_i of a vector."""
+    if j is None:
+        _need("vector", _vector, t)
+        return t[_index(i), 0]
+    _need("tensor", _tensor, t)
+    return t[_index(i), _index(j)]
+
+
+def _row(t, i):
+    """Row i (1-based) of a tensor's matrix, as a vector (e'_i for a transformation a)."""
+    _need("tensor", _tensor, t)
+    return _im(t[_index(i), :].T)
+
+
+def _col(t, j):
+    _need("tensor", _tensor, t)
+    return _im(t[:, _index(j)])
+
+
+def _diff(x, s):
+    """d/ds of a scalar, vector or tensor; s a parameter or a generic scalar."""
+    if not isinstance(s, sp.Symbol):
+        raise TypeError("differentiate with respect to a plain symbol (a parameter, or a "
+                        "`for_all` scalar)")
+    return _im(x.diff(s)) if isinstance(x, sp.MatrixBase) else sp.diff(x, s)
+
+
+def _coordinates(r) -> list[sp.Symbol]:
+    _need("vector", _vector, r)
+    if not all(isinstance(c, sp.Symbol) for c in r):
+        raise TypeError("the position must be a vector of three plain symbols [x, y, z]")
+    return list(r)
+
+
+def _grad(x, r):
+    """∇f (a vector) of a scalar field, or the dyad ∇v, (∇v)_ij = ∂v_j/∂x_i (Symon Eq.
+    10-175), of a vector field; `r` = [x, y, z], Cartesian."""
+    xs = _coordinates(r)
+    if _scalar(x):
+        return _im(sp.Matrix([sp.diff(x, c) for c in xs]))
+    _need("vector", _vector, x)
+    return _im(sp.Matrix(3, 3, lambda i, j: sp.diff(x[j], xs[i])))
+
+
+def _div(x, r):
+    """∇·v of a vector field (a scalar), or ∇·P, (∇·P)_j = Σ_i ∂P_ij/∂x_i, of a tensor."""
+    xs = _coordinates(r)
+    if _vector(x):
+        return sum((sp.diff(x[i], xs[i]) for i in range(3)), sp.S.Zero)
+    _need("tensor", _tensor, x)
+    return _im(sp.Matrix([sum((sp.diff(x[i, j], xs[i]) for i in range(3)), sp.S.Zero)
+                          for j in range(3)]))
+
+
+def _subs(x, s, v):
+    """x with the symbol s replaced by the scalar v (a boundary value, a change of
+    variables)."""
+    if not isinstance(s, sp.Symbol):
+        raise TypeError("substitute for a plain symbol")
+    _need("scalar", _scalar, v)
+    return _im(x.xreplace({s: v})) if isinstance(x, sp.MatrixBase) else x.xreplace({s: v})
+
+
+def _integral(f, s, lo, hi):
+    """The definite integral of a scalar over s from lo to hi (SymPy's integrate; an
+    integral it cannot do in closed form is an error)."""
+    if not isinstance(s, sp.Symbol):
+        raise TypeError("integrate over a plain symbol")
+    _need("scalar", _scalar, f, lo, hi)
+    out = sp.integrate(f, (s, lo, hi))
+    if out.has(sp.Integral):
+        raise ValueError("SymPy finds no closed form for this integral")
+    return out
+
+
+def _norm(v):
+    _need("vector", _vector, v)
+    return sp.sqrt(v.dot(v))
+
+
+def _scalar_fn(fn):
+    def apply(x):
+        _need("scalar", _scalar, x)
+        return fn(x)
+    return apply
+
+
+TENSOR_FUNCTIONS: dict[str, Callable] = {
+    "dyad": _dyad, "dot": _dot, "ddot": _ddot, "cross": _cross, "transpose": _transpose,
+    "det": _det,
+    "trace": _trace, "second_invariant": _second_invariant, "inverse": _inverse,
+    "unit": _unit, "rotation": _rotation, "skew": _skew, "entry": _entry, "norm": _norm,
+    "row": _row, "col": _col, "diff": _diff, "grad": _grad, "div": _div, "subs": _subs,
+    "integral": _integral,
+    "i": lambda: sp.I, "expi": _scalar_fn(lambda x: sp.exp(sp.I * x)),
+    "re": _scalar_fn(sp.re), "im": _scalar_fn(sp.im), "conj": _scalar_fn(sp.conjugate),
+}
+TENSOR_ARITY = {"dyad": (2, 2), "dot": (2, 2), "ddot": (2, 2), "cross": (2, 2), "unit": (0, 0),
+                "rotation": (2, 2), "entry": (2, 3), "row": (2, 2), "col": (2, 2),
+                "diff": (2, 2), "i": (0, 0), "grad": (2, 2), "div": (2, 2), "subs": (3, 3),
+                "integral": (4, 4)}
+
+
+def _point(obj, p):
+    _need("vector", _vector, p)
+    return p
+
+
+# functions whose first argument names a declared body: (method, arity without the body)
+BODY_FUNCTIONS: dict[str, tuple[Callable, tuple[int, int]]] = {
+    "mass": (lambda b: b.mass, (0, 0)),
+    "center_of_mass": (lambda b: _im(b.center_of_mass), (0, 0)),
+    "inertia": (lambda b, p=None: _im(b.inertia(None if p is None else _point(b, p))), (0, 1)),
+    "moment": (lambda b, p, n: b.moment(_point(b, p), _point(b, n)), (2, 2)),
+}
+
+
+def kind(value) -> str:
+    """'scalar', 'vector' or 'tensor'."""
+    return _kind(value)

@@ -1,0 +1,275 @@
+"""Quantities of the nonlinear motion from a given start: `turning_points`, `excursion`,
+`motion_frequency`, `mean_rate`, `event_time`.
+
+A part gives the start (`initial:` coordinates and velocities, zero unless given) and the
+oscillating `coordinate:` (or `signal:`, any function of the state, for turning points).
+Where every other coordinate is cyclic, the motion lies on a level set of the cyclic
+momenta and the energy and is reduced to one degree of freedom (mechbook.engine.levelset):
+turning points, period and the advance of the cyclic coordinates per period are then
+computed in 50-digit arithmetic and compared at 1e-10 (asymptotic formulas with `limit:`).
+Otherwise they are measured by integrating the full equations (mechbook.numerics.measure,
+DOP853 at 1e-12) and compared at MEASURE_RTOL = 1e-7, the stated accuracy of that
+measurement.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import sympy as sp
+
+from mechbook.engine.levelset import LevelSet
+from mechbook.errors import UnsupportedError
+from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
+from mechbook.numerics.model import build_model
+from mechbook.verify.compare import Verdict, match_multiset
+from mechbook.verify.context import Context, numbers
+from mechbook.verify.quantities.oscillations import asymptotic
+from mechbook.verify.registry import ESTIMATE, EXPR, LIMIT, POINT, quantity
+
+LEVEL_RTOL = 1e-10
+LEVEL_POINTS = 6
+MEASURED_POINTS = 3
+START = {"initial": POINT, "coordinate": {"type": "string"}}
+
+
+class Motion:
+    """What a trajectory part refers to: its start, coordinate and how it is computed."""
+
+    def __init__(self, ctx: Context):
+        self.ctx = ctx
+        data, sys = ctx.part.data, ctx.system
+        self.start = _start(ctx)
+        name = data.get("coordinate")
+        self.of = None
+        if "signal" in data:
+            self.of = ctx.parse(data["signal"], ("signal",))
+            self.coordinate = None
+        elif name in sys.coord_names:
+            self.coordinate = sys.q[sys.coord_names.index(name)]
+        else:
+            raise ctx.part.error(("coordinate",), "name the oscillating `coordinate:` (or "
+                                 "give `of:`)")
+        self.level = None
+        if self.coordinate is not None:
+            try:
+                self.level = _level(ctx, self.coordinate)
+            except UnsupportedError:
+                self.level = None
+        self.rtol = ctx.sampler.rtol if "estimate" in data else (
+            LEVEL_RTOL if self.level else MEASURE_RTOL)
+
+    def state(self, pt: dict) -> dict:
+        return {k: v.subs(pt) for k, v in self.start.items()}
+
+    def orbit(self, pt: dict):
+        return self.level.orbit(self.state(pt), pt)
+
+    def measured(self, pt: dict):
+        ctx, sys = self.ctx, self.ctx.system
+        params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
+        model = build_model(sys, ctx.dyn, params)
+        signal = self.of if self.of is not None else self.coordinate
+        stray = signal.free_symbols - set(sys.q + sys.qd) - {sys.t} - set(pt)
+        if stray:
+            raise ctx.part.error(("signal",), "unknown in `signal:`: " + ", ".join(map(str, stray)))
+        fn = signal_functions(sys, ctx.dyn, pt, signal.subs(pt))
+        st = self.state(pt)
+        q0 = np.array([float(st[q]) for q in sys.q])
+        qd0 = np.array([float(st[v]) for v in sys.qd])
+        scale = 1.0 / (1.0 + float(np.max(np.abs(qd0))))
+        return measure(model, fn, q0, qd0, scale)
+
+    def points(self) -> int:
+        return LEVEL_POINTS if self.level else MEASURED_POINTS
+
+
+def _start(ctx: Context) -> dict:
+    """The initial state of `initial:` (coordinates and velocities; the rest zero)."""
+    data, sys = ctx.part.data, ctx.system
+    if "initial" not in data:
+        raise ctx.part.error((), "a trajectory quantity needs `initial:` (the start)")
+    start = {}
+    for k, v in ctx.as_map(data["initial"], ("initial",)).items():
+        if k in sys.coord_names:
+            sym = sys.q[sys.coord_names.index(k)]
+        elif k.endswith("dot") and k[:-3] in sys.coord_names:
+            sym = sys.qd[sys.coord_names.index(k[:-3])]
+        else:
+            raise ctx.part.error(("initial", k), f"{k!r} is neither a coordinate nor a velocity")
+        start[sym] = ctx.parse(v, ("initial", k))
+    for sym in sys.q + sys.qd:
+        start.setdefault(sym, sp.S.Zero)
+    return start
+
+
+def _level(ctx: Context, coordinate) -> LevelSet:
+    cache = ctx.analysis.__dict__.setdefault("_level_sets", {})
+    key = (ctx.part.system, str(coordinate))
+    if key not in cache:
+        level = LevelSet(ctx.dyn, coordinate)
+        level.reduced  # noqa: B018 - derive now: an unsupported reduction falls back here
+        cache[key] = level
+    return cache[key]
+
+
+def _book_values(ctx: Context, val) -> list:
+    vals = val if isinstance(val, list) else [val]
+    return [ctx.parse(v, ("book", i) if isinstance(val, list) else ("book",))
+            for i, v in enumerate(vals)]
+
+
+def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
+             partial: bool = False) -> Verdict:
+    """Book values against engine values (a function of the parameter point), at random
+    points; with `limit:` the relative error must fall by decades."""
+    if "limit" in ctx.part.data:
+        if motion.level is None:
+            raise UnsupportedError("an asymptotic trajectory formula needs the level-set "
+                                   "reduction (every other coordinate cyclic)")
+
+        def error(pt) -> float:
+            eng = engine_of(pt)
+            worst = 0.0
+            for b in _at_start(motion.start, book, pt):
+                worst = max(worst, min(abs(e - b) for e in eng) / max(abs(b), 1e-300))
+            return worst
+
+        return asymptotic(ctx, error)
+    how = "level set" if motion.level else "measured"
+    for n in range(1, motion.points() + 1):
+        pt = ctx.sampler.draw()
+        eng = engine_of(pt)
+        ok, why = match_multiset(_at_start(motion.start, book, pt), eng, partial, rtol=motion.rtol)
+        if not ok:
+            return Verdict(False, f"{how}({n} points)", f"{what}: {why}")
+    return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})")
+
+
+def _at_start(start: dict, book: list, pt: dict) -> list[float]:
+    """Book values at the parameter point; a value may use functions of the state (first
+    integrals such as L²/2T), evaluated at the start."""
+    state = {k: v.subs(pt) for k, v in start.items()}
+    return numbers([sp.S(b).subs(state) for b in book], pt)
+
+
+def _extremes(motion: Motion, pt: dict) -> list[float]:
+    if motion.level is not None and motion.of is None:
+        lo, hi = motion.orbit(pt).turning_points
+        return [float(lo), float(hi)]
+    m = motion.measured(pt)
+    return [m.low, m.high]
+
+
+KEYS = {**START, "partial": {"type": "boolean"}, "limit": LIMIT, "estimate": ESTIMATE}
+
+
+@quantity('turning_points',
+          book='list of the turning values of the coordinate (or of `signal:`)',
+          how=('the least and greatest values of the coordinate (or of the function `signal:` of '
+               'the state) over the motion from `initial:`: roots of V_eff = E on the level '
+               'set of the first integrals (50 digits, rtol 1e-10) or, with other '
+               'non-cyclic coordinates, measured by integration (rtol 1e-7); a subset with '
+               '`partial: true`'),
+          keys={**KEYS, "signal": EXPR})
+def check_turning_points(ctx: Context, val) -> Verdict:
+    motion = Motion(ctx)
+    return _compare(ctx, motion, _book_values(ctx, val), lambda pt: _extremes(motion, pt),
+                    "turning points", bool(ctx.part.data.get("partial")))
+
+
+@quantity('excursion',
+          book='expression: greatest minus least value of the coordinate (or of `signal:`)',
+          how='as `turning_points`, the difference of the two (its own relative error)',
+          keys={**KEYS, "signal": EXPR})
+def check_excursion(ctx: Context, val) -> Verdict:
+    motion = Motion(ctx)
+
+    def engine(pt):
+        if motion.level is not None and motion.of is None:
+            lo, hi = motion.orbit(pt).turning_points
+            return [float(hi - lo)]
+        lo, hi = _extremes(motion, pt)
+        return [hi - lo]
+
+    return _compare(ctx, motion, _book_values(ctx, val), engine, "excursion")
+
+
+@quantity('motion_frequency',
+          book='expression: 2π over the period of the oscillation of the coordinate',
+          how=('2π/T for the period T of the nonlinear oscillation of the coordinate from '
+               '`initial:` (level-set quadrature, or measured by integration)'),
+          keys=KEYS)
+def check_motion_frequency(ctx: Context, val) -> Verdict:
+    motion = Motion(ctx)
+
+    def engine(pt):
+        if motion.level is not None:
+            return [float(2 * math.pi / motion.orbit(pt).period)]
+        return [2 * math.pi / motion.measured(pt).period()]
+
+    return _compare(ctx, motion, _book_values(ctx, val), engine, "frequency")
+
+
+@quantity('mean_rate',
+          book='expression: the mean rate of coordinate `rate:` over a period',
+          how=('how far the coordinate `rate:` advances over one period of the oscillating '
+               '`coordinate:`, divided by the period (level-set quadratures, or measured by '
+               'integration)'),
+          keys={**KEYS, "rate": {"type": "string"}})
+def check_mean_rate(ctx: Context, val) -> Verdict:
+    motion = Motion(ctx)
+    name = ctx.part.data.get("rate")
+    if name not in ctx.system.coord_names:
+        raise ctx.part.error(("rate",), "`rate:` names the coordinate whose mean rate is given")
+    q = ctx.system.q[ctx.system.coord_names.index(name)]
+
+    def engine(pt):
+        if motion.level is not None:
+            orbit = motion.orbit(pt)
+            return [float(orbit.advance(q) / orbit.period)]
+        m = motion.measured(pt)
+        return [m.advance(ctx.system.q.index(q)) / m.period()]
+
+    return _compare(ctx, motion, _book_values(ctx, val), engine, "mean rate")
+
+
+
+@quantity('event_time',
+          book='expression: the time of the event (or, with `advance:`, how far that '
+               'coordinate has moved by then)',
+          how=('the first t > 0 at which `event:` (a function of the state and t) changes '
+               'sign along the motion from `initial:`, measured by integrating the full '
+               'equations (DOP853 at 1e-12; rtol 1e-7, or an `estimate:`\'s)'),
+          keys={"initial": POINT, "event": EXPR, "advance": {"type": "string"},
+                "estimate": ESTIMATE})
+def check_event_time(ctx: Context, val) -> Verdict:
+    sys = ctx.system
+    if "event" not in ctx.part.data:
+        raise ctx.part.error((), "an event time needs `event:` (what changes sign)")
+    event = ctx.parse(ctx.part.data["event"], ("event",))
+    start = _start(ctx)
+    name = ctx.part.data.get("advance")
+    if name is not None and name not in sys.coord_names:
+        raise ctx.part.error(("advance",), f"{name!r} is not a coordinate")
+    rtol = ctx.sampler.rtol if "estimate" in ctx.part.data else MEASURE_RTOL
+    book = _book_values(ctx, val)
+    for n in range(1, MEASURED_POINTS + 1):
+        pt = ctx.sampler.draw()
+        params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
+        model = build_model(sys, ctx.dyn, params)
+        fn = signal_functions(sys, ctx.dyn, pt, event.subs(pt))
+        st = {k: v.subs(pt) for k, v in start.items()}
+        q0 = np.array([float(st[q]) for q in sys.q])
+        qd0 = np.array([float(st[v]) for v in sys.qd])
+        t, y = first_event(model, fn, q0, qd0, 1.0 / (1.0 + float(np.max(np.abs(qd0)))))
+        if name is None:
+            engine = t
+        else:
+            i = sys.coord_names.index(name)
+            engine = float(y[i] - q0[i])
+        ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
+        if not ok:
+            return Verdict(False, f"measured({n} points)", f"event: {why}")
+    return Verdict(True, f"measured({MEASURED_POINTS} points, rtol {rtol:g})")

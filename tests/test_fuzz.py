@@ -1,0 +1,123 @@
+"""A sample of the fuzz run (`make fuzz` runs 10,000 cases, tests/fuzz.py) and property
+tests of the safe parser with Hypothesis: every input ends in success or a MechbookError —
+never a traceback, never a hang past the time limit, never memory past the bound."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+import sympy as sp
+from fuzz import BAD, KINDS, fuzz, generate, seeds, summary
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from mechbook.errors import ExpressionError
+from mechbook.model.expr import parse
+
+SAMPLE = 120  # cases in `make test` (all kinds); `make fuzz` runs 10,000
+
+
+def test_a_sample_of_the_fuzz_run_has_no_traceback_hang_or_bomb(tmp_path):
+    results = fuzz(SAMPLE, seed=20260101, jobs=2, keep=tmp_path / "kept", chunk=SAMPLE)
+    assert len(results) == SAMPLE
+    bad = [r for r in results if r.status in BAD]
+    assert not bad, summary(results) + "\n" + "\n".join(
+        f"case {r.index} ({r.kind}): {r.status}: {r.message[:300]}" for r in bad)
+    statuses = {r.status for r in results}
+    assert {"ok", "refused"} <= statuses  # the generator makes good and bad files
+
+
+def test_every_kind_is_generated_and_deterministic():
+    pool = seeds()
+    cases = [generate(i, 5, pool, list(KINDS)) for i in range(400)]
+    assert {c.kind for c in cases} == set(KINDS)
+    again = generate(17, 5, pool, list(KINDS))
+    assert again.files == cases[17].files and again.kind == cases[17].kind
+
+
+def test_the_harness_reports_a_hang_and_a_crash(tmp_path, monkeypatch):
+    """The harness can fail: a case that runs past the limit on the real batch machinery is
+    a hang, one that raises a plain exception is a crash, one that raises a MechbookError
+    is refused."""
+    import fuzz as harness
+
+    import mechbook.app.validate as validate
+    from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.errors import SpecError
+
+    batch = Batch(tmp_path, BatchOptions(jobs=1, timeout=2, memory_mb=0),
+                  task=_sleep, failed=harness.stopped)
+    ((status, message, _),) = batch.run(["validate:x"])
+    assert status == "hang" and "time limit" in message
+
+    monkeypatch.setattr(validate, "validate_file", lambda path: 1 / 0)
+    status, message, _ = harness.run_one("validate:x", tmp_path, None, lambda s: None)
+    assert status == "crash" and "ZeroDivisionError" in message and "Traceback" in message
+
+    def refuse(path):
+        raise SpecError("bad", path, 3)
+
+    monkeypatch.setattr(validate, "validate_file", refuse)
+    assert harness.run_one("validate:x", tmp_path, None, lambda s: None)[:2] == \
+        ("refused", "x:3: bad")
+
+
+def _sleep(item, base, options, stage):
+    time.sleep(30)
+
+
+# ---- the parser, property-tested -----------------------------------------------------------
+
+NAMES = {"x": sp.Symbol("x", real=True), "m": sp.Symbol("m", positive=True),
+         "k": sp.Symbol("k", positive=True)}
+ATOMS = st.sampled_from(["x", "m", "k", "0", "1", "2", "-1", "0.5", "1e30", "1e-30", "pi",
+                         "10**30", "t", "E", "I", "oo", "__x", "x.y"])
+FUNCS = st.sampled_from(["sin", "cos", "tan", "cot", "sec", "csc", "asin", "acos", "atan",
+                         "sinh", "cosh", "tanh", "asinh", "acosh", "atanh", "exp", "log",
+                         "sqrt", "Abs", "sign", "cbrt", "eval", "open"])
+OPS = st.sampled_from(["+", "-", "*", "/", "**", "<", "==", "and", "//", "%", "@", ","])
+
+
+def _expr(depth: int):
+    if depth == 0:
+        return ATOMS
+    sub = _expr(depth - 1)
+    return st.one_of(
+        ATOMS,
+        st.tuples(sub, OPS, sub).map(lambda t: f"({t[0]}){t[1]}({t[2]})"),
+        st.tuples(FUNCS, sub).map(lambda t: f"{t[0]}({t[1]})"),
+        st.tuples(sub, sub).map(lambda t: f"atan2({t[0]}, {t[1]})"),
+        sub.map(lambda s: f"-({s})"),
+    )
+
+
+def _check(text: str, relations: bool) -> None:
+    start = time.perf_counter()
+    try:
+        out = parse(text, NAMES, relations)
+    except ExpressionError:
+        pass
+    else:
+        assert isinstance(out, sp.Basic)
+        assert not out.has(sp.zoo, sp.nan, sp.oo, -sp.oo, sp.I), (text, out)
+    assert time.perf_counter() - start < 5.0, text
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_expr(4), st.booleans())
+def test_parser_on_generated_expressions(text, relations):
+    _check(text, relations)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(alphabet=st.sampled_from(list("xmk0129.e()+-*/<>=,_ abcsinqrtlogp[]{}'\"\\")),
+               max_size=60), st.booleans())
+def test_parser_on_random_text(text, relations):
+    _check(text, relations)
+
+
+@pytest.mark.parametrize("text", ["(x)**((10**30)**(10**30))", "exp(exp(exp(exp(100))))",
+                                  "sqrt(-m)", "cbrt(-1)*x", "(x<1)**2", "-" * 500 + "x"])
+def test_parser_examples_hypothesis_found_or_was_given(text):
+    _check(text, True)

@@ -1,0 +1,157 @@
+"""Trajectory quantities of the nonlinear motion, against closed forms: the plane pendulum
+(turning points ±theta0, period 4*sqrt(l/g)*K(sin(theta0/2))), a body falling from rest
+(time sqrt(2h/g) to fall h), and the heavy top's level set against its measurement."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+from ruamel.yaml import YAML
+from scipy.special import ellipk
+from systems import pendulum
+
+from mechbook.engine.analysis import Analysis
+from mechbook.engine.levelset import LevelSet
+from mechbook.model.problem import load_problem
+from mechbook.numerics.measure import measure, signal_functions
+from mechbook.numerics.model import build_model
+from mechbook.verify.answers import load_answers
+from mechbook.verify.checker import check_problem
+
+M, L, G = 0.3, 0.8, 9.81
+
+
+@pytest.fixture(scope="module")
+def pend(tmp_path_factory) -> Analysis:
+    path = tmp_path_factory.mktemp("traj") / "text-test-pendulum.yaml"
+    path.write_text(pendulum(M, L, header="id: symon-text-test-pendulum\nsource: test\n"
+                             "title: pendulum\n"))
+    return Analysis(load_problem(path))
+
+
+def exact_period(theta0: float) -> float:
+    return 4 * math.sqrt(L / G) * ellipk(math.sin(theta0 / 2) ** 2)
+
+
+@pytest.mark.parametrize("theta0", [0.3, 1.2, 2.5])
+def test_level_set_of_the_pendulum(pend, theta0):
+    sys = pend.system()
+    th, thd = sys.q[0], sys.qd[0]
+    orbit = LevelSet(pend.dynamics(), th).orbit({th: theta0, thd: 0}, pend.problem.values())
+    lo, hi = orbit.turning_points
+    assert abs(float(lo) + theta0) < 1e-14 and abs(float(hi) - theta0) < 1e-14
+    assert abs(float(orbit.period) / exact_period(theta0) - 1) < 1e-12
+
+
+@pytest.mark.parametrize("theta0", [0.3, 1.2, 2.5])
+def test_measured_pendulum_is_accurate_to_1e9(pend, theta0):
+    """The stated accuracy of the integrator measurement (MEASURE_RTOL = 1e-7) has margin."""
+    sys = pend.system()
+    values = pend.problem.values()
+    model = build_model(sys, pend.dynamics(), values)
+    fn = signal_functions(sys, pend.dynamics(), values, sys.q[0])
+    m = measure(model, fn, np.array([theta0]), np.array([0.0]), 0.5)
+    assert abs(m.high - theta0) < 1e-9 and abs(m.low + theta0) < 1e-9
+    assert abs(m.period() / exact_period(theta0) - 1) < 1e-9
+
+
+def check(analysis, tmp_path, problem_id: str, **part):
+    doc = {"problem": problem_id, "source": "test", "symbols": {"theta0": {"value": 1.1}},
+           "parts": [{"part": "x", "cite": "test", **part}]}
+    YAML().dump(copy.deepcopy(doc), (tmp_path / "key.yaml").open("w"))
+    out = check_problem(analysis, load_answers(tmp_path / "key.yaml"))[0]
+    return out.status, out.method, out.detail
+
+
+START = {"coordinate": "theta", "initial": {"theta": "theta0"}}
+
+
+@pytest.mark.parametrize("quantity, book, status", [
+    ("turning_points", ["-theta0", "theta0"], "pass"),
+    ("turning_points", ["-theta0", "1.01*theta0"], "fail"),
+    ("turning_points", ["theta0"], "fail"),             # a subset needs `partial: true`
+    ("excursion", "2*theta0", "pass"),
+    ("excursion", "theta0", "fail"),
+    ("motion_frequency", "sqrt(g/l)", "fail"),          # only in the limit of small swings
+])
+def test_pendulum_quantities(pend, tmp_path, quantity, book, status):
+    got, method, detail = check(pend, tmp_path, "symon-text-test-pendulum", quantity=quantity,
+                                **START, book=book)
+    assert got == status, detail
+    assert method.startswith("level set") or got == "fail"
+
+
+@pytest.mark.parametrize("book, status", [
+    ("sqrt(g/l)", "pass"), ("sqrt(g/l)*(1 + theta0**2/16)", "pass"), ("2*sqrt(g/l)", "fail")])
+def test_small_swings_in_the_limit(pend, tmp_path, book, status):
+    got, _, detail = check(pend, tmp_path, "symon-text-test-pendulum",
+                           quantity="motion_frequency", **START,
+                           limit={"parameter": "theta0", "to": 0}, book=book)
+    assert got == status, detail
+
+
+@pytest.mark.parametrize("book, status", [(["-l", "-l*cos(theta0)"], "pass"),
+                                          (["-l", "-l*cos(2*theta0)"], "fail")])
+def test_signal_measured_by_integration(pend, tmp_path, book, status):
+    """The bob's height: a function of the state, measured (not on the level set)."""
+    got, method, detail = check(pend, tmp_path, "symon-text-test-pendulum",
+                                quantity="turning_points", signal="-l*cos(theta)",
+                                initial={"theta": "theta0"}, book=book)
+    assert got == status, detail
+    assert method.startswith("measured")
+
+
+FALL = """\
+id: symon-text-test-fall
+source: test
+title: a body thrown horizontally
+parameters:
+  m: {value: 1.0}
+  g: {}
+  h: {value: 2.0}
+  u: {value: 0.7}
+coordinates:
+  x: {}
+  z: {}
+particles:
+  p: {mass: m, position: [x, z]}
+gravity: {}
+"""
+
+
+@pytest.mark.parametrize("extra, book, status", [
+    ({}, "sqrt(2*h/g)", "pass"), ({}, "sqrt(h/g)", "fail"),
+    ({"advance": "x"}, "u*sqrt(2*h/g)", "pass"), ({"advance": "x"}, "sqrt(2*h/g)", "fail")])
+def test_event_time(tmp_path, extra, book, status):
+    path = tmp_path / "text-test-fall.yaml"
+    path.write_text(FALL)
+    analysis = Analysis(load_problem(path))
+    got, _, detail = check(analysis, tmp_path, "symon-text-test-fall", quantity="event_time",
+                           initial={"z": "h", "xdot": "u"}, event="z", book=book, **extra)
+    assert got == status, detail
+
+
+def test_heavy_top_level_set_matches_its_measurement():
+    """The level set's turning points, period and mean precession of a top released at rest
+    against the same measured by integration, at rtol 1e-8."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    analysis = Analysis(load_problem(root / "problems" / "symon" / "text-11-5-heavy-top.yaml"))
+    sys = analysis.system("euler")
+    dyn = analysis.dynamics("euler")
+    th, ph, ps = sys.q
+    values = analysis.problem.values()
+    state = {th: sp.Float(0.9), ph: 0, ps: 0, sys.qd[0]: 0, sys.qd[1]: 0, sys.qd[2]: 40}
+    orbit = LevelSet(dyn, th).orbit(state, values)
+    model = build_model(sys, dyn, values)
+    m = measure(model, signal_functions(sys, dyn, values, th), np.array([0.9, 0, 0]),
+                np.array([0, 0, 40.0]), 0.05)
+    lo, hi = (float(x) for x in orbit.turning_points)
+    assert abs(m.low - lo) < 1e-9 and abs(m.high - hi) < 1e-9
+    assert abs(m.period() / float(orbit.period) - 1) < 1e-8
+    assert abs(m.advance(1) / float(orbit.advance(ph)) - 1) < 1e-8
