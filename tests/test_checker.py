@@ -31,6 +31,7 @@ from mechbook.model.tensorexpr import kind
 from mechbook.verify.answers import AnswerKey, Part, load_answers
 from mechbook.verify.checker import check_problem
 from mechbook.verify.context import Context
+from mechbook.verify.registry import quantities
 
 ROOT = Path(__file__).resolve().parents[1]
 ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
@@ -226,8 +227,6 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     elif q == "mode_node":
         for k in val:
             yield Slot(root + (k,), "value")
-    elif q == "stability":
-        yield Slot(root, "verdict")
     elif q == "effective_potential":
         yield Slot(root, "potential")
     elif q == "expression":
@@ -246,6 +245,29 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     elif q == "phase_region":
         for i in range(len(val)):
             yield Slot(root + (i,), "inequality")
+    elif q == "simultaneous_diagonalization":
+        yield Slot(root, "flag")
+    elif q == "steady_motion":
+        for group in ("at", "rates"):
+            for k in val.get(group) or {}:
+                yield Slot(root + (group, k), "steady")
+    elif q == "stability":
+        yield Slot(root, "relation" if re.search(r"[<>]", str(val)) else "verdict")
+    elif q == "equilibrium_count":
+        yield Slot(root, "count")
+        if "stable" in part.data:
+            yield Slot(("stable",), "flag")
+    elif q == "characteristic_polynomial":
+        yield Slot(root, "polynomial")
+    elif q == "exponents":
+        for i in range(len(val)):
+            yield Slot(root + (i,), "exponent")
+    elif q == "complex_modes":
+        for i, mode in enumerate(val):
+            yield Slot(root + (i, "exponent"), "exponent")
+            if len(mode.get("shape", {})) > 1:
+                for c in mode["shape"]:
+                    yield Slot(root + (i, "shape", c), "component")
     else:  # a quantity this test does not know yet: walk the value's structure
         yield from walk(val, root)
 
@@ -324,14 +346,20 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
         yield "minus one", value - 1
         return
     if slot.kind == "flag":
-        yield "flip stable", not value
+        yield "flip", not value
         return
-    if slot.kind == "verdict":
-        yield "flip verdict", "unstable" if value == "stable" else "stable"
+    if slot.kind == "verdict":  # stable / unstable / marginal
+        for other in ("stable", "unstable", "marginal"):
+            if other != value:
+                yield f"say {other}", other
         return
     s = str(value)
     if slot.kind in ("lagrangian", "value", "potential"):
         yield from expression_mutants(s, names)
+    elif slot.kind == "steady":  # -rate (time reversal) and mirrored angles are steady too
+        yield "double", f"2*({s})"
+        yield "add a third", f"({s}) + 1/3"
+        yield from swap_names(s, names)
     elif slot.kind == "point":
         yield "negate", f"-({s})"
         yield "double", f"2*({s})"
@@ -374,6 +402,22 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
         yield from swap_names(s, names)
     elif slot.kind == "general_function":  # a general solution: any multiple is one too
         yield "add t**2", f"({s}) + t**2"
+    elif slot.kind == "polynomial":  # a multiple has the same roots: change the roots
+        flipped = flip_first_sign(s)
+        if flipped:
+            yield "flip sign of a term", flipped
+        doubled = double_first_term(s)
+        if doubled:
+            yield "double a term", doubled
+        yield "add one", f"({s}) + 1"
+        yield from swap_names(s, names)
+    elif slot.kind == "exponent":  # -p and conj(p) may be exponents too: scale instead
+        yield "double", f"2*({s})"
+        doubled = double_first_term(s)
+        if doubled:
+            yield "double a term", doubled
+        yield "add a third", f"({s}) + 1/3"
+        yield from swap_names(s, names)
     else:  # pragma: no cover
         raise AssertionError(slot.kind)
 
@@ -423,12 +467,25 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
         return True
     if slot.kind in ("count", "flag", "verdict"):
         return False
-    if slot.kind == "relation":  # the same condition once parsed (factors reordered)
+    if slot.kind == "relation":  # the same condition once parsed (factors reordered), or
+        # the same up to moving terms (e.g. a symmetric one with names swapped)
         try:
-            return ctx.parse(old, slot.path, relation=True) == \
-                ctx.parse(new, slot.path, relation=True)
+            a = ctx.parse(old, slot.path, relation=True)
+            b = ctx.parse(new, slot.path, relation=True)
         except Exception:  # noqa: BLE001 - a mutant that does not parse is not the same
             return False
+        if a == b:
+            return True
+        return (isinstance(a, sp.core.relational.Relational) and type(a) is type(b)
+                and _zero((a.lhs - a.rhs) - (b.lhs - b.rhs)))
+    if slot.kind == "steady":  # another true steady motion (a symmetry: -rate, -angle, ...)
+        return _also_steady(ctx, slot, part_data, new)
+    extra = quantities()[ctx.part.quantity].names
+    if extra is not None:  # the quantity's own names (a polynomial's variable, W0(j), ...)
+        names = extra(ctx)
+        a = ctx.part.parse(old, slot.path, names)
+        b = ctx.part.parse(new, slot.path, names)
+        return _zero(b - a)
     sys = ctx.system
     motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}
     sub = slot.path
@@ -461,6 +518,23 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     if slot.kind == "potential":
         return all(_zero(sp.diff(b - a, q)) for q in sys.q)
     return _zero(b - a)
+
+
+def _also_steady(ctx: Context, slot: Slot, part_data: dict, new) -> bool:
+    """The mutated uniform motion provably solves the equations too (SymPy simplifies every
+    residual to zero): a symmetric copy of the book's steady motion, not a wrong one."""
+    from mechbook.engine.steady import steady_residuals
+
+    book = copy.deepcopy(get(part_data, slot.path[:-2]))
+    book[slot.path[-2]][slot.path[-1]] = new
+    sys = ctx.system
+
+    def coords(group):
+        return {sys.q[sys.coord_names.index(k)]: ctx.parse(v, slot.path)
+                for k, v in (book.get(group) or {}).items()}
+
+    residuals = steady_residuals(ctx.dyn, coords("rates"), coords("at"))
+    return all(_zero(r) for r in residuals)
 
 
 # ---- tensor and body quantities (mechbook/verify/quantities/tensors.py) ----------------------

@@ -223,3 +223,19 @@ def test_independent_kinematics_agree_with_the_engine_and_catch_a_wrong_one():
     wrong = shape_inertia("solid_sphere", m, dims["solid_sphere"]) * sp.Rational(5, 4)
     assert sp.simplify(inertia_of_shape("solid_sphere", m, dims["solid_sphere"]) - wrong) \
         != sp.zeros(3, 3)
+
+
+def test_a_double_exponent_with_one_mode_is_not_measured():
+    """A Jordan block (critically damped oscillator: p = -1 twice, one eigenvector) is
+    recognised, and a double root with two modes (two equal oscillators) is not."""
+    import numpy as np
+    import scipy.linalg
+
+    from mechbook.crosscheck.frequencies import _defective
+
+    critical = np.array([[0.0, 1.0], [-1.0, -2.0]])
+    lam, V = scipy.linalg.eig(critical)
+    assert _defective(lam, V, 0, float(np.max(np.abs(lam))))
+    pair = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.eye(2), np.zeros((2, 2))]])
+    lam, V = scipy.linalg.eig(pair)
+    assert not any(_defective(lam, V, j, 1.0) for j in range(4))

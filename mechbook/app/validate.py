@@ -16,6 +16,7 @@ from mechbook.model.yamlio import load
 from mechbook.verify.answers import load_answers
 from mechbook.verify.context import Context, strip_const
 from mechbook.verify.quantities.tensors import validate_part
+from mechbook.verify.registry import quantities
 
 BUILD_SECONDS = 15.0  # CPU; `validate` runs in the caller's process, so it bounds itself
 
@@ -85,24 +86,28 @@ def check_part_expressions(part, analysis: Analysis) -> None:
     if ctx.tensor_mode:  # vectors, tensors, bodies: built once, nothing judged
         validate_part(ctx)
         return
+    q = quantities()[part.quantity]
+    names = q.names(ctx) if q.names else ctx.names  # a book value's extra names
     for field in ("book", "about", "initial", "released", "region", "time", "hold", "signal",
                   "event"):
-        if field in part.data and not (field == "book" and part.quantity == "stability"):
-            _walk(ctx, part.data[field], (field,))
+        if field == "book" and part.data.get("book") in q.literals:
+            continue  # a word such as "stable", not an expression
+        if field in part.data:
+            _walk(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
     if "erratum" in part.data:
-        _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"))
+        _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
 
 
-def _walk(ctx: Context, value, sub: tuple) -> None:
+def _walk(ctx: Context, value, sub: tuple, names: dict) -> None:
     if isinstance(value, dict):
         for k, v in value.items():
-            _walk(ctx, v, sub + (k,))
+            _walk(ctx, v, sub + (k,), names)
     elif isinstance(value, list):
         for i, v in enumerate(value):
-            _walk(ctx, v, sub + (i,))
+            _walk(ctx, v, sub + (i,), names)
     elif isinstance(value, str):
         value = strip_const(value)  # a first integral may be written "... = constant"
         if "<" in value or ">" in value:
-            ctx.parse(value, sub, relation=True)
+            ctx.part.parse(value, sub, names, relation=True)
         else:
-            ctx.parse(value, sub, equation=True)
+            ctx.part.parse(value, sub, names, equation=True)

@@ -26,3 +26,19 @@ def expand_lagrangian(lag: sp.Expr, q: list, qd: list, point: dict, small: list,
         out += term.subs(EPS, 0) / sp.factorial(k)
     back = {c: c - point.get(c, sp.S.Zero) for c in q}
     return sp.expand(out.subs(back, simultaneous=True))
+
+
+def trig_canonical(expr: sp.Expr, velocities: list | None = None) -> sp.Expr:
+    """expr expanded, with every sin(x)**2 written 1 - cos(x)**2: an exact rewriting, far
+    cheaper than simplify, that lets a kinetic energy built from Cartesian positions
+    collapse (cos**2 + sin**2 terms cancel) before Routh's reduction differentiates it.
+    With `velocities`, the coefficient of each monomial in them is factored (small
+    polynomials: (l - r)**2*sin(theta)**2 stays one product instead of six terms)."""
+    e = sp.expand(expr)
+    sines = {x for x in e.atoms(sp.sin)}
+    if sines:
+        e = sp.expand(e.subs({x**2: 1 - sp.cos(x.args[0]) ** 2 for x in sines}))
+    if not velocities:
+        return e
+    parts = sp.collect(e, list(velocities), evaluate=False)
+    return sp.Add(*[sp.factor(c) * m for m, c in parts.items()])

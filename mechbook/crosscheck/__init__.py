@@ -5,6 +5,8 @@ None of them looks at the book's answers:
     newton       the engine's equations against Newton's and Euler's laws, with kinematics
                  computed here independently (kinematics.py)
     conserved    the book's first integrals constant along a simulated trajectory
+    response     a steady-state amplitude measured from the driven nonlinear motion
+                 (frequencies.py also measures damped modes' decay rates)
     amplitude    the frequency measured at a finite amplitude (for `mechbook sweep
                  --quantity drift`: where the linear answer stops being good)
     motion       steady motions kept by a simulation; trajectory quantities of the level
@@ -42,7 +44,11 @@ from mechbook.verify.answers import AnswerKey
 from mechbook.verify.context import Context  # how a part names its point
 
 FREQUENCY_QUANTITIES = ("frequencies", "period", "normal_modes", "normal_coordinates",
-                        "mode_node", "stability_condition", "stability")
+                        "mode_node", "normal_transformation", "complex_modes", "exponents",
+                        "decay_rates", "characteristic_polynomial", "matrices", "stability",
+                        "stability_condition", "resonances", "steady_amplitude",
+                        "secular_growth")
+RESPONSE_QUANTITIES = ("steady_amplitude",)  # also simulated driven (crosscheck.response)
 EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "state_identity",
                        "solution",
                        "precession_rate", "rotation_matrix")
@@ -141,6 +147,9 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                                    detail=_fault(exc))
             freq[tag].parts.append(part.name)
             continue
+        if part.quantity in RESPONSE_QUANTITIES:
+            stage(f"cross-check response:{part.name}")
+            out.append(_guarded_response(analysis, ctx, lin, values, part, models))
         label = _point_label(lin)
         tag = (sname, *_numeric_key(lin, values, params))
         if tag not in freq:
@@ -188,6 +197,21 @@ def _guarded_conserved(analysis: Analysis, part, models: dict) -> CrossCheck | N
     except Exception as exc:  # noqa: BLE001 - reported, never hidden
         x.detail = _fault(exc)
     x.seconds = time.perf_counter() - start
+    return x
+
+
+def _guarded_response(analysis, ctx, lin, values, part, models) -> CrossCheck:
+    """The driven simulation of a steady-amplitude part (crosscheck.response)."""
+    from mechbook.crosscheck.response import response_crosscheck
+    from mechbook.verify.compare import value
+
+    try:
+        omega = value(ctx.parse(part.data["frequency"], ("frequency",)), values).real
+        x = response_crosscheck(analysis, lin, values, omega, f"response:{part.name}", models)
+    except Exception as exc:  # noqa: BLE001 - reported, never hidden
+        x = CrossCheck(f"response:{part.name}", "response", part.system or "", "error",
+                       detail=_fault(exc))
+    x.parts.append(part.name)
     return x
 
 

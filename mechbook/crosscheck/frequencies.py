@@ -25,11 +25,13 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from mechbook.engine.analysis import Analysis
+from mechbook.engine.linear import ZERO_CLUSTER
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.model import Model, build_model
 from mechbook.records import CrossCheck
 
-REL_TOL = 1e-4  # required agreement of measured and linear frequencies
+REL_TOL = 1e-4  # required agreement of measured and linear frequencies (and decay rates)
+DECAY_FLOOR = 1e-6  # a mode decaying slower than this (relative to ω) is not damped
 SHIFT_TOL = 1e-5  # the nonlinear shift must be known to be below this
 START_AMPLITUDE = 1e-3
 PERIODS = 4
@@ -49,6 +51,8 @@ class _Setup:
     C: np.ndarray
     K: np.ndarray
     engine: np.ndarray  # the engine's numeric frequencies
+    turn: np.ndarray | None = None  # uniform rates of a steady motion kept in full (per
+    # model coordinate): the reference state moves, q*(t) = q_star + turn*t
 
 
 def _float_values(values: dict) -> dict:
@@ -89,6 +93,12 @@ def _setup(analysis: Analysis, lin, values: dict, models: dict) -> _Setup:
     setup = _Setup(model, q_star, v_star, idx, cyclic, p_cyc, M, C, K, engine)
     if steady:
         setup.v_star = _with_cyclic_rates(setup, q_star, np.zeros(n))
+    if lin.velocity:  # a steady motion kept in all its coordinates (`reduce: false`)
+        turn = np.zeros(n)
+        for q, rate in lin.velocity.items():
+            turn[base.q.index(q)] = float(sp.N(sp.S(rate).subs(values)))
+        setup.turn = turn
+        setup.v_star = turn.copy()
     return setup
 
 
@@ -137,15 +147,31 @@ def _modes(s: _Setup) -> list[dict]:
         w = W[:, j] / np.conj(np.vdot(W[:, j], v))  # left eigenvector with wᴴv = 1
         start = v.real / max(1e-300, float(np.max(np.abs(v.real[:n]))))
         kind = ""
-        if abs(lam[j]) <= 1e-9 * scale:
+        if abs(lam[j]) <= ZERO_CLUSTER * scale:  # a zero exponent split by rounding
             kind = "zero"
+        elif _defective(lam, V, j, scale):  # before `unstable`: rounding splits the root
+            kind = "defective"
         elif lam[j].real > 1e-8 * scale:
             kind = "unstable"
         elif abs(lam[j].imag) <= 1e-9 * scale:
             kind = "overdamped"
         out.append({"omega": float(abs(lam[j].imag)), "kind": kind, "start": start,
-                    "weights": np.conj(w), "complex": True})
+                    "weights": np.conj(w), "complex": True, "decay": float(-lam[j].real)})
     return out
+
+
+def _defective(lam: np.ndarray, V: np.ndarray, j: int, scale: float) -> bool:
+    """Is exponent j a multiple root with a single eigenvector (a Jordan block: a stability
+    boundary, where solutions grow like t·e^{pt})? Rounding splits the root by about the
+    square root of the machine precision and leaves the two computed eigenvectors parallel
+    to the same order; an oscillation of fixed amplitude does not exist there to measure."""
+    v = V[:, j] / np.linalg.norm(V[:, j])
+    for i in range(len(lam)):
+        if i != j and abs(lam[i] - lam[j]) <= 1e-6 * scale:
+            u = V[:, i] / np.linalg.norm(V[:, i])
+            if abs(np.vdot(u, v)) >= 1 - 1e-6:
+                return True
+    return False
 
 
 def _signal(s: _Setup, mode: dict):
@@ -156,12 +182,28 @@ def _signal(s: _Setup, mode: dict):
     nl = len(idx)
     wq, wv = weights[:nl], weights[nl:]
     q_star, v_star = s.q_star[idx], s.v_star[idx]
+    turn = s.turn[idx] if s.turn is not None else np.zeros(nl)
 
     def g(t, y):
-        val = np.dot(wq, y[idx] - q_star) + np.dot(wv, y[n_full + idx] - v_star)
+        val = np.dot(wq, y[idx] - q_star - turn * t) + np.dot(wv, y[n_full + idx] - v_star)
         return float(np.real(val))
 
     return g
+
+
+def _complex_signal(s: _Setup, mode: dict):
+    """The complex modal amplitude w·(y − y*(t)) (its modulus decays like e^{Re p t})."""
+    n_full = len(s.q_star)
+    idx = np.array(s.index)
+    nl = len(idx)
+    wq, wv = mode["weights"][:nl], mode["weights"][nl:]
+    turn = s.turn[idx] if s.turn is not None else np.zeros(nl)
+
+    def z(t, y):
+        return complex(np.dot(wq, y[idx] - s.q_star[idx] - turn * t)
+                       + np.dot(wv, y[n_full + idx] - s.v_star[idx]))
+
+    return z
 
 
 def _initial(s: _Setup, mode: dict, amplitude: float) -> np.ndarray:
@@ -243,6 +285,10 @@ def _frequency_crosscheck(analysis, lin, values, out: CrossCheck, models: dict) 
         raise UnsupportedError("frequency cross-check: the equations are not autonomous at "
                                "the default parameters (time-dependent coefficients)")
     modes = _modes(s)
+    growing = _unstable_modes(s)
+    if growing:  # an unstable point: the simulation confirms the growth, not frequencies
+        _crosscheck_growth(s, growing, out)
+        return
     live = [m["omega"] for m in modes if not m["kind"] and m["omega"] > 0]
     if not live:
         kinds = sorted({m["kind"] or "?" for m in modes})
@@ -261,6 +307,10 @@ def _frequency_crosscheck(analysis, lin, values, out: CrossCheck, models: dict) 
         if mode["kind"] in ("unstable", "overdamped"):
             entry["status"] = "n.a."
             notes.append(f"mode {k}: {mode['kind']}, no oscillation to measure")
+        elif mode["kind"] == "defective":
+            entry["status"] = "n.a."
+            notes.append(f"mode {k}: a double exponent with one mode (secular growth at a "
+                         "stability boundary), no oscillation of fixed amplitude to measure")
         elif mode["kind"] == "zero":
             if mode.get("complex"):
                 entry["status"] = "n.a."
@@ -277,6 +327,10 @@ def _frequency_crosscheck(analysis, lin, values, out: CrossCheck, models: dict) 
             entry.update(_measure_mode(s, mode))
             rel = entry["relative_error"]
             ok = rel < REL_TOL and entry["shift"] < SHIFT_TOL
+            if mode.get("decay", 0.0) > DECAY_FLOOR * mode["omega"]:  # a damped mode
+                entry.update(_measure_decay(s, mode))
+                ok &= entry["decay_error"] < REL_TOL
+                rel = max(rel, entry["decay_error"])
             entry["status"] = "pass" if ok else "fail"
             failed |= not ok
             worst = max(worst, rel)
@@ -286,7 +340,10 @@ def _frequency_crosscheck(analysis, lin, values, out: CrossCheck, models: dict) 
     zeros = [m for m in out.modes if m["kind"] == "zero" and "measured" in m]
     bits = [f"ω {m['engine']:.6g}: measured {m['measured']:.10g} (rel {m['relative_error']:.1e},"
             f" amplitude {m['amplitude']:.0e}, shift {m['shift']:.0e}, extrapolated rel "
-            f"{m['extrapolated_error']:.0e})" for m in measured]
+            f"{m['extrapolated_error']:.0e})"
+            + (f", decay rate {m['decay']:.6g}: measured {m['decay_measured']:.10g} (rel "
+               f"{m['decay_error']:.1e})" if "decay_measured" in m else "")
+            for m in measured]
     bits += [f"zero mode stays (ω_eff/ω_max {m['relative_error']:.0e})" for m in zeros]
     out.detail = "; ".join(bits + notes)
     out.status = "fail" if failed else ("pass" if measured else "n.a.")
@@ -312,3 +369,78 @@ def _measure_mode(s: _Setup, mode: dict) -> dict:
             "extrapolated_error": abs(extrapolated - nearest) / nearest}
 
 
+def _measure_decay(s: _Setup, mode: dict) -> dict:
+    """The decay rate of a damped mode measured from the nonlinear motion: the modulus of
+    the complex modal amplitude w·(y − y*) along the trajectory started in the mode, fitted
+    as log|z| = log|z0| − γt over PERIODS periods (at two amplitudes, a and a/2, like the
+    frequency: the nonlinear part of the decay is known to be below their difference)."""
+    gamma = mode["decay"]
+    period = 2 * np.pi / mode["omega"]
+    horizon = min(PERIODS * period, 3.0 / gamma)  # a few e-foldings at most
+    z = _complex_signal(s, mode)
+    rates = []
+    for a in (START_AMPLITUDE, START_AMPLITUDE / 2):
+        y0 = _initial(s, mode, a)
+        scale = np.maximum(np.abs(y0), 1.0)
+        sol = solve_ivp(s.model.rhs, (0.0, horizon), y0, method="DOP853", rtol=1e-12,
+                        atol=1e-13 * a * scale, dense_output=True)
+        if not sol.success:
+            raise MechbookError(f"integration failed: {sol.message}")
+        ts = np.linspace(0.0, horizon, 200)
+        logs = np.log([abs(z(t, sol.sol(t))) for t in ts])
+        rates.append(-float(np.polyfit(ts, logs, 1)[0]))
+    return {"decay": gamma, "decay_measured": rates[1],
+            "decay_error": abs(rates[1] - gamma) / max(gamma, 1e-300),
+            "decay_shift": abs(rates[0] - rates[1]) / max(gamma, 1e-300)}
+
+
+def _unstable_modes(s: _Setup) -> list[dict]:
+    """The exponents with a positive real part (one per conjugate pair) and their modes,
+    from the state-space eigenproblem (left eigenvectors give each mode's amplitude)."""
+    n = len(s.index)
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(s.M, s.K), -np.linalg.solve(s.M, s.C)]])
+    lam, W, V = scipy.linalg.eig(A, left=True, right=True)
+    scale = max(1e-300, float(np.max(np.abs(lam))))
+    out = []
+    for j in range(2 * n):
+        if lam[j].real <= 1e-8 * scale or lam[j].imag < -1e-9 * scale:
+            continue
+        if abs(lam[j]) <= ZERO_CLUSTER * scale:
+            continue
+        v = V[:, j]
+        big = int(np.argmax(np.abs(v[:n])))
+        v = v * np.exp(-1j * np.angle(v[big]))
+        w = W[:, j] / np.conj(np.vdot(W[:, j], v))
+        start = v.real / max(1e-300, float(np.max(np.abs(v.real[:n]))))
+        out.append({"omega": float(abs(lam[j].imag)), "growth": float(lam[j].real),
+                    "kind": "unstable", "start": start, "weights": np.conj(w)})
+    return out
+
+
+def _crosscheck_growth(s: _Setup, growing: list[dict], out: CrossCheck) -> None:
+    """Each unstable mode's growth rate measured from the nonlinear motion started in it:
+    log|w·(y − y*)| fitted over three e-foldings (small amplitude: the growth stays linear)."""
+    worst, bits = 0.0, []
+    for k, mode in enumerate(growing):
+        gamma = mode["growth"]
+        z = _complex_signal(s, mode)
+        horizon = 3.0 / gamma
+        a = START_AMPLITUDE / 10
+        y0 = _initial(s, mode, a)
+        sol = solve_ivp(s.model.rhs, (0.0, horizon), y0, method="DOP853", rtol=1e-12,
+                        atol=1e-13 * a * np.maximum(np.abs(y0), 1.0), dense_output=True)
+        if not sol.success:
+            raise MechbookError(f"integration failed: {sol.message}")
+        ts = np.linspace(0.0, horizon, 200)
+        rate = float(np.polyfit(ts, np.log([abs(z(t, sol.sol(t))) for t in ts]), 1)[0])
+        rel = abs(rate - gamma) / gamma
+        worst = max(worst, rel)
+        out.modes.append({"mode": k, "kind": "unstable", "growth": gamma,
+                          "growth_measured": rate, "relative_error": rel,
+                          "status": "pass" if rel < REL_TOL * 10 else "fail"})
+        bits.append(f"growth rate {gamma:.6g}: measured {rate:.10g} (rel {rel:.1e})")
+    out.error = worst
+    out.status = "pass" if worst < REL_TOL * 10 else "fail"
+    out.detail = "unstable: " + "; ".join(bits) + " (oscillating modes not measured: the " \
+        "motion leaves the point)"

@@ -268,8 +268,8 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
         what.append("torques")
     if spec.get("attractors"):
         what.append("attracting masses (force and gravity-gradient torque)")
-    other = [k for k in ("kinetic", "potential", "lagrangian", "velocity_potential", "forces")
-             if k in spec]
+    other = [k for k in ("kinetic", "potential", "lagrangian", "velocity_potential", "forces",
+                         "dissipation") if k in spec]
     if any("length" in s for s in spec.get("springs") or []):
         other.append("length springs")
     out.detail = (f"E = Jᵀ(m r̈ − F) over {' and '.join(what)} at {used} random states, "

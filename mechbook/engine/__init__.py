@@ -5,10 +5,17 @@ reader asks (mechbook solve).
     equilibria  static equilibria, and the linearization about a point
     linear      the linear system about a point: frequencies, modes, stability
     routh       Routh's reduction about a steady motion
-    steady      steady motions: conditions, real rates, existence, effective potential
+    steady      steady motions: residuals of a uniform motion, conditions at fixed rates or
+                momenta, a family's real rates and their existence, effective potential
+    steady_search  steady motions found numerically: counts in a region, each one's
+                stability
     levelset    the motion on a level set of the first integrals, reduced to one coordinate
     phase       the phase-space flow in (q, p)
     analysis    one problem's results, cached per system and point (what checks pull from)
+    response    linear response: complex exponents and modes, decay rates, harmonic
+                response, forced initial-value motion, Jordan blocks (secular growth)
+    perturbation  perturbation theory's objects exactly (50 digits): unperturbed normal
+                coordinates, W', exact eigenpairs, shifted equilibria
     sweep       a linear system over a grid of parameters: compiled once, stacked
                 eigensolvers, the 30-digit path at single points
     derive      results as text for a reader, and the summary a check run stores

@@ -41,23 +41,33 @@ class Analysis:
             self._eq[sys.name] = Equilibria(self.dynamics(name))
         return self._eq[sys.name]
 
-    def linear(self, name: str | None, point: dict) -> LinearSystem:
+    def linear(self, name: str | None, point: dict, given: dict | None = None) -> LinearSystem:
+        """The linear system about the equilibrium `point` (an equilibrium where the
+        parameters satisfy `given`, {parameter: expression}, when that is not empty)."""
         sys = self.system(name)
-        key = (sys.name, tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())))
+        key = (sys.name, tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())),
+               _key(given))
         if key not in self._lin:
-            self._lin[key] = self.equilibria(name).linearize(point)
+            self._lin[key] = self.equilibria(name).linearize(point, given=given)
         return self._lin[key]
 
-    def steady_linear(self, name: str | None, rates: dict, point: dict) -> LinearSystem:
-        """Linearization about a steady motion: cyclic coordinates turning at `rates`, the
-        others at `point`, by Routh's reduction (momenta of the cyclic coordinates fixed)."""
+    def steady_linear(self, name: str | None, rates: dict, point: dict,
+                      reduce: bool = True, given: dict | None = None) -> LinearSystem:
+        """Linearization about a steady motion: coordinates turning at `rates`, the others
+        at `point`. By Routh's reduction (momenta of the cyclic coordinates fixed) unless
+        `reduce` is false: then every coordinate is kept, the turning ones as deviations
+        from the uniform turn (their zero roots stay in the secular equation)."""
         sys = self.system(name)
-        key = (sys.name, "steady",
-               tuple(sorted((str(k), sp.srepr(v)) for k, v in {**rates, **point}.items())))
+        key = (sys.name, "steady" if reduce else "steady-full",
+               tuple(sorted((str(k), sp.srepr(v)) for k, v in rates.items())),
+               tuple(sorted((str(k), sp.srepr(v)) for k, v in point.items())), _key(given))
         if key not in self._lin:
-            reduced = ReducedSystem(sys, rates, point, self.simplify)
-            dyn = Dynamics(reduced, self.simplify)
-            self._lin[key] = Equilibria(dyn).linearize(point)
+            if reduce:
+                reduced = ReducedSystem(sys, rates, point, self.simplify)
+                dyn = Dynamics(reduced, self.simplify)
+                self._lin[key] = Equilibria(dyn).linearize(point, given=given)
+            else:
+                self._lin[key] = self.equilibria(name).linearize(point, rates, given)
         return self._lin[key]
 
     def stable_equilibria(self, name: str | None = None,
@@ -104,3 +114,7 @@ class Analysis:
                 return origin
         raise UnsupportedError("choosing the equilibrium: the answer must name `about:` "
                                f"({len(distinct)} stable equilibria found)")
+
+
+def _key(given: dict | None) -> tuple:
+    return tuple(sorted((str(k), sp.srepr(v)) for k, v in (given or {}).items()))

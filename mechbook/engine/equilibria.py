@@ -41,7 +41,9 @@ class Equilibria:
             raise UnsupportedError("equilibria of a system with multiplier constraints")
         zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
         zero.update({s: 0 for s in self.sys.small_params})
-        conds = [without_absent(e.subs(zero), [self.sys.t]) for e in self.dyn.residuals]
+        held = getattr(self.sys, "held", {})  # a reduced system's momenta, put back
+        conds = [without_absent(e.subs(zero).xreplace(held), [self.sys.t])
+                 for e in self.dyn.residuals]
         if any(c.has(self.sys.t) for c in conds):
             raise UnsupportedError("static equilibria of a non-autonomous system")
         free = {s for syms in self.sys.free_driven for s in syms}
@@ -149,7 +151,7 @@ class Equilibria:
         # each second derivative from the smallest expression that still holds it:
         # A from L at the point (a function of q̇), C and the force from L at rest,
         # B from ∂L/∂q̇ at rest
-        held = getattr(self.sys, "deferred", {})  # Routh's held momenta: symbols until now
+        held = getattr(self.sys, "held", {})  # Routh's held momenta: symbols until now
         L_at, L_rest = dyn.L.subs(at), dyn.L.subs(rest)
         b = [sp.diff(dyn.L, v).subs(rest) for v in dyn.qd]
         dq = [sp.diff(L_rest, q) for q in dyn.q]
@@ -167,23 +169,57 @@ class Equilibria:
         return LinearSystem(dyn, dict(point), A, (B - B.T).applyfunc(simp),
                             (-C).applyfunc(simp), sp.zeros(n, 1))
 
-    def linearize(self, point: dict) -> LinearSystem:
-        """First-order expansion of the equations of motion about `point` (q̇ = 0)."""
+    def linearize(self, point: dict, velocity: dict | None = None,
+                  given: dict | None = None) -> LinearSystem:
+        """First-order expansion of the equations of motion about `point` (q̇ = 0), or, with
+        `velocity`, about the uniform motion q*(t) = point + velocity·t (a steady motion
+        kept in all its coordinates: δq of a uniformly turning coordinate is its deviation
+        from the uniform turn). The coefficients must then be free of t (the motion is a
+        symmetry orbit, e.g. a cyclic coordinate or a rotation of the whole system).
+        `given` ({parameter: expression}) restricts the parameters to a surface on which
+        the point is an equilibrium (an answer's `restrict:`): the zeroth order must vanish
+        there; M, C, K and F stay in the original parameters."""
         dyn = self.dyn
-        if self._conservative():
+        if not velocity and not given and self._conservative():
             return self._linearize_lagrangian(point)
+        velocity = dict(velocity or {})
+        t = self.sys.t
+        # a point or rate given by a long expression (an orbit parametrized by an answer's
+        # symbol) stands in as a plain symbol while differentiating, and is put back at the
+        # end: differentiating through it would multiply its size many times over
+        holders: dict[sp.Symbol, sp.Expr] = dict(getattr(self.sys, "held", {}))
+
+        def held(value, tag: str) -> sp.Expr:
+            value = sp.S(value)
+            if value.is_Atom or sp.count_ops(value) <= 4:
+                return value
+            for sym, v in holders.items():  # equal rates stay equal (a rigid rotation)
+                if v == value:
+                    return sym
+            sym = sp.Symbol(f"held_{tag}_{len(holders)}", real=True)
+            holders[sym] = value
+            return sym
+
         sub = {}
-        for q in dyn.q:
-            sub[q] = point.get(q, sp.S.Zero) + EPS * q
-        sub.update({v: EPS * v for v in dyn.qd + dyn.qdd})
+        for q, v in zip(dyn.q, dyn.qd, strict=True):
+            sub[q] = (held(point.get(q, 0), q.name) + held(velocity.get(q, 0), v.name) * t
+                      + EPS * q)
+            sub[v] = held(velocity.get(q, 0), v.name) if q in velocity else sp.S.Zero
+            sub[v] += EPS * v
+        sub.update({v: EPS * v for v in dyn.qdd})
         sub.update({s: EPS * s for s in self.sys.small_params})
         lin = []
         zeroth = []
-        held = getattr(self.sys, "deferred", {})  # Routh's held momenta (see routh.py)
         for e in dyn.residuals:
-            e_sub = e.subs(sub, simultaneous=True).subs(held)
+            e_sub = e.subs(sub, simultaneous=True)
             zeroth.append(e_sub.subs(EPS, 0))
             lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
+        zeroth = [z.xreplace(holders) for z in zeroth]
+        if velocity:  # zeroth order must vanish along the whole uniform motion
+            zeroth = [z.subs(t, sp.Rational(7, 5)) for z in zeroth] + \
+                     [z.subs(t, sp.Rational(-3, 7)) for z in zeroth]
+        if given:
+            zeroth = [z.subs(given) for z in zeroth]
         bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
@@ -203,12 +239,15 @@ class Equilibria:
         else:
             def simp(x, absent=t):
                 return without_absent(x, absent)
-        M, C, K = (raw[k].applyfunc(simp) for k in ("M", "C", "K"))
-        F = (-rest).applyfunc(lambda x: simp(sp.expand(x), state))
+        M, C, K = (raw[k].applyfunc(simp).xreplace(holders) for k in ("M", "C", "K"))
+        F = (-rest).applyfunc(lambda x: simp(sp.expand(x), state)).xreplace(holders)
         bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
-        return LinearSystem(dyn, dict(point), M, C, K, F)
+        if velocity and any(x.has(t) for A in (M, C, K) for x in A):
+            raise UnsupportedError("linearization about a uniform motion whose linear "
+                                   "equations have time-dependent coefficients")
+        return LinearSystem(dyn, dict(point), M, C, K, F, velocity)
 
 
 def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:

@@ -12,19 +12,21 @@ parts of the state-space eigenvalues.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 import scipy.linalg
 import sympy as sp
 
+from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, is_zero
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
 from mechbook.errors import MechbookError, UnsupportedError
 
 ZERO_TOL = 1e-9
+ZERO_CLUSTER = 1e-6  # |p| below this (relative) is a zero exponent split by rounding
 
 
 @dataclass
@@ -37,6 +39,9 @@ class LinearSystem:
     C: sp.Matrix
     K: sp.Matrix
     F: sp.Matrix
+    velocity: dict = field(default_factory=dict)  # uniform rates of a steady motion kept
+    # in full (mechbook.engine.equilibria.Equilibria.linearize); empty about a rest point
+    _compiled: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def q(self):
@@ -201,23 +206,33 @@ class LinearSystem:
             lam = mpmath.eig(A, left=False, right=False)
             return np.array([complex(x) for x in lam])
 
+    def fast_matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """M, C, K at `values` in double precision through the compile layer (compiled once):
+        for sweeps over many parameter points (stability over a parameter space), where
+        `matrices`' 30-digit evaluation would dominate."""
+        if self._compiled is None:
+            syms = sorted(set().union(*(A.free_symbols for A in (self.M, self.C, self.K))),
+                          key=lambda x: x.name)
+            entries = [x for A in (self.M, self.C, self.K) for x in A]
+            try:
+                fn, _ = compile_exprs(syms, entries)
+            except UnsupportedError:
+                fn = None
+            self._compiled = (syms, fn)
+        syms, fn = self._compiled
+        if fn is None or any(x not in values for x in syms):
+            return self.matrices(values)
+        with np.errstate(all="ignore"):
+            out = np.asarray(fn(np.array([float(values[x]) for x in syms])), dtype=float)
+        if not np.all(np.isfinite(out)):
+            return self.matrices(values)
+        n = self.M.rows
+        return (out[: n * n].reshape(n, n), out[n * n: 2 * n * n].reshape(n, n),
+                out[2 * n * n:].reshape(n, n))
+
     def numeric_stability(self, values: dict) -> str:
         """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
-        M, C, K = self.matrices(values)
-        n = M.shape[0]
-        if not np.any(C):
-            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
-            scale = max(1.0, float(np.max(np.abs(w2))))
-            if np.any(w2 < -ZERO_TOL * scale):
-                return "unstable"
-            return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
-        A = np.block([[np.zeros((n, n)), np.eye(n)],
-                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-        re = np.linalg.eigvals(A).real
-        scale = max(1.0, float(np.max(np.abs(np.linalg.eigvals(A)))))
-        if np.any(re > 1e-8 * scale):
-            return "unstable"
-        return "stable"
+        return classify_matrices(*self.fast_matrices(values))
 
     @cached_property
     def stability_condition(self) -> sp.Basic:
@@ -227,6 +242,29 @@ class LinearSystem:
         K = self.K
         minors = [try_simplify(K[:k, :k].det(), 5) for k in range(1, K.rows + 1)]
         return sp.And(*[mi > 0 for mi in minors])
+
+
+def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
+    """'stable', 'unstable' or 'marginal' for M·q̈ + C·q̇ + K·q = 0 (numbers)."""
+    n = M.shape[0]
+    if not np.any(C):
+        w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+        scale = max(1.0, float(np.max(np.abs(w2))))
+        if np.any(w2 < -ZERO_TOL * scale):
+            return "unstable"
+        return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    lam = np.linalg.eigvals(A)
+    scale = max(1.0, float(np.max(np.abs(lam))))
+    # exponents at zero (a symmetry: an ignorable coordinate kept in the linearization, a
+    # family of steady motions) split by rounding into a tiny cluster whose real parts mean
+    # nothing; they are neutral here (their polynomial growth is `secular_growth`'s
+    # question), and the verdict rests on the others
+    live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
+    if np.any(live.real > 1e-8 * scale):
+        return "unstable"
+    return "stable"
 
 
 def _entry(x: sp.Expr, values: dict, digits: int, exact: bool = False):

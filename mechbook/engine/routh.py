@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechbook.core.expansion import trig_canonical
 from mechbook.core.numeval import is_zero
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.errors import UnsupportedError
@@ -24,7 +25,11 @@ class ReducedSystem:
     """
 
     def __init__(self, base: System, rates: dict[sp.Symbol, sp.Expr], point: dict,
-                 simplify: bool = False):
+                 simplify: bool = False, momenta: dict[sp.Symbol, sp.Expr] | None = None):
+        """`rates` names the cyclic coordinates and their steady rates at `point`, which
+        fix the momenta; or `momenta` gives the momenta directly (then only the keys of
+        `rates` are used: steady motions at a fixed momentum, wherever they are)."""
+        momenta_given = momenta
         self.base = base
         self.problem = base.problem
         self.t = base.t
@@ -46,7 +51,7 @@ class ReducedSystem:
         self.coord_names = [base.coord_names[i] for i in keep]
         self.forces = [base.forces[i] for i in keep]
         self.names = base.names
-        L = base.lagrangian
+        L = trig_canonical(base.lagrangian, base.qd)  # exact; keeps the reduction small
         cyc_rates = [base.qd[i] for i in idx]
         momenta = [sp.diff(L, v) for v in cyc_rates]
         # the momenta's values at the steady motion: rates given, others at rest at `point`
@@ -54,15 +59,22 @@ class ReducedSystem:
         at_steady.update(point)
         at_steady.update({base.qd[i]: rates[c] for i, c in zip(idx, cyc, strict=True)})
         simp = sp.simplify if simplify else (lambda e: e)  # for a reader only
-        p_values = [simp(p.subs(at_steady)) for p in momenta]
+        if momenta_given is not None:
+            p_values = [sp.S(momenta_given[c]) for c in cyc]
+        else:
+            p_values = [simp(p.subs(at_steady)) for p in momenta]
         # the held momenta stay symbols P until the linear system is formed: their values
-        # (large expressions for a rate given as a root of a quadratic) are put into the
-        # small matrices M, C, K, not into L' and its derivatives (Equilibria.linearize)
-        held = [sp.Symbol(f"P_held_{c}", real=True) for c in cyc]
-        rate_of = _solve_rates(momenta, held, cyc_rates, point, base.numeric_values())
-        routh = sum((P * v for P, v in zip(held, cyc_rates, strict=True)), sp.S.Zero)
-        self.lagrangian = simp((L - routh).subs(rate_of))
-        self.deferred = dict(zip(held, p_values, strict=True))
+        # (large expressions for a rate given as a root of a quadratic, or the steady
+        # motion's point and rate substituted) are put into the small matrices M, C, K and
+        # the equilibrium conditions, not into L' and its derivatives (Equilibria puts
+        # them back through `held`)
+        symbols = [sp.Symbol(f"P_held_{c}", real=True) for c in cyc]
+        rate_of = _solve_rates(momenta, symbols, cyc_rates, point, base.numeric_values())
+        rate_of = {v: _smaller(e, _cancel(e)) for v, e in rate_of.items()}
+        routh = sum((P * v for P, v in zip(symbols, cyc_rates, strict=True)), sp.S.Zero)
+        reduced = (L - routh).subs(rate_of)
+        self.lagrangian = simp(_smaller(reduced, _cancel(reduced)))
+        self.held: dict[sp.Symbol, sp.Expr] = dict(zip(symbols, p_values, strict=True))
         self.momenta = dict(zip(cyc, p_values, strict=True))
 
     def dt(self, expr):
@@ -107,3 +119,19 @@ def _solve_rates(momenta: list, values: list, rates: list, point: dict,
         raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
                                "their momenta")
     return sol[0]
+
+
+def _cancel(expr: sp.Expr, seconds: float = 5.0) -> sp.Expr:
+    """expr as one rational function (common denominator, common factors cancelled): exact
+    polynomial arithmetic, not simplify, and it keeps Routh's function small for the
+    differentiations that follow; given up (expr unchanged) after `seconds`."""
+    try:
+        with time_limit(seconds):
+            return sp.cancel(expr)
+    except (Timeout, sp.PolynomialError):
+        return expr
+
+
+def _smaller(a: sp.Expr, b: sp.Expr) -> sp.Expr:
+    """The one of two equal expressions with fewer operations."""
+    return b if sp.count_ops(b) < sp.count_ops(a) else a

@@ -1,22 +1,24 @@
-"""Steady motions: cyclic coordinates turning at constant rates, the others at rest.
+"""Steady motions: where they are, and at which rates (Symon §11-5, §12-6).
 
-A steady motion of a system with cyclic coordinates φ (absent from L, no force on them) has
-the other coordinates fixed at q* and constant rates φ̇. It exists exactly when the
-generalized forces on the other coordinates vanish there:
-    E_i(q*, q̇ = (0, φ̇), q̈ = 0) = 0   for every non-cyclic i,
-(the cyclic equations hold by themselves: their momenta depend on q and q̇ only). With one
-rate left unknown — the others fixed by relations such as ω3 = ψ̇ + φ̇ cos θ — these
-conditions are equations in that rate x; `SteadyFamily` returns them, their real roots at
-given parameter values (for conditions polynomial in x after clearing denominators), and
-whether any exists (the minimum spin of a top).
+A steady motion turns some coordinates at constant rates while the others stay put; with no
+rates it is an equilibrium. This module says where steady motions are; counting them in a
+region and judging each one's stability from numbers is mechbook.engine.steady_search, and
+small oscillations about a given one are `Analysis.steady_linear` (Routh's reduction,
+mechbook.engine.routh, or the motion kept in full). Nothing here knows a particular system:
+chapter 11's tops and chapter 12's orbits and three bodies use the same functions.
 
-The effective potential of Routh's reduction, V_eff(q; p) = [Σ p_φ φ̇ − L] at q̇ = 0 with
-φ̇ expressed by the momenta p_φ, is here too: the energy that remains for the non-cyclic
-coordinates when the cyclic momenta are held (Symon's 'V'(θ) of the top).
-
-Small oscillations and stability about a steady motion are `Analysis.steady_linear`
-(Routh's reduction, mechbook.engine.routh); this module is shared with any system that
-has cyclic coordinates (chapter 12's steady motions too).
+    steady_residuals   the equations of motion along q*(t) = point + rates·t (q̈ = 0): all
+                       zero, at two times, exactly when that uniform motion is steady
+    steady_conditions  the conditions on the non-turning coordinates at fixed rates, or at
+                       fixed cyclic momenta (the equilibria of Routh's reduced system)
+    SteadyFamily       steady motions at a given point with one cyclic rate x unknown (the
+                       others fixed by `hold:` relations such as ω3 = ψ̇ + φ̇ cos θ): the
+                       conditions as functions of x, their real roots at given parameter
+                       values (polynomial in x after clearing denominators), so whether any
+                       exists (the minimum spin of a top)
+    effective_potential  Routh's V_eff(q; p) = [Σ p_φ φ̇ − L] at q̇ = 0 with φ̇ expressed by
+                       the momenta: the energy left for the non-cyclic coordinates when the
+                       cyclic momenta are held (Symon's V'(θ) of the top)
 """
 
 from __future__ import annotations
@@ -28,10 +30,57 @@ import sympy as sp
 
 from mechbook.core.numeval import is_zero
 from mechbook.core.timeout import Timeout, time_limit
+from mechbook.engine.equilibria import Equilibria
 from mechbook.engine.lagrange import Dynamics
+from mechbook.engine.routh import ReducedSystem
 from mechbook.errors import UnsupportedError
 
 DIGITS = 30
+TIMES = (sp.Rational(7, 5), sp.Rational(-3, 7))  # a steady motion's residual vanishes at all t
+
+
+def steady_residuals(dyn: Dynamics, rates: dict, point: dict) -> list[sp.Expr]:
+    """E_i along q*(t) = point + rates·t, q̇ = rates, q̈ = 0 (small parameters off), at two
+    times: every one vanishes exactly when that uniform motion solves the equations."""
+    sys = dyn.sys
+    sub = {}
+    for q, v, a in zip(dyn.q, dyn.qd, dyn.qdd, strict=True):
+        sub[q] = sp.S(point.get(q, 0)) + sp.S(rates.get(q, 0)) * sys.t
+        sub[v] = sp.S(rates.get(q, 0))
+        sub[a] = sp.S.Zero
+    sub.update({s: sp.S.Zero for s in sys.small_params})
+    out = []
+    for e in dyn.residuals:
+        e = e.subs(sub, simultaneous=True)
+        out += [e.subs(sys.t, tv) for tv in TIMES] if e.has(sys.t) else [e]
+    return out
+
+
+def reduced_at(sys, momenta: dict) -> ReducedSystem:
+    """The system left when the cyclic coordinates `momenta` names keep those momenta."""
+    return ReducedSystem(sys, {c: sp.S.Zero for c in momenta}, {}, momenta=momenta)
+
+
+def steady_conditions(sys, rates: dict | None = None, momenta: dict | None = None
+                      ) -> tuple[list[sp.Expr], list[sp.Symbol], Equilibria]:
+    """The conditions on the non-turning coordinates for a steady motion, those
+    coordinates, and the Equilibria object that linearizes about one: at fixed `rates`
+    (E_i with q̇ = rates), at fixed cyclic `momenta` (the equilibrium conditions of Routh's
+    reduced system), or neither (static equilibria)."""
+    if momenta:
+        reduced = reduced_at(sys, momenta)
+        eq = Equilibria(Dynamics(reduced))
+        return eq.conditions, list(reduced.q), eq
+    dyn = Dynamics(sys)
+    rates = rates or {}
+    free = [q for q in dyn.q if q not in rates]
+    conds = []
+    for e in steady_residuals(dyn, rates, {q: q for q in free}):
+        if e.has(sys.t):
+            raise UnsupportedError("steady motions of a non-autonomous system")
+        if e != 0:
+            conds.append(e)
+    return conds, free, Equilibria(dyn)
 
 
 def cyclic_check(dyn: Dynamics, coords: list[sp.Symbol]) -> None:

@@ -46,8 +46,31 @@ FUNCTIONS: dict[str, object] = {
     "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt, "Abs": sp.Abs, "abs": sp.Abs,
     "sign": sp.sign, "cbrt": sp.cbrt,
 }
-ARITY = {"atan2": (2, 2), "log": (1, 2)}
+def _diff(expr, var, times=1):
+    """diff(expr, x[, n]): the derivative with respect to a declared name (at most 6th)."""
+    if not isinstance(var, sp.Symbol):
+        raise ValueError("differentiate with respect to a declared name")
+    if not (isinstance(times, int | sp.Integer) and 1 <= int(times) <= 6):
+        raise ValueError("the order is a whole number from 1 to 6")
+    return sp.diff(expr, var, int(times))
+
+
+FUNCTIONS["diff"] = _diff
+ARITY = {"atan2": (2, 2), "log": (1, 2), "diff": (2, 3)}
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
+
+
+class Operator:
+    """A function a quantity offers to the expressions of its own parts (e.g. a perturbation
+    coefficient W0(j), or sum(expr, r)): called by name with the parsed arguments. The
+    safe parser knows only this class; what it computes is the quantity's business."""
+
+    def __init__(self, name: str, fn, arity: tuple[int, int]):
+        self.name, self.fn, self.arity = name, fn, arity
+
+    def __call__(self, *args):
+        return self.fn(*args)
+
 
 # values that are statements, not numbers (a Symbol is also a SymPy Boolean, so not that)
 _TRUTHS = (sp.core.relational.Relational, sp.logic.boolalg.BooleanFunction,
@@ -179,6 +202,8 @@ class _Builder:
             raise self.fail(node, f"name {name!r} is not allowed (leading underscore)")
         if name in self.names:
             value = self.names[name]
+            if isinstance(value, Operator):
+                raise self.fail(node, f"function {name!r} used without a call")
             entries = list(value) if isinstance(value, sp.MatrixBase) else [value]
             if any(e.args for e in entries):  # a name standing for an expression (or a
                 # vector or tensor of them): count what it brings
@@ -228,16 +253,25 @@ class _Builder:
         if not isinstance(node.func, ast.Name):
             raise self.fail(node, "only calls of whitelisted functions by name are allowed")
         name = node.func.id
-        if name not in FUNCTIONS:
+        op = self.names.get(name)
+        if name not in FUNCTIONS and not isinstance(op, Operator):
             raise self.fail(node, f"call of unknown function {name!r}")
         if node.keywords:
             raise self.fail(node, f"keyword arguments are not allowed in {name}()")
-        lo, hi = ARITY.get(name, (1, 1))
+        lo, hi = op.arity if isinstance(op, Operator) else ARITY.get(name, (1, 1))
         if not lo <= len(node.args) <= hi:
             raise self.fail(node, f"{name}() takes {lo if lo == hi else f'{lo} to {hi}'} "
                                   f"argument(s), got {len(node.args)}")
         args = [self.build(a, depth, True) for a in node.args]
-        return FUNCTIONS[name](*args)
+        if isinstance(op, Operator):
+            try:
+                return op(*args)
+            except (TypeError, ValueError) as exc:
+                raise self.fail(node, f"{name}(): {exc}") from None
+        try:
+            return FUNCTIONS[name](*args)
+        except ValueError as exc:
+            raise self.fail(node, f"{name}(): {exc}") from None
 
     def _Compare(self, node: ast.Compare, depth: int) -> sp.Basic:
         if not self.allow_relations:
@@ -290,29 +324,37 @@ def syntax_tree(text: str | int | float) -> tuple[str, ast.Expression]:
 
 
 def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
-          allow_relations: bool = False) -> sp.Basic:
-    """Parse one expression (or, with allow_relations, a condition such as ``a < b``)."""
+          allow_relations: bool = False, complex_ok: bool = False) -> sp.Basic:
+    """Parse one expression (or, with allow_relations, a condition such as ``a < b``).
+    Constants must be finite and real; with `complex_ok` (an answer whose values are complex
+    on purpose: exponents, complex modes) finite complex constants such as sqrt(-1) are
+    allowed."""
     names = names or {}
     text, tree = syntax_tree(text)
+    builder = _Builder(text, names, allow_relations)
+    builder.complex_ok = complex_ok
     try:
-        result = _Builder(text, names, allow_relations).build(tree)
+        result = builder.build(tree)
     except RecursionError:  # MAX_AST_DEPTH keeps clear of it; a deep caller may not
         raise ExpressionError(f"expression {text[:60]!r} nested too deeply", text) from None
-    if isinstance(result, sp.Basic) and (result.has(*_NOT_FINITE) or result.has(sp.I)):
+    if isinstance(result, sp.Basic) and (result.has(*_NOT_FINITE)
+                                         or (result.has(sp.I) and not complex_ok)):
         raise ExpressionError(f"expression {text!r} holds a constant that is not finite "
                               f"and real: {result}", text)
     return result
 
 
-def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None) -> sp.Expr:
+def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None,
+                   complex_ok: bool = False) -> sp.Expr:
     """Parse ``lhs = rhs`` (or a bare ``expr`` meaning ``expr = 0``) into ``lhs - rhs``."""
     if not isinstance(text, str):
-        return parse(text, names)
+        return parse(text, names, complex_ok=complex_ok)
     pieces = _split_single_equals(text)
     if len(pieces) == 1:
-        return parse(pieces[0], names)
+        return parse(pieces[0], names, complex_ok=complex_ok)
     if len(pieces) == 2:
-        return parse(pieces[0], names) - parse(pieces[1], names)
+        return (parse(pieces[0], names, complex_ok=complex_ok)
+                - parse(pieces[1], names, complex_ok=complex_ok))
     raise ExpressionError(f"more than one '=' in equation {text!r}", text)
 
 

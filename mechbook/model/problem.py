@@ -9,6 +9,7 @@ Everything a system says is parsed with the safe parser; an error names the file
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -16,7 +17,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
-from mechbook.model.expr import CONSTANTS, FUNCTIONS, parse
+from mechbook.model.expr import CONSTANTS, FUNCTIONS, Operator, parse
 from mechbook.model.limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, loads
@@ -25,8 +26,8 @@ T = sp.Symbol("t", real=True)
 RESERVED = {"t"} | set(CONSTANTS) | set(FUNCTIONS)
 SYSTEM_KEYS = ("coordinates", "driven", "particles", "rigid_bodies", "gravity", "springs",
                "kinetic", "potential", "lagrangian", "velocity_potential", "constraints",
-               "forces", "torques", "attractors", "average", "approximation", "equilibria",
-               "initial", "compute", "doc")
+               "forces", "torques", "attractors", "dissipation", "string", "average",
+               "approximation", "equilibria", "initial", "compute", "doc")
 DEFAULT_VALUES = {"g": 9.81}  # documented default for the gravitational acceleration
 DEFAULT_VALUE = 1.0
 
@@ -65,6 +66,7 @@ class Problem:
     sha256: str
     description: str = ""
     conditions: list = field(default_factory=list)
+    functions: dict = field(default_factory=dict)  # name -> Operator (arbitrary functions)
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -72,7 +74,9 @@ class Problem:
         return self.id.split("-")[0]
 
     def names(self) -> dict[str, sp.Basic]:
-        return {n: p.symbol for n, p in self.parameters.items()}
+        names: dict[str, sp.Basic] = {n: p.symbol for n, p in self.parameters.items()}
+        names.update(self.functions)
+        return names
 
     def values(self) -> dict[sp.Symbol, float]:
         return {p.symbol: p.value for p in self.parameters.values()}
@@ -103,6 +107,37 @@ def _parameter(doc: Document, name: str, spec: dict | None) -> Parameter:
                      bool(spec.get("small", False)))
 
 
+def _function(doc: Document, name: str, spec: dict, params: dict) -> Operator:
+    """An arbitrary smooth function of one argument, as the book keeps it (a field B_z(r)).
+
+    It is realized as a polynomial c0 + c1*x + ... + cd*x**d whose coefficients are
+    parameters `<name>_c<k>` (real, any sign), sampled like every other parameter: an
+    identity between expressions in the function's values and derivatives at a point holds
+    for every smooth function exactly when it holds for every such polynomial of degree at
+    least the highest derivative used, so random coefficients test it as random parameter
+    values test any other identity. `degree` (default 6) bounds the derivatives a check may
+    use; `values` gives the coefficients' defaults (default 1/(k+1)!, a gentle function)."""
+    if name in params or name in RESERVED:
+        raise doc.error(("functions", name), f"{name!r} is already a name")
+    degree = spec.get("degree", 6)
+    defaults = spec.get("values") or [1.0 / math.factorial(k + 1) for k in range(degree + 1)]
+    if len(defaults) != degree + 1:
+        raise doc.error(("functions", name, "values"), f"give {degree + 1} coefficients")
+    coeffs = []
+    for k in range(degree + 1):
+        cname = f"{name}_c{k}"
+        if cname in params:
+            raise doc.error(("functions", name), f"{cname!r} is already a parameter")
+        params[cname] = Parameter(cname, sp.Symbol(cname, real=True), float(defaults[k]),
+                                  f"coefficient of x**{k} in the function {name}")
+        coeffs.append(params[cname].symbol)
+
+    def realize(x):
+        return sum((c * x**k for k, c in enumerate(coeffs)), sp.S.Zero)
+
+    return Operator(name, realize, (1, 1))
+
+
 def load_problem(path: str | Path) -> Problem:
     """Load and validate a problem file; raise SpecError naming file and line on any fault."""
     raw = read_bytes(path)
@@ -111,6 +146,9 @@ def load_problem(path: str | Path) -> Problem:
     check_problem_counts(doc)
     data = doc.data
     params = {n: _parameter(doc, n, s) for n, s in data["parameters"].items()}
+    functions = {}
+    for name, spec in (data.get("functions") or {}).items():
+        functions[name] = _function(doc, name, spec or {}, params)
     if "systems" in data:
         inline = [k for k in SYSTEM_KEYS if k in data]
         if inline:
@@ -129,7 +167,7 @@ def load_problem(path: str | Path) -> Problem:
         raise doc.error(("id",), why)
     sha = hashlib.sha256(raw).hexdigest()
     problem = Problem(data["id"], data["title"], data["source"], str(path), doc, params, systems,
-                      sha, data.get("description", ""))
+                      sha, data.get("description", ""), functions=functions)
     problem.conditions = [problem.parse(c, ("conditions", i), relation=True)
                           for i, c in enumerate(data.get("conditions", []))]
     if not all(bool(c.subs(problem.values())) for c in problem.conditions):

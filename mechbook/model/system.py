@@ -106,6 +106,10 @@ class System:
         for name, b in (s.get("rigid_bodies") or {}).items():
             kinetic += self._rigid_body(name, b)
         potential += self._gravity() + self._springs()
+        if "string" in s:
+            t_string, v_string = self._string()
+            kinetic += t_string
+            potential += v_string
         if s.get("attractors"):
             potential += attractor_potential(self, s["attractors"])
         if "lagrangian" in s:
@@ -294,6 +298,53 @@ class System:
             total += k * (length - natural) ** 2 / 2
         return total
 
+    def _string(self) -> tuple[sp.Expr, sp.Expr]:
+        """A stretched string fixed at x = 0 and x = l, its transverse displacement expanded
+        in the first N sine modes, u(x, t) = sum_k q_k(t)*sin(k*pi*x/l) (a Galerkin form:
+        the coordinates `amplitudes` are the q_k). T = (1/2)*integral sigma(x)*u_t**2 dx and
+        V = (1/2)*integral tau*u_x**2 dx, integrated exactly (products of sines turned into
+        sums first); sigma may depend on x, tau is constant. The truncation to N modes is a
+        discretization: its accuracy is measured in tests/test_string.py and stated in
+        docs/schema.md."""
+        from sympy.simplify.fu import TR8
+
+        spec = self.spec["string"]
+        sub = ("string",)
+        x = sp.Symbol("x", real=True)
+        names = dict(self.names)
+        if "x" in names:
+            raise self._error(sub, "the string's coordinate along it is x: the name is taken")
+        names["x"] = x
+        length = self._parse_with(spec["length"], sub + ("length",), names)
+        tension = self._parse_with(spec["tension"], sub + ("tension",), names)
+        density = self._parse_with(spec["density"], sub + ("density",), names)
+        if tension.has(x) or length.has(x):
+            raise self._error(sub, "the length and the tension do not depend on x")
+        amps = []
+        for i, name in enumerate(spec["amplitudes"]):
+            if name not in self.coord_names:
+                raise self._error(sub + ("amplitudes", i), f"{name!r} is not a coordinate")
+            amps.append(self.coord_names.index(name))
+        modes = [sp.sin((k + 1) * sp.pi * x / length) for k in range(len(amps))]
+        kinetic = potential = sp.S.Zero
+        for a, ia in enumerate(amps):
+            for b, ib in enumerate(amps):
+                if b < a:
+                    continue
+                mult = 1 if a == b else 2
+                try:
+                    mass = sp.integrate(sp.expand(TR8(density * modes[a] * modes[b])),
+                                        (x, 0, length))
+                except Exception as exc:  # noqa: BLE001 - SymPy's many failure modes
+                    raise self._error(sub + ("density",), f"cannot integrate: {exc}") from None
+                if mass.has(sp.Integral) or mass.has(x):
+                    raise self._error(sub + ("density",), "the mass integrals have no closed "
+                                      "form")
+                kinetic += mult * mass * self.qd[ia] * self.qd[ib] / 2
+            k = a + 1
+            potential += tension * (k * sp.pi / length) ** 2 * (length / 2) * self.q[ia] ** 2 / 2
+        return kinetic, potential
+
     def _forces(self) -> list[sp.Expr]:
         forces = self.spec.get("forces") or {}
         out = []
@@ -303,6 +354,9 @@ class System:
         if unknown:
             raise self._error(("forces", sorted(unknown)[0]), "generalized forces are keyed by "
                               "coordinate; no coordinate of that name")
+        if "dissipation" in self.spec:  # Rayleigh's function R(q, q̇): Q_k = −∂R/∂q̇_k
+            rayleigh = self._parse(self.spec["dissipation"], ("dissipation",))
+            out = [f - sp.diff(rayleigh, v) for f, v in zip(out, self.qd, strict=True)]
         return out
 
     # ---- calculus ------------------------------------------------------------------------

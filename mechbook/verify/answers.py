@@ -76,10 +76,14 @@ class Part:
 
     def parse(self, text, sub: tuple, names: dict, equation: bool = False,
               relation: bool = False) -> sp.Basic:
+        from mechbook.verify.registry import quantities
+
+        known = quantities().get(self.quantity)
+        complex_ok = bool(known and known.complex_values)  # exponents, complex modes
         try:
             if equation:
-                return parse_equation(text, names)
-            return parse(text, names, relation)
+                return parse_equation(text, names, complex_ok)
+            return parse(text, names, relation, complex_ok)
         except ExpressionError as exc:
             message = str(exc)
             for abbr, why in self._unavailable.items():

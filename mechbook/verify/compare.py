@@ -39,7 +39,8 @@ class Sampler:
 
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
                  seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
-                 rtol: float = RTOL, fixed: Sequence[sp.Symbol] = ()):
+                 rtol: float = RTOL, fixed: Sequence[sp.Symbol] = (),
+                 derived: dict[sp.Symbol, sp.Expr] | None = None):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
@@ -47,6 +48,26 @@ class Sampler:
         self.policy = policy  # carried with the sampler to every comparison it serves
         self.rtol = rtol  # relative tolerance of `equal` and `vanishes` (a numeric estimate's)
         self.fixed = set(fixed)  # symbols kept at their base values (a numeric estimate)
+        # symbols fixed by the others (a part's `restrict:`, a surface in parameter space):
+        # computed after each draw, in order, so a later one may use an earlier one
+        self.derived = dict(derived or {})
+
+    def _complete(self, point: dict) -> dict | None:
+        """The point with its derived symbols computed (None where one is not real)."""
+        for sym, expr in self.derived.items():
+            try:  # all 30 digits: a point exactly on a surface (a double root) stays on it
+                v = sp.N(expr.subs(point), DIGITS)
+                re, im = v.as_real_imag()
+                if not (re.is_number and im.is_number):
+                    return None
+            except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+                return None
+            if not (math.isfinite(float(re)) and abs(im) <= 1e-20 * max(1.0, abs(re))):
+                return None
+            if sym.is_positive and re <= 0:
+                return None
+            point[sym] = sp.Float(re, DIGITS)
+        return point
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
              tries: int = 2000) -> dict[sp.Symbol, sp.Float]:
@@ -72,16 +93,28 @@ class Sampler:
                 if v not in point:
                     point[v] = self.rng.uniform(0.1, 1.0) if v.is_positive \
                         else self.rng.uniform(-1.0, 1.0)
-            point = {k: sp.Float(v, DIGITS) for k, v in point.items()}
-            if all(holds(c, point) for c in self.conditions):
+            point = self._complete({k: sp.Float(v, DIGITS) for k, v in point.items()})
+            if point is not None and all(holds(c, point) for c in self.conditions):
                 return point
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
+    def complete(self, point: dict) -> dict | None:
+        """`point` with its derived (restricted) symbols recomputed, or None if one is not
+        real there (for a caller that moved a parameter itself, e.g. towards a limit)."""
+        return self._complete({k: v for k, v in point.items() if k not in self.derived})
+
+    def widened(self, spread: float) -> Sampler:
+        """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
+        return Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
+                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived)
+
     def default(self) -> dict[sp.Symbol, sp.Float]:
         """The default values (when they satisfy the conditions on the parameters alone;
-        a condition on a state variable, such as r > 0, is for the states drawn later)."""
-        point = {k: sp.Float(v, DIGITS) for k, v in self.base.items()}
-        if all(holds(c, point) for c in self.conditions if c.free_symbols <= set(point)):
+        a condition on a state variable, such as r > 0, is for the states drawn later),
+        with the derived (restricted) symbols computed."""
+        point = self._complete({k: sp.Float(v, DIGITS) for k, v in self.base.items()})
+        if point is not None and all(holds(c, point) for c in self.conditions
+                                     if c.free_symbols <= set(point)):
             return point
         return {k: v for k, v in self.draw().items() if k in self.base}
 

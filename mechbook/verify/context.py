@@ -69,6 +69,16 @@ class Context:
                   for i, c in enumerate(self.part.data.get("assume", []))]
         base = dict(self.analysis.problem.values())
         base.update(self.part.key.symbol_values)
+        derived = {}
+        for k, v in (self.part.data.get("restrict") or {}).items():
+            sym = self.names.get(k)
+            if not isinstance(sym, sp.Symbol) or sym not in base:
+                raise self.part.error(("restrict", k), f"{k!r} is not a parameter or symbol")
+            expr = self.parse(v, ("restrict", k))
+            if expr.free_symbols & ({sym} | set(derived)):
+                raise self.part.error(("restrict", k), "a restricted symbol is given by the "
+                                      "others, not by itself or another restricted one")
+            derived[sym] = expr
         if "estimate" in self.part.data:  # a number the book computed: one point, its rtol
             est = self.part.data["estimate"]
             for k, v in (est.get("values") or {}).items():
@@ -81,9 +91,9 @@ class Context:
                     raise self.part.error(("estimate", "values", k), "a number is expected")
                 base[sym] = float(val)
             self.sampler = Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
-                                   fixed=list(base))
+                                   fixed=list(base), derived=derived)
         else:
-            self.sampler = Sampler(base, conds, policy=self.policy)
+            self.sampler = Sampler(base, conds, policy=self.policy, derived=derived)
 
     @property
     def dyn(self):
@@ -111,19 +121,27 @@ class Context:
             point[self.system.q[self.system.coord_names.index(k)]] = self.parse(v, ("about", k))
         return point
 
+    def rates(self) -> dict:
+        """The rates of a steady motion (`steady:`), by coordinate symbol."""
+        rates = {}
+        for k, v in (self.part.data.get("steady") or {}).items():
+            if k not in self.system.coord_names:
+                raise self.part.error(("steady", k), f"{k!r} is not a coordinate")
+            rates[self.system.q[self.system.coord_names.index(k)]] = \
+                self.parse(v, ("steady", k))
+        return rates
+
     def linear(self) -> LinearSystem:
         if "steady" in self.part.data:
             if "about" not in self.part.data:
                 raise self.part.error(("steady",), "a steady motion needs `about:` for the "
                                       "coordinates that stay put")
-            rates = {}
-            for k, v in self.part.data["steady"].items():
-                if k not in self.system.coord_names:
-                    raise self.part.error(("steady", k), f"{k!r} is not a coordinate")
-                rates[self.system.q[self.system.coord_names.index(k)]] = \
-                    self.parse(v, ("steady", k))
-            return self.analysis.steady_linear(self.part.system, rates, self.point())
-        return self.analysis.linear(self.part.system, self.point())
+            return self.analysis.steady_linear(self.part.system, self.rates(), self.point(),
+                                               self.part.data.get("reduce", True),
+                                               self.sampler.derived)
+        if "reduce" in self.part.data:
+            raise self.part.error(("reduce",), "`reduce:` applies to a steady motion")
+        return self.analysis.linear(self.part.system, self.point(), self.sampler.derived)
 
     def as_list(self, val, sub) -> list:
         if isinstance(val, list):

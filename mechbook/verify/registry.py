@@ -20,8 +20,9 @@ from functools import cache
 from mechbook.model.schema import bundled
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
-COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "assume",
-               "define", "note", "verdict", "erratum", "unsupported", "origin")
+COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
+               "assume", "restrict", "define", "note", "verdict", "erratum", "unsupported",
+               "origin")
 
 
 # schema fragments shared by several quantities' keys
@@ -47,21 +48,30 @@ class Quantity:
     book: str  # what `book:` holds
     how: str  # how it is checked
     keys: dict = field(default_factory=dict)  # extra part keys -> JSON-Schema fragments
+    names: Callable | None = None  # ctx -> the names its `book:` may use beyond ctx.names
+    literals: tuple = ()  # words a `book:` value may be instead of an expression
     needs_system: bool = True  # False: tensors and bodies, checked without a system
+    complex_values: bool = False  # its expressions may hold complex constants (sqrt(-1))
 
 
 QUANTITIES: dict[str, Quantity] = {}
 
 
 def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
-             needs_system: bool = True):
-    """Register the decorated function as the check of quantity `name` (`needs_system`:
-    False for quantities of declared tensors and bodies, which a problem without a system
-    can have)."""
+             names: Callable | None = None, literals: tuple = (), needs_system: bool = True,
+             complex_values: bool = False):
+    """Register the decorated function as the check of quantity `name` (`names`: a function
+    of the part's context giving the names its book value may use beyond the usual ones,
+    e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`: words
+    the book value may be instead, e.g. "stable"; `needs_system`: False for quantities of
+    declared tensors and bodies, which a problem without a system can have;
+    `complex_values`: its values are complex on purpose, so its expressions may hold
+    constants such as sqrt(-1), which are refused elsewhere)."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
-        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), needs_system)
+        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names,
+                                    tuple(literals), needs_system, complex_values)
         return fn
 
     return register

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from mechbook.core.numeval import holds
-from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine, vanishes
+from mechbook.verify.compare import Verdict, all_vanish, combine, vanishes
 from mechbook.verify.context import Context
 from mechbook.verify.registry import quantity
 
@@ -51,7 +51,7 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
     if "stable" in ctx.part.data:
         want = ctx.part.data["stable"]
         for pt in candidates:
-            lin = ctx.analysis.linear(ctx.part.system, pt)
+            lin = ctx.analysis.linear(ctx.part.system, pt, ctx.sampler.derived)
             for _ in range(4):
                 got = lin.numeric_stability(ctx.sampler.draw())
                 if (got == "stable") != want:
@@ -68,7 +68,7 @@ def check_stability_condition(ctx: Context, val) -> Verdict:
     parameter points drawn widely on both sides of the boundary."""
     cond = ctx.parse(val, ("book",), relation=True)
     lin = ctx.linear()
-    wide = Sampler(ctx.sampler.base, ctx.sampler.conditions, spread=2.0, policy=ctx.policy)
+    wide = ctx.sampler.widened(2.0)
     seen = {True: 0, False: 0}
     n = 0
     for _ in range(400):

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from mechbook.engine import perturbation
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, match_multiset, vanishes
@@ -70,22 +71,28 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
 
 def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
     def error(pt) -> float:
-        eng = list(lin.numeric_frequencies(pt))
+        eng = [float(w) for w in perturbation.precise_frequencies(lin, pt)]
         worst = 0.0
         for b in numbers(book, pt):  # one-to-one: each engine frequency matches once
-            if not eng:
+            if not eng or not np.isfinite(b):  # a book value that is not real here fails
                 return float("inf")
             nearest = min(range(len(eng)), key=lambda i, b=b: abs(eng[i] - b))
             worst = max(worst, abs(eng.pop(nearest) - b) / max(abs(b), 1e-300))
         return worst
 
-    return _asymptotic(ctx, error)
+    return asymptotic(ctx, error)
 
 
-def _asymptotic(ctx: Context, error) -> Verdict:
+LIMIT_STEPS = tuple(10.0 ** (-1 - k / 2) for k in range(7))  # 1e-1 ... 1e-4, half decades
+
+
+def asymptotic(ctx: Context, error) -> Verdict:
     """`limit: {parameter, to, order}`: the book's formula holds in a limit of the
-    parameters. The relative error `error(point)` must fall as the parameter goes to 0 or ∞
-    by decades, faster than 10^-order per decade (halved, for safety), and end below 1e-3."""
+    parameters, to the stated order. The error `error(point)` (relative, from values exact
+    to 50 digits) is measured as the parameter goes to 0 or ∞ in half decades from 1e-1 to
+    1e-4 of its value; over the last three steps it must fall like the parameter to a power
+    of at least order + 0.5 (a formula right to order k errs like ε^(k+1); one wrong at
+    order k errs like ε^k), ending below 1e-3 — or vanish (below 1e-30) there: exact."""
     spec = ctx.part.data["limit"]
     name = spec["parameter"]
     if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
@@ -95,19 +102,31 @@ def _asymptotic(ctx: Context, error) -> Verdict:
     to_zero = str(spec["to"]) == "0"
     base = ctx.sampler.default()
     errors = []
-    for eps in (1e-3, 1e-4, 1e-5):
+    for eps in LIMIT_STEPS:
         pt = dict(base)
-        pt[sym] = base[sym] * eps if to_zero else base[sym] / eps
-        errors.append(error(pt))
-    ratios = [errors[i + 1] / errors[i] if errors[i] > 1e-14 else 0.0 for i in range(2)]
-    needed = 0.5 * 10.0 ** (-order)
-    ok = errors[-1] < 1e-3 and all(r <= needed for r in ratios)
-    detail = (f"relative error {errors[0]:.2g}, {errors[1]:.2g}, {errors[2]:.2g} as "
-              f"{name} -> {spec['to']} by decades (needs decrease faster than x{needed:g})")
+        pt[sym] = sp.Float(base[sym] * eps if to_zero else base[sym] / eps, 30)
+        pt = ctx.sampler.complete(pt)
+        errors.append(float(error(pt)) if pt is not None else float("nan"))
+    tail = errors[-3:]
+    shown = ", ".join(f"{e:.2g}" for e in errors)
+    if not all(np.isfinite(tail)):
+        return Verdict(False, "numeric(asymptotic)", f"relative error {shown}: the formula "
+                       "does not evaluate (or match) near the limit")
+    if all(e < 1e-30 for e in tail):
+        return Verdict(True, "numeric(asymptotic)", f"relative error {shown}: exact in the "
+                       "limit's last steps")
+    if not all(np.isfinite(tail)) or min(tail) <= 0:
+        return Verdict(False, "numeric(asymptotic)", f"relative error {shown}")
+    logs = np.log10(tail)
+    steps = np.log10(LIMIT_STEPS[-3:])
+    slope = float(np.polyfit(steps, logs, 1)[0])
+    ok = tail[-1] < 1e-3 and slope >= order + 0.5
+    detail = (f"relative error {shown} as {name} -> {spec['to']} by half decades from 1e-1: "
+              f"it falls like {name}**{slope:.2f} (needs {order + 0.5:g} or more)"
+              if to_zero else
+              f"relative error {shown} as {name} -> oo by half decades from x10: it falls "
+              f"like (1/{name})**{slope:.2f} (needs {order + 0.5:g} or more)")
     return Verdict(ok, "numeric(asymptotic)", detail)
-
-
-asymptotic = _asymptotic  # the same decades test for steady rates and trajectory formulas
 
 
 @quantity('period',
@@ -187,19 +206,22 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
                        _shape(ctx, mode.get("shape"), ("book", i, "shape"))))
 
     def error(pt) -> float:
-        w2, vecs = lin.numeric_modes(pt)
+        w2, modes = perturbation.precise_modes(lin, pt)
+        w2 = np.array([float(x) for x in w2])
+        vecs = np.array([[float(modes[i, j]) for j in range(modes.cols)]
+                         for i in range(modes.rows)])
         free = list(range(len(w2)))
         worst = 0.0
         for freq, shape in parsed:
             w = numbers([freq], pt)[0]
             u = np.array(numbers(list(shape), pt))
-            if not free or not np.any(u):
+            if not free or not np.any(u) or not np.isfinite(w) or not np.all(np.isfinite(u)):
                 return float("inf")
             best = float("inf")
             for j in free:
-                v = vecs[:, j]
-                cos = abs(u @ v) / (np.linalg.norm(u) * np.linalg.norm(v))
-                sin = float(np.sqrt(max(0.0, 1.0 - cos**2)))
+                v = vecs[:, j] / np.linalg.norm(vecs[:, j])
+                # the sine of the angle, from the part of u off v (no cancellation)
+                sin = float(np.linalg.norm(u - (u @ v) * v) / np.linalg.norm(u))
                 dw = abs(np.sqrt(abs(w2[j])) - w) / max(abs(w), 1e-300)
                 best_j = max(sin, dw)
                 if best_j < best:
@@ -208,7 +230,7 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
             worst = max(worst, best)
         return worst
 
-    return _asymptotic(ctx, error)
+    return asymptotic(ctx, error)
 
 
 def _near(values, x, rtol=1e-8):
@@ -216,17 +238,21 @@ def _near(values, x, rtol=1e-8):
 
 
 def _shape(ctx: Context, shape, sub) -> sp.Matrix:
+    """A mode shape over the linear system's coordinates (a steady motion reduced by Routh
+    has lost its cyclic ones)."""
     shape = ctx.as_map(shape, sub)
-    unknown = set(shape) - set(ctx.system.coord_names)
+    names = ctx.linear().dyn.sys.coord_names
+    unknown = set(shape) - set(names)
     if unknown:
-        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate")
-    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0
-                      for c in ctx.system.coord_names])
+        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the linear "
+                             "system")
+    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0 for c in names])
 
 
 @quantity('normal_coordinates',
           book='list of `{coordinate: linear form, frequency?}`',
-          how='c·q is a normal coordinate iff M⁻¹c is a mode')
+          how=('c·q is a normal coordinate iff M⁻¹c is a mode (with velocity terms C, also '
+               'an eigenvector of M⁻¹C: then C does not couple it)'))
 def check_normal_coordinates(ctx: Context, val) -> Verdict:
     """A linear form c·q is a normal coordinate iff u = M⁻¹c is a mode: (K − ω²M)u = 0."""
     lin = ctx.linear()
@@ -250,6 +276,9 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
             if _eig_residual(K, M, w2, u) > 1e-8:
                 return Verdict(False, "numeric", f"{item['coordinate']} is not a normal "
                                "coordinate (M^-1 c is not a mode)")
+            if np.any(C) and _eig_residual(C, M, float(u @ C @ u / (u @ M @ u)), u) > 1e-8:
+                return Verdict(False, "numeric", f"{item['coordinate']} is not a normal "
+                               "coordinate: the velocity terms C couple it to the others")
             if "frequency" in item:
                 w = numbers([ctx.parse(item["frequency"], ("book", i, "frequency"))], pt)[0]
                 if abs(np.sqrt(max(w2, 0)) - w) > 1e-8 * max(1, w):

@@ -1,18 +1,22 @@
-"""Steady motions as answers: `steady_rates`, `steady_exists`, `stability`,
-`effective_potential` (mechbook.engine.steady; Routh's reduction for stability).
+"""Where steady motions are, as answers: `steady_motion`, `steady_rates`, `steady_exists`,
+`effective_potential` (mechbook.engine.steady). Their stability and counts are
+mechbook.verify.quantities.stability.
 
-A part names the steady motion by `about:` (the coordinates at rest, e.g. theta: theta0),
-`unknown:` (the cyclic coordinate whose rate the book gives) and `hold:` (relations that fix
-the other cyclic rates, e.g. "psidot + phidot*cos(theta) = omega3").
+A part names a family of steady motions by `about:` (the coordinates at rest, e.g. theta:
+theta0), `unknown:` (the cyclic coordinate whose rate the book gives or whose existence it
+states) and `hold:` (relations that fix the other cyclic rates, e.g. "psidot +
+phidot*cos(theta) = omega3").
 """
 
 from __future__ import annotations
 
+import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import holds
+from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
-from mechbook.verify.compare import Sampler, Verdict, all_vanish, combine
+from mechbook.verify.compare import Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
@@ -20,6 +24,34 @@ from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
 HOLD = {"type": "array", "items": {"type": "string"}}
 ROOT_RTOL = 1e-9
 STEADY_KEYS = {"hold": HOLD, "unknown": NAME}
+
+
+def coordinate_map(ctx: Context, mapping, sub) -> dict:
+    mapping = ctx.as_map(mapping, sub)
+    out = {}
+    for k, v in mapping.items():
+        if k not in ctx.system.coord_names:
+            raise ctx.part.error(sub + (k,), f"{k!r} is not a coordinate")
+        out[ctx.system.q[ctx.system.coord_names.index(k)]] = ctx.parse(v, sub + (k,))
+    return out
+
+
+@quantity('steady_motion',
+          book='`{at: {q: value}, rates: {q: rate}}`',
+          how=('the uniform motion q = at + rates·t (every coordinate in `at:` or `rates:`) '
+               'solves the equations of motion: each residual vanishes identically (at two '
+               'times, at random points; answer symbols such as an orbit radius are '
+               'sampled too)'))
+def check_steady_motion(ctx: Context, val) -> Verdict:
+    val = ctx.as_map(val, ("book",))
+    point = coordinate_map(ctx, val.get("at") or {}, ("book", "at"))
+    rates = coordinate_map(ctx, val.get("rates") or {}, ("book", "rates"))
+    missing = [c for c, q in zip(ctx.system.coord_names, ctx.system.q, strict=True)
+               if q not in point and q not in rates]
+    if missing:
+        raise ctx.part.error(("book",), f"give every coordinate a value (`at:`) or a rate "
+                             f"(`rates:`): {', '.join(missing)} missing")
+    return all_vanish(steady.steady_residuals(ctx.dyn, rates, point), ctx.sampler)
 
 
 def family(ctx: Context) -> SteadyFamily:
@@ -131,26 +163,36 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
 
 
 @quantity('steady_exists',
-          book='relation',
-          how=('at ≥ 60 parameter points drawn widely (both outcomes must occur), the '
-               'relation holds exactly where a real steady rate exists (the minimum spin '
-               'of a top)'),
+          book='relation (where a steady motion exists)',
+          how=('at ≥ 60 parameter points drawn widely (both outcomes must occur, ≥ 10 '
+               'each), the relation holds exactly where some real rate of the `unknown:` '
+               'coordinate makes the configuration `about:` (with the other cyclic rates '
+               'fixed by `hold:`) a steady motion: the conditions, polynomials in the rate, '
+               'have a common real root (a coefficient that cancels to 1e-20 of its terms '
+               'counts as zero; the roots are checked on every condition). The minimum spin '
+               'of a top, the region where circular orbits exist'),
           keys=STEADY_KEYS)
 def check_steady_exists(ctx: Context, val) -> Verdict:
     fam = family(ctx)
     cond = ctx.parse(val, ("book",), relation=True)
-    wide = Sampler(ctx.sampler.base, ctx.sampler.conditions, spread=2.0, policy=ctx.policy)
+    key = ("steady-coefficients", id(fam))
+    cache = ctx.analysis.__dict__.setdefault("_steady_coefficients", {})
+    if key not in cache:
+        cache[key] = (fam, _coefficients(ctx, fam))
+    coefficients = cache[key][1]
+    wide = ctx.sampler.widened(2.0)
     seen = {True: 0, False: 0}
     n = 0
     for _ in range(400):
         pt = wide.draw()
-        exists = bool(fam.real_rates(pt))
+        exists = _common_real_root(coefficients, pt)
         claim = holds(cond, pt)
         if claim != exists:
+            shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
+                pt.items(), key=lambda kv: kv[0].name)[:8])
             return Verdict(False, f"numeric({n + 1} points)",
-                           f"book says {'a' if claim else 'no'} steady motion, the engine "
-                           f"finds {'some' if exists else 'none'} at "
-                           f"{{{', '.join(f'{k}={float(v):.4g}' for k, v in pt.items())}}}")
+                           f"book says {'a' if claim else 'no'} steady motion, engine finds "
+                           f"{'one' if exists else 'none'} at {{{shown}}}")
         seen[claim] += 1
         n += 1
         if n >= 60 and min(seen.values()) >= 10:
@@ -158,41 +200,54 @@ def check_steady_exists(ctx: Context, val) -> Verdict:
     if min(seen.values()) == 0:
         return Verdict(False, "numeric", "sampling never crossed the existence boundary; the "
                        "check cannot discriminate")
-    return Verdict(True, f"numeric({n} points: {seen[True]} exist, {seen[False]} do not)")
+    return Verdict(True, f"numeric({n} points: {seen[True]} with, {seen[False]} without)")
 
 
-VERDICTS = ("stable", "unstable")
-
-
-@quantity('stability',
-          book='`stable` or `unstable`',
-          how=('the linearized motion about the equilibrium or steady motion (`about:`, '
-               '`steady:`) is so at every one of 12 parameter points drawn widely (factors '
-               'up to e² about the defaults; `assume:` bounds the region); no boundary '
-               'crossing is needed. Points where the linearization is marginal are not '
-               'counted (8 decided points needed)'),
-          keys={})
-def check_stability(ctx: Context, val) -> Verdict:
-    if val not in VERDICTS:
-        raise ctx.part.error(("book",), f"book must be one of {VERDICTS}")
-    lin = ctx.linear()
-    wide = Sampler(ctx.sampler.base, ctx.sampler.conditions, spread=2.0, policy=ctx.policy)
-    decided = 0
-    for i in range(40):
-        if decided >= 12:
-            break
-        pt = wide.draw()
-        got = lin.numeric_stability(pt)
-        if got == "marginal":
+def _coefficients(ctx: Context, fam: SteadyFamily) -> list[list]:
+    """Each condition of the family as a polynomial in its rate x: the coefficient lists
+    (highest first) of the numerators."""
+    out = []
+    for c in fam.conditions:
+        if c == 0:
             continue
-        decided += 1
-        if got != val:
-            return Verdict(False, f"numeric({i + 1} points)",
-                           f"engine finds {got} at "
-                           f"{{{', '.join(f'{k}={float(v):.4g}' for k, v in pt.items())}}}")
-    if decided < 8:
-        return Verdict(False, "numeric", f"only {decided} points were not marginal")
-    return Verdict(True, f"numeric({decided} points)")
+        try:
+            poly = sp.Poly(sp.expand(c), fam.x)
+        except sp.PolynomialError:
+            poly = None
+        if poly is None or any(a.has(fam.x) for a in poly.all_coeffs()):
+            num = sp.together(c).as_numer_denom()[0]
+            try:
+                poly = sp.Poly(sp.expand(num), fam.x)
+            except sp.PolynomialError:
+                raise ctx.part.error(("unknown",), "the steady conditions are not "
+                                     "polynomial in the rate") from None
+        out.append(poly.all_coeffs())
+    return out
+
+
+def _common_real_root(coefficients: list[list], pt: dict) -> bool:
+    """Do the polynomials (coefficient lists, highest first) have a common real root at
+    `pt`? A coefficient counts as zero when it cancels to 1e-20 of its terms."""
+    polys = []
+    for coeffs in coefficients:
+        vals = []
+        for c in coeffs:
+            v, size = value_and_scale(c, pt)
+            vals.append(0.0 if abs(v) <= 1e-20 * max(size, 1e-300) else v.real)
+        while vals and vals[0] == 0.0:
+            vals.pop(0)
+        if not vals:
+            continue  # vanishes identically here
+        if len(vals) == 1:
+            return False  # a nonzero constant: no rate makes this residual vanish
+        polys.append(np.array(vals))
+    if not polys:
+        return True
+    roots = [r.real for r in np.roots(polys[0]) if abs(r.imag) <= 1e-9 * max(1, abs(r))]
+    for r in roots:
+        if all(abs(np.polyval(c, r)) <= 1e-9 * np.polyval(np.abs(c), abs(r)) for c in polys):
+            return True
+    return False
 
 
 @quantity('effective_potential',

@@ -1,0 +1,149 @@
+"""Stability and counts of equilibria and steady motions as answers: `stability`,
+`equilibrium_count`, `secular_growth` (mechbook.engine.steady_search, .response).
+`stability_condition` (a relation) is in mechbook.verify.quantities.equilibria.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mechbook.engine import response, steady
+from mechbook.engine.steady_search import classify, classify_at, roots_in
+from mechbook.verify.compare import Verdict, value
+from mechbook.verify.context import Context
+from mechbook.verify.quantities.equilibria import check_stability_condition
+from mechbook.verify.quantities.steady import coordinate_map
+from mechbook.verify.registry import EXPR, POINT, REGION, quantity
+
+
+@quantity('stability',
+          book='stable, unstable or marginal (or a relation: stable exactly where it holds)',
+          how=('the linearized system about the part\'s equilibrium or steady motion '
+               '(`about:`, `steady:`) has that verdict at every one of 60 parameter points '
+               'drawn widely (factors up to e² about the defaults; `assume:` bounds the '
+               'region): "always stable / always unstable" claims, no boundary crossing '
+               'needed. A marginal point (a zero frequency without gyroscopic terms) counts '
+               'against `stable` and `unstable`; zero exponents of a symmetry are neutral. A '
+               'relation is checked as `stability_condition`'),
+          literals=("stable", "unstable", "marginal"))
+def check_stability(ctx: Context, val) -> Verdict:
+    if isinstance(val, str) and ("<" in val or ">" in val):  # a condition after all
+        return check_stability_condition(ctx, val)
+    if val not in ("stable", "unstable", "marginal"):
+        raise ctx.part.error(("book",), "expected stable, unstable or marginal (or a "
+                             "relation: where it is stable)")
+    lin = ctx.linear()
+    wide = ctx.sampler.widened(2.0)
+    seen: dict[str, int] = {}
+    for n in range(60):
+        pt = wide.draw()
+        got = classify(lin, pt)
+        seen[got] = seen.get(got, 0) + 1
+        if got != val:
+            shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
+                pt.items(), key=lambda kv: kv[0].name)[:8])
+            return Verdict(False, f"numeric({n + 1} points)",
+                           f"engine finds it {got} at {{{shown}}}")
+    return Verdict(True, f"numeric(60 points, all {val})")
+
+
+def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:
+    region = ctx.part.data.get("search")
+    boxes = region if isinstance(region, list) else [region]
+    out = []
+    for i, box in enumerate(boxes):
+        sub = ("search", i) if isinstance(region, list) else ("search",)
+        box = ctx.as_map(box, sub)
+        parsed = {}
+        for k, (lo, hi) in box.items():
+            if k not in ctx.system.coord_names:
+                raise ctx.part.error(sub + (k,), f"{k!r} is not a coordinate")
+            q = ctx.system.q[ctx.system.coord_names.index(k)]
+            if q not in unknowns:
+                raise ctx.part.error(sub + (k,), f"{k!r} turns at a fixed rate or momentum "
+                                     "here; the region is over the other coordinates")
+            parsed[q] = tuple(value(ctx.parse(x, sub + (k, j)), pt).real
+                              for j, x in enumerate((lo, hi)))
+        out.append(parsed)
+    return out
+
+
+@quantity('equilibrium_count',
+          book='integer',
+          how=('the number of distinct equilibria, or steady motions at fixed `rates:` or at '
+               'fixed cyclic `momenta:` (equilibria of Routh\'s reduced system), inside '
+               '`search:` (a box or a list of boxes over the other coordinates), found by '
+               'multistart root finding at 3 points (a count the search can miss is a lower '
+               'bound: say so in the note); `stable: true/false` also checks each one\'s '
+               'stability'),
+          keys={"search": {"oneOf": [REGION, {"type": "array", "minItems": 1,
+                                               "items": REGION}]},
+                "rates": POINT, "momenta": POINT, "stable": {"type": "boolean"}})
+def check_equilibrium_count(ctx: Context, val) -> Verdict:
+    if not isinstance(val, int) or isinstance(val, bool):
+        raise ctx.part.error(("book",), "expected an integer")
+    if "search" not in ctx.part.data:
+        raise ctx.part.error((), "a count needs `search:` (the region to count in)")
+    rates = coordinate_map(ctx, ctx.part.data.get("rates") or {}, ("rates",))
+    momenta = coordinate_map(ctx, ctx.part.data.get("momenta") or {}, ("momenta",))
+    if rates and momenta:
+        raise ctx.part.error(("momenta",), "fix either rates or momenta")
+    conds, unknowns, eq = steady.steady_conditions(ctx.system, rates, momenta)
+    want = ctx.part.data.get("stable")
+    counts = []
+    for _ in range(3):
+        pt = ctx.sampler.draw()
+        roots = roots_in(conds, unknowns, pt, _boxes(ctx, pt, unknowns))
+        counts.append(len(roots))
+        where = "; ".join("(" + ", ".join(f"{x:.5g}" for x in r) + ")" for r in roots[:6])
+        if len(roots) != val:
+            return Verdict(False, "numeric(root search)",
+                           f"found {len(roots)} in the region: {where}")
+        if want is not None:
+            for r in roots:
+                got = classify_at(eq, dict(zip(unknowns, r, strict=True)), pt, rates)
+                if (got == "stable") != want:
+                    at = ", ".join(f"{x:.5g}" for x in r)
+                    return Verdict(False, "numeric(root search)", f"the one at ({at}) is {got}")
+    how = "" if want is None else f", each {'stable' if want else 'unstable'}"
+    return Verdict(True, f"numeric(root search, 3 points{how})", f"counts {counts}")
+
+
+@quantity('secular_growth',
+          book='integer k (solutions grow like t^k·e^{pt})',
+          how=('the largest Jordan block of the state matrix (at `exponent:`, or over all '
+               'exponents) has size k + 1: k = 0 no secular terms, k = 1 t·cos growth at a '
+               'double root with one mode; ranks of (A − pI)^j in mpmath at 40 digits, 3 '
+               'points'),
+          keys={"exponent": EXPR},
+          complex_values=True)
+def check_secular_growth(ctx: Context, val) -> Verdict:
+    if not isinstance(val, int) or isinstance(val, bool) or val < 0:
+        raise ctx.part.error(("book",), "expected a non-negative integer")
+    lin = ctx.linear()
+    sizes = []
+    for _ in range(3):
+        pt = ctx.sampler.draw()
+        if "exponent" in ctx.part.data:
+            targets = [value(ctx.parse(ctx.part.data["exponent"], ("exponent",)), pt)]
+        else:
+            targets = _clusters(response.exponents(lin, pt, precise=True))
+        size = max(response.jordan_size(lin, pt, p) for p in targets)
+        sizes.append(size)
+        if size != val + 1:
+            return Verdict(False, "numeric(Jordan blocks, 40 digits)",
+                           f"largest Jordan block {size}: solutions grow like t^{size - 1}")
+    return Verdict(True, "numeric(Jordan blocks, 40 digits, 3 points)")
+
+
+def _clusters(lam: np.ndarray) -> list[complex]:
+    """One representative per group of (nearly) equal exponents."""
+    scale = max(1e-300, float(np.max(np.abs(lam))))
+    out: list[complex] = []
+    for x in lam:
+        if not any(abs(x - y) <= 1e-6 * scale for y in out):
+            out.append(complex(x))
+    return out
+
+
+

@@ -1,0 +1,108 @@
+"""Perturbation theory and asymptotic checks: the `perturbation` quantity on a hand-solved
+two-mode system, `limit:` orders measured at 50 digits, and the parser's Operator names."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+import sympy as sp
+
+from mechbook.engine import perturbation as pert
+from mechbook.engine.analysis import Analysis
+from mechbook.errors import ExpressionError
+from mechbook.model.expr import Operator, parse
+from mechbook.model.problem import load_problem
+from mechbook.verify.answers import load_answers
+from mechbook.verify.checker import check_problem
+
+# unit masses, W0 = (1, 4), V' = eps*(a*x1**2/2 + c*x1*x2 + d*x2**2/2)
+TWO = """\
+id: lim-9501
+source: test
+title: two oscillators, weakly coupled
+parameters:
+  a: {value: 0.7}
+  c: {value: 0.9}
+  d: {value: -0.4, positive: false}
+  eps: {value: 1.0}
+coordinates:
+  x1: {}
+  x2: {}
+particles:
+  p1: {mass: 1, position: [x1]}
+  p2: {mass: 1, position: [x2]}
+potential: (x1**2 + 4*x2**2)/2 + eps*(a*x1**2/2 + c*x1*x2 + d*x2**2/2)
+"""
+
+
+def load(tmp_path: Path, text: str, num: str) -> Analysis:
+    text = re.sub(r"^id: .*$", f"id: lim-{num}", text, count=1, flags=re.M)
+    d = tmp_path / "problems" / "lim"
+    d.mkdir(parents=True, exist_ok=True)
+    (d / f"{num}.yaml").write_text(text)
+    return Analysis(load_problem(d / f"{num}.yaml"))
+
+
+def run(tmp_path: Path, an: Analysis, part: dict):
+    d = tmp_path / "answers" / "lim"
+    d.mkdir(parents=True, exist_ok=True)
+    f = d / f"{an.problem.id.split('-')[1]}.yaml"
+    f.write_text(json.dumps({"problem": an.problem.id, "source": "test",
+                             "parts": [{"cite": "t", **part}]}))
+    return check_problem(an, load_answers(f))[0]
+
+
+def part(order: int, book: str, **extra) -> dict:
+    return {"part": "p", "quantity": "perturbation", "about": {"x1": 0, "x2": 0},
+            "approximates": "squared_frequency", "mode": 1,
+            "limit": {"parameter": "eps", "to": "0", "order": order}, "book": book, **extra}
+
+
+FIRST = "W0(1) + Wp(1, 1)"
+SECOND = "W0(1) + Wp(1, 1) - sum(Wp(1, r)**2/(W0(r) - W0(1)), r, 1)"
+
+
+def test_the_split_by_hand(tmp_path):
+    """W0 = (1, 4); W' = eps*[[a, c], [c, d]] in these (already normal, unit-mass) coordinates."""
+    an = load(tmp_path, TWO, "9501")
+    lin = an.linear(None, {q: sp.S.Zero for q in an.system().q})
+    eps, a, c, d = (an.problem.parameters[n].symbol for n in ("eps", "a", "c", "d"))
+    values = {eps: sp.Float("0.01", 30), a: sp.Float("0.7", 30), c: sp.Float("0.9", 30),
+              d: sp.Float("-0.4", 30)}
+    s = pert.split(lin, values, {eps: 0})
+    assert [float(w) for w in s.W0] == pytest.approx([1.0, 4.0])
+    assert float(s.Wp[0, 0]) == pytest.approx(0.007, rel=1e-12)
+    assert abs(float(s.Wp[0, 1])) == pytest.approx(0.009, rel=1e-12)
+    assert float(s.Wp[1, 1]) == pytest.approx(-0.004, rel=1e-12)
+
+
+def test_orders_are_measured(tmp_path):
+    an = load(tmp_path, TWO, "9501")
+    assert run(tmp_path, an, part(1, FIRST)).status == "pass"
+    assert run(tmp_path, an, part(2, FIRST)).status == "fail"  # only first order right
+    assert run(tmp_path, an, part(2, SECOND)).status == "pass"
+    wrong_sign = SECOND.replace(" - sum", " + sum")
+    out = run(tmp_path, an, part(2, wrong_sign))
+    assert out.status == "fail" and "falls like eps**2" in out.detail
+
+
+def test_mode_components_to_first_order(tmp_path):
+    an = load(tmp_path, TWO, "9501")
+    comp = part(1, "-Wp(j, 1)/(W0(j) - W0(1))", approximates="component", component="j")
+    assert run(tmp_path, an, comp).status == "pass"
+    assert run(tmp_path, an, dict(comp, book="Wp(j, 1)/(W0(j) - W0(1))")).status == "fail"
+
+
+def test_operator_names_in_the_parser():
+    f = sp.Function("W0")
+    names = {"W0": Operator("W0", f, (1, 1)), "j": sp.Symbol("j", integer=True)}
+    assert parse("W0(j) + 1", names) == f(sp.Symbol("j", integer=True)) + 1
+    with pytest.raises(ExpressionError, match="without a call"):
+        parse("W0 + 1", names)
+    with pytest.raises(ExpressionError, match="argument"):
+        parse("W0(1, 2)", names)
+    with pytest.raises(ExpressionError, match="unknown function"):
+        parse("W0(1)", {})
