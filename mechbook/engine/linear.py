@@ -168,12 +168,17 @@ class LinearSystem:
     def _mp_matrices(self, values: dict, dps: int = 50):
         import mpmath
 
-        def conv(A):
-            with mpmath.workdps(dps):
-                return mpmath.matrix([[mpmath.re(_entry(x, values, dps, exact=True))
-                                       for x in row] for row in A.tolist()])
+        with mpmath.workdps(dps):
+            return tuple(mpmath.matrix([[mpmath.re(x) for x in row] for row in
+                                        mp_matrix(X, values, dps).tolist()])
+                         for X in (self.M, self.C, self.K))
 
-        return conv(self.M), conv(self.C), conv(self.K)
+    def mp_state_matrix(self, values: dict, dps: int = 50):
+        """The first-order (state-space) matrix at `values`, in mpmath at `dps` digits."""
+        import mpmath
+
+        with mpmath.workdps(dps):
+            return state_matrix(*(mp_matrix(X, values, dps) for X in (self.M, self.C, self.K)))
 
     def _precise_squared(self, values: dict, dps: int = 50) -> np.ndarray:
         """ω² by Cholesky reduction and a symmetric eigensolver in mpmath."""
@@ -193,16 +198,7 @@ class LinearSystem:
         import mpmath
 
         with mpmath.workdps(dps):
-            M, C, K = self._mp_matrices(values, dps)
-            n = M.rows
-            Minv = mpmath.inverse(M)
-            A = mpmath.zeros(2 * n, 2 * n)
-            MK, MC = -Minv * K, -Minv * C
-            for i in range(n):
-                A[i, n + i] = 1
-                for j in range(n):
-                    A[n + i, j] = MK[i, j]
-                    A[n + i, n + j] = MC[i, j]
+            A = state_matrix(*self._mp_matrices(values, dps))
             lam = mpmath.eig(A, left=False, right=False)
             return np.array([complex(x) for x in lam])
 
@@ -265,6 +261,53 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     if np.any(live.real > 1e-8 * scale):
         return "unstable"
     return "stable"
+
+
+def mp_matrix(A: sp.Matrix, values: dict, dps: int):
+    """A at `values` as an mpmath matrix of `dps` digits: each entry by numeval's walk
+    (milliseconds even for Routh's large reduced matrices), SymPy's evalf where the walk
+    cannot go; UnsupportedError for an entry that gives no finite number."""
+    import mpmath
+
+    out = mpmath.matrix(A.rows, A.cols)
+    with mpmath.workdps(dps):
+        for i in range(A.rows):
+            for j in range(A.cols):
+                out[i, j] = _mp_entry(A[i, j], values, dps)
+    return out
+
+
+def _mp_entry(x: sp.Expr, values: dict, dps: int):
+    import mpmath
+
+    try:
+        v = evaluate_mp(x, values, dps)
+        if mpmath.isfinite(v):
+            return mpmath.mpf(v) if mpmath.im(v) == 0 else v
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+        pass
+    x = sp.N(sp.S(x).subs(values), dps)
+    if not x.is_number or x.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+        raise UnsupportedError(f"a matrix entry does not evaluate to a number ({x})")
+    re, im = x.as_real_imag()
+    real = mpmath.mpf(sp.Float(re, dps)._mpf_)
+    return real if im == 0 else mpmath.mpc(real, mpmath.mpf(sp.Float(im, dps)._mpf_))
+
+
+def state_matrix(M, C, K):
+    """[[0, 1], [−M⁻¹K, −M⁻¹C]] from mpmath M, C, K (at the working precision): ẋ = A x
+    for x = (q, q̇), whose eigenvalues are the exponents p of e^{pt}."""
+    import mpmath
+
+    n = M.rows
+    Minv = mpmath.inverse(M)
+    A = mpmath.zeros(2 * n, 2 * n)
+    MK, MC = -Minv * K, -Minv * C
+    for i in range(n):
+        A[i, n + i] = 1
+        for j in range(n):
+            A[n + i, j], A[n + i, n + j] = MK[i, j], MC[i, j]
+    return A
 
 
 def _entry(x: sp.Expr, values: dict, digits: int, exact: bool = False):

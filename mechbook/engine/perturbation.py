@@ -26,38 +26,15 @@ from dataclasses import dataclass
 import mpmath
 import sympy as sp
 
-from mechbook.core.numeval import NotNumeric, evaluate_mp
-from mechbook.engine.linear import LinearSystem
+from mechbook.engine.linear import LinearSystem, mp_matrix, state_matrix
 from mechbook.errors import UnsupportedError
 
 DPS = 50
 
 
 def _mp(A: sp.Matrix, values: dict):
-    """A at `values` as an mpmath matrix of DPS digits: each entry by numeval's memoized
-    walk (milliseconds even for Routh's large reduced matrices), SymPy's evalf where the
-    walk cannot go."""
-    out = mpmath.matrix(A.rows, A.cols)
-    with mpmath.workdps(DPS + 5):
-        for i in range(A.rows):
-            for j in range(A.cols):
-                out[i, j] = _mp_entry(A[i, j], values)
-    return out
-
-
-def _mp_entry(x: sp.Expr, values: dict):
-    try:
-        v = evaluate_mp(x, values, DPS + 5)
-        if mpmath.isfinite(v):
-            return mpmath.mpf(v) if mpmath.im(v) == 0 else v
-    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
-        pass
-    x = sp.N(sp.S(x).subs(values), DPS + 5)
-    if not x.is_number:
-        raise UnsupportedError(f"perturbation: a matrix entry does not evaluate ({x})")
-    re, im = x.as_real_imag()
-    real = mpmath.mpf(sp.Float(re, DPS + 5)._mpf_)
-    return real if im == 0 else mpmath.mpc(real, mpmath.mpf(sp.Float(im, DPS + 5)._mpf_))
+    """A at `values` as an mpmath matrix (DPS digits and five guard digits)."""
+    return mp_matrix(A, values, DPS + 5)
 
 
 def generalized_eigh(K, M) -> tuple[list, mpmath.matrix]:
@@ -86,15 +63,7 @@ def precise_squared_frequencies(lin: LinearSystem, values: dict) -> list:
 def precise_exponents(lin: LinearSystem, values: dict) -> list:
     """The 2n exponents p of e^{pt} (state-space eigenvalues) at DPS digits."""
     with mpmath.workdps(DPS):
-        M, C, K = (_mp(X, values) for X in (lin.M, lin.C, lin.K))
-        n = M.rows
-        Minv = mpmath.inverse(M)
-        A = mpmath.zeros(2 * n, 2 * n)
-        MK, MC = -Minv * K, -Minv * C
-        for i in range(n):
-            A[i, n + i] = 1
-            for j in range(n):
-                A[n + i, j], A[n + i, n + j] = MK[i, j], MC[i, j]
+        A = state_matrix(*(_mp(X, values) for X in (lin.M, lin.C, lin.K)))
         return list(mpmath.eig(A, left=False, right=False))
 
 

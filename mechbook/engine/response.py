@@ -39,28 +39,6 @@ def state_matrix(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
 
 
-def _mp_matrix(A: sp.Matrix, values: dict, dps: int):
-    rows = A.evalf(dps + 5, subs=values).tolist()
-    return mpmath.matrix([[mpmath.mpmathify(complex(x)) if not x.is_real else
-                           mpmath.mpf(sp.Float(x, dps + 5)._mpf_) for x in row] for row in rows])
-
-
-def mp_state_matrix(lin: LinearSystem, values: dict, dps: int = DPS):
-    """The state matrix in mpmath at `dps` digits."""
-    with mpmath.workdps(dps):
-        M, C, K = (_mp_matrix(X, values, dps) for X in (lin.M, lin.C, lin.K))
-        n = M.rows
-        Minv = mpmath.inverse(M)
-        A = mpmath.zeros(2 * n, 2 * n)
-        MK, MC = -Minv * K, -Minv * C
-        for i in range(n):
-            A[i, n + i] = 1
-            for j in range(n):
-                A[n + i, j] = MK[i, j]
-                A[n + i, n + j] = MC[i, j]
-        return A
-
-
 def eigenpairs(lin: LinearSystem, values: dict, precise: bool = False,
                dps: int = DPS) -> tuple[np.ndarray, np.ndarray]:
     """All 2n exponents p (complex, sorted by imaginary then real part) and the displacement
@@ -68,7 +46,7 @@ def eigenpairs(lin: LinearSystem, values: dict, precise: bool = False,
     n = len(lin.q)
     if precise:
         with mpmath.workdps(dps):
-            A = mp_state_matrix(lin, values, dps)
+            A = lin.mp_state_matrix(values, dps)
             lam, V = mpmath.eig(A)
             lam = np.array([complex(x) for x in lam])
             V = np.array([[complex(V[i, j]) for j in range(2 * n)] for i in range(2 * n)])
@@ -160,7 +138,7 @@ def jordan_size(lin: LinearSystem, values: dict, p: complex, dps: int = DPS) -> 
     the ranks of (A − pI)^j, a singular value below 10^(−dps/3) of the largest counting as
     zero, fall to 2n − (multiplicity) after as many steps as the largest block is long."""
     with mpmath.workdps(dps):
-        A = mp_state_matrix(lin, values, dps)
+        A = lin.mp_state_matrix(values, dps)
         lam = mpmath.eig(A, left=False, right=False)
         near = [x for x in lam if abs(x - p) <= mpmath.mpf(10) ** (-dps // 4) * max(1, abs(p))]
         if not near:
