@@ -26,6 +26,7 @@ from typing import Any
 import sympy as sp
 
 from mechbook.app.mathml import math
+from mechbook.core.compile import as_expr
 from mechbook.engine.analysis import Analysis
 from mechbook.model.books import Book, book_of
 from mechbook.model.catalog import problem_path, root
@@ -128,8 +129,7 @@ class SystemView:
                                f"({', '.join(sys.coord_names)})")
             if isinstance(val, str):
                 val = self.problem.model.parse(val, (), dict(sys.names))
-            out[sys.q[sys.coord_names.index(key)]] = sp.sympify(val) \
-                if isinstance(val, (int, float)) else val
+            out[sys.q[sys.coord_names.index(key)]] = as_expr(val)
         return out
 
     def linear(self, about: dict | None = None):

@@ -13,6 +13,8 @@ from collections.abc import Iterable
 import sympy as sp
 from sympy.printing.mathml import MathMLPresentationPrinter
 
+from mechbook.core.compile import as_expr
+
 NS = "http://www.w3.org/1998/Math/MathML"
 _MARKS = (("ddot", "\u00a8"), ("dot", "\u02d9"))
 
@@ -49,7 +51,7 @@ def inner(expr) -> str:
     if isinstance(expr, bool):
         expr = sp.true if expr else sp.false
     if isinstance(expr, (int, float)):
-        expr = sp.sympify(expr)  # a Python number, never text
+        expr = as_expr(expr)  # a Python number, never text
     return _Printer({"mat_delim": "["}).doprint(expr)
 
 

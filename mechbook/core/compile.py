@@ -20,6 +20,7 @@ refuses anything else).
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -38,10 +39,12 @@ def as_expr(e) -> sp.Basic:
     above all) is refused; nothing here is ever parsed."""
     if isinstance(e, sp.Basic):
         return e
-    if isinstance(e, int) and not isinstance(e, bool):
-        return sp.Integer(e)
-    if isinstance(e, float):
-        return sp.Float(e)
+    if isinstance(e, numbers.Integral) and not isinstance(e, bool):  # NumPy's too
+        return sp.Integer(int(e))
+    if isinstance(e, numbers.Real):
+        return sp.Float(float(e))
+    if isinstance(e, numbers.Complex):
+        return sp.Float(e.real) + sp.I * sp.Float(e.imag)
     raise TypeError(f"not an engine expression: {type(e).__name__}")
 
 
@@ -69,7 +72,7 @@ def _compile_symengine(args, exprs, backend: str) -> Compiled:
 
     # SymPy objects converted to SymEngine ones (as_expr has refused anything but those)
     se_args = [se.sympify(as_expr(a)) for a in args]
-    se_exprs = [se.sympify(e) for e in exprs]
+    se_exprs = [se.sympify(as_expr(e)) for e in exprs]
     if not exprs:
         return lambda x: np.zeros(0)
     fn = se.Lambdify(se_args, se_exprs, real=True, cse=True, backend=backend)
@@ -140,7 +143,7 @@ def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
                 import symengine as se
 
                 fn = se.Lambdify([se.sympify(as_expr(a)) for a in args],
-                                 [se.sympify(e) for e in exprs], real=True, cse=True,
+                                 [se.sympify(as_expr(e)) for e in exprs], real=True, cse=True,
                                  backend="llvm" if name == "llvm" else "lambda")
                 fn(np.full((2, len(args)), 0.3))  # translation errors now, not mid-run
 

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from mechbook.core.compile import as_expr
 from mechbook.core.numeval import holds
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.verify.compare import Sampler, Verdict, value_and_scale
@@ -160,8 +161,8 @@ def _evaluate(st: Statement, symbols, sampler: Sampler) -> Verdict:
     """The generic statement at random instances: exact rational points when it is a
     rational function with rational coefficients, else 30-digit points (each residual
     judged against the size of what cancelled in it)."""
-    exprs = [sp.sympify(e) for e in st.exprs]
-    extra = [sp.sympify(e) for _, e in st.nonzero]
+    exprs = [as_expr(e) for e in st.exprs]
+    extra = [as_expr(e) for _, e in st.nonzero]
     variables = sorted(set(symbols) | (set().union(*(e.free_symbols for e in exprs + extra))
                                        - set(sampler.base)), key=str)
     exact = all(_rational(e) for e in exprs + extra)
@@ -197,8 +198,8 @@ def _per_instance(names_at: Names, build: Build, symbols, sampler: Sampler) -> V
             break
         point = rational_point(sampler, symbols)
         st = build(names_at(point))
-        numbers = [sp.sympify(e).xreplace(point) for e in st.exprs]
-        tests = [sp.sympify(e).xreplace(point) for _, e in st.nonzero]
+        numbers = [as_expr(e).xreplace(point) for e in st.exprs]
+        tests = [as_expr(e).xreplace(point) for _, e in st.nonzero]
         if not all(v.is_Rational for v in numbers + tests):
             exact = False
             numbers = [value_and_scale(v, {}) for v in numbers]
@@ -267,7 +268,7 @@ def _proved(st: Statement, sampler: Sampler) -> bool:
     """A symbolic proof for the generic objects, within the time allowed: `cancel` when the
     statement is rational, `expand`/`radsimp` for numbers, `simplify` only with --prove."""
     policy = sampler.policy
-    exprs = [sp.sympify(e) for e in st.exprs]
+    exprs = [as_expr(e) for e in st.exprs]
     try:
         with time_limit(policy.seconds if policy.prove else CANCEL_SECONDS):
             if all(e == 0 for e in exprs):

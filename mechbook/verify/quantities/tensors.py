@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechbook.core.compile import as_expr
 from mechbook.errors import ExpressionError
 from mechbook.model.tensorexpr import kind, parse_tensor, parse_tensor_equation
 from mechbook.verify.compare import Verdict
@@ -222,7 +223,7 @@ def _estimate_components(ctx: Context, val) -> Verdict:
     rtol = ctx.sampler.rtol
     values = []
     for label, b, e in pairs:
-        b, e = (complex(sp.N(sp.sympify(x).xreplace(point), 30)) for x in (b, e))
+        b, e = (complex(sp.N(as_expr(x).xreplace(point), 30)) for x in (b, e))
         values.append((label, b, e))
     scale = max(max(abs(b), abs(e)) for _, b, e in values)
     method = f"estimate(rtol {rtol:g})"
