@@ -153,6 +153,18 @@ class Context:
             return val
         raise self.part.error(sub, "expected a mapping")
 
+    def mode_shape(self, shape, sub) -> sp.Matrix:
+        """A mode shape over the linear system's coordinates (a steady motion reduced by
+        Routh has lost its cyclic ones); a coordinate left out is 0."""
+        shape = self.as_map(shape, sub)
+        names = self.linear().dyn.sys.coord_names
+        unknown = set(shape) - set(names)
+        if unknown:
+            raise self.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the "
+                                  "linear system")
+        return sp.Matrix([self.parse(shape[c], sub + (c,)) if c in shape else 0
+                          for c in names])
+
 
 def _merge_declared(names: dict, extra: dict, part: Part) -> None:
     """The problem's vectors and tensors beside a system's names (parameters are shared)."""

@@ -185,7 +185,7 @@ def check_normal_modes(ctx: Context, val) -> Verdict:
         for i, mode in enumerate(modes):
             mode = ctx.as_map(mode, ("book", i))
             freq = ctx.parse(mode["frequency"], ("book", i, "frequency"))
-            shape = _shape(ctx, mode.get("shape"), ("book", i, "shape"))
+            shape = ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))
             if abs(numbers([freq], pt)[0]) not in _near(lin.numeric_frequencies(pt),
                                                          numbers([freq], pt)[0]):
                 return Verdict(False, "numeric", f"mode {i}: frequency not an engine frequency")
@@ -203,7 +203,7 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
     for i, mode in enumerate(modes):
         mode = ctx.as_map(mode, ("book", i))
         parsed.append((ctx.parse(mode["frequency"], ("book", i, "frequency")),
-                       _shape(ctx, mode.get("shape"), ("book", i, "shape"))))
+                       ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))))
 
     def error(pt) -> float:
         w2, modes = perturbation.precise_modes(lin, pt)
@@ -235,18 +235,6 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
 
 def _near(values, x, rtol=1e-8):
     return [x] if any(abs(v - x) <= rtol * max(1, abs(x)) for v in values) else []
-
-
-def _shape(ctx: Context, shape, sub) -> sp.Matrix:
-    """A mode shape over the linear system's coordinates (a steady motion reduced by Routh
-    has lost its cyclic ones)."""
-    shape = ctx.as_map(shape, sub)
-    names = ctx.linear().dyn.sys.coord_names
-    unknown = set(shape) - set(names)
-    if unknown:
-        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the linear "
-                             "system")
-    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0 for c in names])
 
 
 @quantity('normal_coordinates',

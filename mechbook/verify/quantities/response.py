@@ -150,16 +150,7 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
           keys={"partial": {"type": "boolean"}},
           complex_values=True)
 def check_exponents(ctx: Context, val) -> Verdict:
-    book = _book_list(ctx, val)
-    lin = ctx.linear()
-    partial = bool(ctx.part.data.get("partial"))
-    for k in range(POINTS):
-        pt = ctx.sampler.draw()
-        ok, why = match_complex(complex_numbers(book, pt), list(response.exponents(lin, pt)),
-                                partial)
-        if not ok:
-            return Verdict(False, f"numeric({k + 1} points)", why)
-    return Verdict(True, f"numeric({POINTS} points, state-space eigenvalues)")
+    return _multiset_at_points(ctx, val, lambda lin, pt: list(response.exponents(lin, pt)))
 
 
 @quantity('decay_rates',
@@ -169,28 +160,22 @@ def check_exponents(ctx: Context, val) -> Verdict:
                'for a subset'),
           keys={"partial": {"type": "boolean"}})
 def check_decay_rates(ctx: Context, val) -> Verdict:
+    return _multiset_at_points(
+        ctx, val, lambda lin, pt: [complex(x) for x in response.decay_rates(lin, pt)])
+
+
+def _multiset_at_points(ctx: Context, val, engine) -> Verdict:
+    """The book's list against engine(lin, point) as a multiset of complex numbers (a
+    subset with `partial: true`) at POINTS random points."""
     book = _book_list(ctx, val)
     lin = ctx.linear()
     partial = bool(ctx.part.data.get("partial"))
     for k in range(POINTS):
         pt = ctx.sampler.draw()
-        ok, why = match_complex(complex_numbers(book, pt),
-                                [complex(x) for x in response.decay_rates(lin, pt)], partial)
+        ok, why = match_complex(complex_numbers(book, pt), engine(lin, pt), partial)
         if not ok:
             return Verdict(False, f"numeric({k + 1} points)", why)
     return Verdict(True, f"numeric({POINTS} points, state-space eigenvalues)")
-
-
-def _shape(ctx: Context, shape, sub) -> sp.Matrix:
-    """A mode shape over the linear system's coordinates (a steady motion reduced by Routh
-    has lost its cyclic ones)."""
-    shape = ctx.as_map(shape, sub)
-    names = ctx.linear().dyn.sys.coord_names
-    unknown = set(shape) - set(names)
-    if unknown:
-        raise ctx.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the linear "
-                             "system")
-    return sp.Matrix([ctx.parse(shape[c], sub + (c,)) if c in shape else 0 for c in names])
 
 
 def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
@@ -213,7 +198,7 @@ def check_complex_modes(ctx: Context, val) -> Verdict:
     for i, mode in enumerate(ctx.as_list(val, ("book",))):
         mode = ctx.as_map(mode, ("book", i))
         modes.append((ctx.parse(mode["exponent"], ("book", i, "exponent")),
-                      _shape(ctx, mode.get("shape"), ("book", i, "shape"))))
+                      ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))))
     for k in range(POINTS):
         pt = ctx.sampler.draw()
         M, C, K = lin.matrices(pt)
