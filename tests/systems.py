@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
+from mechbook.engine.analysis import Analysis
+from mechbook.model.problem import load_problem
+
 
 def pendulum(m: float, l: float, g: float | None = None, header: str = "") -> str:  # noqa: E741
     """A plane simple pendulum (bob on a massless rod from a fixed pivot), theta from the
@@ -19,3 +25,13 @@ particles:
   bob: {{mass: m, position: [l*sin(theta), -l*cos(theta)]}}
 gravity: {{}}
 """
+
+
+def load_analysis(tmp_path: Path, text: str, num: str) -> Analysis:
+    """The analysis of `text` written as problem lim-<num> in a tree under tmp_path (its
+    `id:` line rewritten to match the file's name)."""
+    text = re.sub(r"^id: .*$", f"id: lim-{num}", text, count=1, flags=re.M)
+    d = tmp_path / "problems" / "lim"
+    d.mkdir(parents=True, exist_ok=True)
+    (d / f"{num}.yaml").write_text(text)
+    return Analysis(load_problem(d / f"{num}.yaml"))

@@ -4,17 +4,16 @@ two-mode system, `limit:` orders measured at 50 digits, and the parser's Operato
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import pytest
 import sympy as sp
+from systems import load_analysis as load
 
 from mechbook.engine import perturbation as pert
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import Operator, parse
-from mechbook.model.problem import load_problem
 from mechbook.verify.answers import load_answers
 from mechbook.verify.checker import check_problem
 
@@ -36,14 +35,6 @@ particles:
   p2: {mass: 1, position: [x2]}
 potential: (x1**2 + 4*x2**2)/2 + eps*(a*x1**2/2 + c*x1*x2 + d*x2**2/2)
 """
-
-
-def load(tmp_path: Path, text: str, num: str) -> Analysis:
-    text = re.sub(r"^id: .*$", f"id: lim-{num}", text, count=1, flags=re.M)
-    d = tmp_path / "problems" / "lim"
-    d.mkdir(parents=True, exist_ok=True)
-    (d / f"{num}.yaml").write_text(text)
-    return Analysis(load_problem(d / f"{num}.yaml"))
 
 
 def run(tmp_path: Path, an: Analysis, part: dict):

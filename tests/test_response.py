@@ -6,19 +6,18 @@ amplitudes from simulations. Every check must also fail a wrong value."""
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 import sympy as sp
+from systems import load_analysis as load
 
 from mechbook.crosscheck.frequencies import frequency_crosscheck
 from mechbook.crosscheck.response import response_crosscheck
 from mechbook.engine import response
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
-from mechbook.model.problem import load_problem
 from mechbook.verify.answers import load_answers
 from mechbook.verify.checker import check_problem
 
@@ -62,14 +61,6 @@ potential: (k*x1**2 + c*(x2 - x1)**2 + k*x2**2)/2
 dissipation: BDISS
 forces: {x2: F0*cos(w*t)}
 """
-
-
-def load(tmp_path: Path, text: str, num: str) -> Analysis:
-    text = re.sub(r"^id: .*$", f"id: lim-{num}", text, count=1, flags=re.M)
-    d = tmp_path / "problems" / "lim"
-    d.mkdir(parents=True, exist_ok=True)
-    (d / f"{num}.yaml").write_text(text)
-    return Analysis(load_problem(d / f"{num}.yaml"))
 
 
 def check(tmp_path: Path, an: Analysis, parts: list[dict]) -> list:

@@ -6,14 +6,13 @@ check also shown to fail a wrong value."""
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import sympy as sp
+from systems import load_analysis as load
 
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import SpecError
-from mechbook.model.problem import load_problem
 from mechbook.verify.answers import load_answers
 from mechbook.verify.checker import check_problem
 
@@ -61,14 +60,6 @@ particles:
   p: {mass: m, position: [x]}
 potential: F(x)
 """
-
-
-def load(tmp_path: Path, text: str, num: str) -> Analysis:
-    text = re.sub(r"^id: .*$", f"id: lim-{num}", text, count=1, flags=re.M)
-    d = tmp_path / "problems" / "lim"
-    d.mkdir(parents=True, exist_ok=True)
-    (d / f"{num}.yaml").write_text(text)
-    return Analysis(load_problem(d / f"{num}.yaml"))
 
 
 def status(tmp_path: Path, an: Analysis, part: dict, symbols: dict | None = None) -> str:

@@ -4,16 +4,13 @@ docs/schema.md and the problem's notes)."""
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
-
 import numpy as np
 import pytest
 import sympy as sp
+from systems import load_analysis as load
 
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import SpecError
-from mechbook.model.problem import load_problem
 
 
 def string(n: int, density: str) -> str:
@@ -36,14 +33,6 @@ string:
   density: {density}
   amplitudes: [{amps}]
 """
-
-
-def load(tmp_path: Path, text: str, num: str) -> Analysis:
-    text = re.sub(r"^id: .*$", f"id: lim-{num}", text, count=1, flags=re.M)
-    d = tmp_path / "problems" / "lim"
-    d.mkdir(parents=True, exist_ok=True)
-    (d / f"{num}.yaml").write_text(text)
-    return Analysis(load_problem(d / f"{num}.yaml"))
 
 
 def frequencies(an: Analysis) -> np.ndarray:
