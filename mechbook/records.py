@@ -46,6 +46,7 @@ class Outcome:
     detail: str = ""
     seconds: float = 0.0
     origin: str = "book"  # 'derived': no printed answer; the value is an independent derivation
+    power: str = ""  # what the pass is worth: the smallest wrong answer it rejects, in words
 
     def as_dict(self) -> dict:
         return asdict(self)

@@ -68,6 +68,8 @@ def print_table(runs: list, verbose: bool) -> None:
             info = o.method
             if o.status in ("fail", "error", "unsupported", "erratum") or verbose:
                 info = f"{o.method} {o.detail}".strip()
+            if verbose and o.power:
+                info = f"[{o.power}] {info}"
             label = o.part if o.origin == "book" else f"{o.part} (derived)"
             cell = ",".join(x.cell() for x in by_part.get(o.part, [])) or "-"
             click.echo(f"{run.pid:<16} {label:<16} {o.quantity:<20} {o.status:<12} {cell:<12} "

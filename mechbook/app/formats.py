@@ -58,7 +58,7 @@ def to_json(runs: list, root: Path, store: Path | None) -> dict:
             parts[o.status] += 1
             rows.append({"part": o.part, "quantity": o.quantity, "cite": o.cite,
                          "origin": o.origin, "status": o.status, "method": o.method,
-                         "detail": o.detail, "seconds": float(o.seconds),
+                         "detail": o.detail, "power": o.power, "seconds": float(o.seconds),
                          "crosschecks": vouch.get(o.part, [])})
         problems.append({
             "id": run.pid, "book": run.pid.split("-", 1)[0], "error": run.error,
@@ -96,6 +96,9 @@ def junit_xml(runs: list) -> ET.ElementTree:
                                  name=f"{o.part} [{o.quantity}]", time=f"{o.seconds:.3f}")
             counts["tests"] += 1
             text = f"{o.cite}\n{o.method} {o.detail}".strip()
+            if o.power:
+                ET.SubElement(case, "properties").append(
+                    ET.Element("property", name="power", value=o.power))
             if o.status == "fail":
                 ET.SubElement(case, "failure", message=o.detail[:500] or "fail").text = text
                 counts["failures"] += 1

@@ -174,7 +174,7 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
         c = checks.create_group(o.part)
         c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
                         "cite": o.cite, "status": o.status, "method": o.method,
-                        "detail": o.detail, "seconds": float(o.seconds)})
+                        "detail": o.detail, "seconds": float(o.seconds), "power": o.power})
     if rec.crosschecks:
         cross = g.create_group("crosschecks", track_order=True)
         for i, x in enumerate(rec.crosschecks):
@@ -347,7 +347,7 @@ def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
 
 
 def _outcomes(pid: str, g: h5py.Group) -> list[Outcome]:
-    fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin")
+    fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin", "power")
     rows = []
     for part, c in g.get("checks", {}).items():
         a = {k: _plain(v) for k, v in c.attrs.items()}

@@ -230,6 +230,16 @@ class LinearSystem:
         """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
         return classify_matrices(*self.fast_matrices(values))
 
+    def precise_stability(self, values: dict, dps: int = 40) -> str:
+        """'stable', 'unstable' or 'marginal' with M, C, K and the eigenvalues in mpmath at
+        `dps` digits: for a point close to a stability boundary, where an exponent or ω² is
+        a relative 1e-8 from zero and double precision's thresholds cannot tell."""
+        import mpmath
+
+        with mpmath.workdps(dps):
+            M, C, K = self._mp_matrices(values, dps)
+            return classify_mp(M, C, K, dps)
+
     @cached_property
     def stability_condition(self) -> sp.Basic:
         """Sufficient and (without gyroscopic terms) necessary condition: K positive definite."""
@@ -261,6 +271,29 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     if np.any(live.real > 1e-8 * scale):
         return "unstable"
     return "stable"
+
+
+def classify_mp(M, C, K, dps: int) -> str:
+    """`classify_matrices` in mpmath at `dps` digits (call inside that precision): ω² (or
+    an exponent's real part) counts as zero below 10^(12 - dps) of the largest; an exponent
+    within 10^(-dps/4) of zero (a symmetry's zero cluster, split by rounding) is neutral."""
+    import mpmath
+
+    n = M.rows
+    tiny = mpmath.mpf(10) ** (12 - dps)
+    if all(C[i, j] == 0 for i in range(n) for j in range(n)):
+        L = mpmath.cholesky(M)
+        Linv = mpmath.inverse(L)
+        A = Linv * K * Linv.T
+        w2 = mpmath.eigsy((A + A.T) / 2, eigvals_only=True)
+        scale = max([abs(x) for x in w2] + [mpmath.mpf(1)])
+        if any(x < -tiny * scale for x in w2):
+            return "unstable"
+        return "marginal" if any(abs(x) <= tiny * scale for x in w2) else "stable"
+    lam = mpmath.eig(state_matrix(M, C, K), left=False, right=False)
+    scale = max([abs(x) for x in lam] + [mpmath.mpf(1)])
+    live = [x for x in lam if abs(x) > mpmath.mpf(10) ** (-dps / 4) * scale]
+    return "unstable" if any(mpmath.re(x) > tiny * scale for x in live) else "stable"
 
 
 def mp_matrix(A: sp.Matrix, values: dict, dps: int):

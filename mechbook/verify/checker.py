@@ -41,9 +41,12 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) ->
             else:
                 out.status, out.method = "erratum", corrected.method
                 out.detail = f"book value fails ({verdict.detail}); corrected value passes"
+                out.power = _power(part, corrected)
         else:
             out.status = "pass" if verdict.ok else "fail"
             out.method, out.detail = verdict.method, verdict.detail
+            if verdict.ok:
+                out.power = _power(part, verdict)
     except UnsupportedError as exc:
         out.status, out.detail = "unsupported", exc.capability
     except NotEquilibriumError as exc:  # the answer's point or steady rate is wrong
@@ -58,6 +61,15 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) ->
     finally:
         out.seconds = time.perf_counter() - start
     return out
+
+
+def _power(part: Part, verdict) -> str:
+    """The pass's power in words: the verdict's own statement (or its method), and that a
+    `partial:` answer leaves the rest of the engine's values unchecked."""
+    power = verdict.power or verdict.method
+    if part.data.get("partial") and "partial" not in power:
+        power += "; partial: the book lists a subset, the rest is unchecked"
+    return power
 
 
 def check_problem(analysis: Analysis, key: AnswerKey,

@@ -32,6 +32,9 @@ class Verdict:
     ok: bool
     method: str  # 'symbolic' or 'numeric(N points, rtol)'
     detail: str = ""
+    # what a pass is worth: the smallest wrong answer it would have rejected, in words
+    # ("6 points at 30 digits, residual ≤ 1e-20 of its scale"); '' where the method says it
+    power: str = ""
 
 
 class Sampler:
@@ -181,9 +184,10 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
-        return Verdict(True, "symbolic")
+        return Verdict(True, "symbolic", power="proved symbolically")
     return Verdict(True, f"numeric({valid} points, rtol {rtol:g})",
-                   f"worst relative {worst:.2g}")
+                   f"worst relative {worst:.2g}",
+                   power=f"{valid} points at {DIGITS} digits, residual ≤ {rtol:g} of its scale")
 
 
 def _residual_rtol(expr: sp.Basic, sampler: Sampler) -> float:
@@ -210,7 +214,8 @@ def all_vanish(exprs: Sequence[sp.Basic], sampler: Sampler,
         if not v.ok:
             return v
     if _prove(sampler, symbolic):
-        verdicts = [Verdict(True, "symbolic") if _symbolic_zero(e, sampler.policy.seconds)
+        verdicts = [Verdict(True, "symbolic", power="proved symbolically")
+                    if _symbolic_zero(e, sampler.policy.seconds)
                     else v
                     for e, v in zip(exprs, verdicts, strict=True)]
     return combine(verdicts)
@@ -224,7 +229,9 @@ def combine(verdicts: Sequence[Verdict]) -> Verdict:
     methods = {v.method.split("(")[0] for v in verdicts}
     method = "symbolic" if methods == {"symbolic"} else ("numeric" if "numeric" in methods else
                                                           ",".join(sorted(methods)))
-    return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail))
+    powers = list(dict.fromkeys(v.power for v in verdicts if v.power))  # once each, in order
+    return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail),
+                   power="; ".join(powers))
 
 
 def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
@@ -248,9 +255,11 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(a - b, sampler.policy.seconds):
-        return Verdict(True, "symbolic")
+        return Verdict(True, "symbolic", power="proved symbolically")
     return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
-                   f"worst relative {worst:.2g}")
+                   f"worst relative {worst:.2g}",
+                   power=(f"within the stated {sampler.rtol:.2g}" if sampler.rtol > RTOL else
+                          f"{valid} points at {DIGITS} digits, within {sampler.rtol:g}"))
 
 
 def _num(z: complex) -> str:

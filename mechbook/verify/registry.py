@@ -52,6 +52,10 @@ class Quantity:
     literals: tuple = ()  # words a `book:` value may be instead of an expression
     needs_system: bool = True  # False: tensors and bodies, checked without a system
     complex_values: bool = False  # its expressions may hold complex constants (sqrt(-1))
+    # changes of one value the check does not see by definition (mechbook.verify.power):
+    # "shift" (a constant added), "scale" (a factor), "function" (a conserved quantity's
+    # function), "direction" (a mode shape's length); stated in docs/answers.md
+    equivalent: tuple | Callable = ()
 
 
 QUANTITIES: dict[str, Quantity] = {}
@@ -59,7 +63,7 @@ QUANTITIES: dict[str, Quantity] = {}
 
 def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
              names: Callable | None = None, literals: tuple = (), needs_system: bool = True,
-             complex_values: bool = False):
+             complex_values: bool = False, equivalent: tuple | Callable = ()):
     """Register the decorated function as the check of quantity `name` (`names`: a function
     of the part's context giving the names its book value may use beyond the usual ones,
     e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`: words
@@ -71,7 +75,8 @@ def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
         QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names,
-                                    tuple(literals), needs_system, complex_values)
+                                    tuple(literals), needs_system, complex_values,
+                                    equivalent if callable(equivalent) else tuple(equivalent))
         return fn
 
     return register

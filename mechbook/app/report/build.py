@@ -138,6 +138,7 @@ def _index_entry(pid: str, page: dict, stored: dict | None, declared: dict) -> d
                      "quantity": c.get("quantity", ""), "origin": c.get("origin", "book"),
                      "status": c.get("status", ""), "cite": c.get("cite", ""),
                      "method": c.get("method", ""), "detail": c.get("detail", ""),
+                     "power": c.get("power", ""),
                      "cross": ", ".join(sorted({x.get("status", "") for x in xs}))})
     if not checks:
         for part in page.get("parts") or [{"part": "-", "quantity": "", "cite": ""}]:

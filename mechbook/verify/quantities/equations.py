@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechbook.model.expr import _split_single_equals
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, linear_accelerations, strip_const
 from mechbook.verify.registry import quantity
@@ -14,7 +15,8 @@ from mechbook.verify.registry import quantity
           book='expression',
           how=("the difference from the engine's L has identically vanishing Lagrange "
                'expressions (equal up to a total time derivative). With `about`, against'
-               " the engine's L expanded to second order"))
+               " the engine's L expanded to second order"),
+          equivalent=("gauge",))
 def check_lagrangian(ctx: Context, val) -> Verdict:
     """Equal up to a total time derivative: the difference has vanishing Lagrange expressions.
     With `about:`, the engine's Lagrangian is first expanded to second order there."""
@@ -52,21 +54,97 @@ def check_eom(ctx: Context, val) -> Verdict:
     return all_vanish(out, ctx.sampler)
 
 
+ENERGY_NAMES = ("energy", "jacobi", "E", "h")  # the energy function (Jacobi's integral)
+
+
 @quantity('conserved',
-          book='expression or list (`= const` allowed)',
-          how='its time derivative vanishes along the motion')
+          book=('expression or list (`= const` allowed); or `name = expression` where the '
+                'book names the quantity: a momentum `p_<q>` (or a sum of them), the energy '
+                'function `E`, `h`, `energy` or `jacobi` (Jacobi\'s integral), or a name '
+                'the problem defines from the motion (a body\'s `rates:`)'),
+          how=('its time derivative vanishes along the motion. A named quantity must also '
+               'equal the engine\'s own (a momentum or a defined name exactly, the energy '
+               'function up to an additive constant), so a constant factor fails; a bare '
+               '"this is conserved" is a claim any function of it satisfies too (so its '
+               'multiples pass), and the verdict says so'),
+          equivalent=("function",))
 def check_conserved(ctx: Context, val) -> Verdict:
-    """d/dt of each book expression vanishes along the motion ('= const' may be written)."""
+    """d/dt of each book expression vanishes along the motion ('= const' may be written);
+    a named one (`p_psi = ...`) is also compared with the engine's quantity of that name."""
     vals = val if isinstance(val, list) else [val]
     out = []
+    named = []
     if "about" in ctx.part.data:
         acc = linear_accelerations(ctx.linear())
     else:
         acc = dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True))
     for i, v in enumerate(vals):
         sub = ("book", i) if isinstance(val, list) else ("book",)
-        e = ctx.parse(strip_const(v), sub)
+        text = strip_const(v)
+        pieces = _split_single_equals(text) if isinstance(text, str) else [text]
+        if len(pieces) == 2:
+            engine, up_to_constant, what = _named(ctx, pieces[0], sub)
+            e = ctx.parse(pieces[1], sub)
+            diff = e - engine
+            if up_to_constant:  # the energy: V (so h) is defined up to a constant
+                motion = list(ctx.system.q) + list(ctx.system.qd) + [ctx.system.t]
+                checks = [sp.diff(diff, x) for x in motion if diff.has(x)]
+            else:
+                checks = [diff]
+            same = all_vanish(checks, ctx.sampler) if checks else None
+            if same is not None and not same.ok:
+                return Verdict(False, same.method, f"{pieces[0].strip()} is {what}: the book's "
+                               f"expression differs from the engine's ({same.detail})")
+            named.append(f"{pieces[0].strip()} ({what})")
+        else:
+            e = ctx.parse(text, sub)
         if not (e.free_symbols & set(ctx.dyn.q + ctx.dyn.qd)):
             raise ctx.part.error(sub, "a conserved quantity must depend on the motion")
         out.append(ctx.system.dt(e).subs(acc))
-    return all_vanish(out, ctx.sampler)
+    verdict = all_vanish(out, ctx.sampler)
+    if verdict.ok:
+        bare = len(vals) - len(named)
+        notes = [f"identified: {'; '.join(named)}"] if named else []
+        if bare:
+            notes.append(f"{bare} bare first integral{'s' if bare > 1 else ''}: any function "
+                         "of one (a multiple, say) is conserved too and passes")
+        verdict.detail = "; ".join(notes + ([verdict.detail] if verdict.detail else []))
+    return verdict
+
+
+def _named(ctx: Context, text: str, sub: tuple) -> tuple[sp.Expr, bool, str]:
+    """The engine's value of a named quantity (the left side of `name = expression`): an
+    expression in momenta p_<q>, the energy function or names the problem derives from the
+    motion; (value, up to a constant?, what it is)."""
+    name = text.strip()
+    sys, dyn = ctx.system, ctx.dyn
+    if name in ENERGY_NAMES and name not in ctx.names:
+        return dyn.energy_function, True, "the energy function, up to a constant"
+    momenta = {sp.Symbol("p_" + q.name, real=True): p
+               for q, p in zip(sys.q, dyn.momenta, strict=True)}
+    lhs = ctx.parse(name, sub)
+    derived = {k for k, v in sys.names.items()
+               if not isinstance(v, sp.Symbol) and k not in ctx.part.key.symbols}
+    used = [k for k in _identifiers(name) if k in derived]
+    if not (lhs.free_symbols & set(momenta)) and not used:
+        known = ", ".join(["p_<coordinate>", *ENERGY_NAMES, *sorted(derived)])
+        raise ctx.part.error(sub, f"{name!r} names no quantity the engine computes; the "
+                             f"left side may use {known}")
+    motion = set(sys.q) | set(sys.qd)
+    if not used and lhs.free_symbols & motion:
+        raise ctx.part.error(sub, "the left side names the quantity (momenta, the energy, "
+                             "defined names); the coordinates belong on the right")
+    used_p = lhs.free_symbols & set(momenta)
+    what = ("as the problem defines it from the motion" if not used_p else
+            "the engine's momentum" if len(used_p) == 1 else "the engine's momenta")
+    return lhs.xreplace(momenta), False, what
+
+
+def _identifiers(text: str) -> list[str]:
+    import ast
+
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError:
+        return []
+    return [n.id for n in ast.walk(tree) if isinstance(n, ast.Name)]

@@ -15,6 +15,12 @@ OF = ["potential", "kinetic", "quadratic_potential", "quadratic_kinetic", "energ
       "hamiltonian", "momenta"]
 
 
+def _potential_shift(data: dict) -> tuple:
+    """A potential (not at a state) is compared up to an additive constant."""
+    plain = data.get("of") in ("potential", "quadratic_potential")
+    return ("shift",) if plain and "at" not in data and "steady" not in data else ()
+
+
 @quantity('expression',
           book='expression, with `of:`',
           how=('`potential`, `quadratic_potential` (up to a constant), `kinetic`, '
@@ -24,7 +30,8 @@ OF = ["potential", "kinetic", "quadratic_potential", "quadratic_kinetic", "energ
                'value *at that state* is compared, constant included. A Hamiltonian is '
                'checked as the Legendre transform without inverting p(q̇): H(q, ∂L/∂q̇) '
                '= h(q, q̇) and ∂H/∂p = q̇'),
-          keys={"of": {"enum": OF}, "at": POINT})
+          keys={"of": {"enum": OF}, "at": POINT},
+          equivalent=_potential_shift)
 def check_expression(ctx: Context, val) -> Verdict:
     """An engine quantity named by `of:`; potentials compare up to an additive constant.
     At a state (`at:` coordinates and velocities, or a steady motion named by `steady:` and

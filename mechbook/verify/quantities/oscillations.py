@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine import perturbation
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
@@ -43,8 +44,68 @@ def check_frequencies(ctx: Context, val) -> Verdict:
         n += 1
         if not ok:
             return Verdict(False, f"numeric({n} points)", why)
-    return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or
-                   f"numeric({n} points, eigensolver)")
+    precise = _precise_frequencies(ctx, book, lin, partial)
+    if precise and not precise.ok:
+        return precise
+    how = f"numeric({n} points, eigensolver" + (", 1 at 50 digits)" if precise else ")")
+    power = f"{n} points to 1e-8" + (f", 1 at 50 digits to {PRECISE_RTOL:g}" if precise else "")
+    if partial:
+        power += f"; partial: {len(book)} of {len(lin.q)} frequencies (the rest unchecked)"
+    return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or how,
+                   precise.detail if precise else "", power=power)
+
+
+PRECISE_RTOL = 1e-20  # book against engine frequencies, both at 50 digits
+
+
+def _precise_frequencies(ctx: Context, book, lin: LinearSystem, partial: bool):
+    """The double-precision pass resolves 1e-8; at one more point both sides are taken at
+    50 digits (mpmath eigenvalues) and must agree to 1e-20, so an answer wrong by less than
+    the eigensolver's rounding still fails. None where 50 digits mean nothing: numbers of
+    double precision in the equations (a numeric equilibrium) or in the book, or an
+    estimate."""
+    if ctx.sampler.rtol > 1e-10 or any(_has_doubles(x) for x in list(book) + list(lin.M)
+                                       + list(lin.K) + list(lin.C)):
+        return None
+    pt = ctx.sampler.draw()
+    try:
+        engine = [float("nan") if w != w else w for w in perturbation.precise_frequencies(lin, pt)]
+    except (UnsupportedError, ZeroDivisionError, ValueError):
+        return None
+    import mpmath
+
+    with mpmath.workdps(perturbation.DPS):
+        values = []
+        for b in book:
+            try:
+                v = evaluate_mp(b, pt, perturbation.DPS)
+            except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
+                return None
+            if abs(mpmath.im(v)) > PRECISE_RTOL * max(1, abs(v)):
+                return None  # not real here: the double-precision pass has judged that
+            values.append(mpmath.re(v))
+        free = [e for e in engine if mpmath.isfinite(e)]
+        worst = mpmath.mpf(0)
+        for v in sorted(values):
+            if not free:
+                return Verdict(False, "numeric(50 digits)", "more book values than engine "
+                               "frequencies")
+            j = min(range(len(free)), key=lambda i: abs(free[i] - v))
+            rel = abs(free[j] - v) / max(abs(v), mpmath.mpf(10) ** -30)
+            worst = max(worst, rel)
+            if rel > PRECISE_RTOL:
+                return Verdict(False, "numeric(50 digits)",
+                               f"book value {mpmath.nstr(v, 25)} differs from the engine's "
+                               f"{mpmath.nstr(free[j], 25)} by a relative {float(rel):.2g} at "
+                               f"50 digits (below double precision's reach)")
+            free.pop(j)
+        if free and not partial:
+            return Verdict(False, "numeric(50 digits)", "the engine has more frequencies")
+    return Verdict(True, "numeric(50 digits)", f"at 50 digits within {float(worst):.1g}")
+
+
+def _has_doubles(x) -> bool:
+    return isinstance(x, sp.Basic) and any(f._prec < 90 for f in x.atoms(sp.Float))
 
 
 def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
@@ -84,15 +145,19 @@ def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
 
 
 LIMIT_STEPS = tuple(10.0 ** (-1 - k / 2) for k in range(7))  # 1e-1 ... 1e-4, half decades
+MORE_STEPS = tuple(10.0 ** (-4.5 - k / 2) for k in range(12))  # on to 1e-10 while needed
+SMALL_ENOUGH = 1e-9  # an error this small ends the walk toward the limit
 
 
 def asymptotic(ctx: Context, error) -> Verdict:
     """`limit: {parameter, to, order}`: the book's formula holds in a limit of the
     parameters, to the stated order. The error `error(point)` (relative, from values exact
-    to 50 digits) is measured as the parameter goes to 0 or ∞ in half decades from 1e-1 to
-    1e-4 of its value; over the last three steps it must fall like the parameter to a power
-    of at least order + 0.5 (a formula right to order k errs like ε^(k+1); one wrong at
-    order k errs like ε^k), ending below 1e-3 — or vanish (below 1e-30) there: exact."""
+    to 50 digits) is measured as the parameter goes to 0 or ∞ in half decades from 1e-1 of
+    its value, to 1e-4 and on (to 1e-10 at most) until the error is below 1e-9; over the
+    last three steps it must fall like the parameter to a power of at least order + 0.5 (a
+    formula right to order k errs like ε^(k+1); one wrong at order k errs like ε^k), ending
+    below 1e-3 — or vanish (below 1e-30) there: exact. Walking on until the error is tiny
+    is what rejects a leading coefficient wrong by 1e-6: its error stops falling there."""
     spec = ctx.part.data["limit"]
     name = spec["parameter"]
     if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
@@ -102,11 +167,15 @@ def asymptotic(ctx: Context, error) -> Verdict:
     to_zero = str(spec["to"]) == "0"
     base = ctx.sampler.default()
     errors = []
-    for eps in LIMIT_STEPS:
+    steps = []
+    for eps in LIMIT_STEPS + MORE_STEPS:
+        if eps in MORE_STEPS and not (errors[-1] >= SMALL_ENOUGH):
+            break  # small enough (or not finite: judged below)
         pt = dict(base)
         pt[sym] = sp.Float(base[sym] * eps if to_zero else base[sym] / eps, 30)
         pt = ctx.sampler.complete(pt)
         errors.append(float(error(pt)) if pt is not None else float("nan"))
+        steps.append(eps)
     tail = errors[-3:]
     shown = ", ".join(f"{e:.2g}" for e in errors)
     if not all(np.isfinite(tail)):
@@ -114,19 +183,20 @@ def asymptotic(ctx: Context, error) -> Verdict:
                        "does not evaluate (or match) near the limit")
     if all(e < 1e-30 for e in tail):
         return Verdict(True, "numeric(asymptotic)", f"relative error {shown}: exact in the "
-                       "limit's last steps")
+                       "limit's last steps", power="exact (below 1e-30) toward the limit")
     if not all(np.isfinite(tail)) or min(tail) <= 0:
         return Verdict(False, "numeric(asymptotic)", f"relative error {shown}")
     logs = np.log10(tail)
-    steps = np.log10(LIMIT_STEPS[-3:])
-    slope = float(np.polyfit(steps, logs, 1)[0])
+    slope = float(np.polyfit(np.log10(steps[-3:]), logs, 1)[0])
     ok = tail[-1] < 1e-3 and slope >= order + 0.5
     detail = (f"relative error {shown} as {name} -> {spec['to']} by half decades from 1e-1: "
               f"it falls like {name}**{slope:.2f} (needs {order + 0.5:g} or more)"
               if to_zero else
               f"relative error {shown} as {name} -> oo by half decades from x10: it falls "
               f"like (1/{name})**{slope:.2f} (needs {order + 0.5:g} or more)")
-    return Verdict(ok, "numeric(asymptotic)", detail)
+    return Verdict(ok, "numeric(asymptotic)", detail,
+                   power=f"error falls like ε^{slope:.2f} toward the limit, to {tail[-1]:.1g} "
+                         f"(order {order} claimed)")
 
 
 @quantity('period',
@@ -172,7 +242,8 @@ def _eig_residual(K: np.ndarray, M: np.ndarray, w2: float, u: np.ndarray) -> flo
                'degenerate eigenspace passes; with `limit:`, each book mode must '
                'approach an engine mode (frequency and the angle between shapes) as the '
                'parameter goes to its limit'),
-          keys={"limit": LIMIT})
+          keys={"limit": LIMIT},
+          equivalent=("direction",))
 def check_normal_modes(ctx: Context, val) -> Verdict:
     """Each (frequency, shape) satisfies (K − ω²M)·u = 0: shape up to scale and sign, and any
     vector of a degenerate eigenspace is accepted."""
@@ -240,7 +311,8 @@ def _near(values, x, rtol=1e-8):
 @quantity('normal_coordinates',
           book='list of `{coordinate: linear form, frequency?}`',
           how=('c·q is a normal coordinate iff M⁻¹c is a mode (with velocity terms C, also '
-               'an eigenvector of M⁻¹C: then C does not couple it)'))
+               'an eigenvector of M⁻¹C: then C does not couple it)'),
+          equivalent=("scale", "shift"))
 def check_normal_coordinates(ctx: Context, val) -> Verdict:
     """A linear form c·q is a normal coordinate iff u = M⁻¹c is a mode: (K − ω²M)u = 0."""
     lin = ctx.linear()

@@ -191,7 +191,8 @@ def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
           how=('p is an exponent of the linearized system and (Mp² + Cp + K)u = 0 for the '
                "book's shape u (relative residual 1e-8; any vector of a degenerate "
                'eigenspace passes), at 5 points'),
-          complex_values=True)
+          complex_values=True,
+          equivalent=("direction",))
 def check_complex_modes(ctx: Context, val) -> Verdict:
     lin = ctx.linear()
     modes = []

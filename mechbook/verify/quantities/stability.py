@@ -44,7 +44,9 @@ def check_stability(ctx: Context, val) -> Verdict:
                 pt.items(), key=lambda kv: kv[0].name)[:8])
             return Verdict(False, f"numeric({n + 1} points)",
                            f"engine finds it {got} at {{{shown}}}")
-    return Verdict(True, f"numeric(60 points, all {val})")
+    return Verdict(True, f"numeric(60 points, all {val})",
+                   power=f"60 points drawn widely (factors to e²), all {val}: a claim of no "
+                         "boundary, checked away from one")
 
 
 def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:

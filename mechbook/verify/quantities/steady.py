@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from mechbook.core.numeval import holds
 from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
+from mechbook.verify import boundary
 from mechbook.verify.compare import Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
@@ -164,13 +164,15 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
 
 @quantity('steady_exists',
           book='relation (where a steady motion exists)',
-          how=('at ≥ 60 parameter points drawn widely (both outcomes must occur, ≥ 10 '
-               'each), the relation holds exactly where some real rate of the `unknown:` '
-               'coordinate makes the configuration `about:` (with the other cyclic rates '
-               'fixed by `hold:`) a steady motion: the conditions, polynomials in the rate, '
-               'have a common real root (a coefficient that cancels to 1e-20 of its terms '
-               'counts as zero; the roots are checked on every condition). The minimum spin '
-               'of a top, the region where circular orbits exist'),
+          how=('decided at its boundary like `stability_condition` (8 random rays, 40 '
+               'points each, every crossing of the relation found to 30 digits and judged '
+               'a relative 1e-8 on either side): the relation holds exactly where some real '
+               'rate of the `unknown:` coordinate makes the configuration `about:` (with the '
+               'other cyclic rates fixed by `hold:`) a steady motion: the conditions, '
+               'polynomials in the rate, have a common real root (a coefficient that cancels '
+               'to 1e-20 of its terms counts as zero; the roots are checked on every '
+               'condition). The minimum spin of a top, the region where circular orbits '
+               'exist'),
           keys=STEADY_KEYS)
 def check_steady_exists(ctx: Context, val) -> Verdict:
     fam = family(ctx)
@@ -180,27 +182,9 @@ def check_steady_exists(ctx: Context, val) -> Verdict:
     if key not in cache:
         cache[key] = (fam, _coefficients(ctx, fam))
     coefficients = cache[key][1]
-    wide = ctx.sampler.widened(2.0)
-    seen = {True: 0, False: 0}
-    n = 0
-    for _ in range(400):
-        pt = wide.draw()
-        exists = _common_real_root(coefficients, pt)
-        claim = holds(cond, pt)
-        if claim != exists:
-            shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
-                pt.items(), key=lambda kv: kv[0].name)[:8])
-            return Verdict(False, f"numeric({n + 1} points)",
-                           f"book says {'a' if claim else 'no'} steady motion, engine finds "
-                           f"{'one' if exists else 'none'} at {{{shown}}}")
-        seen[claim] += 1
-        n += 1
-        if n >= 60 and min(seen.values()) >= 10:
-            break
-    if min(seen.values()) == 0:
-        return Verdict(False, "numeric", "sampling never crossed the existence boundary; the "
-                       "check cannot discriminate")
-    return Verdict(True, f"numeric({n} points: {seen[True]} with, {seen[False]} without)")
+    result = boundary.compare(cond, lambda pt, near: _common_real_root(coefficients, pt),
+                              ctx.sampler, ("a steady motion", "none"))
+    return boundary.verdict(result)
 
 
 def _coefficients(ctx: Context, fam: SteadyFamily) -> list[list]:
@@ -255,7 +239,8 @@ def _common_real_root(coefficients: list[list], pt: dict) -> bool:
           how=("Routh's reduction: with the momenta of the `cyclic:` coordinates held, V_eff"
                " = [Σ p φ̇ − L] at rest in the other coordinates; equal to the book's up to "
                "a function of the momenta (its gradient in the coordinates agrees)"),
-          keys={"cyclic": {"type": "array", "minItems": 1, "items": NAME}})
+          keys={"cyclic": {"type": "array", "minItems": 1, "items": NAME}},
+          equivalent=("shift",))
 def check_effective_potential(ctx: Context, val) -> Verdict:
     names = ctx.part.data.get("cyclic") or []
     coords = []

@@ -1,0 +1,347 @@
+"""Relations decided at their boundary: where the book's condition changes truth.
+
+A book's relation (a stability condition, where a steady motion exists) is right only if its
+boundary is the engine's. Points drawn at random rarely land between a boundary and one
+moved by a percent, so sampling alone passes near misses. Here the parameter space is
+crossed along random rays (log coordinates for positive symbols, factors up to e^SPAN each
+way); on each ray a grid of points compares the two verdicts widely, every place where
+the book's relation changes truth is found by bisection and refined on the atom that
+flips (30 digits), and both verdicts are taken just inside and just outside it, a relative
+offset EPS away. A boundary the engine puts elsewhere, by more than EPS, disagrees on one
+side. Tangencies (an atom touching zero without changing sign: a double root of the
+boundary) are found as minima of |atom| along the ray and judged on both sides too.
+
+The engine's verdict is a function `classify(point, near) -> bool | None` (None: no
+verdict there, e.g. marginal); `near` asks for its precise path (a boundary is close).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, holds
+from mechbook.verify.compare import DIGITS, Sampler, Verdict
+
+RAYS = 8  # random rays through parameter space
+MORE_RAYS = 16  # tried in addition when the first rays cross no boundary
+GRID = 40  # points per ray, each judged by both sides
+SPAN = 2.5  # a positive parameter moves by factors up to e^SPAN each way along a ray
+EPS = 1e-8  # relative offset of the points judged on either side of a crossing
+EPS_STEPS = (1e-8, 1e-6, 1e-4)  # coarser offsets where the engine has no verdict closer
+BISECT_TOL = 1e-13  # the Boolean bisection's bracket (in ray units, ~ relative change)
+TANGENT_RTOL = 1e-12  # an atom's minimum this small against its scale is a touching zero
+
+Classifier = Callable[[dict, bool], "bool | None"]
+
+
+@dataclass
+class BoundaryResult:
+    """What the comparison saw: crossings judged, tangencies, the offset used."""
+
+    ok: bool
+    crossings: int = 0
+    tangencies: int = 0
+    unjudged: int = 0  # crossings where the engine gave no verdict even at the coarsest EPS
+    points: int = 0  # grid points judged by both sides
+    eps: float = EPS
+    detail: str = ""
+
+
+class Ray:
+    """Parameter points along p(t): log-linear in positive symbols, linear in the others."""
+
+    def __init__(self, sampler: Sampler, origin: dict, direction: np.ndarray,
+                 symbols: list[sp.Symbol]):
+        self.sampler = sampler
+        self.origin = origin
+        self.symbols = symbols
+        self.direction = direction
+
+    def point(self, t) -> dict | None:
+        """The admissible point at t (None where a condition fails or a derived symbol is
+        not real), all values at 30 digits."""
+        with mpmath.workdps(DIGITS + 5):
+            t = mpmath.mpf(t)
+            pt = dict(self.origin)
+            for sym, d in zip(self.symbols, self.direction, strict=True):
+                x0 = mpmath.mpf(self.origin[sym]._mpf_)
+                if sym.is_positive:
+                    x = x0 * mpmath.exp(t * d)
+                else:
+                    x = x0 + t * d * max(1, abs(x0))
+                pt[sym] = sp.Float(x, DIGITS)
+        pt = self.sampler.complete(pt)
+        if pt is None or not all(holds(c, pt) for c in self.sampler.conditions):
+            return None
+        return pt
+
+
+def _atoms(cond: sp.Basic) -> list[sp.Expr]:
+    """lhs − rhs of every relation in a condition (joined by and/or/not)."""
+    rels = [a for a in cond.atoms(sp.core.relational.Relational)] \
+        if isinstance(cond, sp.Basic) else []
+    return [r.lhs - r.rhs for r in rels]
+
+
+def _value(f: sp.Expr, pt: dict) -> tuple[float, float] | None:
+    try:
+        v, m = evaluate(f, pt, DIGITS)
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+        return None
+    if not (math.isfinite(v.real) and abs(v.imag) <= 1e-20 * max(1.0, abs(v))):
+        return None
+    return v.real, m
+
+
+class _Judge:
+    """Both verdicts at points of one ray."""
+
+    def __init__(self, cond: sp.Basic, classify: Classifier, ray: Ray):
+        self.cond, self.classify, self.ray = cond, classify, ray
+
+    def book(self, t) -> bool | None:
+        pt = self.ray.point(t)
+        return None if pt is None else holds(self.cond, pt)
+
+    def both(self, t, near: bool) -> tuple[bool | None, bool | None, dict | None]:
+        pt = self.ray.point(t)
+        if pt is None:
+            return None, None, None
+        return holds(self.cond, pt), self.classify(pt, near), pt
+
+
+def _bisect(fn: Callable, a: float, b: float, fa) -> tuple[float, float] | None:
+    """Shrink [a, b] (fn(a) = fa ≠ fn(b)) to BISECT_TOL; None if fn has no value inside."""
+    while b - a > BISECT_TOL:
+        m = (a + b) / 2
+        fm = fn(m)
+        if fm is None:
+            return None
+        if fm == fa:
+            a = m
+        else:
+            b = m
+    return a, b
+
+
+def _refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> mpmath.mpf:
+    """The crossing to 30 digits: the root of the atom that changes sign in [a, b]
+    (the bisection's midpoint where none does cleanly)."""
+    pa, pb = ray.point(a), ray.point(b)
+    for f in atoms:
+        va = _value(f, pa) if pa else None
+        vb = _value(f, pb) if pb else None
+        if va is None or vb is None or (va[0] > 0) == (vb[0] > 0):
+            continue
+
+        g = _along(f, ray)
+        try:
+            with mpmath.workdps(DIGITS):
+                return mpmath.findroot(g, (mpmath.mpf(a), mpmath.mpf(b)), solver="anderson",
+                                       tol=mpmath.mpf(10) ** (-2 * DIGITS + 10))
+        except (ValueError, ZeroDivisionError):
+            break
+    return mpmath.mpf((a + b) / 2)
+
+
+def _along(f: sp.Expr, ray: Ray) -> Callable:
+    """t ↦ f at the ray's point (an mpmath number; ValueError where it has none)."""
+    def g(t):
+        pt = ray.point(t)
+        if pt is None:
+            raise ValueError("no admissible point")
+        try:
+            got = evaluate_mp(f, pt, DIGITS)
+        except (NotNumeric, ZeroDivisionError, TypeError, OverflowError) as exc:
+            raise ValueError(str(exc)) from None
+        if not isinstance(got, mpmath.mpf):
+            if abs(mpmath.im(got)) > 1e-20 * max(1, abs(got)):
+                raise ValueError("not real")
+            got = mpmath.re(got)
+        return got
+
+    return g
+
+
+def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[mpmath.mpf]:
+    """Places where an atom touches zero without changing sign (a double root): local
+    minima of |atom| on the grid, refined by golden-section search, kept if they reach
+    TANGENT_RTOL of the atom's scale."""
+    out = []
+    for f in atoms:
+        vals = []
+        for t in ts:
+            pt = ray.point(t)
+            vals.append(None if pt is None else _value(f, pt))
+        for k in range(1, len(ts) - 1):
+            trio = vals[k - 1: k + 2]
+            if any(v is None for v in trio):
+                continue
+            (a, _), (b, _), (c, _) = trio
+            if not (abs(b) <= abs(a) and abs(b) <= abs(c)) or (a > 0) != (c > 0) or \
+                    (a > 0) != (b > 0):
+                continue
+            t_min, v_min, scale = _golden(f, ray, ts[k - 1], ts[k + 1])
+            if v_min is not None and v_min <= TANGENT_RTOL * max(scale, 1e-300):
+                out.append(t_min)
+    return out
+
+
+def _golden(f: sp.Expr, ray: Ray, a: float, b: float, steps: int = 80):
+    ratio = (math.sqrt(5) - 1) / 2
+
+    def h(t):
+        pt = ray.point(t)
+        got = None if pt is None else _value(f, pt)
+        return (math.inf, 1.0) if got is None else (abs(got[0]), got[1])
+
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    hc, hd = h(c), h(d)
+    for _ in range(steps):
+        if hc[0] <= hd[0]:
+            b, d, hd = d, c, hc
+            c = b - ratio * (b - a)
+            hc = h(c)
+        else:
+            a, c, hc = c, d, hd
+            d = a + ratio * (b - a)
+            hd = h(d)
+        if b - a < BISECT_TOL:
+            break
+    best = min((hc, c), (hd, d), key=lambda x: x[0][0])
+    (v, scale), t = best
+    return mpmath.mpf(t), (None if v == math.inf else v), scale
+
+
+def _show(pt: dict) -> str:
+    items = sorted(pt.items(), key=lambda kv: kv[0].name)[:8]
+    return "{" + ", ".join(f"{k}={float(v):.10g}" for k, v in items) + "}"
+
+
+def _engine_crossing(judge: _Judge, a: float, b: float) -> str:
+    """Where the engine's verdict changes between a and b, for the message."""
+    ea = judge.classify(judge.ray.point(a), True) if judge.ray.point(a) else None
+    eb = judge.classify(judge.ray.point(b), True) if judge.ray.point(b) else None
+    if ea is None or eb is None or ea == eb:
+        return ""
+    got = _bisect(lambda t: judge.classify(judge.ray.point(t), True)
+                  if judge.ray.point(t) else None, a, b, ea)
+    if got is None:
+        return ""
+    return f"; the engine's boundary on this ray is at {_show(judge.ray.point(got[0]))}"
+
+
+def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
+            words: tuple[str, str] = ("true", "false"), seed: int = 20261125) -> BoundaryResult:
+    """Does the book's `cond` hold exactly where `classify` says True? `words` name the two
+    verdicts in messages (e.g. 'stable', 'unstable')."""
+    rng = np.random.default_rng(seed)
+    symbols = sorted((s for s in sampler.base if s not in sampler.fixed
+                      and s not in sampler.derived), key=lambda s: s.name)
+    if not symbols:
+        return BoundaryResult(False, detail="no free parameter to vary")
+    atoms = _atoms(cond)
+    ts = np.linspace(-SPAN, SPAN, GRID)
+    res = BoundaryResult(True)
+    seen = {True: 0, False: 0}
+    rays = 0
+    while rays < RAYS + MORE_RAYS:
+        if rays >= RAYS and res.crossings + res.tangencies > 0:
+            break
+        rays += 1
+        origin = sampler.draw()
+        d = rng.normal(size=len(symbols))
+        d /= np.linalg.norm(d)
+        ray = Ray(sampler, origin, d, symbols)
+        judge = _Judge(cond, classify, ray)
+        grid = [judge.both(t, False) for t in ts]
+        for b, e, pt in grid:
+            if b is None or e is None:
+                continue
+            res.points += 1
+            seen[b] += 1
+            if b != e:
+                res.ok = False
+                res.detail = (f"the book says {words[0] if b else words[1]}, the engine finds "
+                              f"{words[0] if e else words[1]} at {_show(pt)}")
+                return res
+        # every change of the book's truth along the ray: bisect, refine, judge both sides
+        for k in range(len(ts) - 1):
+            b0, b1 = grid[k][0], grid[k + 1][0]
+            if b0 is None or b1 is None or b0 == b1:
+                continue
+            bracket = _bisect(judge.book, float(ts[k]), float(ts[k + 1]), b0)
+            if bracket is None:
+                continue
+            t_star = _refine(atoms, ray, *bracket)
+            bad = _judge_crossing(judge, t_star, res, words)
+            if bad:
+                res.ok = False
+                res.detail = bad + _engine_crossing(judge, float(ts[k]), float(ts[k + 1]))
+                return res
+            res.crossings += 1
+        for t_star in _tangencies(atoms, ray, ts):
+            bad = _judge_crossing(judge, t_star, res, words, tangent=True)
+            if bad:
+                res.ok = False
+                res.detail = bad
+                return res
+            res.tangencies += 1
+    if res.crossings + res.tangencies == 0 or min(seen.values()) == 0:
+        res.ok = False
+        res.detail = (f"no ray crossed the book's boundary ({rays} rays, {res.points} points: "
+                      f"{seen[True]} {words[0]}, {seen[False]} {words[1]}): the check cannot "
+                      "discriminate (widen the parameters or `assume:` a region)")
+        return res
+    if res.unjudged and res.unjudged == res.crossings:
+        res.ok = False
+        res.detail = (f"the engine gives no verdict near any of the {res.crossings} crossings "
+                      "(marginal there): the boundary cannot be compared")
+        return res
+    judged = res.crossings - res.unjudged
+    tang = f", {res.tangencies} tangencies" if res.tangencies else ""
+    skipped = f", {res.unjudged} not judged (marginal)" if res.unjudged else ""
+    res.detail = (f"boundary agrees at {judged} crossings to {res.eps:g}{tang}{skipped}; "
+                  f"{res.points} points on {rays} rays ({seen[True]} {words[0]}, "
+                  f"{seen[False]} {words[1]})")
+    return res
+
+
+def _judge_crossing(judge: _Judge, t_star, res: BoundaryResult, words: tuple[str, str],
+                    tangent: bool = False) -> str:
+    """Both verdicts just inside and just outside the crossing at t_star ('' if they agree;
+    a crossing where the engine has no verdict at any offset counts as unjudged)."""
+    for eps in EPS_STEPS:
+        sides = [judge.both(t_star + s * eps, True) for s in (-1, 1)]
+        if any(b is None for b, _, _ in sides):
+            continue  # the crossing sits on the edge of the admissible region
+        if any(e is None for _, e, _ in sides):
+            continue
+        res.eps = max(res.eps, eps)
+        for b, e, pt in sides:
+            if b != e:
+                kind = "touches its boundary" if tangent else "changes"
+                return (f"where the book's relation {kind} ({_show(judge.ray.point(t_star))}),"
+                        f" at a relative offset {eps:g}: the book says "
+                        f"{words[0] if b else words[1]}, the engine finds "
+                        f"{words[0] if e else words[1]} at {_show(pt)}")
+        return ""
+    res.unjudged += 1
+    return ""
+
+
+def verdict(result: BoundaryResult, crossings_word: str = "crossings") -> Verdict:
+    """A Verdict stating the boundary's resolution (its power)."""
+    if not result.ok:
+        return Verdict(False, "boundary", result.detail)
+    judged = result.crossings - result.unjudged
+    tang = f" and {result.tangencies} tangencies" if result.tangencies else ""
+    return Verdict(True, f"boundary({judged} {crossings_word} to {result.eps:g})", result.detail,
+                   power=f"boundary at {judged} {crossings_word}{tang} to {result.eps:g}, "
+                         f"{result.points} points on both sides")
