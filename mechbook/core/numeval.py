@@ -53,6 +53,24 @@ def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
         return v
 
 
+def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits: int = 240,
+                      margin: int = 10):
+    """expr at `point` as an mpmath number, the working precision doubled (from `digits` up
+    to `max_digits`) until the value stands `margin` digits clear of what cancelled on the
+    way; 0 if it never does (it is zero to max_digits). For a value judged close to a
+    boundary, where terms of size 1e24 cancel to 1e-25 and 30 digits leave only noise."""
+    d = digits
+    while True:
+        with mpmath.workdps(d):
+            pt = {k: _number(v) for k, v in point.items()}
+            v, m = _walk(expr, pt, {})
+            if abs(v) > mpmath.mpf(10) ** (margin - d) * m:
+                return v
+        if d >= max_digits:
+            return mpmath.mpf(0)
+        d = min(2 * d, max_digits)
+
+
 def _number(v):
     """A point's value (a SymPy number or a Python number; never text) as an mpmath number."""
     if isinstance(v, (int, float)) and not isinstance(v, bool):

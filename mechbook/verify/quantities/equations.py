@@ -122,14 +122,15 @@ def _named(ctx: Context, text: str, sub: tuple) -> tuple[sp.Expr, bool, str]:
         return dyn.energy_function, True, "the energy function, up to a constant"
     momenta = {sp.Symbol("p_" + q.name, real=True): p
                for q, p in zip(sys.q, dyn.momenta, strict=True)}
-    lhs = ctx.parse(name, sub)
     derived = {k for k, v in sys.names.items()
                if not isinstance(v, sp.Symbol) and k not in ctx.part.key.symbols}
-    used = [k for k in _identifiers(name) if k in derived]
-    if not (lhs.free_symbols & set(momenta)) and not used:
+    idents = _identifiers(name)
+    used = [k for k in idents if k in derived]
+    if not used and not any(sp.Symbol(k, real=True) in momenta for k in idents):
         known = ", ".join(["p_<coordinate>", *ENERGY_NAMES, *sorted(derived)])
         raise ctx.part.error(sub, f"{name!r} names no quantity the engine computes; the "
                              f"left side may use {known}")
+    lhs = ctx.parse(name, sub)
     motion = set(sys.q) | set(sys.qd)
     if not used and lhs.free_symbols & motion:
         raise ctx.part.error(sub, "the left side names the quantity (momenta, the energy, "

@@ -10,13 +10,16 @@ phidot*cos(theta) = omega3").
 
 from __future__ import annotations
 
+import mpmath
 import numpy as np
 import sympy as sp
+
+from mechbook.core.numeval import NotNumeric, evaluate_resolved
 
 from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
 from mechbook.verify import boundary
-from mechbook.verify.compare import Verdict, all_vanish, combine, value_and_scale
+from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
@@ -182,7 +185,7 @@ def check_steady_exists(ctx: Context, val) -> Verdict:
     if key not in cache:
         cache[key] = (fam, _coefficients(ctx, fam))
     coefficients = cache[key][1]
-    result = boundary.compare(cond, lambda pt, near: _common_real_root(coefficients, pt),
+    result = boundary.compare(cond, lambda pt, near: _common_real_root(coefficients, pt, near),
                               ctx.sampler, ("a steady motion", "none"))
     return boundary.verdict(result)
 
@@ -209,28 +212,69 @@ def _coefficients(ctx: Context, fam: SteadyFamily) -> list[list]:
     return out
 
 
-def _common_real_root(coefficients: list[list], pt: dict) -> bool:
+def _common_real_root(coefficients: list[list], pt: dict, precise: bool = False) -> bool:
     """Do the polynomials (coefficient lists, highest first) have a common real root at
-    `pt`? A coefficient counts as zero when it cancels to 1e-20 of its terms."""
+    `pt`? A coefficient counts as zero when it cancels to 1e-20 of its terms. A root is real
+    when its imaginary part is below 1e-9 of its own size (not of 1: near an existence
+    boundary at infinity the rates themselves are tiny, and ±1e-16i is not real). `precise`
+    (close to a boundary): each coefficient evaluated with its precision raised until it
+    stands clear of what cancels in it, the roots in mpmath, real below 1e-20 of their
+    size."""
     polys = []
     for coeffs in coefficients:
         vals = []
         for c in coeffs:
-            v, size = value_and_scale(c, pt)
-            vals.append(0.0 if abs(v) <= 1e-20 * max(size, 1e-300) else v.real)
-        while vals and vals[0] == 0.0:
+            if precise:  # precision raised until the coefficient stands clear of rounding
+                try:
+                    vals.append(mpmath.re(evaluate_resolved(c, pt, DIGITS)))
+                    continue
+                except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+                    pass
+                v, size = value_and_scale(c, pt)
+                vals.append(mpmath.mpf(0) if abs(v) <= 1e-20 * max(size, 1e-300)
+                            else mpmath.mpf(v.real))
+            else:
+                v, size = value_and_scale(c, pt)
+                vals.append(0.0 if abs(v) <= 1e-20 * max(size, 1e-300) else v.real)
+        while vals and vals[0] == 0:
             vals.pop(0)
         if not vals:
             continue  # vanishes identically here
         if len(vals) == 1:
             return False  # a nonzero constant: no rate makes this residual vanish
-        polys.append(np.array(vals))
+        polys.append(vals)
     if not polys:
         return True
-    roots = [r.real for r in np.roots(polys[0]) if abs(r.imag) <= 1e-9 * max(1, abs(r))]
+    if precise:
+        return _common_real_root_mp(polys)
+    polys = [np.array([float(v) for v in c]) for c in polys]
+    roots = [r.real for r in np.roots(polys[0]) if abs(r.imag) <= 1e-9 * abs(r)]
     for r in roots:
         if all(abs(np.polyval(c, r)) <= 1e-9 * np.polyval(np.abs(c), abs(r)) for c in polys):
             return True
+    return False
+
+
+def _common_real_root_mp(polys: list[list]) -> bool:
+    with mpmath.workdps(DIGITS + 10):
+        first = list(polys[0])
+        zeros = 0
+        while first and first[-1] == 0:  # x = 0 is an exact root
+            first.pop()
+            zeros += 1
+        roots = [mpmath.mpf(0)] if zeros else []
+        if len(first) > 1:
+            try:
+                found = mpmath.polyroots(first, maxsteps=200, extraprec=2 * DIGITS)
+            except mpmath.libmp.NoConvergence:
+                found = mpmath.polyroots(first, maxsteps=2000, extraprec=4 * DIGITS,
+                                         error=False)
+            roots += [mpmath.re(r) for r in (found if isinstance(found, list) else [found])
+                      if abs(mpmath.im(r)) <= mpmath.mpf(10) ** -20 * abs(r)]
+        for r in roots:
+            if all(abs(mpmath.polyval(c, r)) <= mpmath.mpf(10) ** -20 *
+                   mpmath.polyval([abs(x) for x in c], abs(r)) for c in polys):
+                return True
     return False
 
 
