@@ -36,6 +36,11 @@ class UnsupportedError(MechbookError):
         super().__init__(f"unsupported: {capability}")
 
 
-class NotEquilibriumError(MechbookError):
+class WrongAnswerError(MechbookError):
+    """A value an answer gives contradicts the system (a point that is no equilibrium, a
+    mode shape off the constraint manifold): the answer is wrong, a fail."""
+
+
+class NotEquilibriumError(WrongAnswerError):
     """A point (or steady motion) named by an answer does not satisfy the equations of motion:
     the answer is wrong, which is a fail, not a missing capability."""

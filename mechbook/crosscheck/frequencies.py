@@ -53,6 +53,9 @@ class _Setup:
     engine: np.ndarray  # the engine's numeric frequencies
     turn: np.ndarray | None = None  # uniform rates of a steady motion kept in full (per
     # model coordinate): the reference state moves, q*(t) = q_star + turn*t
+    # on a constraint manifold: (q, v) ↦ (q, v) with the dependent coordinates and rates
+    # moved onto the constraints (the linear system's are the independent ones)
+    manifold: object = None
 
 
 def _float_values(values: dict) -> dict:
@@ -81,8 +84,9 @@ def _setup(analysis: Analysis, lin, values: dict, models: dict) -> _Setup:
     idx = [base.q.index(q) for q in lin.q]
     n = len(base.q)
     q_star = np.zeros(n)
-    for q in lin.q:
-        q_star[base.q.index(q)] = float(sp.N(sp.S(lin.point.get(q, 0)).subs(values)))
+    for q in base.q:  # every coordinate: a dependent one has its own place on a manifold
+        if q in lin.q or q in lin.point:
+            q_star[base.q.index(q)] = float(sp.N(sp.S(lin.point.get(q, 0)).subs(values)))
     v_star = np.zeros(n)
     cyclic: list[int] = []
     p_cyc = np.zeros(0)
@@ -91,6 +95,8 @@ def _setup(analysis: Analysis, lin, values: dict, models: dict) -> _Setup:
         p_cyc = np.array([float(sp.N(sp.S(p).subs(values)))
                           for p in sys_lin.momenta.values()])
     setup = _Setup(model, q_star, v_star, idx, cyclic, p_cyc, M, C, K, engine)
+    if getattr(lin, "embedding", None) is not None:
+        setup.manifold = _manifold(base, idx, vals)
     if steady:
         setup.v_star = _with_cyclic_rates(setup, q_star, np.zeros(n))
     if lin.velocity:  # a steady motion kept in all its coordinates (`reduce: false`)
@@ -100,6 +106,36 @@ def _setup(analysis: Analysis, lin, values: dict, models: dict) -> _Setup:
         setup.turn = turn
         setup.v_star = turn.copy()
     return setup
+
+
+def _manifold(base, independent: list[int], values: dict):
+    """(q, v) ↦ (q, v) on the constraints g(q) = 0, A(q)·v = 0: the dependent coordinates
+    by Newton's method from where they are, their rates solved from the others'. A start
+    displaced along a mode of the linear system is first order; on the constraints exactly,
+    the simulated system is the one whose frequencies are compared."""
+    from mechbook.core.compile import compile_exprs
+
+    cons = [f.subs(values) for _, f in base.constraints]
+    A = sp.Matrix([[sp.diff(f, q) for q in base.q] for f in cons])
+    g_num, _ = compile_exprs(base.q, cons)
+    a_num, _ = compile_exprs(base.q, list(A))
+    n, m = len(base.q), len(cons)
+    dep = [i for i in range(n) if i not in independent]
+
+    def project(q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        q, v = q.copy(), v.copy()
+        scale = max(1.0, float(np.max(np.abs(q))))
+        for _ in range(50):
+            r = np.asarray(g_num(q), float)
+            if np.max(np.abs(r)) <= 1e-15 * scale:
+                break
+            J = np.asarray(a_num(q), float).reshape(m, n)
+            q[dep] -= np.linalg.solve(J[:, dep], r)
+        J = np.asarray(a_num(q), float).reshape(m, n)
+        v[dep] = -np.linalg.solve(J[:, dep], J[:, independent] @ v[independent])
+        return q, v
+
+    return project
 
 
 def _with_cyclic_rates(s: _Setup, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -213,6 +249,8 @@ def _initial(s: _Setup, mode: dict, amplitude: float) -> np.ndarray:
     v = s.v_star.copy()
     q[s.index] += amplitude * mode["start"][:nl]
     v[s.index] += amplitude * mode["start"][nl:]
+    if s.manifold is not None:
+        q, v = s.manifold(q, v)
     v = _with_cyclic_rates(s, q, v)
     y = np.empty(2 * n_full)
     y[:n_full], y[n_full:] = q, v

@@ -36,9 +36,24 @@ class Equilibria:
 
     @cached_property
     def conditions(self) -> list[sp.Expr]:
-        """E_i(q, 0, 0) with small parameters switched off: zero at an equilibrium."""
+        """What vanishes at an equilibrium, in the `unknowns`: E_i(q, 0, 0) with small
+        parameters switched off; with multiplier constraints, E(q, 0, 0) − A(q)ᵀλ and the
+        constraints g(q) (mechbook.engine.constrained)."""
         if self.sys.constraints:
-            raise UnsupportedError("equilibria of a system with multiplier constraints")
+            from mechbook.engine.constrained import equilibrium_conditions
+
+            return equilibrium_conditions(self)[0]
+        return self.rest_residuals()
+
+    @cached_property
+    def unknowns(self) -> list[sp.Symbol]:
+        """The coordinates, and the constraints' multipliers where there are constraints."""
+        return list(self.dyn.q) + (list(self.dyn.multipliers) if self.sys.constraints else [])
+
+    def rest_residuals(self) -> list[sp.Expr]:
+        """E_i(q, 0, 0) with small parameters switched off (no constraint forces)."""
+        if "_rest" in self.__dict__:
+            return self.__dict__["_rest"]
         zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
         zero.update({s: 0 for s in self.sys.small_params})
         held = getattr(self.sys, "held", {})  # a reduced system's momenta, put back
@@ -49,6 +64,7 @@ class Equilibria:
         free = {s for syms in self.sys.free_driven for s in syms}
         if any(c.free_symbols & free for c in conds):
             raise UnsupportedError("static equilibria with an arbitrary driven coordinate")
+        self.__dict__["_rest"] = conds
         return conds
 
     SIMPLIFY_SECONDS = 5.0  # per condition, before solving
@@ -85,27 +101,33 @@ class Equilibria:
             if seconds <= 0:
                 raise Timeout("no time left")
             with time_limit(seconds):
-                sols = sp.solve(conds, self.dyn.q, dict=True)
+                sols = sp.solve(conds, self.unknowns, dict=True)
         except (Timeout, NotImplementedError):
             if deadline is not None and cpu_time() >= deadline - 1e-3:
                 self._gave_up_at = budget  # cut short by the budget: may retry with more
                 return []
             self._solved = []
             return []
-        self._solved = [s for s in sols if len(s) == len(self.dyn.q)
+        q = set(self.dyn.q)
+        self._solved = [{k: v for k, v in s.items() if k in q} for s in sols
+                        if len(s) == len(self.unknowns)
                         and all(v.is_real is not False for v in s.values())]
         return self._solved
 
     def numeric(self, values: dict, search: dict | None = None,
                 starts: int = 7) -> list[np.ndarray]:
-        """Equilibria at `values` by root finding from a grid of starting points."""
+        """Equilibria at `values` by root finding from a grid of starting points (the
+        coordinates only; with constraints the multipliers are unknowns too, each start
+        taking them by least squares from the force left at rest there)."""
         q = self.dyn.q
+        unknowns = self.unknowns
         conds = [c.subs(values) for c in self.conditions]
         F = sp.Matrix(conds)
-        J = F.jacobian(q)
-        n = len(q)
-        f_num, _ = compile_exprs(q, list(F))
-        jac, _ = compile_exprs(q, list(J))
+        J = F.jacobian(unknowns)
+        n = len(unknowns)
+        f_num, _ = compile_exprs(unknowns, list(F))
+        jac, _ = compile_exprs(unknowns, list(J))
+        start_lambda = self._multiplier_start(values)
 
         def j_num(x):
             return jac(x).reshape(n, n)
@@ -116,12 +138,37 @@ class Equilibria:
         if len(mesh) > 2000:
             mesh = mesh[np.random.default_rng(0).choice(len(mesh), 2000, replace=False)]
         for x0 in mesh:
-            sol = scipy.optimize.root(lambda x: np.asarray(f_num(x), float), x0,
-                                      jac=lambda x: np.asarray(j_num(x), float))
-            if np.all(np.isfinite(sol.x)) and np.max(np.abs(f_num(sol.x))) < 1e-10:
-                if not any(np.allclose(sol.x, f, atol=1e-7) for f in found):
-                    found.append(sol.x)
+            x0 = np.concatenate([x0, start_lambda(x0)])
+            with np.errstate(all="ignore"):
+                sol = scipy.optimize.root(lambda x: np.asarray(f_num(x), float), x0,
+                                          jac=lambda x: np.asarray(j_num(x), float))
+                if not (np.all(np.isfinite(sol.x)) and
+                        np.max(np.abs(f_num(sol.x))) < 1e-10):
+                    continue
+            x = sol.x[: len(q)]
+            if not any(np.allclose(x, f, atol=1e-7) for f in found):
+                found.append(x)
         return found
+
+    def _multiplier_start(self, values: dict):
+        """x0 ↦ starting multipliers (least squares of Aᵀλ = E at x0); none without
+        constraints."""
+        if not self.sys.constraints:
+            return lambda x0: np.zeros(0)
+        q = self.dyn.q
+        A = self.dyn.constraint_jacobian.subs(values)
+        E = [r.subs(values) for r in self.rest_residuals()]
+        a_num, _ = compile_exprs(q, list(A))
+        e_num, _ = compile_exprs(q, E)
+        m = A.rows
+
+        def start(x0):
+            with np.errstate(all="ignore"):
+                At = np.asarray(a_num(x0), float).reshape(m, len(q)).T
+                lam = np.linalg.lstsq(At, np.asarray(e_num(x0), float), rcond=None)[0]
+            return np.where(np.isfinite(lam), lam, 0.0)
+
+        return start
 
     def quadratic_lagrangian(self, point: dict) -> sp.Expr:
         """L expanded to second order about `point` (see mechbook.expansion)."""
@@ -129,6 +176,12 @@ class Equilibria:
         return expand_lagrangian(dyn.L, dyn.q, dyn.qd, point, self.sys.small_params, 2)
 
     def residual(self, point: dict) -> list[sp.Expr]:
+        """What must vanish if `point` is an equilibrium (with constraints: each constraint
+        and the force along the constraint manifold)."""
+        if self.sys.constraints:
+            from mechbook.engine.constrained import residual_at
+
+            return residual_at(self, point)
         return [c.subs(point) for c in self.conditions]
 
     def _conservative(self) -> bool:
@@ -178,10 +231,28 @@ class Equilibria:
         symmetry orbit, e.g. a cyclic coordinate or a rotation of the whole system).
         `given` ({parameter: expression}) restricts the parameters to a surface on which
         the point is an equilibrium (an answer's `restrict:`): the zeroth order must vanish
-        there; M, C, K and F stay in the original parameters."""
-        dyn = self.dyn
+        there; M, C, K and F stay in the original parameters. A system with multiplier
+        constraints is linearized on its constraint manifold (mechbook.engine.constrained)."""
+        if self.sys.constraints:
+            from mechbook.engine.constrained import linearize_on_manifold
+
+            return linearize_on_manifold(self, point, velocity, given)
         if not velocity and not given and self._conservative():
             return self._linearize_lagrangian(point)
+        zeroth, M, C, K, F = self.expand(point, velocity, given)
+        bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
+        if bad:
+            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
+                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
+                                      "is left there")
+        return LinearSystem(self.dyn, dict(point), M, C, K, F, dict(velocity or {}))
+
+    def expand(self, point: dict, velocity: dict | None = None, given: dict | None = None
+               ) -> tuple[list, sp.Matrix, sp.Matrix, sp.Matrix, sp.Matrix]:
+        """The residuals E (without constraint forces) to first order about `point` (and the
+        uniform motion at `velocity`): (zeroth order, M, C, K, F), not yet required to be an
+        equilibrium."""
+        dyn = self.dyn
         velocity = dict(velocity or {})
         t = self.sys.t
         # a point or rate given by a long expression (an orbit parametrized by an answer's
@@ -220,11 +291,6 @@ class Equilibria:
                      [z.subs(t, sp.Rational(-3, 7)) for z in zeroth]
         if given:
             zeroth = [z.subs(given) for z in zeroth]
-        bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
-        if bad:
-            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
-                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
-                                      "is left there")
         n = len(dyn.q)
         raw = {name: sp.Matrix(n, n, lambda i, j, v=v: sp.diff(lin[i], v[j]))
                for name, v in (("M", dyn.qdd), ("C", dyn.qd), ("K", dyn.q))}
@@ -244,10 +310,10 @@ class Equilibria:
         bad = set().union(*(x.free_symbols for x in F)) & set(dyn.q + dyn.qd + dyn.qdd)
         if bad:
             raise UnsupportedError("linearization: nonlinear remainder")  # pragma: no cover
-        if velocity and any(x.has(t) for A in (M, C, K) for x in A):
+        if velocity and any(x.has(self.sys.t) for A in (M, C, K) for x in A):
             raise UnsupportedError("linearization about a uniform motion whose linear "
                                    "equations have time-dependent coefficients")
-        return LinearSystem(dyn, dict(point), M, C, K, F, velocity)
+        return zeroth, M, C, K, F
 
 
 def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:

@@ -41,11 +41,59 @@ class LinearSystem:
     F: sp.Matrix
     velocity: dict = field(default_factory=dict)  # uniform rates of a steady motion kept
     # in full (mechbook.engine.equilibria.Equilibria.linearize); empty about a rest point
+    # On a constraint manifold (multiplier constraints): M, C, K, F are over the independent
+    # coordinates `coords` (a subset of the system's), and δq = embedding·δs gives every
+    # coordinate's displacement (mechbook.engine.constrained); None otherwise.
+    coords: list | None = None
+    embedding: sp.Matrix | None = None
     _compiled: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
-    def q(self):
-        return self.dyn.q
+    def q(self) -> list:
+        """The coordinates of the linear system (the independent ones on a constraint
+        manifold)."""
+        return list(self.coords) if self.coords is not None else self.dyn.q
+
+    def _rates(self, of: list) -> list:
+        if self.coords is None:
+            return of
+        return [of[self.dyn.q.index(c)] for c in self.coords]
+
+    @property
+    def qd(self) -> list:
+        return self._rates(self.dyn.qd)
+
+    @property
+    def qdd(self) -> list:
+        return self._rates(self.dyn.qdd)
+
+    @property
+    def coord_names(self) -> list[str]:
+        return [str(q) for q in self.q] if self.coords is not None else \
+            list(self.dyn.sys.coord_names)
+
+    @property
+    def dependent(self) -> dict:
+        """{dependent coordinate: its linear displacement in the independent ones}, empty
+        without constraints."""
+        if self.embedding is None:
+            return {}
+        ds = self.displacement()
+        out = {}
+        for i, q in enumerate(self.dyn.q):
+            if q not in self.coords:
+                out[q] = sum((self.embedding[i, j] * ds[j] for j in range(len(self.coords))),
+                             sp.S.Zero)
+        return out
+
+    def gradient(self, form: sp.Expr) -> list[sp.Expr]:
+        """The gradient at the point of a function of the coordinates, over the linear
+        system's coordinates (on a constraint manifold: through the embedding δq = N·δs)."""
+        grad = [sp.diff(form, q).subs(self.point) for q in self.dyn.q]
+        if self.embedding is None:
+            return grad
+        return [sum((grad[i] * self.embedding[i, j] for i in range(len(grad))), sp.S.Zero)
+                for j in range(len(self.coords))]
 
     def displacement(self) -> sp.Matrix:
         return sp.Matrix([q - self.point.get(q, 0) for q in self.q])
@@ -53,7 +101,7 @@ class LinearSystem:
     def equations(self) -> list[sp.Expr]:
         """Linear equations (each = 0) in the original coordinate symbols."""
         dq = self.displacement()
-        lhs = self.M * sp.Matrix(self.dyn.qdd) + self.C * sp.Matrix(self.dyn.qd) + self.K * dq
+        lhs = self.M * sp.Matrix(self.qdd) + self.C * sp.Matrix(self.qd) + self.K * dq
         return [sp.expand(e) for e in lhs - self.F]
 
     @cached_property

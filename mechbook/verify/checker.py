@@ -11,7 +11,7 @@ import time
 import traceback
 
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import MechbookError, NotEquilibriumError, SpecError, UnsupportedError
+from mechbook.errors import MechbookError, SpecError, UnsupportedError, WrongAnswerError
 from mechbook.records import Outcome
 from mechbook.verify.answers import AnswerKey, Part
 from mechbook.verify.compare import NUMERIC, ProofPolicy
@@ -49,7 +49,7 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) ->
                 out.power = _power(part, verdict)
     except UnsupportedError as exc:
         out.status, out.detail = "unsupported", exc.capability
-    except NotEquilibriumError as exc:  # the answer's point or steady rate is wrong
+    except WrongAnswerError as exc:  # the answer's point, steady rate or shape is wrong
         out.status, out.detail = "fail", str(exc)
     except SpecError as exc:
         out.status, out.detail = "error", str(exc)

@@ -17,10 +17,11 @@ import sympy as sp
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
+from mechbook.errors import WrongAnswerError
 from mechbook.model.declared import declared
 from mechbook.records import NUMERIC, ProofPolicy
 from mechbook.verify.answers import Part
-from mechbook.verify.compare import Sampler, value
+from mechbook.verify.compare import Sampler, value, vanishes
 from mechbook.verify.registry import quantities
 
 
@@ -155,15 +156,29 @@ class Context:
 
     def mode_shape(self, shape, sub) -> sp.Matrix:
         """A mode shape over the linear system's coordinates (a steady motion reduced by
-        Routh has lost its cyclic ones); a coordinate left out is 0."""
+        Routh has lost its cyclic ones); a coordinate left out is 0. On a constraint
+        manifold the shape is over the independent coordinates; a dependent coordinate the
+        book also gives must move as the constraints make it (WrongAnswerError if not)."""
         shape = self.as_map(shape, sub)
-        names = self.linear().dyn.sys.coord_names
-        unknown = set(shape) - set(names)
+        lin = self.linear()
+        names = lin.coord_names
+        dependent = {str(q): q for q in lin.dependent}
+        unknown = set(shape) - set(names) - set(dependent)
         if unknown:
             raise self.part.error(sub + (sorted(unknown)[0],), "not a coordinate of the "
                                   "linear system")
-        return sp.Matrix([self.parse(shape[c], sub + (c,)) if c in shape else 0
-                          for c in names])
+        u = sp.Matrix([self.parse(shape[c], sub + (c,)) if c in shape else 0
+                       for c in names])
+        for c in sorted(set(shape) & set(dependent)):
+            i = lin.dyn.q.index(dependent[c])
+            implied = sum((lin.embedding[i, j] * u[j] for j in range(len(names))), sp.S.Zero)
+            got = vanishes(self.parse(shape[c], sub + (c,)) - implied, self.sampler,
+                           symbolic=False)
+            if not got.ok:
+                raise WrongAnswerError(f"the shape's {c} is not what the constraints make it "
+                                       f"({sp.sstr(implied)} for the other entries given): "
+                                       f"{got.detail}")
+        return u
 
 
 def _merge_declared(names: dict, extra: dict, part: Part) -> None:
@@ -187,9 +202,9 @@ def strip_const(text):
 def linear_accelerations(lin: LinearSystem) -> dict:
     """q̈ solved from the linear equations M·q̈ + C·q̇ + K·δq = F."""
     n = len(lin.q)
-    rhs = lin.F - lin.C * sp.Matrix(lin.dyn.qd) - lin.K * lin.displacement()
-    sol = solve_accelerations(lin.M, rhs, list(lin.dyn.qdd))
-    return {lin.dyn.qdd[i]: sol[i] for i in range(n)}
+    rhs = lin.F - lin.C * sp.Matrix(lin.qd) - lin.K * lin.displacement()
+    sol = solve_accelerations(lin.M, rhs, list(lin.qdd))
+    return {lin.qdd[i]: sol[i] for i in range(n)}
 
 
 def numbers(exprs, pt) -> list[float]:

@@ -60,16 +60,21 @@ def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict
     coords = _coordinates_from(ctx, funcs)
     t = ctx.system.t
     subs = {}
-    for q, qd, qdd in zip(lin.dyn.q, lin.dyn.qd, lin.dyn.qdd, strict=True):
+    for q, qd, qdd in zip(lin.q, lin.qd, lin.qdd, strict=True):
         if q in coords:
             f = coords[q]
             subs.update({q: f, qd: sp.diff(f, t), qdd: sp.diff(f, t, 2)})
     checked = []
     for e in lin.equations():
         r = e.subs(subs)
-        if r.free_symbols & set(lin.dyn.q + lin.dyn.qd + lin.dyn.qdd):
+        if r.free_symbols & set(lin.q + lin.qd + lin.qdd):
             continue
         checked.append(r)
+    for q, moved in lin.dependent.items():  # on a constraint manifold: as the others make it
+        if q in coords:
+            r = (coords[q] - lin.point.get(q, 0) - moved).subs(subs)
+            if not r.free_symbols & set(lin.q):
+                checked.append(r)
     if not checked:
         raise UnsupportedError("checking a motion that leaves every equation with unknown "
                                "coordinates (give the initial conditions instead)")

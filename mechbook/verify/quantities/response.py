@@ -225,12 +225,12 @@ def _linear_forms(ctx: Context, keys: list[str], lin) -> dict[str, list]:
     define = ctx.part.data.get("define") or {}
     out = {}
     for k in keys:
-        names = lin.dyn.sys.coord_names
+        names = lin.coord_names
         if k in names:
             out[k] = [sp.S(int(c == k)) for c in names]
         elif k in define:
             form = ctx.names[k]
-            out[k] = [sp.diff(form, q).subs(lin.point) for q in lin.q]
+            out[k] = lin.gradient(form)
         else:
             raise ctx.part.error(("book", k), "neither a coordinate nor a `define:` name")
     return out
@@ -352,7 +352,7 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
           keys={"frequencies": {"type": "object", "additionalProperties": EXPR}})
 def check_normal_transformation(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
-    names = ctx.linear().dyn.sys.coord_names
+    names = ctx.linear().coord_names
     if set(val) != set(names):
         raise ctx.part.error(("book",), "give every coordinate as a form in the normal "
                              "coordinates")

@@ -15,10 +15,9 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_resolved
-
 from mechbook.engine import steady
-from mechbook.errors import UnsupportedError
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
+from mechbook.errors import UnsupportedError
 from mechbook.verify import boundary
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
