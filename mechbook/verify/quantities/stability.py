@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechbook.engine import response, steady
+from mechbook.engine.certified_count import certified_count
 from mechbook.engine.steady_search import classify, classify_at, roots_in
 from mechbook.verify.compare import Verdict, value
 from mechbook.verify.context import Context
@@ -75,9 +76,11 @@ def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:
           how=('the number of distinct equilibria, or steady motions at fixed `rates:` or at '
                'fixed cyclic `momenta:` (equilibria of Routh\'s reduced system), inside '
                '`search:` (a box or a list of boxes over the other coordinates), found by '
-               'multistart root finding at 3 points (a count the search can miss is a lower '
-               'bound: say so in the note); `stable: true/false` also checks each one\'s '
-               'stability'),
+               'multistart root finding at 3 points; where the conditions are polynomial (after '
+               'factors that never vanish are removed) the count is certified exactly by a '
+               'Gröbner basis and real-root isolation at a rational point, otherwise it is a '
+               'lower bound and the outcome says so; `stable: true/false` also checks each '
+               'one\'s stability'),
           keys={"search": {"oneOf": [REGION, {"type": "array", "minItems": 1,
                                                "items": REGION}]},
                 "rates": POINT, "momenta": POINT, "stable": {"type": "boolean"}})
@@ -93,11 +96,20 @@ def check_equilibrium_count(ctx: Context, val) -> Verdict:
     conds, unknowns, eq = steady.steady_conditions(ctx.system, rates, momenta)
     want = ctx.part.data.get("stable")
     counts = []
+    certified = 0
     for _ in range(3):
         pt = ctx.sampler.draw()
-        roots = roots_in(conds, unknowns, pt, _boxes(ctx, pt, unknowns))
+        boxes = _boxes(ctx, pt, unknowns)
+        roots = roots_in(conds, unknowns, pt, boxes)
         counts.append(len(roots))
         where = "; ".join("(" + ", ".join(f"{x:.5g}" for x in r) + ")" for r in roots[:6])
+        exact = certified_count(conds, unknowns, pt, boxes)
+        if exact is not None:
+            certified += 1
+            if exact[0] != val:
+                return Verdict(False, "exact(real-root isolation)",
+                               f"exactly {exact[0]} in the region at the rational point "
+                               f"{_fmt(exact[1])} (the search found {len(roots)}: {where})")
         if len(roots) != val:
             return Verdict(False, "numeric(root search)",
                            f"found {len(roots)} in the region: {where}")
@@ -108,7 +120,19 @@ def check_equilibrium_count(ctx: Context, val) -> Verdict:
                     at = ", ".join(f"{x:.5g}" for x in r)
                     return Verdict(False, "numeric(root search)", f"the one at ({at}) is {got}")
     how = "" if want is None else f", each {'stable' if want else 'unstable'}"
-    return Verdict(True, f"numeric(root search, 3 points{how})", f"counts {counts}")
+    if certified:
+        power = (f"exactly {val} (real-root isolation of the polynomial conditions at "
+                 f"{certified} rational points)")
+    else:
+        power = (f"at least {val} (multistart search at 3 points; the conditions are not "
+                 "polynomial, so others could hide: a lower bound)")
+    return Verdict(True, f"numeric(root search, 3 points{how})", f"counts {counts}",
+                   power=power + how)
+
+
+def _fmt(pt: dict) -> str:
+    return "{" + ", ".join(f"{k}={v}" for k, v in sorted(pt.items(), key=lambda kv: str(kv[0]))
+                           [:8]) + "}"
 
 
 @quantity('secular_growth',
