@@ -67,6 +67,7 @@ ENERGY_NAMES = ("energy", "jacobi", "E", "h")  # the energy function (Jacobi's i
                'function up to an additive constant), so a constant factor fails; a bare '
                '"this is conserved" is a claim any function of it satisfies too (so its '
                'multiples pass), and the verdict says so'),
+          names=lambda ctx: _with_energy_names(ctx),
           equivalent=("function",))
 def check_conserved(ctx: Context, val) -> Verdict:
     """d/dt of each book expression vanishes along the motion ('= const' may be written);
@@ -110,6 +111,15 @@ def check_conserved(ctx: Context, val) -> Verdict:
                          "of one (a multiple, say) is conserved too and passes")
         verdict.detail = "; ".join(notes + ([verdict.detail] if verdict.detail else []))
     return verdict
+
+
+def _with_energy_names(ctx: Context) -> dict:
+    """The part's names and the energy function's (E, h, energy, jacobi) where the problem
+    does not use them: a book value may name the quantity it gives."""
+    out = dict(ctx.names)
+    for n in ENERGY_NAMES:
+        out.setdefault(n, sp.Symbol(n, real=True))
+    return out
 
 
 def _named(ctx: Context, text: str, sub: tuple) -> tuple[sp.Expr, bool, str]:

@@ -10,7 +10,7 @@ import sympy as sp
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine import perturbation
 from mechbook.engine.linear import LinearSystem
-from mechbook.errors import UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.verify.compare import Verdict, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registry import EXPR, LIMIT, quantity
@@ -132,16 +132,28 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
 
 def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
     def error(pt) -> float:
-        eng = [float(w) for w in perturbation.precise_frequencies(lin, pt)]
-        worst = 0.0
-        for b in numbers(book, pt):  # one-to-one: each engine frequency matches once
-            if not eng or not np.isfinite(b):  # a book value that is not real here fails
-                return float("inf")
-            nearest = min(range(len(eng)), key=lambda i, b=b: abs(eng[i] - b))
-            worst = max(worst, abs(eng.pop(nearest) - b) / max(abs(b), 1e-300))
-        return worst
+        """The worst relative difference, book against engine, both at 50 digits (the walk
+        toward the limit goes where the difference is far below double precision)."""
+        import mpmath
 
-    return asymptotic(ctx, error)
+        with mpmath.workdps(perturbation.DPS):
+            eng = list(perturbation.precise_frequencies(lin, pt))
+            worst = mpmath.mpf(0)
+            for b in book:  # one-to-one: each engine frequency matches once
+                try:
+                    v = evaluate_mp(b, pt, perturbation.DPS)
+                except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
+                    return float("inf")
+                if abs(mpmath.im(v)) > mpmath.mpf(10) ** -40 * max(1, abs(v)):
+                    return float("inf")  # a book value that is not real here fails
+                v = mpmath.re(v)
+                if not eng:
+                    return float("inf")
+                nearest = min(range(len(eng)), key=lambda i, v=v: abs(eng[i] - v))
+                worst = max(worst, abs(eng.pop(nearest) - v) / max(abs(v), mpmath.mpf(10) ** -300))
+            return float(worst)
+
+    return asymptotic(ctx, error, floor=1e-40)
 
 
 LIMIT_STEPS = tuple(10.0 ** (-1 - k / 2) for k in range(7))  # 1e-1 ... 1e-4, half decades
@@ -149,15 +161,20 @@ MORE_STEPS = tuple(10.0 ** (-4.5 - k / 2) for k in range(12))  # on to 1e-10 whi
 SMALL_ENOUGH = 1e-9  # an error this small ends the walk toward the limit
 
 
-def asymptotic(ctx: Context, error) -> Verdict:
+def asymptotic(ctx: Context, error, floor: float | None = None) -> Verdict:
     """`limit: {parameter, to, order}`: the book's formula holds in a limit of the
     parameters, to the stated order. The error `error(point)` (relative, from values exact
     to 50 digits) is measured as the parameter goes to 0 or ∞ in half decades from 1e-1 of
-    its value, to 1e-4 and on (to 1e-10 at most) until the error is below 1e-9; over the
-    last three steps it must fall like the parameter to a power of at least order + 0.5 (a
+    its value, to 1e-4 and on (to 1e-10 at most, or as far as the engine computes) until
+    the error is below 1e-9 of ε^order (the size of the last term claimed); over the last
+    three steps it must fall like the parameter to a power of at least order + 0.5 (a
     formula right to order k errs like ε^(k+1); one wrong at order k errs like ε^k), ending
     below 1e-3 — or vanish (below 1e-30) there: exact. Walking on until the error is tiny
-    is what rejects a leading coefficient wrong by 1e-6: its error stops falling there."""
+    against the claimed order's term is what rejects a coefficient of that order wrong by
+    1e-6: its error stops falling faster than ε^k there. `floor` is the error function's
+    resolution (1e-13 for one computed in double precision, 1e-40 at 50 digits): the walk
+    goes past 1e-4 only when it is given, stops at it, and judges the steps above it; an
+    error function with no stated floor (a simulation's) stops at 1e-4."""
     spec = ctx.part.data["limit"]
     name = spec["parameter"]
     if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
@@ -168,14 +185,28 @@ def asymptotic(ctx: Context, error) -> Verdict:
     base = ctx.sampler.default()
     errors = []
     steps = []
-    for eps in LIMIT_STEPS + MORE_STEPS:
-        if eps in MORE_STEPS and not (errors[-1] >= SMALL_ENOUGH):
-            break  # small enough (or not finite: judged below)
+    for eps in LIMIT_STEPS + (MORE_STEPS if floor is not None else ()):
+        if eps in MORE_STEPS and not (errors[-1] / steps[-1] ** order >= SMALL_ENOUGH
+                                      and errors[-1] >= 10 * floor):
+            break  # small enough against the claimed order's term, or at the resolution
         pt = dict(base)
         pt[sym] = sp.Float(base[sym] * eps if to_zero else base[sym] / eps, 30)
         pt = ctx.sampler.complete(pt)
-        errors.append(float(error(pt)) if pt is not None else float("nan"))
+        if eps in MORE_STEPS:  # beyond the usual walk: where the engine gives up, stop
+            try:
+                e = float(error(pt)) if pt is not None else float("nan")
+            except (MechbookError, ZeroDivisionError, ValueError, OverflowError):
+                break
+            if not np.isfinite(e):
+                break
+            errors.append(e)
+        else:
+            errors.append(float(error(pt)) if pt is not None else float("nan"))
         steps.append(eps)
+    if floor is not None:  # the steps at the error function's resolution say nothing
+        while len(errors) > 3 and errors[-1] < 10 * floor and steps[-1] in MORE_STEPS:
+            errors.pop()
+            steps.pop()
     tail = errors[-3:]
     shown = ", ".join(f"{e:.2g}" for e in errors)
     if not all(np.isfinite(tail)):
@@ -301,7 +332,7 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
             worst = max(worst, best)
         return worst
 
-    return asymptotic(ctx, error)
+    return asymptotic(ctx, error, floor=1e-13)
 
 
 def _near(values, x, rtol=1e-8):

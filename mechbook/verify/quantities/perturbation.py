@@ -260,7 +260,7 @@ def check_perturbation(ctx: Context, val):
         with mpmath.workdps(pert.DPS):
             return float(_error(ctx, kind, book, T, names, f, mode))
 
-    return asymptotic(ctx, error)
+    return asymptotic(ctx, error, floor=1e-40)
 
 
 def _error(ctx, kind, book, T: _Tables, names, f, mode):
