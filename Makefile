@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test lint fuzz report bench bench-check bench-sweep clean
+.PHONY: check test lint fuzz report bench bench-check bench-sweep bench-power clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -46,6 +46,11 @@ bench-sweep: $(STAMP)  ## 10^6-point sweeps: points per second, float64 vs 30 di
 	mkdir -p results/bench
 	$(BIN)/python bench/sweep.py --csv results/bench/sweep.csv > results/bench/sweep.txt \
 		&& cat results/bench/sweep.txt
+
+bench-power: $(STAMP)  ## the checker's power: small wrong answers rejected, per quantity, before/after -> docs/answers.md (~1 h)
+	mkdir -p results/bench
+	$(BIN)/python bench/power.py --docs --json results/bench/power.jsonl \
+		--out results/bench/power.md
 
 lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench

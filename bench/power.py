@@ -72,8 +72,6 @@ def _put(data, path, value):
 
 # ---- measuring one tree (run in a subprocess with that tree first on sys.path) ----------
 def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> None:
-    import sympy as sp
-
     from mechbook.core.timeout import Timeout, time_limit
     from mechbook.engine.analysis import Analysis
     from mechbook.verify.answers import Part, load_answers
@@ -86,7 +84,6 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
     except ImportError:  # pragma: no cover - a much older layout
         raise SystemExit("the measured tree has no mechbook.model.catalog") from None
     mutate = _mutate_module()
-    counts = {"equilibrium_count", "mode_count", "secular_growth"}
     with open(out, "a") as sink:
         for f in files:
             key = load_answers(f)
@@ -105,8 +102,7 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                 root = ("erratum", "corrected") if erratum else ("book",)
                 value = _get(part.data, root)
                 try:
-                    ctx = Context(analysis, part)
-                    sizes = _sizes(ctx, value, root, mutate, sp)
+                    sizes = mutate.shift_sizes(Context(analysis, part), value, root)
                 except Exception:  # noqa: BLE001 - a size is only for the shift mutants
                     sizes = {}
                 est = part.data.get("estimate")
@@ -115,7 +111,7 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                 seen_discrete = False
                 for delta in classes:
                     for m in mutate.part_mutants(value, root, names, delta, sizes,
-                                                 counts=part.quantity in counts):
+                                                 counts=part.quantity in mutate.COUNTS):
                         if m.kind == "discrete":
                             if seen_discrete:
                                 continue
@@ -140,41 +136,6 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                         sink.flush()
                     seen_discrete = True
                 sink.write(json.dumps({**base, "done": time.process_time() - t0}) + "\n")
-
-
-def _sizes(ctx, value, root, mutate, sp) -> dict:
-    """|leaf| at the default point (3 significant digits, exact) for the shift mutants: an
-    expression's value, an equation's cancellation scale, a relation's last right side."""
-    from mechbook.verify.compare import value_and_scale
-    from mechbook.verify.context import strip_const
-
-    point = ctx.sampler.default()
-    out = {}
-    for path, leaf in mutate.leaves(value, root):
-        if isinstance(leaf, bool) or not isinstance(leaf, str | int | float):
-            continue
-        if isinstance(leaf, str) and leaf in mutate.WORDS:
-            continue
-        text = str(leaf)
-        try:
-            if any(c in text for c in "<>"):
-                expr = ctx.parse(text, path, relation=True)
-                rels = sorted(expr.atoms(sp.core.relational.Relational), key=str)
-                expr = rels[-1].rhs if rels else None
-            elif len(mutate._split_single_equals(text)) == 2:
-                expr = ctx.parse(strip_const(text), path, equation=True)
-            else:
-                expr = ctx.parse(text, path)
-        except Exception:  # noqa: BLE001 - e.g. a leaf that names an operator
-            continue
-        if expr is None or not isinstance(expr, sp.Basic):
-            continue
-        free = {s: 0.5 for s in expr.free_symbols if s not in point}  # motion variables
-        v, scale = value_and_scale(expr, {**point, **free})
-        size = abs(v) if abs(v) > 1e-12 * max(scale, 1e-300) else scale
-        if size == size and 0 < size < 1e30:
-            out[path] = Fraction(f"{size:.3g}")
-    return out
 
 
 # ---- equivalence of survivors (in this tree) ---------------------------------------------

@@ -20,7 +20,9 @@ from mechbook.model.catalog import problem_path
 from mechbook.model.problem import load_problem
 from mechbook.verify.answers import Part, load_answers
 from mechbook.verify.checker import check_part, check_problem
-from mechbook.verify.mutate import part_mutants, shifted, text_mutants
+from mechbook.verify.context import Context
+from mechbook.verify.mutate import COUNTS, part_mutants, shift_sizes, shifted, text_mutants
+from mechbook.verify.power import same_meaning
 
 ROOT = Path(__file__).resolve().parents[1]
 RELATION_QUANTITIES = ("stability_condition", "steady_exists", "stability")
@@ -39,6 +41,7 @@ def _relation_parts() -> list[tuple[Path, str]]:
 
 
 RELATIONS = _relation_parts()
+ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
 _ANALYSES: dict = {}
 
 
@@ -204,3 +207,55 @@ def test_discrete_values_get_their_nearest_wrong_value():
     assert ("count + 1", 4) in got and ("count - 1", 2) in got
     assert ("flag flipped", False) in got
     assert ("stable -> unstable", "unstable") in got
+
+
+# ---- the 1e-2 class over every answer part of both books ----------------------------------
+def _get(data, path):
+    for p in path:
+        data = data[p]
+    return data
+
+
+def _put(data, path, value):
+    _get(data, path[:-1])[path[-1]] = value
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("answer_file", ANSWER_FILES,
+                         ids=[f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES])
+def test_every_one_percent_mutant_fails(answer_file: Path):
+    """Every number and every parameter occurrence of every passing part's value scaled by
+    1.01, the value shifted by 1 % of its size, a count moved by one, a flag or verdict
+    flipped (a part with `estimate:` at twice its stated precision): the checker must reject
+    each mutant, unless it provably means the same (mechbook.verify.power.same_meaning: a
+    factor that cancels, a constant the quantity is defined up to, a relation with the same
+    truth everywhere). The same mutants as bench/power.py's δ = 1e-2 class."""
+    key, analysis = _load(answer_file)
+    names = set(analysis.problem.parameters) | set(key.symbols) | set(
+        key.doc.data.get("abbreviations") or {})
+    survivors, tried = [], 0
+    for part in key.parts:
+        original = check_part(analysis, part)
+        if original.status not in ("pass", "erratum"):
+            continue
+        erratum = "erratum" in part.data
+        root = ("erratum", "corrected") if erratum else ("book",)
+        value = _get(part.data, root)
+        ctx = Context(analysis, part)
+        est = part.data.get("estimate")
+        delta = Fraction(2 * est["rtol"]).limit_denominator(10**9) if est else Fraction(1, 100)
+        for m in part_mutants(value, root, names, delta, shift_sizes(ctx, value, root),
+                              counts=part.quantity in COUNTS):
+            tried += 1
+            data = copy.deepcopy(part.data)
+            _put(data, m.path, m.value)
+            got = check_part(analysis, Part(key, part.index, data))
+            killed = got.status != "erratum" if erratum else got.status in ("fail", "error")
+            if killed:
+                continue
+            why = same_meaning(ctx, m.path, _get(part.data, m.path), m.value)
+            if not why:
+                survivors.append(f"{part.name} [{part.quantity}] {'/'.join(map(str, m.path))}: "
+                                 f"{m.label}: {got.status} {got.detail[:200]}")
+    assert not survivors, f"{len(survivors)} of {tried} mutants passed:\n  " + \
+        "\n  ".join(survivors)

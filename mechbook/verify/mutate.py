@@ -21,6 +21,7 @@ from fractions import Fraction
 from mechbook.model.expr import _split_single_equals
 
 WORDS = ("stable", "unstable", "marginal")
+COUNTS = ("equilibrium_count", "mode_count", "secular_growth")  # integers that are counts
 
 
 @dataclass(frozen=True)
@@ -176,3 +177,42 @@ def part_mutants(value, root: tuple, names: set[str], delta: Fraction,
             if new is not None:
                 yield Mutant(path, f"shifted by {float(delta):g}×{float(size):.3g}", new,
                              "shift")
+
+
+def shift_sizes(ctx, value, root: tuple) -> dict:
+    """|leaf| at the default point (3 significant digits, exact) for the shift mutants: an
+    expression's value, an equation's cancellation scale, a relation's last right side.
+    (Imports only what every tree since 00b0b7e has: bench/power.py loads this module by
+    path to measure an earlier tree with the same mutants.)"""
+    import sympy as sp
+
+    from mechbook.verify.compare import value_and_scale
+    from mechbook.verify.context import strip_const
+
+    point = ctx.sampler.default()
+    out = {}
+    for path, leaf in leaves(value, root):
+        if isinstance(leaf, bool) or not isinstance(leaf, str | int | float):
+            continue
+        if isinstance(leaf, str) and leaf in WORDS:
+            continue
+        text = str(leaf)
+        try:
+            if any(c in text for c in "<>"):
+                expr = ctx.parse(text, path, relation=True)
+                rels = sorted(expr.atoms(sp.core.relational.Relational), key=str)
+                expr = rels[-1].rhs if rels else None
+            elif len(_split_single_equals(text)) == 2:
+                expr = ctx.parse(strip_const(text), path, equation=True)
+            else:
+                expr = ctx.parse(text, path)
+        except Exception:  # noqa: BLE001 - e.g. a leaf that names an operator, not a value
+            continue
+        if expr is None or not isinstance(expr, sp.Basic):
+            continue
+        free = {s: 0.5 for s in expr.free_symbols if s not in point}  # motion variables
+        v, scale = value_and_scale(expr, {**point, **free})
+        size = abs(v) if abs(v) > 1e-12 * max(scale, 1e-300) else scale
+        if size == size and 0 < size < 1e30:
+            out[path] = Fraction(f"{size:.3g}")
+    return out
