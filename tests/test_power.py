@@ -259,3 +259,20 @@ def test_every_one_percent_mutant_fails(answer_file: Path):
                                  f"{m.label}: {got.status} {got.detail[:200]}")
     assert not survivors, f"{len(survivors)} of {tried} mutants passed:\n  " + \
         "\n  ".join(survivors)
+
+
+# ---- a region of phase space, at its boundary ----------------------------------------------
+@pytest.mark.parametrize("new, status", [
+    ("-b < p_z + m*g*t < b", "pass"),
+    ("-(b*(1000001/1000000)) < p_z + m*g*t < b", "fail"),  # one side moved by 1e-6 of b
+    ("-b < p_z + (m*(1000001/1000000))*g*t < b", "fail"),  # the shift moved by 1e-6
+])
+def test_phase_region_boundary(new, status):
+    key, analysis = _load(ROOT / "answers" / "symon" / "09-33.yaml")
+    part = next(p for p in key.parts if p.name == "region")
+    data = copy.deepcopy(part.data)
+    data["book"][0] = new
+    got = check_part(analysis, Part(key, part.index, data))
+    assert got.status == status, got.detail
+    if status == "pass":
+        assert "boundary at" in got.power, got.power

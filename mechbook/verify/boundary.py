@@ -54,14 +54,16 @@ class BoundaryResult:
 
 
 class Ray:
-    """Parameter points along p(t): log-linear in positive symbols, linear in the others."""
+    """Parameter points along p(t): log-linear in positive symbols, linear in the others
+    (in units of `scales[symbol]`, by default max(1, |value|))."""
 
     def __init__(self, sampler: Sampler, origin: dict, direction: np.ndarray,
-                 symbols: list[sp.Symbol]):
+                 symbols: list[sp.Symbol], scales: dict | None = None):
         self.sampler = sampler
         self.origin = origin
         self.symbols = symbols
         self.direction = direction
+        self.scales = scales or {}
 
     def point(self, t) -> dict | None:
         """The admissible point at t (None where a condition fails or a derived symbol is
@@ -71,7 +73,9 @@ class Ray:
             pt = dict(self.origin)
             for sym, d in zip(self.symbols, self.direction, strict=True):
                 x0 = mpmath.mpf(self.origin[sym]._mpf_)
-                if sym.is_positive:
+                if sym in self.scales:
+                    x = x0 + t * d * mpmath.mpf(self.scales[sym])
+                elif sym.is_positive:
                     x = x0 * mpmath.exp(t * d)
                 else:
                     x = x0 + t * d * max(1, abs(x0))
@@ -238,27 +242,34 @@ def _engine_crossing(judge: _Judge, a: float, b: float) -> str:
 
 
 def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
-            words: tuple[str, str] = ("true", "false"), seed: int = 20261125) -> BoundaryResult:
+            words: tuple[str, str] = ("true", "false"), seed: int = 20261125,
+            scales: dict | None = None, rays: int = RAYS, grid: int = GRID,
+            origins: Callable[[], dict] | None = None) -> BoundaryResult:
     """Does the book's `cond` hold exactly where `classify` says True? `words` name the two
-    verdicts in messages (e.g. 'stable', 'unstable')."""
+    verdicts in messages (e.g. 'stable', 'unstable'). The rays vary the sampler's free
+    symbols (not fixed, not derived); `scales` ({symbol: length}) sets a symbol's unit
+    along a ray (a phase-space coordinate in units of its region's size, say); `rays` and
+    `grid` trade cost for coverage where one verdict is expensive (a flow integrated);
+    `origins` draws each ray's starting point (default: the sampler's draw)."""
     rng = np.random.default_rng(seed)
     symbols = sorted((s for s in sampler.base if s not in sampler.fixed
                       and s not in sampler.derived), key=lambda s: s.name)
     if not symbols:
         return BoundaryResult(False, detail="no free parameter to vary")
     atoms = _atoms(cond)
-    ts = np.linspace(-SPAN, SPAN, GRID)
+    ts = np.linspace(-SPAN, SPAN, grid)
     res = BoundaryResult(True)
     seen = {True: 0, False: 0}
+    n_rays = rays
     rays = 0
-    while rays < RAYS + MORE_RAYS:
-        if rays >= RAYS and res.crossings + res.tangencies > 0:
+    while rays < n_rays + MORE_RAYS:
+        if rays >= n_rays and res.crossings + res.tangencies > 0:
             break
         rays += 1
-        origin = sampler.draw()
+        origin = origins() if origins is not None else sampler.draw()
         d = rng.normal(size=len(symbols))
         d /= np.linalg.norm(d)
-        ray = Ray(sampler, origin, d, symbols)
+        ray = Ray(sampler, origin, d, symbols, scales)
         judge = _Judge(cond, classify, ray)
         grid = [judge.both(t, False) for t in ts]
         for b, e, pt in grid:

@@ -8,7 +8,7 @@ import sympy as sp
 
 from mechbook.core.compile import compile_batch
 from mechbook.errors import UnsupportedError
-from mechbook.verify.compare import Verdict, value
+from mechbook.verify.compare import Sampler, Verdict, value
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registry import EXPR, REGION, quantity
 
@@ -201,5 +201,52 @@ def check_phase_region(ctx: Context, val) -> Verdict:
     if inside == 0 or inside == judged:
         return Verdict(False, "numeric", "the sampled points never straddle the region's "
                        "boundary; the check cannot discriminate")
+    edge = _region_boundary(ctx, conds, variables, bounds, time, flow)
+    if not edge.ok:
+        return Verdict(False, "boundary", edge.detail)
     return Verdict(True, f"numeric({PHASE_POINTS} points x {REGION_SAMPLES} phase points, "
-                   "flow DOP853 rtol 1e-12)", f"{inside} of {judged} judged points inside")
+                   "flow DOP853 rtol 1e-12) and boundary",
+                   f"{inside} of {judged} judged points inside; {edge.detail}",
+                   power=f"{judged} phase points away from the boundary; "
+                         f"{edge.power}")
+
+
+def _region_boundary(ctx: Context, conds: list, variables: list, bounds, time, flow
+                     ) -> Verdict:
+    """The book's region decided at its boundary (mechbook.verify.boundary) at one parameter
+    point: rays through phase space, in units of the region's size, cross the book's
+    inequalities; just inside and just outside each crossing (1e-8 of the size) the flow
+    carried back must land inside and outside the initial box. Random points judge only
+    away from the boundary (1e-6), so a region moved by less would pass them."""
+    from mechbook.engine.phase import image_bounds, in_box
+    from mechbook.verify import boundary
+
+    pt = ctx.sampler.draw()
+    lo, hi, tv = _phasenumbers(ctx, bounds, time, pt)
+    ilo, ihi = image_bounds(flow, pt, lo, hi, tv)
+    clo, chi = np.minimum(lo, ilo), np.maximum(hi, ihi)
+    n = len(ctx.system.q)
+    params = {k: v for k, v in pt.items() if k not in variables}
+    centre = {v: sp.Float((a + b) / 2, 30) for v, a, b in zip(variables, clo, chi, strict=True)}
+    scales = {v: float((b - a) / 2) for v, a, b in zip(variables, clo, chi, strict=True)}
+    space = Sampler({**params, **centre}, fixed=list(params))
+    rng = np.random.default_rng(20261126)
+
+    def origin() -> dict:
+        return {**params, **{v: sp.Float(rng.uniform(a, b), 30)
+                             for v, a, b in zip(variables, clo, chi, strict=True)}}
+
+    def inside(point: dict, near: bool) -> bool | None:
+        X = np.array([[float(point[v]) for v in variables]])
+        try:
+            q0, p0 = flow.map(params, X[:, :n], X[:, n:], 0.0, tv)
+        except UnsupportedError:
+            return None
+        got, close = in_box(np.column_stack((q0, p0)), lo, hi,
+                            1e-11 if near else REGION_MARGIN)
+        return None if close[0] else bool(got[0])
+
+    cond = sp.And(*[c.subs(ctx.system.t, sp.Float(tv, 30)) for c in conds])
+    result = boundary.compare(cond, inside, space, ("inside", "outside"), scales=scales,
+                              rays=4, grid=24, origins=origin)
+    return boundary.verdict(result)
