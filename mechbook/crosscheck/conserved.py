@@ -28,15 +28,16 @@ SEARCH_SECONDS = 3.0  # for a stable equilibrium to start near (no part asked fo
 
 def book_integrals(ctx) -> list[sp.Expr]:
     """The part's conserved expressions in (q, q̇, t), or [] when it states none."""
-    from mechbook.verify.context import strip_const
+    from mechbook.verify.context import split_named
 
     part, data = ctx.part, ctx.part.data
     if "about" in data or "steady" in data or "at" in data or "erratum" in data:
         return []
     val = data.get("book")
-    if part.quantity == "conserved":
+    if part.quantity == "conserved":  # a named one (`p_psi = ...`): its value
         vals = val if isinstance(val, list) else [val]
-        return [ctx.parse(strip_const(v), ("book",)) for v in vals]
+        return [ctx.parse(split_named(v)[1], ("book", i) if isinstance(val, list) else ("book",))
+                for i, v in enumerate(vals)]
     if part.quantity == "expression" and data.get("of") in ("hamiltonian", "energy_function"):
         if ctx.system.lagrangian.has(ctx.system.t) or any(f != 0 for f in ctx.system.forces):
             return []  # h is conserved only for an autonomous, conservative system

@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from mechbook.model.expr import _split_single_equals
 from mechbook.verify.compare import Verdict, all_vanish
-from mechbook.verify.context import Context, linear_accelerations, strip_const
+from mechbook.verify.context import Context, linear_accelerations, split_named
 from mechbook.verify.registry import quantity
 
 
@@ -81,11 +80,10 @@ def check_conserved(ctx: Context, val) -> Verdict:
         acc = dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True))
     for i, v in enumerate(vals):
         sub = ("book", i) if isinstance(val, list) else ("book",)
-        text = strip_const(v)
-        pieces = _split_single_equals(text) if isinstance(text, str) else [text]
-        if len(pieces) == 2:
-            engine, up_to_constant, what = _named(ctx, pieces[0], sub)
-            e = ctx.parse(pieces[1], sub)
+        name, text = split_named(v)
+        if name is not None:
+            engine, up_to_constant, what = _named(ctx, name, sub)
+            e = ctx.parse(text, sub)
             diff = e - engine
             if up_to_constant:  # the energy: V (so h) is defined up to a constant
                 motion = list(ctx.system.q) + list(ctx.system.qd) + [ctx.system.t]
@@ -94,9 +92,9 @@ def check_conserved(ctx: Context, val) -> Verdict:
                 checks = [diff]
             same = all_vanish(checks, ctx.sampler) if checks else None
             if same is not None and not same.ok:
-                return Verdict(False, same.method, f"{pieces[0].strip()} is {what}: the book's "
+                return Verdict(False, same.method, f"{name} is {what}: the book's "
                                f"expression differs from the engine's ({same.detail})")
-            named.append(f"{pieces[0].strip()} ({what})")
+            named.append(f"{name} ({what})")
         else:
             e = ctx.parse(text, sub)
         if not (e.free_symbols & set(ctx.dyn.q + ctx.dyn.qd)):
