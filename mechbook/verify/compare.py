@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from mechbook.core.numeval import NotNumeric, evaluate, holds
+from mechbook.core.numeval import NotNumeric, evaluate, evaluate_resolved, holds
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.records import NUMERIC, ProofPolicy
 
@@ -177,6 +177,14 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
             continue
         valid += 1
         rel = abs(v) / scale if scale > 0 else abs(v)
+        if rtol == EXACT_RTOL and AMBIGUOUS * scale < abs(v) <= rtol * scale:
+            # above 30 digits' rounding but under the tolerance: a real residual hidden by
+            # what cancels? Decided with the precision raised until it stands clear
+            deeper = _resolved(expr, point)
+            if deeper:
+                return Verdict(False, f"numeric({valid} points, to {DEEP_DIGITS} digits)",
+                               f"residual {abs(deeper):.3g} at {_fmt(point)} (below 30 "
+                               f"digits' reach: {rel:.2g} of the terms that cancel)")
         worst = max(worst, rel)
         if rel > rtol:
             return Verdict(False, f"numeric({valid} points)",
@@ -188,6 +196,19 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
     return Verdict(True, f"numeric({valid} points, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=f"{valid} points at {DIGITS} digits, residual ≤ {rtol:g} of its scale")
+
+
+AMBIGUOUS = 1e-27  # a residual above this fraction of its scale is more than rounding
+DEEP_DIGITS = 240  # how far the precision is raised to decide such a residual
+
+
+def _resolved(expr: sp.Basic, point: dict) -> complex:
+    """expr at `point` with the precision raised (60 to DEEP_DIGITS digits) until the value
+    stands clear of what cancels in it; 0 if it never does (zero to that precision)."""
+    try:
+        return complex(evaluate_resolved(expr, point, 60, DEEP_DIGITS))
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+        return 0j
 
 
 def _residual_rtol(expr: sp.Basic, sampler: Sampler) -> float:
@@ -235,8 +256,14 @@ def combine(verdicts: Sequence[Verdict]) -> Verdict:
 
 
 def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
-    """Do a and b agree identically?"""
+    """Do a and b agree identically? Exact expressions must agree to 1e-20 of what cancels
+    in a − b (30-digit arithmetic: a difference far below double precision, or between
+    values of 1e-30, still fails); an estimate, or an expression holding double-precision
+    numbers, to the sampler's relative tolerance."""
     variables = _free_variables([a, b], sampler.base)
+    diff = a - b
+    rtol = _residual_rtol(diff, sampler)
+    exact = rtol < sampler.rtol
     worst = 0.0
     valid = 0
     for _ in range(POINTS * 3):
@@ -246,20 +273,36 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
         va, vb = value(a, point), value(b, point)
         if not all(np.isfinite([va.real, va.imag, vb.real, vb.imag])):
             continue
+        if exact:
+            d, scale = value_and_scale(diff, point)
+            if not (np.isfinite(d.real) and np.isfinite(d.imag) and np.isfinite(scale)):
+                continue
+            rel = abs(d) / scale if scale > 0 else abs(d)
+            size = max(abs(va), abs(vb))
+            if rel <= rtol and abs(d) > rtol * size:
+                # zero against what cancels in a − b, not against the values themselves:
+                # decided with the precision raised until the difference stands clear
+                deeper = _resolved(diff, point)
+                if deeper and abs(deeper) > rtol * size:
+                    return Verdict(False, f"numeric({valid + 1} points, to {DEEP_DIGITS} "
+                                   "digits)", f"{_num(va)} vs {_num(vb)} differ by "
+                                   f"{abs(deeper):.3g} (relative {abs(deeper) / size:.2g}) "
+                                   f"at {_fmt(point)}")
+        else:
+            rel = abs(va - vb) / max(abs(va), abs(vb), 1e-300)
         valid += 1
-        rel = abs(va - vb) / max(abs(va), abs(vb), 1e-300)
         worst = max(worst, rel)
-        if rel > sampler.rtol and abs(va - vb) > 1e-25:
+        if rel > rtol:
             return Verdict(False, f"numeric({valid} points)",
-                           f"{_num(va)} vs {_num(vb)} at {_fmt(point)}")
+                           f"{_num(va)} vs {_num(vb)} (relative {rel:.2g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
-    if _prove(sampler, symbolic) and _symbolic_zero(a - b, sampler.policy.seconds):
+    if _prove(sampler, symbolic) and _symbolic_zero(diff, sampler.policy.seconds):
         return Verdict(True, "symbolic", power="proved symbolically")
-    return Verdict(True, f"numeric({valid} points, rtol {sampler.rtol:g})",
+    return Verdict(True, f"numeric({valid} points, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=(f"within the stated {sampler.rtol:.2g}" if sampler.rtol > RTOL else
-                          f"{valid} points at {DIGITS} digits, within {sampler.rtol:g}"))
+                          f"{valid} points at {DIGITS} digits, within {rtol:g}"))
 
 
 def _num(z: complex) -> str:
