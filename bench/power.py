@@ -20,7 +20,7 @@ quantity and δ (stdout, or --out FILE; --docs writes it into docs/answers.md be
 power markers) and every mutant as JSON lines (--json FILE). Never gates CI.
 
     python bench/power.py [--before REF | --no-before] [-j N] [--only ID ...] [--out F]
-                          [--docs] [--json F]
+                          [--docs] [--json F] [--from-json F]
 """
 
 from __future__ import annotations
@@ -153,8 +153,14 @@ def equivalence(records: list[dict]) -> dict:
     for r in records:
         by_problem[r["problem"]].append(r)
     for pid, rs in by_problem.items():
-        key = load_answers(answer_path(pid, ROOT))
-        analysis = Analysis(load_problem(problem_path(pid, ROOT)))
+        try:
+            key = load_answers(answer_path(pid, ROOT))
+            analysis = Analysis(load_problem(problem_path(pid, ROOT)))
+        except Exception as exc:  # noqa: BLE001 - undecided counts against the checker
+            for r in rs:
+                out[_id(r)] = ""
+                r["equivalence_error"] = f"{type(exc).__name__}: {exc}"[:200]
+            continue
         parts = {p.name: p for p in key.parts}
         for r in rs:
             part = parts[r["part"]]
@@ -263,6 +269,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path)
     ap.add_argument("--json", type=Path)
     ap.add_argument("--docs", action="store_true", help="write the table into docs/answers.md")
+    ap.add_argument("--from-json", type=Path, help="tables from an earlier run's --json "
+                    "records (no measuring)")
     args = ap.parse_args(argv)
     sys.path.insert(0, str(ROOT))
     from mechbook.model.catalog import all_ids, answer_path
@@ -271,6 +279,11 @@ def main(argv: list[str] | None = None) -> int:
     files = [answer_path(i, ROOT) for i in ids]
     deltas = list(DELTAS)
     started = time.time()
+    if args.from_json:
+        records = [json.loads(line) for line in args.from_json.read_text().splitlines() if line]
+        after = [r for r in records if r.get("tree") != "before"]
+        before = [r for r in records if r.get("tree") == "before"]
+        return _report(args, after, before, started)
     with tempfile.TemporaryDirectory(prefix="mechbook-power-") as tmp:
         tmp = Path(tmp)
         after = run_tree(ROOT, files, args.jobs, tmp, "after", deltas)
@@ -285,15 +298,26 @@ def main(argv: list[str] | None = None) -> int:
             finally:
                 subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force",
                                 str(old)], check=False)
+    for r in before:  # the same answer files, by their path in this tree
+        r["tree"] = "before"
+    if args.json:  # the measurements first: an equivalence step that fails loses nothing
+        with open(args.json, "w") as f:
+            for r in before + after:
+                f.write(json.dumps(r, default=str) + "\n")
+    return _report(args, after, before, started)
+
+
+def _report(args, after: list[dict], before: list[dict], started: float) -> int:
+    """Equivalence of the survivors, the tables, and where they go."""
     mutants_after = [r for r in after if "label" in r]
     mutants_before = [r for r in before if "label" in r]
-    for r in mutants_before:  # the same answer files, by their path in this tree
-        r["tree"] = "before"
     unkilled = {_id(r): r for r in mutants_after + mutants_before if not r["killed"]}
     equiv = equivalence(list(unkilled.values()))
     seconds = time.time() - started
-    report = [f"Measured {time.strftime('%Y-%m-%d')} by `bench/power.py` in {seconds:.0f} s "
-              f"({args.jobs} processes): {len(mutants_after)} mutants of "
+    when = (f"Measured {time.strftime('%Y-%m-%d')} by `bench/power.py` in {seconds:.0f} s "
+            f"({args.jobs} processes)" if not args.from_json else
+            f"Tables by `bench/power.py --from-json` from the records in {args.from_json.name}")
+    report = [f"{when}: {len(mutants_after)} mutants of "
               f"{len({(r['problem'], r['part']) for r in mutants_after})} parts.", ""]
     if mutants_before:
         report += [table(mutants_before, equiv, f"before ({args.before})"), ""]
@@ -304,9 +328,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.out:
         args.out.write_text(text)
     print(text)
-    if args.json:
+    if args.json and not args.from_json:
         with open(args.json, "w") as f:
-            for r in mutants_before + mutants_after:
+            for r in before + after:
                 r["equivalent"] = equiv.get(_id(r), "")
                 f.write(json.dumps(r, default=str) + "\n")
     if args.docs:
