@@ -152,9 +152,10 @@ def decide(names_at: Names, build: Build, symbols: Sequence[sp.Symbol],
         return verdict
     if generic is not None and _proved(generic, sampler):
         return Verdict(True, "symbolic", f"proved for the generic objects; also "
-                       f"{verdict.method}")
+                       f"{verdict.method}", power="proved for the generic objects")
     return Verdict(True, verdict.method, verdict.detail or
-                   ("no symbolic proof within the time allowed" if generic is None else ""))
+                   ("no symbolic proof within the time allowed" if generic is None else ""),
+                   power=verdict.power)
 
 
 def _evaluate(st: Statement, symbols, sampler: Sampler) -> Verdict:
@@ -183,12 +184,19 @@ def _evaluate(st: Statement, symbols, sampler: Sampler) -> Verdict:
     if valid == 0:
         return Verdict(False, "numeric", "the statement does not evaluate at any instance")
     if constant:
-        return Verdict(True, "exact" if exact else "numeric(30 digits)", "numbers only")
+        return Verdict(True, "exact" if exact else "numeric(30 digits)", "numbers only",
+                       power="exact" if exact else _THIRTY)
     return Verdict(True, f"exact({valid} instances)" if exact else
-                   f"numeric({valid} instances, 30 digits)")
+                   f"numeric({valid} instances, 30 digits)",
+                   power=(f"exact rational arithmetic at {valid} instances" if exact else
+                          f"{valid} instances, {_THIRTY}"))
 
 
-def _per_instance(names_at: Names, build: Build, symbols, sampler: Sampler) -> Verdict:
+_THIRTY = "30 digits, each residual to 1e-10 of what cancels in it"
+
+
+def _per_instance(
+names_at: Names, build: Build, symbols, sampler: Sampler) -> Verdict:
     """Built anew from each rational instance (numbers in, numbers out): compared exactly
     when the numbers are rational, else to 30 digits."""
     valid = 0
@@ -213,7 +221,9 @@ def _per_instance(names_at: Names, build: Build, symbols, sampler: Sampler) -> V
     if valid == 0:
         return Verdict(False, "numeric", "the statement does not evaluate at any instance")
     return Verdict(True, f"exact({valid} instances)" if exact else
-                   f"numeric({valid} instances, 30 digits)")
+                   f"numeric({valid} instances, 30 digits)",
+                   power=(f"exact rational arithmetic at {valid} instances" if exact else
+                          f"{valid} instances, {_THIRTY}"))
 
 
 def _finite(v) -> bool:

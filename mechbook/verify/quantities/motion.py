@@ -132,4 +132,6 @@ def check_motion(ctx: Context, val) -> Verdict:
                     return Verdict(False, "numeric", f"{name}(t={tv}) = {got:.10g}, "
                                    f"engine {expected:.10g}")
     how = "driven, DOP853 rtol 1e-13" if lin.driven else "matrix exponential"
-    return Verdict(True, f"numeric(4 points x 4 times, linear initial-value solution, {how})")
+    return Verdict(True, f"numeric(4 points x 4 times, linear initial-value solution, {how})",
+                   power="4 points x 4 times: each coordinate to 1e-8 of the motion's size")
+

@@ -109,7 +109,9 @@ def check_phase_area(ctx: Context, val) -> Verdict:
                            f"{tv:.6g}, {_fmt_point(pt)}")
         worst = max(worst, rel)
     return Verdict(True, f"numeric({PHASE_POINTS} points, flow DOP853 rtol 1e-12, "
-                   f"rtol {PHASE_RTOL:g})", f"worst relative {worst:.2g}")
+                   f"rtol {PHASE_RTOL:g})", f"worst relative {worst:.2g}",
+                   power=f"{PHASE_POINTS} points: the image's area to {PHASE_RTOL:g}")
+
 
 
 def _truth(expr, env: dict, n_points: int):

@@ -159,7 +159,9 @@ def check_secular_growth(ctx: Context, val) -> Verdict:
         if size != val + 1:
             return Verdict(False, "numeric(Jordan blocks, 40 digits)",
                            f"largest Jordan block {size}: solutions grow like t^{size - 1}")
-    return Verdict(True, "numeric(Jordan blocks, 40 digits, 3 points)")
+    return Verdict(True, "numeric(Jordan blocks, 40 digits, 3 points)",
+                   power="exact sizes of Jordan blocks (ranks at 40 digits), 3 points")
+
 
 
 def _clusters(lam: np.ndarray) -> list[complex]:

@@ -124,7 +124,8 @@ def check_steady_rates(ctx: Context, val) -> Verdict:
             return Verdict(False, f"estimate(rtol {rtol:g})", f"the engine finds "
                            f"{len(engine)} steady rates, the book lists {len(book)}")
         return Verdict(True, f"estimate(rtol {rtol:g})",
-                       f"engine's steady rates {[f'{e:.6g}' for e in engine]}")
+                       f"engine's steady rates {[f'{e:.6g}' for e in engine]}",
+                       power=f"within the stated {rtol:g}")
     verdicts = [all_vanish(fam.residuals_at(b), ctx.sampler) for b in book]
     verdict = combine(verdicts)
     if not verdict.ok or ctx.part.data.get("partial"):
@@ -165,7 +166,9 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
     if not seen:  # two equations without real roots agree without saying anything
         return Verdict(False, f"numeric({n} points)", "no steady motion exists at any sampled "
                        "point: the check cannot discriminate (`assume:` a region where one does)")
-    return Verdict(True, f"numeric({n} points, polynomial roots)")
+    return Verdict(True, f"numeric({n} points, polynomial roots)",
+                   power=f"{n} points: the real roots, all of them, to {ROOT_RTOL:g}")
+
 
 
 def _vanishes_at_rates(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:

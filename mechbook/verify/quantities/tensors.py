@@ -237,7 +237,9 @@ def _estimate_components(ctx: Context, val) -> Verdict:
     worst = max(abs(b - e) / max(abs(b), abs(e)) for _, b, e in values
                 if max(abs(b), abs(e)) > 1e-12 * scale)
     return Verdict(True, method, f"{len(values)} component(s) at the book's numbers, "
-                   f"largest relative difference {worst:.2g}")
+                   f"largest relative difference {worst:.2g}",
+                   power=f"each component within the stated {rtol:g}")
+
 
 
 def _characteristic(t: sp.Matrix) -> tuple:

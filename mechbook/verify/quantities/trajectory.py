@@ -144,7 +144,10 @@ def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
         ok, why = match_multiset(_at_start(motion.start, book, pt), eng, partial, rtol=motion.rtol)
         if not ok:
             return Verdict(False, f"{how}({n} points)", f"{what}: {why}")
-    return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})")
+    return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})",
+                   power=(f"within the stated {motion.rtol:g}" if "estimate" in ctx.part.data
+                          else f"{motion.points()} points, each value to {motion.rtol:g} "
+                               f"({how})"))
 
 
 def _at_start(start: dict, book: list, pt: dict) -> list[float]:
@@ -272,4 +275,6 @@ def check_event_time(ctx: Context, val) -> Verdict:
         ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
         if not ok:
             return Verdict(False, f"measured({n} points)", f"event: {why}")
-    return Verdict(True, f"measured({MEASURED_POINTS} points, rtol {rtol:g})")
+    return Verdict(True, f"measured({MEASURED_POINTS} points, rtol {rtol:g})",
+                   power=f"{MEASURED_POINTS} points, measured by integration to {rtol:g}")
+
