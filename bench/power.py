@@ -130,6 +130,7 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                             **base, "path": list(m.path), "label": m.label, "kind": m.kind,
                             "delta": "discrete" if m.kind == "discrete" else str(delta),
                             "old": _get(part.data, m.path), "new": m.value,
+                            "token": getattr(m, "token", ""),
                             "status": status, "killed": killed and status != "timeout",
                             "detail": detail, "estimate": bool(est),
                             "seconds": time.process_time() - start}, default=str) + "\n")
@@ -166,7 +167,9 @@ def equivalence(records: list[dict]) -> dict:
             part = parts[r["part"]]
             try:
                 ctx = Context(analysis, part)
-                why = same_meaning(ctx, tuple(r["path"]), r["old"], r["new"])
+                why = same_meaning(ctx, tuple(r["path"]), r["old"], r["new"],
+                                   r.get("token", ""))
+
             except Exception as exc:  # noqa: BLE001 - undecided counts against the checker
                 why = ""
                 r["equivalence_error"] = f"{type(exc).__name__}: {exc}"[:200]

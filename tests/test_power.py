@@ -54,7 +54,7 @@ def _load(answer_file: Path):
 
 def _moved(text: str, names: set[str], delta: Fraction) -> str:
     """The relation with its first parameter p replaced by (1 + δ)·p."""
-    for kind, _, new in text_mutants(text, names, delta):
+    for kind, _, new, _ in text_mutants(text, names, delta):
         if kind == "parameter":
             return new
     raise AssertionError(f"no parameter in {text!r}")
@@ -185,7 +185,7 @@ def test_named_conserved_unknown_name_is_a_clear_error():
 
 # ---- the mutants themselves ---------------------------------------------------------------
 def test_text_mutants_scale_each_number_and_parameter_once():
-    got = [new for _, _, new in text_mutants("m*g*l*(1 - cos(theta)) = 2*E", {"m", "g", "l"},
+    got = [new for _, _, new, _ in text_mutants("m*g*l*(1 - cos(theta)) = 2*E", {"m", "g", "l"},
                                              Fraction(1, 100))]
     assert got == ["(m*(101/100))*g*l*(1 - cos(theta)) = 2*E",
                    "m*(g*(101/100))*l*(1 - cos(theta)) = 2*E",
@@ -253,7 +253,8 @@ def test_every_one_percent_mutant_fails(answer_file: Path):
             killed = got.status != "erratum" if erratum else got.status in ("fail", "error")
             if killed:
                 continue
-            why = same_meaning(ctx, m.path, _get(part.data, m.path), m.value)
+            why = same_meaning(ctx, m.path, _get(part.data, m.path), m.value, m.token)
+
             if not why:
                 survivors.append(f"{part.name} [{part.quantity}] {'/'.join(map(str, m.path))}: "
                                  f"{m.label}: {got.status} {got.detail[:200]}")

@@ -29,7 +29,7 @@ from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, holds
 from mechbook.verify.compare import DIGITS, Sampler, Verdict
 
 RAYS = 8  # random rays through parameter space
-MORE_RAYS = 16  # tried in addition when the first rays cross no boundary
+MORE_RAYS = 40  # tried in addition while some side of the relation is not yet crossed
 GRID = 40  # points per ray, each judged by both sides
 SPAN = 2.5  # a positive parameter moves by factors up to e^SPAN each way along a ray
 EPS = 1e-8  # relative offset of the points judged on either side of a crossing
@@ -51,6 +51,8 @@ class BoundaryResult:
     points: int = 0  # grid points judged by both sides
     eps: float = EPS
     detail: str = ""
+    sides: tuple = (0, 0)  # sides of the relation crossed, of those that can be
+
 
 
 class Ray:
@@ -134,11 +136,11 @@ def _bisect(fn: Callable, a: float, b: float, fa) -> tuple[float, float] | None:
     return a, b
 
 
-def _refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> mpmath.mpf:
-    """The crossing to 30 digits: the root of the atom that changes sign in [a, b]
-    (the bisection's midpoint where none does cleanly)."""
+def _refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> tuple[mpmath.mpf, int]:
+    """The crossing to 30 digits: the root of the atom that changes sign in [a, b], and
+    that atom's index (the bisection's midpoint and -1 where none does cleanly)."""
     pa, pb = ray.point(a), ray.point(b)
-    for f in atoms:
+    for i, f in enumerate(atoms):
         va = _value(f, pa) if pa else None
         vb = _value(f, pb) if pb else None
         if va is None or vb is None or (va[0] > 0) == (vb[0] > 0):
@@ -148,10 +150,10 @@ def _refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> mpmath.mpf:
         try:
             with mpmath.workdps(DIGITS):
                 return mpmath.findroot(g, (mpmath.mpf(a), mpmath.mpf(b)), solver="anderson",
-                                       tol=mpmath.mpf(10) ** (-2 * DIGITS + 10))
+                                       tol=mpmath.mpf(10) ** (-2 * DIGITS + 10)), i
         except (ValueError, ZeroDivisionError):
-            break
-    return mpmath.mpf((a + b) / 2)
+            return mpmath.mpf((a + b) / 2), i
+    return mpmath.mpf((a + b) / 2), -1
 
 
 def _along(f: sp.Expr, ray: Ray) -> Callable:
@@ -173,12 +175,12 @@ def _along(f: sp.Expr, ray: Ray) -> Callable:
     return g
 
 
-def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[mpmath.mpf]:
+def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
     """Places where an atom touches zero without changing sign (a double root): local
     minima of |atom| on the grid, refined by golden-section search, kept if they reach
     TANGENT_RTOL of the atom's scale."""
     out = []
-    for f in atoms:
+    for i, f in enumerate(atoms):
         vals = []
         for t in ts:
             pt = ray.point(t)
@@ -193,7 +195,7 @@ def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[mpmath.m
                 continue
             t_min, v_min, scale = _golden(f, ray, ts[k - 1], ts[k + 1])
             if v_min is not None and v_min <= TANGENT_RTOL * max(scale, 1e-300):
-                out.append(t_min)
+                out.append((t_min, i))
     return out
 
 
@@ -262,9 +264,11 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
     seen = {True: 0, False: 0}
     n_rays = rays
     rays = 0
+    sides = {i for i, f in enumerate(atoms) if f.free_symbols & set(symbols)}
+    crossed: set[int] = set()
     while rays < n_rays + MORE_RAYS:
-        if rays >= n_rays and res.crossings + res.tangencies > 0:
-            break
+        if rays >= n_rays and res.crossings + res.tangencies > 0 and sides <= crossed:
+            break  # every side of the relation crossed at least once
         rays += 1
         origin = origins() if origins is not None else sampler.draw()
         d = rng.normal(size=len(symbols))
@@ -290,14 +294,17 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
             bracket = _bisect(judge.book, float(ts[k]), float(ts[k + 1]), b0)
             if bracket is None:
                 continue
-            t_star = _refine(atoms, ray, *bracket)
+            t_star, side = _refine(atoms, ray, *bracket)
+            crossed.add(side)
+
             bad = _judge_crossing(judge, t_star, res, words)
             if bad:
                 res.ok = False
                 res.detail = bad + _engine_crossing(judge, float(ts[k]), float(ts[k + 1]))
                 return res
             res.crossings += 1
-        for t_star in _tangencies(atoms, ray, ts):
+        for t_star, side in _tangencies(atoms, ray, ts):
+            crossed.add(side)
             bad = _judge_crossing(judge, t_star, res, words, tangent=True)
             if bad:
                 res.ok = False
@@ -318,9 +325,13 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
     judged = res.crossings - res.unjudged
     tang = f", {res.tangencies} tangencies" if res.tangencies else ""
     skipped = f", {res.unjudged} not judged (marginal)" if res.unjudged else ""
-    res.detail = (f"boundary agrees at {judged} crossings to {res.eps:g}{tang}{skipped}; "
-                  f"{res.points} points on {rays} rays ({seen[True]} {words[0]}, "
-                  f"{seen[False]} {words[1]})")
+    missed = len(sides - crossed)
+    side_note = (f", {len(sides) - missed} of {len(sides)} sides crossed" if missed else
+                 (f", all {len(sides)} sides crossed" if len(sides) > 1 else ""))
+    res.sides = (len(sides) - missed, len(sides))
+    res.detail = (f"boundary agrees at {judged} crossings to {res.eps:g}{tang}{skipped}"
+                  f"{side_note}; {res.points} points on {rays} rays ({seen[True]} "
+                  f"{words[0]}, {seen[False]} {words[1]})")
     return res
 
 
@@ -353,6 +364,10 @@ def verdict(result: BoundaryResult, crossings_word: str = "crossings") -> Verdic
         return Verdict(False, "boundary", result.detail)
     judged = result.crossings - result.unjudged
     tang = f" and {result.tangencies} tangencies" if result.tangencies else ""
+    crossed, sides = result.sides
+    where = (f" ({crossed} of {sides} sides)" if crossed < sides else
+             f" (all {sides} sides)" if sides > 1 else "")
     return Verdict(True, f"boundary({judged} {crossings_word} to {result.eps:g})", result.detail,
-                   power=f"boundary at {judged} {crossings_word}{tang} to {result.eps:g}, "
-                         f"{result.points} points on both sides")
+                   power=f"boundary at {judged} {crossings_word}{tang}{where} to "
+                         f"{result.eps:g}, {result.points} points on both sides")
+

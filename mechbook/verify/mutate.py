@@ -30,6 +30,7 @@ class Mutant:
     label: str  # what was changed, for messages
     value: object  # the new leaf (text, or an int/bool for discrete values)
     kind: str  # 'number' · 'parameter' · 'shift' · 'discrete'
+    token: str = ""  # the number or name scaled ('' for a shift or a discrete change)
 
 
 def factor(delta: Fraction) -> str:
@@ -68,9 +69,12 @@ def _sites(text: str, names: set[str]) -> list[tuple[int, int, str, str]]:
         return []
     lines = _byte_offsets(text)
     out = []
+    indices = _index_arguments(tree)
     for node in ast.walk(tree):
         if isinstance(node, ast.Constant) and isinstance(node.value, int | float) \
                 and not isinstance(node.value, bool):
+            if id(node) in indices:
+                continue  # W0(1), entry(J, 1, 3), diff(f, x, 2): an index, not a value
             kind = "number"
         elif isinstance(node, ast.Name) and node.id in names:
             kind = "parameter"
@@ -83,9 +87,28 @@ def _sites(text: str, names: set[str]) -> list[tuple[int, int, str, str]]:
     return sorted(out)
 
 
-def text_mutants(text: str, names: set[str], delta: Fraction) -> Iterator[tuple[str, str, str]]:
-    """(kind, label, new text) for each number and named parameter of `text` scaled by
-    1 + δ; equations 'lhs = rhs' are mutated on each side, a trailing '= const' kept."""
+def _index_arguments(tree: ast.AST) -> set[int]:
+    """ids of the whole-number literals passed straight to a call that is not a function of
+    real values (a table of the text's notation, a tensor's entry, a derivative's order)."""
+    from mechbook.model.expr import FUNCTIONS
+
+    values = set(FUNCTIONS) - {"diff"}
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name)
+                                               and node.func.id in values):
+            for arg in node.args:
+                if isinstance(arg, ast.Constant) and isinstance(arg.value, int) \
+                        and not isinstance(arg.value, bool):
+                    out.add(id(arg))
+    return out
+
+
+def text_mutants(
+text: str, names: set[str], delta: Fraction
+                 ) -> Iterator[tuple[str, str, str, str]]:
+    """(kind, label, new text, token) for each number and named parameter of `text` scaled
+    by 1 + δ; equations 'lhs = rhs' are mutated on each side, a trailing '= const' kept."""
     pieces = _split_single_equals(text)
     if len(pieces) > 2:
         return
@@ -103,7 +126,7 @@ def text_mutants(text: str, names: set[str], delta: Fraction) -> Iterator[tuple[
             whole = pieces[:k] + [piece[:lead] + new + piece[lead + len(stripped):]] + \
                 pieces[k + 1:]
             yield kind, f"{token}×(1+{float(delta):g}) at column {offset + lead + a + 1}", \
-                "=".join(whole)
+                "=".join(whole), token
         offset += len(piece) + 1
 
 
@@ -169,8 +192,9 @@ def part_mutants(value, root: tuple, names: set[str], delta: Fraction,
             leaf = repr(leaf)
         if not isinstance(leaf, str):
             continue
-        for kind, label, new in text_mutants(leaf, names, delta):
-            yield Mutant(path, label, new, kind)
+        for kind, label, new, token in text_mutants(leaf, names, delta):
+            yield Mutant(path, label, new, kind, token)
+
         size = (sizes or {}).get(path)
         if size:
             new = shifted(leaf, size, delta)

@@ -313,31 +313,51 @@ def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
                        ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))))
 
     def error(pt) -> float:
-        w2, modes = perturbation.precise_modes(lin, pt)
-        w2 = np.array([float(x) for x in w2])
-        vecs = np.array([[float(modes[i, j]) for j in range(modes.cols)]
-                         for i in range(modes.rows)])
-        free = list(range(len(w2)))
-        worst = 0.0
-        for freq, shape in parsed:
-            w = numbers([freq], pt)[0]
-            u = np.array(numbers(list(shape), pt))
-            if not free or not np.any(u) or not np.isfinite(w) or not np.all(np.isfinite(u)):
-                return float("inf")
-            best = float("inf")
-            for j in free:
-                v = vecs[:, j] / np.linalg.norm(vecs[:, j])
-                # the sine of the angle, from the part of u off v (no cancellation)
-                sin = float(np.linalg.norm(u - (u @ v) * v) / np.linalg.norm(u))
-                dw = abs(np.sqrt(abs(w2[j])) - w) / max(abs(w), 1e-300)
-                best_j = max(sin, dw)
-                if best_j < best:
-                    best, pick = best_j, j
-            free.remove(pick)
-            worst = max(worst, best)
-        return worst
+        """The worst of each book mode's frequency error and the sine of its angle to the
+        nearest engine mode, all at 50 digits (the walk toward the limit goes where they
+        are far below double precision)."""
+        import mpmath
 
-    return asymptotic(ctx, error, floor=1e-13)
+        with mpmath.workdps(perturbation.DPS):
+            w2, modes = perturbation.precise_modes(lin, pt)
+            n = modes.rows
+            vecs = []
+            for j in range(modes.cols):
+                v = [modes[i, j] for i in range(n)]
+                norm = mpmath.sqrt(mpmath.fsum(x * x for x in v))
+                vecs.append([x / norm for x in v])
+            free = list(range(len(w2)))
+            worst = mpmath.mpf(0)
+            for freq, shape in parsed:
+                try:
+                    w = evaluate_mp(freq, pt, perturbation.DPS)
+                    u = [evaluate_mp(x, pt, perturbation.DPS) for x in shape]
+                except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
+                    return float("inf")
+                if any(abs(mpmath.im(x)) > mpmath.mpf(10) ** -40 * max(1, abs(x))
+                       for x in [w, *u]):
+                    return float("inf")
+                w, u = mpmath.re(w), [mpmath.re(x) for x in u]
+                size = mpmath.sqrt(mpmath.fsum(x * x for x in u))
+                if not free or size == 0:
+                    return float("inf")
+                best, pick = None, None
+                for j in free:
+                    v = vecs[j]
+                    dot = mpmath.fsum(a * b for a, b in zip(u, v, strict=True))
+                    # the sine of the angle, from the part of u off v (no cancellation)
+                    off = mpmath.sqrt(mpmath.fsum((a - dot * b) ** 2
+                                                  for a, b in zip(u, v, strict=True)))
+                    dw = abs(mpmath.sqrt(abs(w2[j])) - w) / max(abs(w), mpmath.mpf(10) ** -300)
+                    best_j = max(off / size, dw)
+                    if best is None or best_j < best:
+                        best, pick = best_j, j
+                free.remove(pick)
+                worst = max(worst, best)
+            return float(worst)
+
+    return asymptotic(ctx, error, floor=1e-40)
+
 
 
 def _near(values, x, rtol=1e-8):

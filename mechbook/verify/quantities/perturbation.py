@@ -247,12 +247,7 @@ def check_perturbation(ctx: Context, val):
     kind = spec["approximates"]
     f = len(ctx.system.q)
     mode = spec.get("mode", 1) - 1
-    unperturbed = {}
-    for k, v in (spec.get("unperturbed") or {spec["limit"]["parameter"]: 0}).items():
-        sym = ctx.names.get(k)
-        if not isinstance(sym, sp.Symbol):
-            raise ctx.part.error(("unperturbed", k), f"unknown parameter {k!r}")
-        unperturbed[sym] = ctx.parse(v, ("unperturbed", k))
+    unperturbed = _unperturbed(ctx)
 
     def error(pt) -> float:
         base = {k: sp.S(v).subs(pt) for k, v in unperturbed.items()}
@@ -263,7 +258,51 @@ def check_perturbation(ctx: Context, val):
     return asymptotic(ctx, error, floor=1e-40)
 
 
+def _unperturbed(ctx: Context) -> dict:
+    """{parameter: its unperturbed value} (`unperturbed:`, default the limit's parameter
+    at 0)."""
+    spec = ctx.part.data
+    out = {}
+    for k, v in (spec.get("unperturbed") or {spec["limit"]["parameter"]: 0}).items():
+        sym = ctx.names.get(k)
+        if not isinstance(sym, sp.Symbol):
+            raise ctx.part.error(("unperturbed", k), f"unknown parameter {k!r}")
+        out[sym] = ctx.parse(v, ("unperturbed", k))
+    return out
+
+
+def formula_difference(ctx: Context, a: sp.Expr, b: sp.Expr):
+    """pt ↦ the largest relative difference of two formulas in the text's notation, their
+    tables filled at pt, over every value 1..f of the index names they use (an index value
+    where either has no value, e.g. a zero denominator W0(j) − W0(1) at j = 1, is skipped):
+    how far apart two answers are, without the engine's exact value."""
+    import itertools
+
+    _, idx = _names(ctx)
+    f = len(ctx.system.q)
+    used = [i for i in idx if a.has(i) or b.has(i)]
+    unperturbed = _unperturbed(ctx)
+
+    def error(pt) -> float:
+        T = _Tables(ctx, pt, {k: sp.S(v).subs(pt) for k, v in unperturbed.items()})
+        worst = mpmath.mpf(0)
+        with mpmath.workdps(pert.DPS):
+            for values in itertools.product(range(1, f + 1), repeat=len(used)):
+                at = dict(zip(used, values, strict=True))
+                try:
+                    va, vb = T.evaluate(a.subs(at)), T.evaluate(b.subs(at))
+                except (ZeroDivisionError, ValueError, TypeError, UnsupportedError):
+                    continue
+                if not (mpmath.isfinite(va) and mpmath.isfinite(vb)):
+                    continue
+                worst = max(worst, abs(va - vb) / max(1, abs(va)))
+        return float(worst)
+
+    return error
+
+
 def _error(ctx, kind, book, T: _Tables, names, f, mode):
+
     if kind in ("squared_frequency", "component", "exponent", "damped_component", "group"):
         s = T.s
     if kind == "squared_frequency":

@@ -294,8 +294,10 @@ def check_eigenvalues(ctx: Context, val) -> Verdict:
                'sign); `plane: n`: every vector perpendicular to n is one (a degenerate '
                'eigenvalue), (T − λ1)·(n²1 − nn) = 0. Three axes (or a plane and an axis) '
                'must also be independent'),
-          keys={"tensor": TENSOR, "for_all": FOR_ALL, "axes": AXES}, needs_system=False)
+          keys={"tensor": TENSOR, "for_all": FOR_ALL, "axes": AXES}, needs_system=False,
+          equivalent=("direction",))
 def check_principal_axes(ctx: Context, val) -> Verdict:
+
     entries = ctx.as_list(val, ("book",))
     for i, entry in enumerate(entries):
         entry = ctx.as_map(entry, ("book", i))
