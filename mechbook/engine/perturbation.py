@@ -67,17 +67,27 @@ def precise_exponents(lin: LinearSystem, values: dict) -> list:
         return list(mpmath.eig(A, left=False, right=False))
 
 
+ZERO_MODE = mpmath.mpf(10) ** (20 - DPS)  # of the largest: a zero mode split by rounding
+
+
 def precise_frequencies(lin: LinearSystem, values: dict) -> list:
     """Normal angular frequencies at DPS digits (NaN for an unstable ω² < 0); with velocity
-    terms the imaginary parts of the exponents with Im p ≥ 0."""
+    terms the imaginary parts of the exponents with Im p ≥ 0. A zero mode (a free
+    translation, a cyclic coordinate kept), split by rounding to about 1e-50 of the
+    largest ω², is exactly 0."""
     with mpmath.workdps(DPS):
         if not lin.gyroscopic:
-            return [mpmath.sqrt(w) if w >= 0 else mpmath.nan
-                    for w in precise_squared_frequencies(lin, values)]
+            w2 = precise_squared_frequencies(lin, values)
+            scale = max([abs(w) for w in w2] + [mpmath.mpf(10) ** -300])
+            return [mpmath.mpf(0) if abs(w) <= ZERO_MODE * scale else
+                    mpmath.sqrt(w) if w >= 0 else mpmath.nan for w in w2]
         lam = precise_exponents(lin, values)
         n = len(lin.q)
         lam = sorted(lam, key=lambda x: -mpmath.im(x))[:n]
-        return sorted(abs(mpmath.im(x)) for x in lam)
+        scale = max([abs(x) for x in lam] + [mpmath.mpf(10) ** -300])
+        return sorted(mpmath.mpf(0) if abs(mpmath.im(x)) <= ZERO_MODE * scale else
+                      abs(mpmath.im(x)) for x in lam)
+
 
 
 def precise_modes(lin: LinearSystem, values: dict) -> tuple[list, mpmath.matrix]:
