@@ -16,8 +16,6 @@ the store, which is rewritten whole on every edit, stays small.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import h5py
@@ -55,7 +53,11 @@ def variables(result) -> tuple[dict, dict, dict]:
 def _attr(v):
     if v is None:
         return ""
-    if isinstance(v, (bool, int, float, str, np.generic)):
+    if isinstance(v, str):
+        from mechbook.app.text import storable
+
+        return storable(v)
+    if isinstance(v, (bool, int, float, np.generic)):
         return v
     return json.dumps(v, default=float)
 
@@ -118,16 +120,18 @@ def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
 
 
 def write_netcdf(result, path: str | Path) -> Path:
-    """The sweep as a netCDF-4 file (written beside, then renamed into place)."""
+    """The sweep as a netCDF-4 file, replacing a regular file (or nothing) at `path` whole
+    (mechbook.app.outputs); OutputError with the path and the reason if it cannot be."""
     import h5netcdf
 
+    from mechbook.app.outputs import OutputError, output_file, replaced
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    real = output_file(path, "netCDF file")
     coords, vars_, attrs = variables(result)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
-    os.close(fd)
     try:
-        with h5netcdf.File(tmp, "w") as f:
+        real.parent.mkdir(parents=True, exist_ok=True)
+        with replaced(real) as fh, h5netcdf.File(fh, "w") as f:
             f.dimensions = {dim: len(v) for dim, v in coords.items()}
             for dim, values in coords.items():
                 f.create_variable(dim, (dim,), data=np.asarray(values))
@@ -135,11 +139,9 @@ def write_netcdf(result, path: str | Path) -> Path:
                 f.create_variable(key, dims, data=arr, compression="gzip")
             for k, v in attrs.items():  # netCDF has no boolean attributes
                 f.attrs[k] = int(v) if isinstance(v, (bool, np.bool_)) else _attr(v)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise OutputError(path, str(exc).splitlines()[0] if str(exc) else
+                          type(exc).__name__, "netCDF file") from exc
     return path
 
 
@@ -154,5 +156,6 @@ def read_netcdf(path: str | Path) -> dict:
 
 
 def _check_name(name: str) -> None:
-    if not name or "/" in name or name.startswith("."):
-        raise ValueError(f"invalid sweep name {name!r}")
+    from mechbook.app.store import check_run_name
+
+    check_run_name(name, "sweep")
