@@ -171,7 +171,7 @@ def _index_entry(pid: str, page: dict, stored: dict | None, declared: dict) -> d
             rows.append({"pid": pid, "book": book, "title": title, "part": part["part"],
                          "quantity": part.get("quantity", ""), "origin": part.get("origin", ""),
                          "status": NOT_CHECKED, "cite": part.get("cite", ""), "method": "",
-                         "detail": "run `mechbook check` first", "cross": ""})
+                         "detail": "run `mechbook check` first", "power": "", "cross": ""})
     return {"pid": pid, "book": book, "title": title, "rows": rows,
             "book_entry": declared.get(book), "date": attrs.get("date", ""),
             "duration": attrs.get("duration_s"),
