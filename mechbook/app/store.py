@@ -356,8 +356,11 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
 def _opened(path: str | Path) -> Iterator[h5py.File]:
     """The store opened for reading; StoreError (what is wrong, how to recover) if it cannot
     be; FileNotFoundError if there is none."""
-    if not Path(path).exists():
+    if not os.path.lexists(path):
         raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
+    if not Path(path).is_file():  # a FIFO would block the open; a directory, a dead link
+        raise StoreError(path, "it is not a regular file (a directory, a FIFO, a device or "
+                         "a broken link): give the path of a store", "read")
     try:
         f = h5py.File(path, "r")
     except Exception as exc:  # noqa: BLE001 - truncated, not HDF5, a directory, unreadable
