@@ -141,10 +141,9 @@ def test_the_store_kind_reports_silent_data_loss(tmp_path, monkeypatch):
 def test_the_symlink_kind_reports_a_leak(tmp_path, monkeypatch):
     """Problem files followed wherever their links go: the marker outside is read."""
     import fuzz_faults as faults
+    from fuzz import _pid, write_case
 
     import mechbook.model.catalog as catalog
-
-    from fuzz import _pid, write_case
 
     case = generate(0, 1, seeds(), ["symlinks"])
     case.spec = {"link": "outside"}
