@@ -332,3 +332,16 @@ def test_named_temporaries_where_there_is_no_anonymous_file(tmp_path, monkeypatc
     with pytest.raises(store.StoreError):
         store.write([make_record(tmp_path, "2032")], path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["problems", "store.h5"]
+
+
+def test_report_says_the_store_is_damaged_instead_of_a_traceback(tmp_path):
+    base, path = _two_problem_store(tmp_path)
+    path.write_bytes(b"not a store\n")
+    out = tmp_path / "report"
+    result = run("--root", base, "report", "lim-2101", "--serial", "--no-simulate",
+                 "--simplify-seconds", "0", "--store", path, "--out", out)
+    assert result.exit_code == 0, result.output
+    assert f"warning: cannot read the store {path}" in result.stderr
+    assert "Traceback" not in result.output
+    page = (out / "problems" / "lim-2101.html").read_text(encoding="utf-8")
+    assert "its stored outcomes are not shown" in page
