@@ -345,3 +345,30 @@ def test_report_says_the_store_is_damaged_instead_of_a_traceback(tmp_path):
     assert "Traceback" not in result.output
     page = (out / "problems" / "lim-2101.html").read_text(encoding="utf-8")
     assert "its stored outcomes are not shown" in page
+
+
+def test_salvage_keeps_simulations_with_their_dimension_scales(tmp_path):
+    """A rebuilt store copies what reads as plain data; a simulation's dimension scales
+    (object references, which do not survive a copy between files) are attached again."""
+    import numpy as np
+    from test_store import make_record
+
+    path = tmp_path / "s.h5"
+    store.write([make_record(tmp_path, "2031"), make_record(tmp_path, "2032")], path)
+    t = np.linspace(0, 1, 5)
+    store.write_simulation("lim-2031", "main-RK45", {"t": t, "q": np.ones((2, 5)),
+                                                     "qdot": np.zeros((2, 5))},
+                           {"coordinates": "x,y"}, None, path)
+    with h5py.File(path, "r") as f:
+        addr = h5py.h5o.get_info(f["problems/lim-2032"].id).addr
+    with open(path, "r+b") as fh:
+        fh.seek(addr)
+        fh.write(b"\xff" * 64)
+    store.write([make_record(tmp_path, "2033")], path)
+    assert store.problems(path) == ["lim-2031", "lim-2033"]
+    sim = store.read_simulation("lim-2031", "main-RK45", path)
+    assert np.array_equal(sim["arrays"]["t"], t)
+    with h5py.File(path, "r") as f:
+        q = f["problems/lim-2031/simulations/main-RK45/q"]
+        assert q.dims[0][0].name.endswith("/coordinate") and q.dims[1][0].name.endswith("/t")
+        assert list(q.dims[0][0].asstr()[()]) == ["x", "y"]

@@ -189,15 +189,30 @@ def damage(path: str | Path) -> str | None:
     return None
 
 
+def _member(group: h5py.Group, name: str):
+    """group[name], {} if there is none; an entry that is listed but cannot be opened (h5py's
+    `get` gives None for it, which reads as absent) raises: it is damage, not absence."""
+    return group[name] if name in group else {}
+
+
+def _walk(group: h5py.Group, prefix: str = "") -> Iterator[tuple[str, object]]:
+    """(relative name, object) of everything under `group`, parents first. By the groups'
+    own listings, as `read` finds things (HDF5's visititems walks the metadata another way
+    and fails on damage that leaves every member readable)."""
+    for name in group:
+        obj = group[name]  # raises if listed but unreadable
+        yield prefix + name, obj
+        if isinstance(obj, h5py.Group):
+            yield from _walk(obj, f"{prefix}{name}/")
+
+
 def _read_all(group: h5py.Group) -> None:
     """Read every attribute, dataset and string under `group` (raises on damage)."""
-    def visit(name, obj):
+    _attrs(group)
+    for _, obj in _walk(group):
         _attrs(obj)
         if isinstance(obj, h5py.Dataset):
             _decoded(obj[()])
-
-    _attrs(group)
-    group.visititems(visit)
 
 
 def _attrs(obj) -> dict:
@@ -282,19 +297,16 @@ def _copy_group(src: h5py.Group, dst: h5py.Group) -> None:
     their paths inside the subtree)."""
     dst.attrs.update(_raw_attrs(src))
     scales, links = [], []
-
-    def visit(name, obj):
+    for name, obj in _walk(src):
         if isinstance(obj, h5py.Group):
-            dst.require_group(name).attrs.update(_raw_attrs(obj))
-            return
+            dst.create_group(name, track_order=True).attrs.update(_raw_attrs(obj))
+            continue
         _copy_dataset(obj, dst, name)
         if obj.is_scale:
             scales.append((name, obj.attrs.get("NAME", b"")))
         for i, dim in enumerate(obj.dims):
             for scale in dim.values():
                 links.append((name, i, scale.name[len(src.name):].lstrip("/")))
-
-    src.visititems(visit)
     for name, label in scales:
         dst[name].make_scale(_decoded(label) or name.rsplit("/", 1)[-1])
     for name, i, scale in links:
@@ -395,25 +407,28 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
 
 def _read_problem(g: h5py.Group) -> dict:
     out = {"attrs": {k: _plain(v) for k, v in g.attrs.items()}, "systems": {}, "checks": []}
-    for sname, s in g.get("systems", {}).items():
+    for sname in _member(g, "systems"):
+        s = g["systems"][sname]
         entry = {"symbolic": {}, "numeric": {}, "notes": {}}
         for kind in entry:
             if kind in s:
-                s[kind].visititems(lambda name, obj, kind=kind, entry=entry:
-                                   _collect(entry[kind], name, obj))
+                for name, obj in _walk(s[kind]):
+                    _collect(entry[kind], name, obj)
         out["systems"][sname] = entry
-    for part, c in g.get("checks", {}).items():
+    for part in _member(g, "checks"):
+        c = g["checks"][part]
         out["checks"].append({"part": part, **{k: _plain(v) for k, v in c.attrs.items()}})
     out["checks"].sort(key=lambda c: c.get("index", 0))
     out["crosschecks"] = _crosschecks(g)
-    out["simulations"] = sorted(g.get("simulations", {}).keys())
+    out["simulations"] = sorted(_member(g, "simulations").keys())
     return out
 
 
 def _crosschecks(g: h5py.Group) -> list[dict]:
     out = []
-    for key, c in g.get("crosschecks", {}).items():
-        entry = {k: _plain(v) for k, v in c.attrs.items()}
+    group = _member(g, "crosschecks")
+    for key in group:
+        entry = {k: _plain(v) for k, v in group[key].attrs.items()}
         for k in ("parts", "modes"):
             if isinstance(entry.get(k), str):
                 entry[k] = json.loads(entry[k])
@@ -536,7 +551,7 @@ def cached(wanted: dict[str, tuple[str, str]], path: str | Path = DEFAULT_PATH,
     engine = engine_sha256()
     try:
         with h5py.File(path, "r") as f:
-            root = f.get("problems", {})
+            root = _member(f, "problems")
             for pid, shas in wanted.items():
                 try:
                     hit = _cached_one(root, pid, shas, engine, crosschecks)
@@ -577,10 +592,11 @@ def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
     out = {}
     try:
         with h5py.File(path, "r") as f:
-            for pid, g in f.get("problems", {}).items():
+            root = _member(f, "problems")
+            for pid in root:
                 try:
-                    out[pid] = float(g.attrs.get("duration_s", 0.0))
-                except Exception:  # noqa: BLE001, S112 - damaged: no duration known
+                    out[pid] = float(root[pid].attrs.get("duration_s", 0.0))
+                except Exception:  # noqa: BLE001 - damaged: no duration known
                     continue
     except Exception:  # noqa: BLE001 - damaged store: no durations
         return out
@@ -590,8 +606,9 @@ def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
 def _outcomes(pid: str, g: h5py.Group) -> list[Outcome]:
     fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin", "power")
     rows = []
-    for part, c in g.get("checks", {}).items():
-        a = {k: _plain(v) for k, v in c.attrs.items()}
+    checks = _member(g, "checks")
+    for part in checks:
+        a = {k: _plain(v) for k, v in checks[part].attrs.items()}
         rows.append((a.get("index", 0), Outcome(pid, part, **{k: a[k] for k in fields
                                                               if k in a})))
     return [o for _, o in sorted(rows, key=lambda r: r[0])]
@@ -601,7 +618,7 @@ def problems(path: str | Path = DEFAULT_PATH) -> list[str]:
     """The ids stored (StoreError if the store cannot be read)."""
     with _opened(path) as f:
         try:
-            return sorted(f.get("problems", {}).keys())
+            return sorted(_member(f, "problems").keys())
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, "the list of problems", exc) from None
 
