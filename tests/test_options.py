@@ -128,3 +128,22 @@ def test_simulate_nan_in_parameters_and_initial_values_is_a_clear_error(tmp_path
                      "--no-store", "--serial")
         assert result.exit_code == 1
         assert "unknown name 'nan'" in result.output and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("timeout, memory", [(float("nan"), 100.0), (10.0, float("nan")),
+                                             (0.0, 100.0), (10.0, -1.0)])
+def test_the_batch_itself_refuses_nan_limits(timeout, memory):
+    """Past the command line (the Python API, the fuzzer): a NaN limit is refused, not
+    taken as no limit."""
+    from mechbook.app.batch import BatchOptions
+    from mechbook.errors import MechbookError
+
+    with pytest.raises(MechbookError, match="batch limits must be numbers"):
+        BatchOptions(timeout=timeout, memory_mb=memory)
+
+
+def test_a_nan_cpu_time_limit_is_refused_not_ignored():
+    from mechbook.core.timeout import time_limit
+
+    with pytest.raises(ValueError, match="NaN"), time_limit(float("nan")):
+        pass

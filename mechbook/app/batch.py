@@ -21,6 +21,7 @@ module, and neither offers all three; the loop below is the whole of it.
 
 from __future__ import annotations
 
+import math
 import multiprocessing as mp
 import os
 import time
@@ -32,7 +33,7 @@ from typing import Any
 
 from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.run import ProblemRun, RunOptions, Stage
-from mechbook.errors import describe
+from mechbook.errors import MechbookError, describe
 
 Task = Callable[[Any, Path, Any, Stage], Any]  # (item, base, options, stage) -> result
 Failed = Callable[[Any, str, float, str], Any]  # (item, why, seconds, stage) -> result
@@ -49,6 +50,13 @@ class BatchOptions:
     max_tasks: int = MAX_TASKS
     run: Any = RunOptions()  # handed to the task (RunOptions for the problem check)
     serial: bool = False  # in the calling process, no limits (debugging)
+
+    def __post_init__(self):
+        """Limits that are numbers: NaN compares false with everything, so a NaN time limit
+        or memory bound would be none at all (the command line refuses it first)."""
+        if not (self.timeout > 0) or math.isnan(self.memory_mb) or self.memory_mb < 0:
+            raise MechbookError(f"batch limits must be numbers: timeout {self.timeout} s "
+                                f"(> 0), memory {self.memory_mb} MB (>= 0; 0: no bound)")
 
     @property
     def workers(self) -> int:
