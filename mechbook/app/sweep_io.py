@@ -89,33 +89,56 @@ def write_store(result, name: str, path: str | Path) -> Path:
 
 
 def read_store(pid: str, name: str, path: str | Path) -> dict:
-    """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}."""
-    with h5py.File(path, "r") as f:
-        g = f["sweeps"][pid][name]
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
-        coords, vars_ = {}, {}
-        for key, d in g.items():
-            if d.is_scale:
-                coords[key] = d[()]
-        for key, d in g.items():
-            if not d.is_scale:
-                dims = tuple(d.dims[i][0].name.rsplit("/", 1)[-1] for i in range(d.ndim))
-                vars_[key] = (dims, d[()])
+    """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; KeyError if
+    absent, StoreError naming what is damaged."""
+    from mechbook.app.store import StoreError, _opened, _reason
+
+    with _opened(path) as f:
+        try:
+            g = f["sweeps"][pid][name]
+        except KeyError:
+            raise KeyError(f"no sweep {name!r} of {pid} in {path}") from None
+        try:
+            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
+            coords, vars_ = {}, {}
+            for key in g:
+                if g[key].is_scale:
+                    coords[key] = g[key][()]
+            for key in g:
+                d = g[key]
+                if not d.is_scale:
+                    dims = tuple(d.dims[i][0].name.rsplit("/", 1)[-1] for i in range(d.ndim))
+                    vars_[key] = (dims, d[()])
+        except Exception as exc:  # noqa: BLE001 - damage inside the sweep, described
+            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
+                             "read") from None
     return {"attrs": attrs, "coords": coords, "variables": vars_}
 
 
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
-    """(name, one-line description) of a problem's stored sweeps."""
+    """(name, one-line description) of a problem's stored sweeps (a damaged entry is one
+    line that says so)."""
+    from mechbook.app.store import _reason
+
     out = []
     try:
         with h5py.File(path, "r") as f:
-            for name, g in f.get("sweeps", {}).get(pid, {}).items():
-                a = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
+            if "sweeps" not in f or pid not in f["sweeps"]:
+                return out
+            group = f["sweeps"][pid]
+            for name in group:
+                try:
+                    g = group[name]
+                    a = {k: (v.decode() if isinstance(v, bytes) else v)
+                         for k, v in g.attrs.items()}
+                except Exception as exc:  # noqa: BLE001 - one damaged entry, said so
+                    out.append((name, f"damaged ({_reason(exc)})"))
+                    continue
                 where = f" in {a['file']}" if a.get("file") else ""
                 out.append((name, f"{a.get('quantity')} over {a.get('axes')} about "
                                   f"{a.get('point')}{where}"))
-    except OSError:
-        pass
+    except Exception as exc:  # noqa: BLE001 - the store itself unreadable: said so
+        out.append(("?", f"the sweeps cannot be read ({_reason(exc)})"))
     return out
 
 
