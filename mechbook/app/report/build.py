@@ -221,4 +221,9 @@ def _num(x) -> str:
 
 
 def _render(template: str, path: Path, **context) -> None:
-    path.write_text(_environment().get_template(template).render(**context), encoding="utf-8")
+    """Write a page; a string that cannot be UTF-8 (a lone surrogate from an old store) is
+    written as an escape instead of ending the report."""
+    from mechbook.app.text import unicode_safe
+
+    text = _environment().get_template(template).render(**context)
+    path.write_text(unicode_safe(text), encoding="utf-8")
