@@ -307,18 +307,19 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
         print_table(ordered, verbose)
         if saver.written and saver.error is None:
             _say(f"results written to {store_file}")
+    unwritten = False
     if junit_path is not None:
         try:
             _say(f"JUnit XML written to {write_junit(ordered, junit_path)}", err=True)
         except MechbookError as exc:
             _say(f"error: {exc}", err=True)
-            sys.exit(1)
+            unwritten = True
     for line in saver.report():
         _say(line, err=True)
     bad = failures(ordered)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
-    if bad or saver.error is not None:
+    if bad or saver.error is not None or unwritten:
         sys.exit(1)
 
 
