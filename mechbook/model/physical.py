@@ -59,25 +59,25 @@ def _mass_matrix(system, values: dict) -> None:
     qd = list(system.qd)
     if not qd or not lag.has(*qd):
         return  # no velocities: statics, nothing to judge
-    hess = sp.Matrix(len(qd), len(qd), lambda i, j: sp.diff(lag, qd[i], qd[j]))
-    # constraints f(q, t) = 0 leave only the velocities along them: the mass matrix must be
-    # positive definite there (a massless pulley held by strings is physical)
-    jac = sp.Matrix([[sp.diff(f, q) for q in system.q] for _, f in system.constraints])
-    free = sorted((hess.free_symbols | jac.free_symbols) - set(values), key=str)
+    try:
+        hess, jac, args = _derivatives(system)
+    except Exception:  # noqa: BLE001 - SymEngine cannot take it: the engine judges later
+        return
     rng = random.Random(SEED)
+    known = {str(k): float(v) for k, v in values.items()}
+    coords = {str(q) for q in system.q}
     seen = []
     for _ in range(POINTS):
-        point = {**values, **{s: rng.uniform(0.3, 1.7) * rng.choice((1, -1)) if
-                              s not in system.q else rng.uniform(-2.5, 2.5) for s in free}}
+        point = {a: known[a] if a in known else rng.uniform(-2.5, 2.5) if a in coords
+                 else rng.uniform(0.3, 1.7) * rng.choice((1, -1)) for a in args}
         try:
-            m = np.array(hess.xreplace(point).evalf(15).tolist(), dtype=float)
-            if jac.rows:
-                j = np.array(jac.xreplace(point).evalf(15).tolist(), dtype=float)
-        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            m, j = _at(hess, jac, args, point)
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError, RuntimeError):
             continue
-        if not np.all(np.isfinite(m)) or (jac.rows and not np.all(np.isfinite(j))):
+        if not np.all(np.isfinite(m)) or not np.all(np.isfinite(j)):
             continue
-        if jac.rows:  # the velocities the constraints allow: the null space of J
+        full = m
+        if j.size:  # the velocities the constraints allow: the null space of J
             _, sv, vt = np.linalg.svd(j)
             rank = int(np.sum(sv > 1e-10 * max(sv.max(initial=0.0), 1e-300)))
             basis = vt[rank:].T
@@ -88,14 +88,47 @@ def _mass_matrix(system, values: dict) -> None:
         scale = max(np.max(np.abs(eig)), 1e-300)
         if eig[0] > 1e-10 * scale:
             return  # positive definite here: physical
-        seen.append((eig, point))
+        seen.append((eig, full, point))
     if not seen:
         return  # no point evaluated: judged later, by the engine, with its own messages
-    eig, point = seen[0]
-    zero = [] if jac.rows else [c for c, row in zip(system.coord_names, hess.tolist(),
-                                                     strict=True)
-                                if all(x.xreplace(values) == 0 for x in row)]
-    where = ", ".join(f"{s}={point[s]:.3g}" for s in free) or "every point"
+    _refuse(system, seen, bool(jac), sorted(set(args) - set(known)))
+
+
+def _derivatives(system) -> tuple[list, list, list[str]]:
+    """The Hessian of L in the velocities and the constraints' Jacobian, by SymEngine
+    (SymPy takes seconds per entry on a long chain's Lagrangian; SymEngine milliseconds),
+    and the names of their arguments."""
+    import symengine as se
+
+    lag = se.sympify(system.lagrangian)
+    vel = [se.sympify(v) for v in system.qd]
+    grad = [lag.diff(v) for v in vel]
+    hess = [[grad[i].diff(vel[j]) for j in range(len(vel))] for i in range(len(vel))]
+    coords = [se.sympify(q) for q in system.q]
+    jac = [[se.sympify(f).diff(q) for q in coords] for _, f in system.constraints]
+    args = set()
+    for e in [x for row in hess + jac for x in row]:
+        args |= {str(a) for a in e.free_symbols}
+    return hess, jac, sorted(args)
+
+
+def _at(hess: list, jac: list, args: list[str], point: dict) -> tuple[np.ndarray, np.ndarray]:
+    import symengine as se
+
+    subs = {se.Symbol(a): point[a] for a in args}
+    m = np.array([[float(x.subs(subs)) for x in row] for row in hess])
+    j = np.array([[float(x.subs(subs)) for x in row] for row in jac]) if jac else \
+        np.zeros((0, len(hess)))
+    return m, j
+
+
+def _refuse(system, seen: list, constrained: bool, drawn: list[str]) -> None:
+    eig, full, point = seen[0]
+    zero = [] if constrained else [
+        c for i, c in enumerate(system.coord_names)
+        if all(np.all(np.abs(f[i]) <= 1e-12 * max(np.max(np.abs(f)), 1e-300))
+               for _, f, _ in seen)]
+    where = ", ".join(f"{a}={point[a]:.3g}" for a in drawn) or "every point"
     if zero:
         why = (f"{', '.join(zero)} carr{'y' if len(zero) > 1 else 'ies'} no inertia (the "
                "kinetic energy does not depend on its velocity): every coordinate needs mass "
