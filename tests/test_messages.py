@@ -133,3 +133,27 @@ def test_a_parameter_cannot_take_a_multipliers_name(tmp_path):
     assert result.exit_code == 1
     assert "constraint 'c' has the multiplier lambda_c, which is already a name" in \
         result.stderr
+
+
+def test_the_physics_check_is_quick_on_a_long_chain(tmp_path):
+    """A 16-link pendulum chain (the most coordinates a system may have): the mass matrix is
+    judged in well under the 15 s a problem may take to build (SymPy's diff took 16 s)."""
+    from mechbook.model.physical import check_physical
+    from mechbook.model.problem import load_problem
+    from mechbook.model.system import system_of
+
+    base = pendulum_tree(tmp_path)
+    x = y = "0"
+    bodies = []
+    for i in range(16):
+        x, y = f"{x} + l*sin(q{i})", f"{y} - l*cos(q{i})"
+        bodies.append(f"  b{i}: {{mass: m, position: [{x}, {y}]}}")
+    path = base / "problems" / "lim" / "2101.yaml"
+    path.write_text("id: lim-2101\nsource: a chain\ntitle: a long chain\nparameters:\n"
+                    "  m: {value: 1.0}\n  l: {value: 0.5}\n  g: {}\ncoordinates:\n" +
+                    "".join(f"  q{i}: {{}}\n" for i in range(16)) + "particles:\n" +
+                    "\n".join(bodies) + "\ngravity: {}\n")
+    system = system_of(load_problem(path))
+    start = time.perf_counter()
+    check_physical(system)
+    assert time.perf_counter() - start < 5
