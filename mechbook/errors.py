@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import logging
+
+FAULTS = "mechbook.faults"  # the logger of unexpected errors' tracebacks (debug level)
+
 
 class MechbookError(Exception):
     """Base class for every error mechbook raises on purpose."""
@@ -44,3 +48,13 @@ class WrongAnswerError(MechbookError):
 class NotEquilibriumError(WrongAnswerError):
     """A point (or steady motion) named by an answer does not satisfy the equations of motion:
     the answer is wrong, which is a fail, not a missing capability."""
+
+
+def describe(exc: BaseException) -> str:
+    """The text an error leaves in a part's or a cross-check's detail: a MechbookError's own
+    message; for anything else (a fault of the engine or of a library) its type and message.
+    Never a traceback: that goes to the debug log (`mechbook check -v` prints it)."""
+    if isinstance(exc, MechbookError):
+        return str(exc)
+    logging.getLogger(FAULTS).debug("%s: %s", type(exc).__name__, exc, exc_info=exc)
+    return f"{type(exc).__name__}: {exc}"

@@ -11,9 +11,11 @@ a memory bomb is stopped and reported, not waited for:
 
 Most cases run what `mechbook validate` runs (schema, systems built, every expression
 parsed); the `check` kind runs the full check of a mutated problem (mechbook.app.run), where
-an engine fault shows as a traceback inside a part's or the problem's error text. A failing
-case's files are kept under --keep (default results/fuzz/) to reproduce it with
-`mechbook validate`.
+an engine fault shows as a traceback in the run's debug log (the details carry messages
+only). The kinds of issue 21 (store faults, strings through every output, numeric options,
+symbolic links) are generated and judged by tests/fuzz_faults.py, which adds the failures
+lost (silent data loss), leak (a file outside the tree read) and unsafe. A failing case's
+files are kept under --keep (default results/fuzz/) to reproduce it with `mechbook validate`.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from __future__ import annotations
 import argparse
 import io
 import json
+import logging
 import os
 import random
 import re
@@ -32,6 +35,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import fuzz_faults as faults
 from ruamel.yaml import YAML
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -53,11 +57,22 @@ KINDS = {
               "(or up to) the limits, and chains of abbreviations that double",
     "check": "a structure or expression mutation that still validates, run through the whole "
              "`mechbook check` of its problem",
+    "store": "a store damaged on disk (truncated, bytes flipped, text, a directory, a FIFO, "
+             "links) and faults injected into each step of a write; every record must stay "
+             "readable or be kept in the side file named (tests/fuzz_faults.py)",
+    "strings": "a NUL, surrogate, control character, bidi override, fullwidth letter ... put "
+               "into a text field or an expression of a real file; what validates goes "
+               "through HDF5, JSON, JUnit XML and the terminal",
+    "options": "NaN, infinities, huge and odd numbers for every numeric option and sweep axis "
+               "of the command line: refused, or accepted finite and within bounds",
+    "symlinks": "a problem file, answer key or book folder replaced by a link: outside the "
+                "tree (with a marker that must never be read), dangling, looping, /dev/zero, "
+                "a FIFO, a directory, or inside the tree",
 }
 
 # shares of a run: a `check` case costs ~50 validations, so that kind gets a small share
 WEIGHTS = {"text": 20, "structure": 22, "expression": 26, "hostile": 14, "counts": 16,
-           "check": 1}
+           "check": 1, "store": 8, "strings": 6, "options": 4, "symlinks": 3}
 
 HOSTILE_EXPRESSIONS = [
     "1/0", "0/0", "1/0*{x}", "sqrt(-1)*{x}**2", "sqrt(-{p})", "log(0)", "log(-1)", "asin(2)",
@@ -127,8 +142,9 @@ class Case:
     kind: str
     files: dict[str, str | bytes]
     target: str  # the file to validate (relative), or the problem id for `check`
-    mode: str = "validate"  # or "check"
+    mode: str = "validate"  # or "check", "store", "strings", "options", "symlink"
     special: str | None = None  # "fifo", "devzero", "directory": the target is not a file
+    spec: dict | None = None  # the parameters of a store, options or symlink case
 
 
 # ---- mutations ---------------------------------------------------------------------------
@@ -435,6 +451,16 @@ def generate(index: int, seed_value: int, pool: list[Seed], kinds: list[str]) ->
         which, text, _ = _counts(rng, seed)
         target = ppath if which == "problem" else apath
         files[target] = text
+    elif kind == "store":
+        return Case(index, kind, {}, "", mode="store", spec=faults.store_spec(rng))
+    elif kind == "options":
+        return Case(index, kind, {}, "", mode="options", spec=faults.options_spec(rng))
+    elif kind == "symlinks":
+        return Case(index, kind, files, ppath, mode="symlink", spec=faults.link_spec(rng))
+    elif kind == "strings":
+        tree, value = faults.strings_doc(rng, json.loads(json.dumps(tree)))
+        files[target] = dump(tree).replace(faults.PLACEHOLDER, json.dumps(value))
+        return Case(index, kind, files, target, mode="strings")
     return Case(index, kind, files, target)
 
 
@@ -460,6 +486,12 @@ def write_case(case: Case, where: Path) -> Path:
             path.write_bytes(content)
         else:
             path.write_text(content, encoding="utf-8", errors="surrogatepass")
+    if case.mode == "symlink":
+        faults.make_links(where, case.target, case.spec["link"])
+        return where
+    if case.mode in ("store", "options"):
+        (where / "spec.json").write_text(json.dumps(case.spec))
+        return where
     target = where / case.target
     if case.special:
         target.unlink(missing_ok=True)
@@ -470,6 +502,23 @@ def write_case(case: Case, where: Path) -> Path:
         else:
             target.mkdir()
     return where if case.mode == "check" else target
+
+
+def _item(case: Case, where: Path, target: Path) -> str:
+    """What the batch task receives: '<mode>:<where>[:<id>]'."""
+    if case.mode == "check":
+        return f"check:{where}:{case.target}"
+    if case.mode == "symlink":
+        return f"symlink:{where}:{_pid(case.target)}"
+    if case.mode in ("store", "options"):
+        return f"{case.mode}:{where}"
+    return f"{'strings' if case.mode == 'strings' else 'validate'}:{target}"
+
+
+def _pid(target: str) -> str:
+    """problems/<book>/<n>.yaml -> <book>-<n>."""
+    parts = Path(target).parts
+    return f"{parts[-2]}-{Path(parts[-1]).stem}"
 
 
 def run_one(item: str, base: Path, options, stage) -> tuple[str, str, float]:
@@ -484,8 +533,23 @@ def _classify(item: str, stage) -> tuple[str, str]:
     from mechbook.errors import MechbookError
 
     os.environ.pop("MECHBOOK_ROOT", None)
+    logging.getLogger("mechbook").setLevel(logging.ERROR)  # a moved store's warning: expected
     mode, _, rest = item.partition(":")
     try:
+        if mode == "store":
+            stage("store")
+            return faults.run_store(Path(rest), json.loads((Path(rest) / "spec.json")
+                                                           .read_text()))
+        if mode == "options":
+            stage("options")
+            return faults.run_options(json.loads((Path(rest) / "spec.json").read_text()))
+        if mode == "strings":
+            stage("strings")
+            return faults.run_strings(Path(rest))
+        if mode == "symlink":
+            stage("symlink")
+            root, _, pid = rest.rpartition(":")
+            return faults.run_symlink(Path(root), pid)
         if mode == "validate":
             from mechbook.app.validate import validate_file
 
@@ -496,7 +560,9 @@ def _classify(item: str, stage) -> tuple[str, str]:
         root, _, pid = rest.rpartition(":")
         run = run_problem(pid, Path(root), RunOptions(crosscheck=False), stage)
         texts = [run.error or ""] + [o.detail for o in run.outcomes if o.status == "error"]
-        crash = next((t for t in texts if TRACEBACK in t), None)
+        # an engine fault: a traceback in the run's debug log (details hold messages only;
+        # a traceback in a detail would be a failure of its own)
+        crash = next((t for t in run.debug + texts if TRACEBACK in t), None)
         if crash:
             return "crash", crash
         return ("refused", run.error) if run.error else ("ok", f"{len(run.outcomes)} parts")
@@ -533,12 +599,11 @@ def run_cases(cases: list[Case], workdir: Path, jobs: int = 2, keep: Path | None
     for case in cases:
         where = workdir / f"case-{case.index}"
         target = write_case(case, where)
-        item = (f"check:{where}:{case.target}" if case.mode == "check"
-                else f"validate:{target}")
+        item = _item(case, where, target)
         items.append(item)
         by_item[item] = (case, where)
     results: list[Result] = []
-    groups = {"validate": [i for i in items if i.startswith("validate:")],
+    groups = {"validate": [i for i in items if not i.startswith("check:")],
               "check": [i for i in items if i.startswith("check:")]}
     for mode, todo in groups.items():
         if not todo:
@@ -552,16 +617,24 @@ def run_cases(cases: list[Case], workdir: Path, jobs: int = 2, keep: Path | None
             results.append(res)
             if on_result:
                 on_result(res)
-            if keep is not None and status in ("crash", "hang", "bomb", "died"):
+            if keep is not None and status in BAD:
                 dest = keep / f"case-{case.index}-{case.kind}-{status}"
                 shutil.rmtree(dest, ignore_errors=True)
                 if case.special:
                     dest.mkdir(parents=True, exist_ok=True)
                     (dest / "SPECIAL").write_text(f"{case.special}: {case.target}\n")
-                else:
-                    shutil.copytree(where, dest, symlinks=True)
+                else:  # links as links; a FIFO or device cannot be copied: noted
+                    shutil.copytree(where, dest, symlinks=True,
+                                    copy_function=_copy_regular)
                 (dest / "RESULT.txt").write_text(f"{status}\n{message}\n")
     return sorted(results, key=lambda r: r.index)
+
+
+def _copy_regular(src: str, dst: str) -> None:
+    if os.path.isfile(src):
+        shutil.copy2(src, dst)
+    else:
+        Path(dst + ".SPECIAL").write_text(f"not a regular file: {src}\n")
 
 
 def fuzz(cases: int, seed: int = 1, jobs: int = 2, kinds: list[str] | None = None,
@@ -589,7 +662,7 @@ def fuzz(cases: int, seed: int = 1, jobs: int = 2, kinds: list[str] | None = Non
     return out
 
 
-BAD = ("crash", "hang", "bomb", "died")
+BAD = ("crash", "hang", "bomb", "died", "lost", "leak", "unsafe")
 
 
 def summary(results: list[Result]) -> str:

@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import NotEquilibriumError, UnsupportedError
+from mechbook.errors import NotEquilibriumError
 from mechbook.model.problem import load_problem
 
 
@@ -394,10 +394,15 @@ def test_multiplier_constraint_residual_convention(tmp_path):
         assert zero(full.subs(dyn.solved))
 
 
-def test_equilibria_with_multipliers_unsupported(tmp_path):
+def test_equilibria_with_multipliers_on_the_constraint(tmp_path):
+    """With a multiplier constraint the equilibria are found on the constraint (the
+    multiplier an unknown too): the bob at the bottom and at the top, nowhere else."""
     an = analysis(tmp_path, CARTESIAN, "2004")
-    with pytest.raises(UnsupportedError):
-        an.equilibria().conditions  # noqa: B018
+    x, y = an.system().q
+    l = next(s for s in an.problem.values() if s.name == "l")  # noqa: E741
+    points = an.equilibria().symbolic
+    assert sorted((p[x], p[y]) for p in points) == sorted([(0, -l), (0, l)])
+
 
 
 # ---- (f) driven support ---------------------------------------------------------------------

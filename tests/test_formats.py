@@ -160,7 +160,7 @@ def test_completion_of_commands_and_problem_ids():
     assert "lim-2031" in ids and all(i.startswith("lim-203") for i in ids), result.output
     env.update(COMP_WORDS="mechbook re", COMP_CWORD="1")
     result = run(env=env, prog_name="mechbook")
-    assert [ln.split(",", 1)[1] for ln in result.output.splitlines()] == ["report"]
+    assert [ln.split(",", 1)[1] for ln in result.output.splitlines()] == ["report", "restore"]
     script = run("completion", "bash")
     assert script.exit_code == 0 and "_MECHBOOK_COMPLETE=bash_complete" in script.output
     assert run("completion", "tcsh").exit_code != 0

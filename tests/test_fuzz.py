@@ -121,3 +121,48 @@ def test_parser_on_random_text(text, relations):
                                   "sqrt(-m)", "cbrt(-1)*x", "(x<1)**2", "-" * 500 + "x"])
 def test_parser_examples_hypothesis_found_or_was_given(text):
     _check(text, True)
+
+
+# ---- the kinds of issue 21 can fail ------------------------------------------------------------
+def test_the_store_kind_reports_silent_data_loss(tmp_path, monkeypatch):
+    """A side file that silently keeps nothing, behind a store that cannot be written:
+    the case is 'lost', not 'refused'."""
+    import fuzz_faults as faults
+
+    import mechbook.app.unsaved as unsaved
+
+    spec = {"records": 2, "strings": ["x"], "file": "none", "inject": "readonly", "seed": 3}
+    assert faults.run_store(tmp_path / "a", spec)[0] == "refused"
+    monkeypatch.setattr(unsaved.SideFile, "keep", lambda self, kind, payload: None)
+    status, message = faults.run_store(tmp_path / "b", spec)
+    assert status == "lost" and "not stored and not kept" in message
+
+
+def test_the_symlink_kind_reports_a_leak(tmp_path, monkeypatch):
+    """Problem files followed wherever their links go: the marker outside is read."""
+    import fuzz_faults as faults
+    from fuzz import _pid, write_case
+
+    import mechbook.model.catalog as catalog
+
+    case = generate(0, 1, seeds(), ["symlinks"])
+    case.spec = {"link": "outside"}
+    where = write_case(case, tmp_path / "case")
+    pid = _pid(case.target)
+    assert faults.run_symlink(where, pid)[0] == "refused"
+    monkeypatch.setattr(catalog, "_stays_inside", lambda path, top: path)
+    assert faults.run_symlink(where, pid)[0] == "leak"
+
+
+def test_the_options_kind_reports_an_unbounded_option(monkeypatch):
+    """An option that takes any float (as `--timeout` did) accepts NaN: 'unsafe'."""
+    import click
+    import fuzz_faults as faults
+
+    from mechbook.app.cli import main
+
+    spec = {"command": "check", "option": "--timeout", "value": "nan"}
+    assert faults.run_options(spec)[0] == "refused"
+    param = next(p for p in main.commands["check"].params if "--timeout" in p.opts)
+    monkeypatch.setattr(param, "type", click.FLOAT)
+    assert faults.run_options(spec)[0] == "unsafe"

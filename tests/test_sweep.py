@@ -259,7 +259,7 @@ def test_store_and_netcdf_keep_named_dimensions(tmp_path):
     assert nc["variables"]["growth"][0] == ("Omega", "k2")
     assert np.array_equal(nc["variables"]["stability"][1], result.arrays["stability"])
     assert nc["attrs"]["gyroscopic"] == 1
-    with pytest.raises(ValueError):
+    with pytest.raises(MechbookError, match="invalid sweep name"):
         write_store(result, "../x", tmp_path / "store.h5")
 
 

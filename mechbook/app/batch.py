@@ -21,6 +21,7 @@ module, and neither offers all three; the loop below is the whole of it.
 
 from __future__ import annotations
 
+import math
 import multiprocessing as mp
 import os
 import time
@@ -32,6 +33,7 @@ from typing import Any
 
 from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.run import ProblemRun, RunOptions, Stage
+from mechbook.errors import MechbookError, describe
 
 Task = Callable[[Any, Path, Any, Stage], Any]  # (item, base, options, stage) -> result
 Failed = Callable[[Any, str, float, str], Any]  # (item, why, seconds, stage) -> result
@@ -48,6 +50,13 @@ class BatchOptions:
     max_tasks: int = MAX_TASKS
     run: Any = RunOptions()  # handed to the task (RunOptions for the problem check)
     serial: bool = False  # in the calling process, no limits (debugging)
+
+    def __post_init__(self):
+        """Limits that are numbers: NaN compares false with everything, so a NaN time limit
+        or memory bound would be none at all (the command line refuses it first)."""
+        if not (self.timeout > 0) or math.isnan(self.memory_mb) or self.memory_mb < 0:
+            raise MechbookError(f"batch limits must be numbers: timeout {self.timeout} s "
+                                f"(> 0), memory {self.memory_mb} MB (>= 0; 0: no bound)")
 
     @property
     def workers(self) -> int:
@@ -66,8 +75,12 @@ def problem_failed(pid: str, why: str, seconds: float, stage: str) -> ProblemRun
     return ProblemRun(pid, error=why, seconds=seconds, stage=stage)
 
 
-def _worker(conn: Connection, base: Path, options: Any, task: Task) -> None:
-    """A worker's loop: receive an item, run the task on it, send stages and the result."""
+def _worker(conn: Connection, base: Path, options: Any, task: Task, run_pid: int) -> None:
+    """A worker's loop: receive an item, run the task on it, send stages and the result.
+    It dies with the run (mechbook.app.lifeline), even one killed with -9."""
+    from mechbook.app.lifeline import die_with
+
+    die_with(run_pid)
     while True:
         try:
             item = conn.recv()
@@ -76,8 +89,14 @@ def _worker(conn: Connection, base: Path, options: Any, task: Task) -> None:
         if item is None:
             return
         try:
-            result = task(item, base, options, lambda text, item=item:
-                          conn.send(("stage", item, text)))
+            try:
+                result = task(item, base, options, lambda text, item=item:
+                              conn.send(("stage", item, text)))
+            except (BrokenPipeError, ConnectionResetError, EOFError):
+                raise
+            except Exception as exc:  # noqa: BLE001 - reported as the item's failure
+                conn.send(("failed", item, f"the task failed: {describe(exc)}"))
+                continue
             conn.send(("done", item, result))
         except (BrokenPipeError, ConnectionResetError, EOFError):
             return  # the parent is gone (killed): nobody to report to
@@ -129,7 +148,8 @@ class Batch:
     def _spawn(self) -> _Slot:
         parent, child = self._ctx.Pipe()
         proc = self._ctx.Process(target=_worker, daemon=True,
-                                 args=(child, self.base, self.options.run, self.task))
+                                 args=(child, self.base, self.options.run, self.task,
+                                       os.getpid()))
         proc.start()
         child.close()
         return _Slot(proc, parent)
@@ -207,6 +227,7 @@ class Batch:
                 self._fail(slot, done, f"{why} while in stage: {slot.stage}")
 
     def _read(self, slot: _Slot, done: dict[Hashable, Any]) -> None:
+        finished = None
         try:
             while slot.conn.poll():
                 kind, pid, payload = slot.conn.recv()
@@ -214,11 +235,19 @@ class Batch:
                     slot.stage = payload
                 elif kind == "done":
                     slot.pid = None
-                    done[pid] = payload
-                    self.on_done(payload)
-                    return
-        except (EOFError, OSError):
+                    done[pid] = finished = payload
+                    break
+                elif kind == "failed":  # the task raised: its message, the worker lives on
+                    slot.pid = None
+                    done[pid] = finished = self.failed(pid, payload,
+                                                       time.monotonic() - slot.started,
+                                                       slot.stage)
+                    break
+        except (EOFError, OSError):  # the worker's pipe only: a dead worker is judged below
             pass
+        if finished is not None:
+            self.on_done(finished)  # outside the pipe's handler: its errors are its own
+            return
         if slot.pid is not None and not slot.process.is_alive():
             code = slot.process.exitcode
             how = f"signal {-code}" if code is not None and code < 0 else f"exit code {code}"

@@ -8,18 +8,62 @@ imports when it runs (a test keeps it so; docs/performance.md has the timing).
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 
 import click
 
 from mechbook import __version__
+from mechbook.app import options as opt
 from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, answer_path, problem_path, root
 
 DEFAULT_PATH = DEFAULT_STORE
 SHELLS = ("bash", "zsh", "fish")
+PLOT_SUFFIXES = (".png", ".svg", ".pdf", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff",
+                 ".webp")
+
+
+def _say(text: str = "", err: bool = False) -> None:
+    """Print text that may come from a problem file or the store: control characters and
+    escape sequences are shown as escapes, never sent to the terminal."""
+    click.echo(for_terminal(text), err=err)
+
+
+class _Warnings(logging.Handler):
+    """mechbook's warnings (a damaged store moved aside) on stderr; with -v, debug records
+    (the tracebacks of unexpected errors) too."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        label = "warning" if record.levelno >= logging.WARNING else "debug"
+        _say(f"{label}: {record.getMessage()}", err=True)
+
+
+def _logging(verbose: bool = False) -> None:
+    logger = logging.getLogger("mechbook")
+    if not any(isinstance(h, _Warnings) for h in logger.handlers):
+        logger.addHandler(_Warnings())
+    logger.setLevel(logging.DEBUG if verbose else logging.WARNING)
+
+
+def _output(path: Path | None, what: str) -> Path | None:
+    """An output path checked before any work: a regular file or nothing (a link is
+    followed to its file); a plot's suffix must name a format."""
+    from mechbook.app.outputs import OutputError, output_file
+
+    if path is None:
+        return None
+    if what == "plot" and path.suffix.lower() not in PLOT_SUFFIXES:
+        raise click.BadParameter(f"{path}: the suffix names the format; use one of "
+                                 f"{', '.join(PLOT_SUFFIXES)}", param_hint="--plot")
+    try:
+        output_file(path, what)
+    except OutputError as exc:
+        raise click.ClickException(str(exc)) from None
+    return path
 
 
 def _complete_ids(ctx: click.Context, param: click.Parameter, incomplete: str) -> list:
@@ -46,6 +90,7 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
     """mechbook: textbook mechanics problems as Lagrangian systems, checked against the book."""
     ctx.ensure_object(dict)
     ctx.obj["root_opt"] = root_dir
+    _logging()
 
 
 def _resolve_root(ctx: click.Context) -> Path:
@@ -94,7 +139,7 @@ def list_cmd(ctx: click.Context) -> None:
         except MechbookError:
             parts = "INVALID answer key"
             invalid += 1
-        click.echo(f"{pid:<22} {parts:<16} {title}")
+        _say(f"{pid:<22} {parts:<16} {title}")
     if invalid:
         click.echo(f"{invalid} invalid file(s)", err=True)
         sys.exit(1)
@@ -148,13 +193,12 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
                    "and engine are unchanged since the stored run reuses the stored outcomes.")
 @click.option("--no-crosscheck", is_flag=True,
               help="Skip the independent cross-checks (simulated frequencies, Newton's law).")
-@click.option("-j", "--jobs", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("-j", "--jobs", type=opt.jobs(), default=0, show_default=True,
               help="Worker processes (0: one per core).")
-@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
-              default=DEFAULT_TIMEOUT, show_default=True,
+@click.option("--timeout", type=opt.seconds(), default=DEFAULT_TIMEOUT, show_default=True,
               help="Wall-clock seconds allowed per problem; a problem that takes longer is "
                    "stopped and reported as an error with the stage it was in.")
-@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+@click.option("--memory", "memory_mb", type=opt.memory(), default=DEFAULT_MEMORY_MB,
               show_default=True, help="Resident memory (MB) allowed per problem (0: no bound).")
 @click.option("--serial", is_flag=True,
               help="Check in this process, one problem after another, without time or memory "
@@ -162,7 +206,7 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
 @click.option("--prove", is_flag=True,
               help="After a part passes numerically (30 digits at random admissible points), "
                    "also try a symbolic proof with SymPy; the method column says which it got.")
-@click.option("--prove-seconds", type=click.FloatRange(min=0, min_open=True), default=10.0,
+@click.option("--prove-seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=10.0,
               show_default=True, help="Time limit of each symbolic proof attempt.")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="Run the problems on the Dask cluster whose scheduler is at ADDRESS "
@@ -193,7 +237,9 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     from mechbook.app.console import Progress, print_table
     from mechbook.app.formats import failures, to_json, write_junit
     from mechbook.app.run import ProblemRun, RunOptions, cached_runs
-    from mechbook.app.store import durations, write
+    from mechbook.app.store import durations
+    from mechbook.app.text import json_safe
+    from mechbook.app.unsaved import Saver
     from mechbook.records import ProofPolicy
 
     base = _resolve_root(ctx)
@@ -211,6 +257,11 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
                 raise click.ClickException(str(exc)) from None
             refused[pid] = ProblemRun(pid, error=str(exc))
     store_file = store_path if store_path.is_absolute() else base / store_path
+    if not no_store:
+        _output(store_file, "store")
+    if junit_path is not None:
+        _output(junit_path, "JUnit XML file")
+    _logging(verbose)
     good = [pid for pid in ids if pid not in refused]
     runs = {} if (fresh or no_store) else cached_runs(good, base, store_file, not no_crosscheck)
     runs.update(refused)
@@ -218,11 +269,15 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     for pid in ids:
         if pid in runs:
             progress.finished(runs[pid])
+    saver = Saver(store_file)
 
     def finished(run) -> None:
         progress.finished(run)
+        if verbose:
+            for text in run.debug:
+                _say(f"debug: {run.pid}: {text}", err=True)
         if run.record is not None and not no_store:
-            write([run.record], store_file)
+            saver.save(run.record)  # never raises: a failure keeps the record aside
 
     past = durations(store_file)
     todo = sorted((pid for pid in ids if pid not in runs),
@@ -242,19 +297,29 @@ def check(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, no
     finally:
         progress.close()
     ordered = [runs[pid] for pid in ids]
-    stored = not no_store and any(r.record is not None or r.cached for r in ordered)
+    stored = not no_store and saver.error is None and \
+        any(r.record is not None or r.cached for r in ordered)
     if fmt == "json":
-        doc = to_json(ordered, base, store_file if stored else None)
-        click.echo(json.dumps(doc, indent=1, ensure_ascii=False))
+        doc = to_json(ordered, base, store_file if stored else None,
+                      str(saver.error) if saver.error else None)
+        click.echo(json.dumps(json_safe(doc), indent=1, ensure_ascii=False))
     else:
         print_table(ordered, verbose)
-        if not no_store and any(r.record is not None for r in ordered):
-            click.echo(f"results written to {store_file}")
+        if saver.written and saver.error is None:
+            _say(f"results written to {store_file}")
+    unwritten = False
     if junit_path is not None:
-        click.echo(f"JUnit XML written to {write_junit(ordered, junit_path)}", err=True)
+        try:
+            _say(f"JUnit XML written to {write_junit(ordered, junit_path)}", err=True)
+        except MechbookError as exc:
+            _say(f"error: {exc}", err=True)
+            unwritten = True
+    for line in saver.report():
+        _say(line, err=True)
     bad = failures(ordered)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
+    if bad or saver.error is not None or unwritten:
         sys.exit(1)
 
 
@@ -268,9 +333,9 @@ def validate(files: tuple[Path, ...]) -> None:
     bad = 0
     for f in files:
         try:
-            click.echo(validate_file(f))
+            _say(validate_file(f))
         except MechbookError as exc:
-            click.echo(f"invalid: {exc}", err=True)
+            _say(f"invalid: {exc}", err=True)
             bad += 1
     if bad:
         sys.exit(1)
@@ -291,38 +356,38 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     try:
         rec = read(check_id(problem_id), path)
     except MechbookError as exc:
-        raise click.ClickException(str(exc)) from None
+        raise click.ClickException(for_terminal(str(exc))) from None
     except (FileNotFoundError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
     a = rec["attrs"]
-    click.echo(f"{problem_id}: {a.get('title')}  [{a.get('source')}]")
-    click.echo(f"stored {a.get('date')} by mechbook {a.get('mechbook')} (SymPy {a.get('sympy')}, "
+    _say(f"{problem_id}: {a.get('title')}  [{a.get('source')}]")
+    _say(f"stored {a.get('date')} by mechbook {a.get('mechbook')} (SymPy {a.get('sympy')}, "
                f"NumPy {a.get('numpy')}); {a.get('duration_s', 0):.1f} s; problem sha256 "
                f"{str(a.get('problem_sha256'))[:12]}")
     for sname, entry in rec["systems"].items():
-        click.echo(f"\n== system {sname}")
+        _say(f"\n== system {sname}")
         for key, text in entry["symbolic"].items():
-            click.echo(f"{key}: {text}")
+            _say(f"{key}: {text}")
         for key, arr in entry["numeric"].items():
-            click.echo(f"{key} (numeric): {arr.tolist()}")
+            _say(f"{key} (numeric): {arr.tolist()}")
         for key, text in entry["notes"].items():
-            click.echo(f"{key}: {text}")
-    click.echo("\n== checks")
+            _say(f"{key}: {text}")
+    _say("\n== checks")
     for c in rec["checks"]:
-        click.echo(f"{c['part']:<16} {c['quantity']:<20} {c['status']:<12} {c['method']} "
+        _say(f"{c['part']:<16} {c['quantity']:<20} {c['status']:<12} {c['method']} "
                    f"{c['detail']}".rstrip())
     if rec.get("crosschecks"):
-        click.echo("\n== cross-checks")
+        _say("\n== cross-checks")
         for x in rec["crosschecks"]:
             parts = ", ".join(x.get("parts") or []) or "-"
-            click.echo(f"{x['name']} [{x['status']}, error {x.get('error', float('nan')):.1e}; "
+            _say(f"{x['name']} [{x['status']}, error {x.get('error', float('nan')):.1e}; "
                        f"parts: {parts}] {x.get('detail', '')}")
     for name in rec.get("simulations", []):
-        click.echo(f"simulation stored: /problems/{problem_id}/simulations/{name}")
+        _say(f"simulation stored: /problems/{problem_id}/simulations/{name}")
     from mechbook.app.sweep_io import stored_sweeps
 
-    for name, text in stored_sweeps(problem_id, path):
-        click.echo(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")
+    for name, text in stored_sweeps(problem_id, path):  # a damaged entry is said so
+        _say(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")
 
 
 @main.command()
@@ -335,21 +400,25 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
                    "(Störmer–Verlet) and yoshida4 (Forest–Ruth) for separable Hamiltonians, "
                    "midpoint (implicit, symplectic) for any conservative system. Default: "
                    "DOP853, or Radau when the run is stiff.")
-@click.option("--accuracy", type=float, default=None,
+@click.option("--accuracy", type=opt.Finite(min=0, min_open=True, max=1, max_open=True),
+              default=None,
               help="Error wanted at the end (relative to each coordinate's and velocity's "
                    "scale): chooses the method (unless given) and tolerance from the measured "
                    "rule (docs/performance.md) and prints the error to expect.")
 @click.option("--param", "params", multiple=True, metavar="NAME=VALUE",
               help="Override a parameter's default value (k=1e6). Repeat for several.")
-@click.option("--rtol", type=float, default=None, help="Relative tolerance (SciPy methods; "
-              "default 1e-8).")
-@click.option("--atol", type=float, default=None, help="Absolute tolerance (SciPy methods; "
-              "default 1e-10).")
-@click.option("--max-step", type=float, default=None, help="Largest step (SciPy methods).")
-@click.option("--step", type=float, default=None,
+@click.option("--rtol", type=opt.Finite(min=0, min_open=True, max=1, max_open=True),
+              default=None, help="Relative tolerance (SciPy methods; default 1e-8).")
+@click.option("--atol", type=opt.Finite(min=0, max=1e6), default=None,
+              help="Absolute tolerance (SciPy methods; default 1e-10).")
+@click.option("--max-step", type=opt.Finite(min=0, min_open=True, max=opt.MAX_TIME),
+              default=None, help="Largest step (SciPy methods).")
+@click.option("--step", type=opt.Finite(min=0, min_open=True, max=opt.MAX_TIME), default=None,
               help="Step size of the fixed-step methods (default: the span / 10000).")
-@click.option("--t-end", type=float, default=10.0, show_default=True, help="End time.")
-@click.option("--points", type=int, default=2001, show_default=True,
+@click.option("--t-end", type=opt.Finite(min=0, min_open=True, max=opt.MAX_TIME),
+              default=10.0, show_default=True, help="End time.")
+@click.option("--points", type=click.IntRange(min=2, max=opt.MAX_POINTS), default=2001,
+              show_default=True,
               help="Samples recorded (SciPy methods; fixed-step methods record every step "
                    "up to 200001 samples).")
 @click.option("--init", "init", multiple=True, metavar="NAME=VALUE",
@@ -363,11 +432,10 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
               default=DEFAULT_PATH, show_default=True, help="HDF5 file to store the run in.")
 @click.option("--no-store", is_flag=True, help="Do not store the run.")
-@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
-              default=DEFAULT_TIMEOUT, show_default=True,
+@click.option("--timeout", type=opt.seconds(), default=DEFAULT_TIMEOUT, show_default=True,
               help="Wall-clock seconds allowed for the run (loading, deriving, integrating, "
                    "plotting); past it the run is stopped and reported with its stage.")
-@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
+@click.option("--memory", "memory_mb", type=opt.memory(), default=DEFAULT_MEMORY_MB,
               show_default=True, help="Resident memory (MB) allowed for the run (0: no bound).")
 @click.option("--serial", is_flag=True,
               help="Run in this process, without time or memory limits (for a debugger).")
@@ -384,31 +452,48 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
     time limit and a memory bound (a worker process stopped from outside when it exceeds
     either); exceeding one is reported with the stage the run was in, exit status 1."""
     from mechbook.app.simrun import SimRequest, run_simulation
-    from mechbook.app.store import write_simulation
+    from mechbook.app.store import StoreError, check_run_name, write_simulation
+    from mechbook.app.unsaved import SideFile
     from mechbook.model.catalog import check_id
 
     base = _resolve_root(ctx)
+    path = store_path if store_path.is_absolute() else base / store_path
     try:
         check_id(problem_id)
+        if name is not None:
+            check_run_name(name, "simulation")
     except MechbookError as exc:
         raise click.ClickException(str(exc)) from None
+    if not no_store:
+        _output(path, "store")
+    _output(plot_path, "plot")
     request = SimRequest(problem_id, system, method, accuracy, tuple(params), rtol, atol,
                          max_step, step, t_end, points, tuple(init), backend,
                          str(plot_path) if plot_path is not None else None)
     report = run_simulation(request, base, timeout, memory_mb, serial)
     if report.error:
-        raise click.ClickException(report.error)
+        raise click.ClickException(for_terminal(report.error))
     for line in report.lines:
-        click.echo(line)
+        _say(line)
+    failed = not report.success
     if not no_store:
-        path = store_path if store_path.is_absolute() else base / store_path
         run_name = name or f"{report.system}-{report.method}"
-        write_simulation(report.problem_id, run_name, report.arrays, report.settings,
-                         report.array_attrs, path)
-        click.echo(f"stored as /problems/{report.problem_id}/simulations/{run_name} in {path}")
+        try:
+            write_simulation(report.problem_id, run_name, report.arrays, report.settings,
+                             report.array_attrs, path)
+            _say(f"stored as /problems/{report.problem_id}/simulations/{run_name} in {path}")
+        except StoreError as exc:
+            failed = True
+            side = SideFile(path).keep("simulation", {
+                "problem_id": report.problem_id, "name": run_name, "arrays": report.arrays,
+                "attrs": report.settings, "array_attrs": report.array_attrs})
+            _say(f"error: {exc}", err=True)
+            _say(f"error: the simulation is kept in {side} (`mechbook restore {side}` stores "
+                 "it once the cause is fixed)" if side else
+                 "error: the simulation could not be kept anywhere", err=True)
     if report.plot is not None:
-        click.echo(f"plot written to {report.plot}")
-    if not report.success:
+        _say(f"plot written to {report.plot}")
+    if failed:
         sys.exit(1)
 
 
@@ -433,17 +518,20 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
               help="Take the point (and the book's answer drawn over) from this answer part.")
 @click.option("--backend", type=click.Choice(["llvm", "symengine", "sympy"]), default="llvm",
               show_default=True, help="How M(p), C(p), K(p) are compiled.")
-@click.option("-j", "--jobs", type=click.IntRange(min=1), default=1, show_default=True,
+@click.option("-j", "--jobs", type=opt.jobs(1), default=1, show_default=True,
               help="Local worker processes for the blocks (1: this process).")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="Evaluate the blocks on the Dask cluster at ADDRESS (default "
                    "$MECHBOOK_SCHEDULER, else locally).")
-@click.option("--timeout", type=click.FloatRange(min=0, min_open=True),
-              default=DEFAULT_TIMEOUT, show_default=True,
+@click.option("--timeout", type=opt.seconds(), default=DEFAULT_TIMEOUT, show_default=True,
               help="Wall-clock seconds allowed per block on a cluster worker.")
-@click.option("--memory", "memory_mb", type=click.FloatRange(min=0), default=DEFAULT_MEMORY_MB,
-              show_default=True, help="Resident memory (MB) allowed per cluster worker's block.")
-@click.option("--samples", type=click.IntRange(min=0), default=24, show_default=True,
+@click.option("--memory", "memory_mb", type=opt.memory(), default=DEFAULT_MEMORY_MB,
+              show_default=True,
+              help="Resident memory (MB) allowed per cluster worker's block, and for the "
+                   "sweep's arrays here (a grid whose arrays would need more is refused "
+                   "before anything is computed; 0: no bound).")
+@click.option("--samples", type=click.IntRange(min=0, max=opt.MAX_SAMPLES), default=24,
+              show_default=True,
               help="Points where the float64 result is checked against 30 digits.")
 @click.option("--name", default=None, help="Name of the stored sweep (default QUANTITY-AXES).")
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
@@ -465,12 +553,14 @@ def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity
     in stacked batches; the float64 result is checked against 30 digits at sampled points
     and the book's answer at the same point is drawn over (and compared)."""
     from mechbook.app.distributed import scheduler_address
-    from mechbook.app.sweep import make_spec, run_sweep
+    from mechbook.app.store import StoreError, check_run_name
+    from mechbook.app.sweep import check_grid, make_spec, run_sweep
     from mechbook.app.sweep_io import STORE_POINTS, write_netcdf, write_store
     from mechbook.app.sweep_text import summary
     from mechbook.engine.sweep import parse_axis
 
     base = _resolve_root(ctx)
+    path = store_path if store_path.is_absolute() else base / store_path
 
     def pairs(items: tuple[str, ...], what: str) -> dict[str, str]:
         out = {}
@@ -483,8 +573,18 @@ def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity
 
     try:
         axes = [parse_axis(p) for p in params]
-    except ValueError as exc:
+        check_grid(axes, memory_mb)
+    except (ValueError, MechbookError) as exc:
         raise click.BadParameter(str(exc), param_hint="--param") from None
+    try:
+        if name is not None:
+            check_run_name(name, "sweep")
+    except MechbookError as exc:
+        raise click.BadParameter(str(exc), param_hint="--name") from None
+    if not no_store:
+        _output(path, "store")
+    _output(out_path, "netCDF file")
+    _output(plot_path, "plot")
     if (about or steady) and part:
         raise click.UsageError("--part takes the point from the answer key: drop --about/"
                                "--steady, or --part")
@@ -497,24 +597,47 @@ def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity
     except (MechbookError, KeyError) as exc:
         raise click.ClickException(str(exc).strip("'\"")) from None
     for line in summary(result):
-        click.echo(line)
+        _say(line)
     run_name = name or "-".join([quantity] + [a.name for a in axes])
     big = result.attrs["points"] > STORE_POINTS
     if out_path is None and big and not no_store:
         out_path = base / "results" / "sweeps" / f"{problem_id}-{run_name}.nc"
-    if out_path is not None:
-        result.attrs["file"] = str(write_netcdf(result, out_path))
-        click.echo(f"written to {out_path} (netCDF-4, dimensions "
-                   f"{', '.join(result.coords)})")
-    if not no_store:
-        path = store_path if store_path.is_absolute() else base / store_path
-        write_store(result, run_name, path)
-        where = "its attributes and the file's path" if big else "stored"
-        click.echo(f"{where} as /sweeps/{problem_id}/{run_name} in {path}")
+    failed = False
+    try:
+        if out_path is not None:
+            result.attrs["file"] = str(write_netcdf(result, out_path))
+            _say(f"written to {out_path} (netCDF-4, dimensions {', '.join(result.coords)})")
+        if not no_store:
+            write_store(result, run_name, path)
+            where = "its attributes and the file's path" if big else "stored"
+            _say(f"{where} as /sweeps/{problem_id}/{run_name} in {path}")
+    except (StoreError, MechbookError) as exc:
+        failed = True
+        _say(f"error: {exc}", err=True)
+        _say(_keep_sweep(result, path, f"{problem_id}-{run_name}"), err=True)
     if plot_path is not None:
         from mechbook.app.sweep_plot import plot_sweep
 
-        click.echo(f"plot written to {plot_sweep(result, plot_path)}")
+        _say(f"plot written to {plot_sweep(result, plot_path)}")
+    if failed:
+        sys.exit(1)
+
+
+def _keep_sweep(result, store: Path, label: str) -> str:
+    """A sweep that could not be written where asked, kept as a netCDF file in the first
+    place that takes it (beside the store, the temporary directory, home)."""
+    import tempfile
+
+    from mechbook.app.sweep_io import write_netcdf
+
+    tried = []
+    for place in (store.parent, Path(tempfile.gettempdir()), Path.home()):
+        try:
+            side = write_netcdf(result, place / f"{label}.unsaved.nc")
+            return f"error: the sweep is kept in {side} (netCDF-4; xarray opens it)"
+        except (OSError, MechbookError, RuntimeError, ValueError) as exc:
+            tried.append(f"{place}: {exc}")
+    return "error: the sweep could not be kept anywhere (" + "; ".join(tried) + ")"
 
 
 @main.command()
@@ -524,16 +647,16 @@ def sweep(ctx: click.Context, problem_id: str, params: tuple[str, ...], quantity
 @click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
               default=Path("results/report"), show_default=True,
               help="Directory to write the report to (index.html and problems/).")
-@click.option("-j", "--jobs", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("-j", "--jobs", type=opt.jobs(), default=0, show_default=True,
               help="Worker processes (0: one per core).")
 @click.option("--serial", is_flag=True, help="Build the pages in this process.")
-@click.option("--seconds", type=click.FloatRange(min=0, min_open=True), default=20.0,
+@click.option("--seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=20.0,
               show_default=True, help="Time limit of each derivation step of a page.")
-@click.option("--simplify-seconds", type=click.FloatRange(min=0), default=3.0,
-              show_default=True,
+@click.option("--simplify-seconds", type=opt.Finite(min=0, max=opt.MAX_STEP_SECONDS),
+              default=3.0, show_default=True,
               help="Time limit of simplifying each expression shown (0: show unsimplified).")
 @click.option("--no-simulate", is_flag=True, help="Leave out the simulated trajectories.")
-@click.option("--t-end", type=click.FloatRange(min=0, min_open=True), default=10.0,
+@click.option("--t-end", type=opt.Finite(min=0, min_open=True, max=1e6), default=10.0,
               show_default=True, help="End time of the simulated trajectories.")
 @click.pass_context
 def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, out_dir: Path,
@@ -548,7 +671,7 @@ def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, o
 
     base = _resolve_root(ctx)
     ids = list(problem_ids) or all_ids(base)
-    for pid in ids:
+    for pid in problem_ids:  # named ones must exist; of all, a bad file gets a page saying so
         try:
             if not problem_path(pid, base).exists():
                 raise click.ClickException(f"no problem {pid}")
@@ -560,8 +683,28 @@ def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, o
                        simplify_budget=30.0 if simplify_seconds > 0 else 0.0,
                        simulate=not no_simulate, t_end=t_end)
     index = build_report(base, store, out, ids, ReportOptions(jobs, serial, page),
-                         log=lambda text: click.echo(text, err=True))
-    click.echo(f"report written to {index}")
+                         log=lambda text: _say(text, err=True))
+    _say(f"report written to {index}")
+
+
+@main.command()
+@click.argument("files", nargs=-1, required=True,
+                type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="HDF5 file to write to (default: the store each result was "
+                                 "meant for).")
+@click.pass_context
+def restore(ctx: click.Context, files: tuple[Path, ...], store_path: Path | None) -> None:
+    """Store the results a run could not write (its side file, named in its error: a
+    read-only or full disk, a directory at the store's path), once the cause is fixed."""
+    from mechbook.app.unsaved import restore as restore_file
+
+    for f in files:
+        try:
+            problems, simulations = restore_file(f, store_path)
+        except MechbookError as exc:
+            raise click.ClickException(for_terminal(str(exc))) from None
+        _say(f"{f}: {problems} problem(s) and {simulations} simulation(s) stored")
 
 
 @main.command()

@@ -19,6 +19,7 @@ from importlib import resources
 from pathlib import Path
 
 from mechbook import __version__
+from mechbook.app.text import for_xml
 from mechbook.records import STATUSES
 
 CROSS_STATUSES = ("pass", "fail", "n.a.", "error")
@@ -44,8 +45,9 @@ def failures(runs: list) -> int:
             + sum(1 for r in runs for x in r.crosschecks if x.failed))
 
 
-def to_json(runs: list, root: Path, store: Path | None) -> dict:
-    """The JSON document of a check run (plain data; `json.dumps` it)."""
+def to_json(runs: list, root: Path, store: Path | None, store_error: str | None = None) -> dict:
+    """The JSON document of a check run (plain data; `json.dumps` it). `store` is where the
+    results were written (None: nowhere); `store_error` why they could not be."""
     problems, parts, crossed = [], Counter(), Counter()
     for run in runs:
         vouch: dict[str, list[str]] = {}
@@ -74,8 +76,10 @@ def to_json(runs: list, root: Path, store: Path | None) -> dict:
                "problem_errors": sum(1 for r in runs if r.error),
                "crosschecks": {s: crossed[s] for s in CROSS_STATUSES},
                "failures": bad, "ok": bad == 0}
+    if store_error:
+        summary["ok"] = False
     return {"format": 1, "mechbook": __version__, "root": str(root),
-            "store": str(store) if store is not None else None,
+            "store": str(store) if store is not None else None, "store_error": store_error,
             "problems": problems, "summary": summary}
 
 
@@ -129,12 +133,32 @@ def junit_xml(runs: list) -> ET.ElementTree:
         totals.update(counts)
     for key in ("tests", "failures", "errors", "skipped"):
         top.set(key, str(totals[key]))
+    _xml_safe(top)
     ET.indent(top)
     return ET.ElementTree(top)
 
 
 def write_junit(runs: list, path: Path) -> Path:
+    """Write the JUnit XML, replacing a regular file (or nothing) at `path` whole
+    (mechbook.app.outputs); OutputError with the path and the reason if it cannot be."""
+    from mechbook.app.outputs import OutputError, output_file, replaced
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    junit_xml(runs).write(path, encoding="utf-8", xml_declaration=True)
+    real = output_file(path, "JUnit XML file")
+    tree = junit_xml(runs)
+    try:
+        real.parent.mkdir(parents=True, exist_ok=True)
+        with replaced(real) as fh:
+            tree.write(fh, encoding="utf-8", xml_declaration=True)
+    except OSError as exc:
+        raise OutputError(path, exc.strerror or str(exc), "JUnit XML file") from exc
     return path
+
+
+def _xml_safe(top: ET.Element) -> None:
+    """Every attribute and text of the tree made legal XML 1.0 (a control character in a
+    detail or a cite would make the document malformed)."""
+    for el in top.iter():
+        el.attrib.update({k: for_xml(v) for k, v in el.attrib.items()})
+        if el.text:
+            el.text = for_xml(el.text)

@@ -13,15 +13,16 @@ reported beside the parts and never takes them down.
 
 from __future__ import annotations
 
+import logging
 import time
-import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from mechbook.app.fingerprint import file_sha256
 from mechbook.app.store import ProblemRecord, cached
-from mechbook.errors import MechbookError
+from mechbook.errors import FAULTS, MechbookError, describe
 from mechbook.model.catalog import answer_path, problem_path
 from mechbook.records import NUMERIC, Outcome, ProofPolicy
 
@@ -45,6 +46,7 @@ class ProblemRun:
     crosschecks: list = field(default_factory=list)  # CrossCheck
     notes: list[str] = field(default_factory=list)  # trouble beside the parts
     stage: str = ""  # the last stage reached (for a problem stopped from outside)
+    debug: list[str] = field(default_factory=list)  # tracebacks of unexpected errors (-v)
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,44 @@ class RunOptions:
 def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
                 stage: Stage = _quiet) -> ProblemRun:
     """Check one problem against its answer key (and cross-check it), from scratch."""
+    start = time.perf_counter()
+    run = ProblemRun(pid)
+    with _tracebacks(run.debug):
+        _check(run, pid, base, options, stage, start)
+    run.seconds = time.perf_counter() - start
+    return run
+
+
+class _Collect(logging.Handler):
+    def __init__(self, into: list[str]):
+        super().__init__(logging.DEBUG)
+        self.into = into
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.into.append(self.format(record))
+
+
+@contextmanager
+def _tracebacks(into: list[str]) -> Iterator[None]:
+    """Collect the tracebacks of unexpected errors (mechbook.errors.describe logs them) into
+    `into`: they travel with the run's plain data and `check -v` prints them; the details
+    keep only the message."""
+    logger = logging.getLogger(FAULTS)
+    handler = _Collect(into)
+    saved = logger.level, logger.propagate
+    logger.addHandler(handler)
+    logger.setLevel(logging.DEBUG)
+    logger.propagate = False
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(saved[0])
+        logger.propagate = saved[1]
+
+
+def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: Stage,
+           start: float) -> None:
     from mechbook.app.validate import build_systems, part_faults
     from mechbook.crosscheck import crosscheck_problem
     from mechbook.engine.analysis import (
@@ -68,8 +108,6 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
     from mechbook.verify.answers import load_answers
     from mechbook.verify.checker import check_part
 
-    start = time.perf_counter()
-    run = ProblemRun(pid)
     try:
         stage("loading")
         problem = load_problem(problem_path(pid, base))
@@ -90,8 +128,7 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
                             for p in key.parts if p.name in faults]
             run.notes.append("the answer key is malformed: its other parts were not checked "
                              "and nothing was stored")
-            run.seconds = time.perf_counter() - start
-            return run
+            return
         for part in key.parts:
             stage(f"part {part.name} ({part.quantity})")
             run.outcomes.append(check_part(analysis, part, options.policy))
@@ -103,7 +140,7 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
             results = computed(analysis)
         except Exception as exc:  # noqa: BLE001 - the summary must not take down the parts
             results = []
-            run.notes.append(f"derived results not stored: {type(exc).__name__}: {exc}")
+            run.notes.append(f"derived results not stored: {describe(exc)}")
         run.seconds = time.perf_counter() - start
         run.record = ProblemRecord.of(problem, results, run.outcomes, run.seconds,
                                       file_sha256(apath),
@@ -111,9 +148,7 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
     except MechbookError as exc:
         run.error = str(exc)
     except Exception as exc:  # noqa: BLE001 - one problem's fault must not end the batch
-        run.error = f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-2).strip()}]"
-    run.seconds = time.perf_counter() - start
-    return run
+        run.error = describe(exc)
 
 
 def cached_runs(ids: list[str], base: Path, store: Path,

@@ -16,7 +16,7 @@ from typing import Any
 
 from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.run import Stage
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, describe
 
 
 @dataclass(frozen=True)
@@ -58,6 +58,7 @@ class SimReport:
 
 def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -> SimReport:
     """The batch task: load, derive, integrate, (plot); errors become report.error."""
+    from mechbook.app.validate import build_systems
     from mechbook.core.compile import DEFAULT_BACKEND
     from mechbook.engine.analysis import Analysis
     from mechbook.model.catalog import problem_path
@@ -69,6 +70,8 @@ def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -
         stage("loading")
         problem = load_problem(problem_path(request.problem_id, base))
         report.problem_id = problem.id
+        stage("validating")
+        build_systems(problem)  # a system that is not physical is refused with the reason
         analysis = Analysis(problem)
         stage("deriving and integrating")
         sim = simulate(analysis, request.system, init=parse_assignments(request.init),
@@ -79,6 +82,9 @@ def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -
                        atol=request.atol, max_step=request.max_step, step=request.step)
     except (MechbookError, KeyError) as exc:
         report.error = str(exc).strip("'\"")
+        return report
+    except Exception as exc:  # noqa: BLE001 - a message; the traceback to the debug log
+        report.error = f"simulate {request.problem_id}: {describe(exc)}"
         return report
     traj = sim.trajectory
     out = report.lines

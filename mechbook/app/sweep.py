@@ -23,6 +23,8 @@ where they disagree (mechbook.app.sweep_book).
 from __future__ import annotations
 
 import hashlib
+import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -40,6 +42,24 @@ AMPLITUDE = "amplitude"
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
 DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
 SAMPLES = 24  # points of the 30-digit accuracy check
+MAX_POINTS = 10_000_000  # points of one grid: its arrays are held in this process
+BYTES_PER_VALUE = 8 * 3  # float64, the blocks and their concatenation, the book's overlay
+
+
+def check_grid(axes: list[Axis], memory_mb: float = 0.0, modes: int = 1) -> int:
+    """The grid's size, refused (MechbookError) before anything is allocated when it has
+    more than MAX_POINTS points or its arrays would need more than `memory_mb` MB (0: no
+    bound): a sweep is bounded in memory like a check."""
+    points = math.prod(a.n for a in axes)
+    if points > MAX_POINTS:
+        raise MechbookError(f"the grid has {points:,} points; at most {MAX_POINTS:,} (use "
+                            "fewer points per axis)")
+    need = points * (2 * modes + 4) * BYTES_PER_VALUE / 2**20
+    if memory_mb and need > memory_mb:
+        raise MechbookError(f"the grid's {points:,} points x {modes} mode(s) would need about "
+                            f"{need:,.0f} MB, more than the memory bound of {memory_mb:g} MB "
+                            "(--memory): use fewer points or raise the bound")
+    return points
 
 
 @dataclass(frozen=True)
@@ -73,6 +93,7 @@ def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
 
     if quantity not in QUANTITIES:
         raise MechbookError(f"unknown quantity {quantity!r}; known: {', '.join(QUANTITIES)}")
+    check_grid(axes)
     files = tree_files(pid, base)
     if not files:
         raise MechbookError(f"no problem {pid} under {base}")
@@ -281,6 +302,7 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
     where asked, and assemble the result in grid order."""
     t0 = time.perf_counter()
     sweeper = Sweeper(spec, base)
+    check_grid(list(spec.axes), memory_mb, sweeper.modes)
     built = time.perf_counter() - t0
     size, step = sweeper.grid.size, sweeper.block_size()
     ranges = [(s, min(s + step, size)) for s in range(0, size, step)]
@@ -303,8 +325,10 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         from concurrent.futures import ProcessPoolExecutor, as_completed
 
         from mechbook.app.batch import _context
+        from mechbook.app.lifeline import die_with
 
-        with ProcessPoolExecutor(jobs, mp_context=_context()) as pool:
+        with ProcessPoolExecutor(jobs, mp_context=_context(), initializer=die_with,
+                                 initargs=(os.getpid(),)) as pool:
             futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
             for fut in as_completed(futures):
                 parts[futures[fut]] = fut.result()

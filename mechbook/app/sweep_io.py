@@ -16,8 +16,6 @@ the store, which is rewritten whole on every edit, stays small.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import h5py
@@ -55,7 +53,11 @@ def variables(result) -> tuple[dict, dict, dict]:
 def _attr(v):
     if v is None:
         return ""
-    if isinstance(v, (bool, int, float, str, np.generic)):
+    if isinstance(v, str):
+        from mechbook.app.text import storable
+
+        return storable(v)
+    if isinstance(v, (bool, int, float, np.generic)):
         return v
     return json.dumps(v, default=float)
 
@@ -87,47 +89,72 @@ def write_store(result, name: str, path: str | Path) -> Path:
 
 
 def read_store(pid: str, name: str, path: str | Path) -> dict:
-    """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}."""
-    with h5py.File(path, "r") as f:
-        g = f["sweeps"][pid][name]
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
-        coords, vars_ = {}, {}
-        for key, d in g.items():
-            if d.is_scale:
-                coords[key] = d[()]
-        for key, d in g.items():
-            if not d.is_scale:
-                dims = tuple(d.dims[i][0].name.rsplit("/", 1)[-1] for i in range(d.ndim))
-                vars_[key] = (dims, d[()])
+    """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; KeyError if
+    absent, StoreError naming what is damaged."""
+    from mechbook.app.store import StoreError, _opened, _reason
+
+    with _opened(path) as f:
+        try:
+            g = f["sweeps"][pid][name]
+        except KeyError:
+            raise KeyError(f"no sweep {name!r} of {pid} in {path}") from None
+        try:
+            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
+            coords, vars_ = {}, {}
+            for key in g:
+                if g[key].is_scale:
+                    coords[key] = g[key][()]
+            for key in g:
+                d = g[key]
+                if not d.is_scale:
+                    dims = tuple(d.dims[i][0].name.rsplit("/", 1)[-1] for i in range(d.ndim))
+                    vars_[key] = (dims, d[()])
+        except Exception as exc:  # noqa: BLE001 - damage inside the sweep, described
+            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
+                             "read") from None
     return {"attrs": attrs, "coords": coords, "variables": vars_}
 
 
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
-    """(name, one-line description) of a problem's stored sweeps."""
+    """(name, one-line description) of a problem's stored sweeps (a damaged entry is one
+    line that says so)."""
+    from mechbook.app.store import _reason
+
     out = []
     try:
         with h5py.File(path, "r") as f:
-            for name, g in f.get("sweeps", {}).get(pid, {}).items():
-                a = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
+            if "sweeps" not in f or pid not in f["sweeps"]:
+                return out
+            group = f["sweeps"][pid]
+            for name in group:
+                try:
+                    g = group[name]
+                    a = {k: (v.decode() if isinstance(v, bytes) else v)
+                         for k, v in g.attrs.items()}
+                except Exception as exc:  # noqa: BLE001 - one damaged entry, said so
+                    out.append((name, f"damaged ({_reason(exc)})"))
+                    continue
                 where = f" in {a['file']}" if a.get("file") else ""
                 out.append((name, f"{a.get('quantity')} over {a.get('axes')} about "
                                   f"{a.get('point')}{where}"))
-    except OSError:
-        pass
+    except Exception as exc:  # noqa: BLE001 - the store itself unreadable: said so
+        out.append(("?", f"the sweeps cannot be read ({_reason(exc)})"))
     return out
 
 
 def write_netcdf(result, path: str | Path) -> Path:
-    """The sweep as a netCDF-4 file (written beside, then renamed into place)."""
+    """The sweep as a netCDF-4 file, replacing a regular file (or nothing) at `path` whole
+    (mechbook.app.outputs); OutputError with the path and the reason if it cannot be."""
     import h5netcdf
 
+    from mechbook.app.outputs import OutputError, output_file, replaced
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    real = output_file(path, "netCDF file")
     coords, vars_, attrs = variables(result)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
-    os.close(fd)
     try:
-        with h5netcdf.File(tmp, "w") as f:
+        real.parent.mkdir(parents=True, exist_ok=True)
+        with replaced(real) as fh, h5netcdf.File(fh, "w") as f:
             f.dimensions = {dim: len(v) for dim, v in coords.items()}
             for dim, values in coords.items():
                 f.create_variable(dim, (dim,), data=np.asarray(values))
@@ -135,11 +162,9 @@ def write_netcdf(result, path: str | Path) -> Path:
                 f.create_variable(key, dims, data=arr, compression="gzip")
             for k, v in attrs.items():  # netCDF has no boolean attributes
                 f.attrs[k] = int(v) if isinstance(v, (bool, np.bool_)) else _attr(v)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise OutputError(path, str(exc).splitlines()[0] if str(exc) else
+                          type(exc).__name__, "netCDF file") from exc
     return path
 
 
@@ -154,5 +179,6 @@ def read_netcdf(path: str | Path) -> dict:
 
 
 def _check_name(name: str) -> None:
-    if not name or "/" in name or name.startswith("."):
-        raise ValueError(f"invalid sweep name {name!r}")
+    from mechbook.app.store import check_run_name
+
+    check_run_name(name, "sweep")

@@ -10,6 +10,7 @@ from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, SpecError
 from mechbook.model.catalog import problem_path, root
 from mechbook.model.declared import declared
+from mechbook.model.physical import check_physical
 from mechbook.model.problem import load_problem
 from mechbook.model.system import system_of
 from mechbook.model.yamlio import load
@@ -52,15 +53,23 @@ def _validate_answers(path: Path) -> str:
     except MechbookError as exc:
         raise key.doc.error(("problem",), str(exc)) from None
     problem = load_problem(ppath)
-    check_expressions(key, Analysis(problem))
+    try:
+        with hard_time_limit(BUILD_SECONDS):  # its problem's systems are built on the way
+            check_expressions(key, Analysis(problem))
+    except Timeout:
+        raise SpecError(f"checking the answer key's expressions (and building its problem "
+                        f"{ppath.name}) took more than {BUILD_SECONDS:g} s of CPU time (the "
+                        "book's take under 1 s): an expression is too large or too deep for "
+                        "the engine", str(path)) from None
     return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
 
 
 def build_systems(problem) -> None:
-    """Build every system of a problem (each expression parsed); SpecError on the first
-    fault."""
+    """Build every system of a problem (each expression parsed) and refuse one that is not
+    physical (a mass not positive, a kinetic energy not positive definite); SpecError on
+    the first fault."""
     for name in problem.systems:
-        system_of(problem, name)
+        check_physical(system_of(problem, name))
 
 
 def check_expressions(key, analysis: Analysis) -> None:

@@ -94,6 +94,7 @@ def _compile_sympy(args, exprs) -> Compiled:
         fn(*([0.3] * len(args)))
     except (NameError, TypeError, ValueError, AttributeError, ZeroDivisionError):
         fn = sp.lambdify(args, exprs, modules="numpy", cse=True)
+        _untranslated(fn, len(args))
 
     nan = np.full(len(exprs), np.nan)
 
@@ -104,6 +105,21 @@ def _compile_sympy(args, exprs) -> Compiled:
             return nan.copy()
 
     return call
+
+
+def _untranslated(fn, nargs: int) -> None:
+    """Refuse now a function lambdify could not translate (it would raise NameError at the
+    first evaluation, mid-run): DiracDelta, from differentiating sign or Heaviside, is the
+    usual one."""
+    try:
+        with np.errstate(all="ignore"):
+            fn(*([0.3] * nargs))
+    except NameError as exc:
+        name = getattr(exc, "name", None) or str(exc)
+        hint = " (the derivative of sign or Heaviside)" if "DiracDelta" in str(exc) else ""
+        raise ValueError(f"{name}{hint} has no numeric form") from None
+    except Exception:  # noqa: BLE001, S110 - a value error at the probe point only
+        pass
 
 
 _COMPILERS: dict[str, Callable[[list, list], Compiled]] = {
@@ -132,6 +148,7 @@ def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
         try:
             if name == "sympy":
                 fn = sp.lambdify(list(args), exprs, modules="numpy", cse=True)
+                _untranslated(fn, len(args))
 
                 def batch(X, fn=fn):
                     X = np.asarray(X, dtype=float)

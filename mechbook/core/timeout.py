@@ -9,6 +9,7 @@ depends on the machine's speed). The wall-clock limit a user sets (`mechbook che
 
 from __future__ import annotations
 
+import math
 import signal
 import threading
 import time
@@ -61,7 +62,9 @@ def _limit(seconds: float, interval: float) -> Iterator[None]:
     """Nested limits: the inner one counts while it is the sooner; when it is left, the
     outer one's timer is set again to what remains of it (at once if it has run out, so
     an inner `except Timeout` that swallowed the outer's alarm does not outlive it)."""
-    if seconds <= 0 or not _usable():
+    if math.isnan(seconds):  # NaN compares false with everything: it would be no limit
+        raise ValueError("a time limit of NaN seconds")
+    if seconds <= 0 or math.isinf(seconds) or not _usable():  # 0 or infinite: no limit
         yield
         return
     deadline = cpu_time() + seconds

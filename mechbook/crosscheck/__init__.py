@@ -24,7 +24,6 @@ check itself could not run: counts as a fail).
 from __future__ import annotations
 
 import time
-import traceback
 
 import sympy as sp
 
@@ -38,7 +37,7 @@ from mechbook.crosscheck.motion import (
 )
 from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import UnsupportedError
+from mechbook.errors import UnsupportedError, describe
 from mechbook.records import CrossCheck
 from mechbook.verify.answers import AnswerKey
 from mechbook.verify.context import Context  # how a part names its point
@@ -216,7 +215,9 @@ def _guarded_response(analysis, ctx, lin, values, part, models) -> CrossCheck:
 
 
 def _fault(exc: BaseException) -> str:
-    return f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-1).strip()}]"
+    """A message (the tool's own errors say what is wrong; the traceback of anything else
+    goes to the debug log, `mechbook check -v`)."""
+    return describe(exc)
 
 
 def _guarded_frequency(analysis, lin, values, name, models) -> CrossCheck:

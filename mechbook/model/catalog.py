@@ -50,6 +50,31 @@ def _inside(base: Path, folder: str, book: str, rest: str) -> Path:
     top = os.path.normpath(base / folder)
     if os.path.commonpath([top, os.path.normpath(path)]) != top:  # check_id makes it so
         raise MechbookError(f"problem id {book}-{rest} resolves outside {top}")
+    return _stays_inside(path, base / folder)
+
+
+def _stays_inside(path: Path, top: Path) -> Path:
+    """`path` if nothing is there yet, or it is a regular file whose real location (links
+    followed, of the file or of a folder on the way) is inside `top`. A link that leaves
+    the tree, dangles or loops, and anything not a regular file, is refused: a problem file
+    is read only from inside the tree, and nothing outside is ever shown."""
+    if not os.path.lexists(path):
+        return path  # nothing there: nothing will be read
+    try:
+        real = path.resolve(strict=True)
+    except FileNotFoundError:
+        raise MechbookError(f"{path}: a symbolic link to nothing "
+                            f"({os.readlink(path)}): remove it or point it at a file "
+                            "inside the tree") from None
+    except (RuntimeError, OSError):  # a loop (RuntimeError on Python 3.11), or unreadable
+        raise MechbookError(f"{path}: a symbolic link that cannot be followed (a loop?): "
+                            "remove it") from None
+    inner = Path(os.path.realpath(top))
+    if real != inner and inner not in real.parents:
+        raise MechbookError(f"{path}: a symbolic link to {real}, outside {top}: problem and "
+                            "answer files must stay inside the tree (copy the file in)")
+    if not real.is_file():
+        raise MechbookError(f"{path}: not a regular file")
     return path
 
 

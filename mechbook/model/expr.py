@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ast
 import math
+import unicodedata
 import warnings
 from collections.abc import Mapping
 
@@ -310,6 +311,7 @@ def syntax_tree(text: str | int | float) -> tuple[str, ast.Expression]:
         raise ExpressionError("empty expression")
     if _depth(text) > MAX_DEPTH:
         raise ExpressionError(f"expression nested too deeply (more than {MAX_DEPTH})", text)
+    _refuse_folded(text)
     try:
         with warnings.catch_warnings():  # '\ ' in a string literal warns; it is refused anyway
             warnings.simplefilter("ignore")
@@ -321,6 +323,18 @@ def syntax_tree(text: str | int | float) -> tuple[str, ast.Expression]:
     except (RecursionError, MemoryError, ValueError):
         raise ExpressionError(f"expression {text[:60]!r} cannot be parsed safely", text) from None
     return text, tree
+
+
+def _refuse_folded(text: str) -> None:
+    """Python reads identifiers in NFKC form, so a fullwidth 'ｍ' or a ligature 'ﬁ' would
+    silently be the name 'm' or 'fi': refuse any character that normalization changes."""
+    if text.isascii():
+        return
+    for col, ch in enumerate(text, 1):
+        folded = unicodedata.normalize("NFKC", ch)
+        if folded != ch:
+            raise ExpressionError(f"character {ch!r} (U+{ord(ch):04X}) at column {col} would "
+                                  f"be read as {folded!r}: write {folded!r}", text)
 
 
 def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,

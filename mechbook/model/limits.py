@@ -45,9 +45,14 @@ SYSTEM_COUNTS = {
 ANSWER_COUNTS = {"parts": 64, "abbreviations": 64, "symbols": 64}
 PART_COUNTS = {"assume": 32, "define": 32}
 
-# what YAML may read as a number (decimal, with '_', '.', an exponent); an expression such
-# as 2*(m*l**2) is text and may be long
-_NUMBERISH = re.compile(r"[-+]?[0-9_]*\.?[0-9_]*(?:[eE][-+]?[0-9_]+)?")
+# what YAML may read as a number (decimal, with '_', '.', an exponent; hexadecimal, octal,
+# binary; YAML 1.1's base 60); an expression such as 2*(m*l**2) is text and may be long
+_NUMBERISH = re.compile(r"[-+]?(?:[0-9_]*\.?[0-9_]*(?:[eE][-+]?[0-9_]+)?|0[xX][0-9a-fA-F_]+"
+                        r"|0[oO]?[0-7_]+|0[bB][01_]+|[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?)")
+# characters text may not hold: C0 and C1 controls but tab and newline, DEL, lone surrogates
+# (no character at all: they cannot be written as UTF-8) and the noncharacters U+FFFE, U+FFFF
+_BAD_TEXT = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\ud800-\udfff\ufffe\uffff]")
+_CHAR_NAMES = {"\x00": "NUL", "\x1b": "escape", "\r": "carriage return", "\x7f": "delete"}
 
 
 def read_text(path: str | Path) -> str:
@@ -131,16 +136,41 @@ def check_events(events, file: str) -> None:
                             file, line)
 
 
+def check_text(value: str, where: Callable[[], tuple[str, int | None]]) -> str:
+    """Text as every output can hold it (HDF5, JSON, XML, a terminal): no NUL, no lone
+    surrogate, no control character but tab and newline; SpecError naming the character
+    and where it is otherwise."""
+    bad = _BAD_TEXT.search(value)
+    if bad:
+        ch = bad.group()
+        code = f"U+{ord(ch):04X}"
+        if "\ud800" <= ch <= "\udfff":
+            what = f"a lone surrogate {code} (not a character)"
+        elif ch in ("\ufffe", "\uffff"):
+            what = f"the noncharacter {code}"
+        else:
+            name = _CHAR_NAMES.get(ch)
+            what = f"the control character {code}" + (f" ({name})" if name else "")
+        raise SpecError(f"text holds {what} at character {bad.start() + 1}: text may hold "
+                        "tabs and line breaks but no other control characters; remove it",
+                        *where())
+    return value
+
+
 def check_scalar(value, where: Callable[[], tuple[str, int | None]]):
-    """A plain scalar of a loaded file (str, bool, None, or a finite number of sane size);
-    anything else YAML can make (dates, binary, sets) is refused."""
-    if value is None or isinstance(value, bool | str):
+    """A plain scalar of a loaded file (valid text, bool, None, or a finite number of sane
+    size); anything else YAML can make (dates, binary, sets) is refused."""
+    if value is None or isinstance(value, bool):
         return value
+    if isinstance(value, str):
+        return check_text(value, where)
     if isinstance(value, int | float):
         if isinstance(value, float) and not math.isfinite(value):
             raise SpecError(f"number {value} is not finite", *where())
         if value != 0 and not MIN_MAGNITUDE <= abs(value) <= MAX_MAGNITUDE:
-            raise SpecError(f"number {value:g} out of range (|x| from {MIN_MAGNITUDE:g} to "
+            shown = f"{value:g}" if isinstance(value, float) else \
+                f"of about {value.bit_length() * math.log10(2):.0f} digits"  # no float: huge
+            raise SpecError(f"number {shown} out of range (|x| from {MIN_MAGNITUDE:g} to "
                             f"{MAX_MAGNITUDE:g}, or 0)", *where())
         return value
     raise SpecError(f"a value of type {type(value).__name__} is not allowed here (quote it "

@@ -146,6 +146,11 @@ class System:
             if f.free_symbols & set(self.qd + self.qdd):
                 raise self._error(("constraints", i, "expr"),
                                   f"constraint {cname!r} must be holonomic: f(q, t) = 0")
+            if f"lambda_{cname}" in self.names:  # the engine's name for its multiplier
+                raise self._error(("constraints", i, "name"),
+                                  f"constraint {cname!r} has the multiplier lambda_{cname}, "
+                                  f"which is already a name here: rename the constraint or "
+                                  f"lambda_{cname}")
 
     def _rigid_body(self, name: str, b: dict) -> sp.Expr:
         sub = ("rigid_bodies", name)

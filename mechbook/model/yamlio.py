@@ -18,7 +18,13 @@ from ruamel.yaml.constructor import DuplicateKeyError
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from mechbook.errors import SpecError
-from mechbook.model.limits import MAX_FILE_BYTES, check_events, check_scalar, read_text
+from mechbook.model.limits import (
+    MAX_FILE_BYTES,
+    check_events,
+    check_scalar,
+    check_text,
+    read_text,
+)
 
 Path_ = tuple[str | int, ...]
 
@@ -65,12 +71,13 @@ class Document:
                 if isinstance(k, dict | list | tuple):
                     raise self.error(path, "a mapping key must be a plain name, not a "
                                      "collection")
+                check_text(str(k), lambda k=k: (self.file, self.line(path + (k,))))
                 out[str(k)] = self._plain(v, path + (k,))
             return out
         if isinstance(node, list):
             return [self._plain(v, path + (i,)) for i, v in enumerate(node)]
         if isinstance(node, str):
-            return str(node)
+            return check_scalar(str(node), lambda: (self.file, self.line(path)))
         return check_scalar(node, lambda: (self.file, self.line(path)))
 
 

@@ -8,10 +8,15 @@ the key carries the derivation) · unsupported (the engine cannot compute it yet
 from __future__ import annotations
 
 import time
-import traceback
 
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import MechbookError, SpecError, UnsupportedError, WrongAnswerError
+from mechbook.errors import (
+    MechbookError,
+    SpecError,
+    UnsupportedError,
+    WrongAnswerError,
+    describe,
+)
 from mechbook.records import Outcome
 from mechbook.verify.answers import AnswerKey, Part
 from mechbook.verify.compare import NUMERIC, ProofPolicy
@@ -57,7 +62,7 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) ->
         out.status, out.detail = "error", str(exc)
     except Exception as exc:  # an engine fault must not hide the other parts
         out.status = "error"
-        out.detail = f"{type(exc).__name__}: {exc} [{traceback.format_exc(limit=-1).strip()}]"
+        out.detail = describe(exc)  # a message; the traceback goes to the debug log
     finally:
         out.seconds = time.perf_counter() - start
     return out

@@ -12,6 +12,7 @@ beside the pages that concern them.
 from __future__ import annotations
 
 import multiprocessing as mp
+import os
 import shutil
 import sys
 from collections import Counter
@@ -40,16 +41,16 @@ class ReportOptions:
 def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = None,
                  options: ReportOptions = ReportOptions(), log=None) -> Path:
     """Write the report for `ids` (every problem by default) to `out`; returns index.html."""
-    from mechbook.app.store import problems, read
-
     log = log or (lambda text: print(text, file=sys.stderr))
     base, out = Path(base), Path(out)
     ids = list(ids or all_ids(base))
-    in_store = set(problems(store)) if Path(store).exists() else set()
-    stored = {pid: read(pid, store) for pid in ids if pid in in_store}
+    stored, damaged = _stored(ids, Path(store), log)
     (out / "problems").mkdir(parents=True, exist_ok=True)
     _copy_assets(out / "assets")
     pages = _pages(ids, base, out, stored, options, log)
+    for pid, why in damaged.items():
+        pages[pid].setdefault("page_notes", []).append(f"its stored outcomes are not shown: "
+                                                       f"{why}")
     declared = books(base)
     rows, problems_index = [], []
     for pid in ids:
@@ -78,7 +79,32 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
     return index
 
 
+def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str, str]]:
+    """The stored records of `ids`, and {id: why} for those the store has but cannot give
+    back (damaged): the report says so and shows them as not checked."""
+    from mechbook.app.store import StoreError, problems, read
+
+    if not store.exists():
+        return {}, {}
+    try:
+        in_store = set(problems(store))
+    except StoreError as exc:
+        log(f"warning: {exc}; every problem is shown as not checked")
+        return {}, {pid: str(exc) for pid in ids}
+    stored, damaged = {}, {}
+    for pid in ids:
+        if pid not in in_store:
+            continue
+        try:
+            stored[pid] = read(pid, store)
+        except StoreError as exc:
+            log(f"warning: {exc}")
+            damaged[pid] = str(exc)
+    return stored, damaged
+
+
 def _pages(ids, base, out, stored, options: ReportOptions, log) -> dict[str, dict]:
+    from mechbook.app.lifeline import die_with
     from mechbook.app.report.page import build_page
 
     args = {pid: (pid, base, out / "figures" / pid, stored.get(pid), options.page)
@@ -92,7 +118,7 @@ def _pages(ids, base, out, stored, options: ReportOptions, log) -> dict[str, dic
     jobs = options.jobs or (mp.cpu_count() or 1)
     ctx = mp.get_context("forkserver")
     ctx.set_forkserver_preload(["mechbook.app.report.page"])
-    pool = ctx.Pool(jobs, maxtasksperchild=10)
+    pool = ctx.Pool(jobs, maxtasksperchild=10, initializer=die_with, initargs=(os.getpid(),))
     try:
         pending = {pid: pool.apply_async(_guarded, (build_page, *args[pid])) for pid in ids}
         for pid, job in pending.items():
@@ -145,7 +171,7 @@ def _index_entry(pid: str, page: dict, stored: dict | None, declared: dict) -> d
             rows.append({"pid": pid, "book": book, "title": title, "part": part["part"],
                          "quantity": part.get("quantity", ""), "origin": part.get("origin", ""),
                          "status": NOT_CHECKED, "cite": part.get("cite", ""), "method": "",
-                         "detail": "run `mechbook check` first", "cross": ""})
+                         "detail": "run `mechbook check` first", "power": "", "cross": ""})
     return {"pid": pid, "book": book, "title": title, "rows": rows,
             "book_entry": declared.get(book), "date": attrs.get("date", ""),
             "duration": attrs.get("duration_s"),
@@ -195,4 +221,9 @@ def _num(x) -> str:
 
 
 def _render(template: str, path: Path, **context) -> None:
-    path.write_text(_environment().get_template(template).render(**context), encoding="utf-8")
+    """Write a page; a string that cannot be UTF-8 (a lone surrogate from an old store) is
+    written as an escape instead of ending the report."""
+    from mechbook.app.text import unicode_safe
+
+    text = _environment().get_template(template).render(**context)
+    path.write_text(unicode_safe(text), encoding="utf-8")

@@ -1,0 +1,79 @@
+"""Worker processes die with the run that started them, even when it is killed with -9.
+
+A killed parent runs no cleanup, so each worker watches for it itself, two ways:
+- the kernel's parent-death signal (Linux prctl PR_SET_PDEATHSIG): SIGKILL as soon as the
+  worker's parent exits (for a forkserver worker that is the fork server, which exits when
+  the run's end of its pipe closes);
+- a watchdog thread on the run's own process (a pidfd, which cannot be fooled by a reused
+  process id; polling where there is none), which kills the worker when the run is gone.
+Either suffices; both together cover a parent that is not the run (the fork server) and a
+platform without prctl.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import select
+import signal
+import threading
+import time
+
+PR_SET_PDEATHSIG = 1
+POLL = 0.5  # seconds between looks at the parent where there is no pidfd
+
+
+def die_with(run_pid: int) -> None:
+    """Call first in a worker: it is killed when its parent or the process `run_pid` (the
+    run that owns it) exits."""
+    _parent_death_signal()
+    try:
+        fd = os.pidfd_open(run_pid)
+    except ProcessLookupError:
+        _die()
+    except (OSError, AttributeError):  # no pidfd here: poll
+        threading.Thread(target=_poll, args=(run_pid,), daemon=True,
+                         name="mechbook-lifeline").start()
+    else:
+        threading.Thread(target=_wait, args=(fd,), daemon=True,
+                         name="mechbook-lifeline").start()
+    if not _alive(run_pid):  # it died before the watch began
+        _die()
+
+
+def _parent_death_signal() -> None:
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the watchdog alone
+        pass
+
+
+def _wait(fd: int) -> None:
+    select.select([fd], [], [])  # readable when the process has exited
+    _die()
+
+
+def _poll(pid: int) -> None:
+    while _alive(pid):
+        time.sleep(POLL)
+    _die()
+
+
+def _alive(pid: int) -> bool:
+    """Running (a process that has exited but is not yet reaped, a zombie, is not)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] != b"Z"
+    except (OSError, IndexError):
+        return True
+
+
+def _die() -> None:
+    os.kill(os.getpid(), signal.SIGKILL)

@@ -1,0 +1,169 @@
+"""Results that could not be stored, kept in a side file instead of being lost.
+
+When the store cannot be written (a read-only or full file system, a directory or device at
+its path), a finished problem's record or a simulation is appended to a side file (JSON
+lines, one result a line, written and synced at once): beside the store if its directory
+takes files, else in the temporary directory, else in the home directory. The command that
+failed names the file and exits non-zero; `mechbook restore FILE` writes its results into
+a store once the cause is fixed (rerunning the command computes them again too).
+
+JSON, not HDF5, because the side file must be writable when HDF5 was what failed, and
+because a reader can see what it holds.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import asdict
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mechbook.app.store import ProblemRecord, StoreError, write, write_simulation
+from mechbook.app.text import json_safe
+from mechbook.errors import MechbookError
+from mechbook.records import Outcome, Results
+
+FORMAT = 1
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON data")
+
+
+def _places(store: Path) -> list[Path]:
+    home = Path.home()
+    return [store.parent, Path(tempfile.gettempdir()), home]
+
+
+class SideFile:
+    """One run's side file, created on the first result that needs it."""
+
+    def __init__(self, store: Path):
+        self.store = Path(store)
+        self.path: Path | None = None
+        self.count = 0
+        self.failures: list[str] = []  # where it could not be written, and why
+
+    def keep(self, kind: str, payload: dict) -> Path | None:
+        """Append one result; the side file's path, or None if no place would take it."""
+        line = json.dumps(json_safe({"format": FORMAT, "kind": kind, "store": str(self.store),
+                                     **payload}), default=_plain) + "\n"
+        places = [self.path.parent] if self.path is not None else _places(self.store)
+        for place in places:
+            path = self.path or place / (f"{self.store.name}.unsaved-"
+                                         f"{datetime.now(UTC):%Y%m%dT%H%M%SZ}-{os.getpid()}"
+                                         ".jsonl")
+            try:
+                _append(path, line)
+            except OSError as exc:
+                self.failures.append(f"{path}: {exc.strerror or exc}")
+                continue
+            self.path = path
+            self.count += 1
+            return path
+        return None
+
+
+def _append(path: Path, line: str) -> None:
+    """Append one line, synced; on failure (a full disk) the file is as it was before."""
+    fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    try:
+        size = os.fstat(fd).st_size
+        try:
+            data = memoryview(line.encode("utf-8"))
+            while data:  # a full disk may take part of it: the rest raises, then undone
+                data = data[os.write(fd, data):]
+            os.fsync(fd)
+        except OSError:
+            try:
+                os.ftruncate(fd, size)
+                if size == 0:
+                    os.unlink(path)
+            except OSError:
+                pass
+            raise
+    finally:
+        os.close(fd)
+
+
+class Saver:
+    """Writes each finished problem to the store at once; a problem that cannot be written
+    is kept in the side file, and the first failure is remembered for the run's end."""
+
+    def __init__(self, store: Path):
+        self.store = Path(store)
+        self.side = SideFile(self.store)
+        self.written = 0
+        self.error: StoreError | None = None
+        self.lost: list[str] = []  # ids neither stored nor kept
+
+    def save(self, record: ProblemRecord) -> None:
+        try:
+            write([record], self.store)
+            self.written += 1
+        except StoreError as exc:
+            self.error = self.error or exc
+            if self.side.keep("problem", {"record": asdict(record)}) is None:
+                self.lost.append(record.problem_id)
+
+    def report(self) -> list[str]:
+        """The lines that say what went wrong and where the results went (empty: none)."""
+        if self.error is None:
+            return []
+        lines = [f"error: {self.error}"]
+        if self.side.path is not None:
+            lines.append(f"error: the results of {self.side.count} problem(s) were not "
+                         f"stored; they are kept in {self.side.path} (`mechbook restore "
+                         f"{self.side.path}` stores them once the cause is fixed)")
+        if self.lost:
+            lines.append(f"error: the results of {', '.join(self.lost)} could not be kept "
+                         "anywhere (" + "; ".join(self.side.failures) + "): check again "
+                         "once the cause is fixed")
+        return lines
+
+
+def restore(side: Path, store: Path | None = None) -> tuple[int, int]:
+    """Write the results kept in a side file into `store` (default: the store each was
+    meant for): (problems, simulations)."""
+    problems = simulations = 0
+    try:
+        lines = Path(side).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MechbookError(f"cannot read {side}: {exc}") from None
+    for number, line in enumerate(lines, 1):
+        try:
+            entry = json.loads(line)
+            target = store or Path(entry["store"])
+            if entry.get("kind") == "problem":
+                write([_record(entry["record"])], target)
+                problems += 1
+            elif entry.get("kind") == "simulation":
+                write_simulation(entry["problem_id"], entry["name"],
+                                 {k: np.asarray(v, dtype=float)
+                                  for k, v in entry["arrays"].items()},
+                                 entry["attrs"], entry.get("array_attrs"), target)
+                simulations += 1
+            else:
+                raise ValueError(f"unknown kind {entry.get('kind')!r}")
+        except StoreError:
+            raise
+        except (ValueError, KeyError, TypeError) as exc:
+            raise MechbookError(f"{side}:{number}: not a kept result ({exc})") from None
+    return problems, simulations
+
+
+def _record(data: dict) -> ProblemRecord:
+    results = [Results(r["system"], r["text"], {k: np.asarray(v, dtype=float)
+                                                 for k, v in r["arrays"].items()}, r["notes"])
+               for r in data.get("results", [])]
+    outcomes = [Outcome(**o) for o in data.get("outcomes", [])]
+    return ProblemRecord(**{**data, "results": results, "outcomes": outcomes})
