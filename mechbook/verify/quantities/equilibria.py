@@ -43,7 +43,10 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
         if not candidates:
             return Verdict(False, "numeric", "no equilibrium found by the engine satisfies "
                            f"{val['where']}; engine found {_engine_points(ctx)}")
-        verdicts = [Verdict(True, "symbolic", f"engine equilibrium {candidates[0]}")]
+        verdicts = [Verdict(True, "symbolic", f"engine equilibrium {candidates[0]}",
+                            power="an equilibrium the engine solves for in closed form "
+                                  "satisfies the book's equations (6 points, 30 digits)")]
+
     else:
         raise ctx.part.error(("book",), "an equilibrium answer gives 'at:' or 'where:'")
     verdict = combine(verdicts)
