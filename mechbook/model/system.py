@@ -96,15 +96,21 @@ class System:
         self.attitudes: dict[str, list] = {}  # body -> chain of rotations (3-D bodies)
         self.inertias: dict[str, sp.Matrix] = {}  # body -> inertia tensor in body axes
         self.body_rates: dict[str, sp.Matrix] = {}  # body -> ω in body axes
+        # each particle's and body's own kinetic energy and potential energy in gravity
+        # (mechbook.engine.parts: the energy of one part of the system)
+        self.part_kinetic: dict[str, sp.Expr] = {}
+        self.part_potential: dict[str, sp.Expr] = {}
         for name, p in (s.get("particles") or {}).items():
             m = self._parse(p["mass"], ("particles", name, "mass"))
             r = sp.Matrix([self._parse(x, ("particles", name, "position", i))
                            for i, x in enumerate(p["position"])])
             self.positions[name], self.masses[name] = r, m
             v = self.dt(r)
-            kinetic += m * v.dot(v) / 2
+            self.part_kinetic[name] = m * v.dot(v) / 2
+            kinetic += self.part_kinetic[name]
         for name, b in (s.get("rigid_bodies") or {}).items():
-            kinetic += self._rigid_body(name, b)
+            self.part_kinetic[name] = self._rigid_body(name, b)
+            kinetic += self.part_kinetic[name]
         potential += self._gravity() + self._springs()
         if "string" in s:
             t_string, v_string = self._string()
@@ -269,7 +275,8 @@ class System:
                                       f"{name}'s position has {r.rows}")
             else:
                 up = sp.Matrix([0] * (r.rows - 1) + [1])  # default: last axis points up
-            total += self.masses[name] * g * r.dot(up)
+            self.part_potential[name] = self.masses[name] * g * r.dot(up)
+            total += self.part_potential[name]
         return total
 
     def _springs(self) -> sp.Expr:
