@@ -2,6 +2,7 @@
 (mechbook.verify.registry). A new family is a new module here and a line below."""
 
 from mechbook.verify.quantities import (  # noqa: F401 - each module registers its checks
+    access,
     equations,
     equilibria,
     expressions,
