@@ -350,6 +350,15 @@ class System:
                 kinetic += mult * mass * self.qd[ia] * self.qd[ib] / 2
             k = a + 1
             potential += tension * (k * sp.pi / length) ** 2 * (length / 2) * self.q[ia] ** 2 / 2
+        if "field" in spec:  # u(x, t) and integrals over the string as names (model/field)
+            from mechbook.model.field import field_names
+
+            named = field_names(spec["field"], x, modes, [self.q[i] for i in amps],
+                                [self.qd[i] for i in amps])
+            for n in named:
+                if n in self.names or n in RESERVED:
+                    raise self._error(sub + ("field",), f"name {n!r} is already taken")
+            self.names.update(named)
         return kinetic, potential
 
     def _forces(self) -> list[sp.Expr]:
