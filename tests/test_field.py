@@ -79,12 +79,12 @@ def test_engine_momenta_match_an_independent_quadrature(string):
     sys = string.system()
     dyn = string.dynamics()
     vals = {str(k): float(v) for k, v in string.problem.values().items()}
-    l, s0, a = vals["l"], vals["sigma0"], vals["alpha"]
+    length, s0, a = vals["l"], vals["sigma0"], vals["alpha"]
     for k in range(3):
         for j in range(3):
-            want, _ = quad(lambda x, k=k, j=j: (s0 + a * math.sin(math.pi * x / l))
-                           * math.sin((k + 1) * math.pi * x / l)
-                           * math.sin((j + 1) * math.pi * x / l), 0, l, epsabs=1e-14)
+            want, _ = quad(lambda x, k=k, j=j: (s0 + a * math.sin(math.pi * x / length))
+                           * math.sin((k + 1) * math.pi * x / length)
+                           * math.sin((j + 1) * math.pi * x / length), 0, length, epsabs=1e-14)
             got = float(dyn.momenta[k].diff(sys.qd[j]).subs(string.problem.values()))
             assert abs(got - want) < 1e-12
 

@@ -3,6 +3,7 @@
 
 from mechbook.verify.quantities import (  # noqa: F401 - each module registers its checks
     access,
+    adiabatic,
     equations,
     equilibria,
     expressions,
