@@ -146,6 +146,13 @@ class System:
         if s.get("torques"):
             self.forces = [f + g for f, g in zip(self.forces, torque_forces(self, s["torques"]),
                                                   strict=True)]
+        self.contacts = []  # sliding friction (mechbook.model.friction)
+        if s.get("friction"):
+            from mechbook.model.friction import contacts
+
+            self.contacts = contacts(self, s["friction"])
+            self.forces = [f + sp.Add(*(c.force[k] for c in self.contacts))
+                           for k, f in enumerate(self.forces)]
         self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))
                             for i, c in enumerate(s.get("constraints") or [])]
         for i, (cname, f) in enumerate(self.constraints):

@@ -130,10 +130,10 @@ def first_event(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: f
     def event(t, y):
         return fn(np.concatenate(([t], y)))[0]
 
-    # terminal only after the start: an event function that is zero at t = 0 (a height
-    # measured from the launch point) would otherwise stop every chunk where it begins
-    event.terminal = False
     t0, y = 0.0, np.concatenate((q0, qd0))
+    # an event function that is zero at the start (a height measured from the launch point)
+    # would stop every chunk where it begins: then the chunks run to their ends instead
+    event.terminal = bool(event(t0, y) != 0)
     for _ in range(max_chunks):
         sol = solve_ivp(model.rhs, (t0, t0 + time_scale), y, method="DOP853", rtol=TOLERANCE,
                         atol=TOLERANCE, events=[event])
