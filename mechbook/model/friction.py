@@ -33,6 +33,7 @@ class Contact:
     """One frictional contact of a system."""
 
     name: str
+    normal: sp.Matrix  # the surface's unit normal (constant)
     mu: sp.Expr
     normal_force: sp.Expr
     tangential: sp.Matrix  # v_t (space components), linear in q̇
@@ -98,5 +99,6 @@ def contacts(sys, specs: list) -> list[Contact]:
         speed = sp.sqrt(vt.dot(vt))
         F = -mu * N * vt / speed
         force = [F.dot(J[:, k]) for k in range(len(sys.q))]
-        out.append(Contact(spec.get("name", f"contact{i + 1}"), mu, N, vt, J, bias, force))
+        out.append(Contact(spec.get("name", f"contact{i + 1}"), n, mu, N, vt, J, bias,
+                           force))
     return out

@@ -147,6 +147,7 @@ class System:
             self.forces = [f + g for f, g in zip(self.forces, torque_forces(self, s["torques"]),
                                                   strict=True)]
         self.contacts = []  # sliding friction (mechbook.model.friction)
+        self.forces_without_friction = list(self.forces)
         if s.get("friction"):
             from mechbook.model.friction import contacts
 
