@@ -193,6 +193,11 @@ class System:
                 tensor = shape_inertia(inertia["shape"], m, dims)
             except ValueError as exc:
                 raise self._error(sub + ("inertia",), str(exc)) from None
+            if r.rows == 2 and tensor[2, 2] == 0 and inertia["shape"] != "point":  # own z
+                raise self._error(sub + ("inertia",), f"a planar body uses the moment about "
+                                  f"its own z axis (normal to the plane), and a "
+                                  f"{inertia['shape']}'s is 0 (its length is along its own "
+                                  "z): give the moment as a number, e.g. m*l**2/12 for a rod")
         elif isinstance(inertia, list):
             tensor = sp.Matrix([[self._parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]
                                 for i, row in enumerate(inertia)])
