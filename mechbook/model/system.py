@@ -417,12 +417,16 @@ class System:
 
 
 def system_of(problem: Problem, name: str | None = None) -> System:
-    """The built (symbolic) system `name` of a problem, or its only one; built once and
-    kept on the problem. KeyError names the systems there are."""
+    """The built (symbolic) system `name` of a problem, or its only one (of several, the one
+    named `main`); built once and kept on the problem. KeyError names the systems there
+    are."""
     if name is None:
-        if len(problem.systems) != 1:
+        if len(problem.systems) == 1:
+            name = next(iter(problem.systems))
+        elif "main" in problem.systems:
+            name = "main"
+        else:
             raise KeyError(f"{problem.id} has several systems: {', '.join(problem.systems)}")
-        name = next(iter(problem.systems))
     if name not in problem.systems:
         raise KeyError(f"{problem.id} has no system {name!r} (has {', '.join(problem.systems)})")
     if name not in problem._cache:
