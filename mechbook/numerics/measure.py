@@ -83,7 +83,9 @@ def _integrator(model: Model):
     and slip where the system has frictional contacts (mechbook.numerics.friction)."""
     factory = getattr(model, "phases", None)
     if factory is not None:
-        phases = factory()
+        phases = getattr(model, "built_phases", None)
+        if phases is None:  # built once per model (its equations are compiled then)
+            phases = model.built_phases = factory()
         return lambda span, y, events: phases.solve_ivp(span, y, events, rtol=TOLERANCE,
                                                         atol=TOLERANCE)
     return lambda span, y, events: solve_ivp(model.rhs, span, y, method="DOP853",
