@@ -179,6 +179,8 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     elif q == "eom":
         for i in range(len(val)):
             yield Slot(root + (i,), "equation")
+    elif q == "adiabatic_invariant":  # a law "f = const": any function of f is the same law
+        yield Slot(root, "conserved")
     elif q == "conserved":
         if isinstance(val, list):
             for i in range(len(val)):

@@ -97,3 +97,18 @@ def test_operator_names_in_the_parser():
         parse("W0(1, 2)", names)
     with pytest.raises(ExpressionError, match="unknown function"):
         parse("W0(1)", {})
+
+
+@pytest.mark.parametrize("name, words", [
+    ("b", "'b' is a name of the problem"),       # the text's friction table b(j, r)
+    ("r", "index 'r' is already a name"),        # a default index name
+])
+def test_a_name_of_the_problem_that_is_also_the_texts_notation_is_refused(tmp_path, name,
+                                                                         words):
+    """A parameter named like the text's notation is refused with the reason, not silently
+    shadowed (the coupling c renamed)."""
+    text = TWO.replace("  c: {value: 0.9}", f"  {name}: {{value: 0.9}}") \
+        .replace("c*x1*x2", f"{name}*x1*x2")
+    an = load(tmp_path, text, "9501")
+    out = run(tmp_path, an, part(1, FIRST))
+    assert out.status == "error" and words in out.detail, out.detail

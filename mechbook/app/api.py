@@ -208,10 +208,13 @@ class Problem:
 
     def system(self, name: str | None = None) -> SystemView:
         if name is None:
-            if len(self.model.systems) != 1:
+            if len(self.model.systems) == 1:
+                name = self.systems[0]
+            elif "main" in self.model.systems:
+                name = "main"  # of several systems, the one named main is the default
+            else:
                 raise KeyError(f"{self.id} has several systems ({', '.join(self.systems)}): "
                                "choose one with p.system(name)")
-            name = self.systems[0]
         if name not in self.model.systems:
             raise KeyError(f"{self.id} has no system {name!r} ({', '.join(self.systems)})")
         if name not in self._views:

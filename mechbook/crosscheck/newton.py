@@ -122,13 +122,44 @@ def _newton_residual(sys) -> list[sp.Expr]:
             res[i] += sp.diff(omega, qd[i]).dot(torque)
     pulls, attractor_q = _attractors(sys, spec, positions, masses, frames, parse)
     torque_q = _torques(sys, spec, frames, parse)
+    friction_q = _friction(sys, spec, positions, frames, parse)
     for name, pull in pulls.items():
         for i in range(n):
             res[i] -= sp.diff(positions[name], q[i]).dot(pull)
     for i in range(n):
         res[i] += sys.dt(sp.diff(rest, qd[i])) - sp.diff(rest, q[i]) - sys.declared_forces[i]
-        res[i] -= attractor_q[i] + torque_q[i]
+        res[i] -= attractor_q[i] + torque_q[i] + friction_q[i]
     return res
+
+
+def _friction(sys, spec: dict, positions: dict, frames: dict, parse) -> list[sp.Expr]:
+    """Generalized forces of sliding friction (`friction:`): F = −μN v_t/|v_t| at the
+    contact, whose material velocity is v_G + ω × (p − r_G) with this module's own ω (from
+    Rᵀ·dR/dt) and R; Q_k = F·∂v/∂q̇_k."""
+    out = [sp.S.Zero] * len(sys.q)
+    for i, c in enumerate(spec.get("friction") or []):
+        sub = ("friction", i)
+        body = c["body"]
+        r = positions[body]
+        p = sp.Matrix([parse(x, sub + ("point", j)) for j, x in enumerate(c["point"])])
+        v = sys.dt(r)
+        if body in frames:
+            _, omega, R = frames[body]
+            d = p - r
+            if R is None and omega.rows == 1:  # planar
+                v = v + sp.Matrix([-omega[0] * d[1], omega[0] * d[0]])
+            else:
+                w = R * omega if R is not None else omega
+                v = v + w.cross(d)
+        n = (sp.Matrix([parse(x, sub + ("normal", j)) for j, x in enumerate(c["normal"])])
+             if "normal" in c else sp.Matrix([0] * (r.rows - 1) + [1]))
+        n = n / sp.sqrt(n.dot(n))
+        vt = v - v.dot(n) * n
+        F = -parse(c["mu"], sub + ("mu",)) * parse(c["normal_force"], sub + ("normal_force",)) \
+            * vt / sp.sqrt(vt.dot(vt))
+        for k, qd in enumerate(sys.qd):
+            out[k] += F.dot(sp.diff(v, qd))
+    return out
 
 
 def _body_frame(sys, name: str, b: dict, m, parse):
@@ -268,6 +299,8 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
         what.append("torques")
     if spec.get("attractors"):
         what.append("attracting masses (force and gravity-gradient torque)")
+    if spec.get("friction"):
+        what.append("sliding friction (own contact velocity)")
     other = [k for k in ("kinetic", "potential", "lagrangian", "velocity_potential", "forces",
                          "dissipation") if k in spec]
     if any("length" in s for s in spec.get("springs") or []):

@@ -19,6 +19,11 @@ reader asks (mechbook solve).
     sweep       a linear system over a grid of parameters: compiled once, stacked
                 eigensolvers, the 30-digit path at single points
     derive      results as text for a reader, and the summary a check run stores
+    extremum    where a function is largest or smallest (one variable, 30 digits; a torus
+                of phases)
+    parts       the energy of one part of a system along the linearized motion
+    access      whether a configuration is reached on a level set of the first integrals
+    adiabatic   the action of a frozen oscillation, and a simulated slow change
 
 May import: mechbook.model, mechbook.core, mechbook.errors, mechbook.records.
 """

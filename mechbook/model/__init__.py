@@ -16,6 +16,9 @@
               (a package)
     attitude  attitude charts: chains of elementary rotations, rotation matrix, body rates
     loads     torques as generalized forces, attracting point masses, averaging over an angle
+    friction  sliding (Coulomb) friction at a contact: sliding velocity, the sliding law's
+              generalized forces, what the stick-slip integrator needs
+    field     a string's displacement field as names (u, udot, x, integral())
 
 May import: mechbook.core, mechbook.errors, mechbook.records.
 """

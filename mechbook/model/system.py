@@ -96,15 +96,21 @@ class System:
         self.attitudes: dict[str, list] = {}  # body -> chain of rotations (3-D bodies)
         self.inertias: dict[str, sp.Matrix] = {}  # body -> inertia tensor in body axes
         self.body_rates: dict[str, sp.Matrix] = {}  # body -> ω in body axes
+        # each particle's and body's own kinetic energy and potential energy in gravity
+        # (mechbook.engine.parts: the energy of one part of the system)
+        self.part_kinetic: dict[str, sp.Expr] = {}
+        self.part_potential: dict[str, sp.Expr] = {}
         for name, p in (s.get("particles") or {}).items():
             m = self._parse(p["mass"], ("particles", name, "mass"))
             r = sp.Matrix([self._parse(x, ("particles", name, "position", i))
                            for i, x in enumerate(p["position"])])
             self.positions[name], self.masses[name] = r, m
             v = self.dt(r)
-            kinetic += m * v.dot(v) / 2
+            self.part_kinetic[name] = m * v.dot(v) / 2
+            kinetic += self.part_kinetic[name]
         for name, b in (s.get("rigid_bodies") or {}).items():
-            kinetic += self._rigid_body(name, b)
+            self.part_kinetic[name] = self._rigid_body(name, b)
+            kinetic += self.part_kinetic[name]
         potential += self._gravity() + self._springs()
         if "string" in s:
             t_string, v_string = self._string()
@@ -140,6 +146,14 @@ class System:
         if s.get("torques"):
             self.forces = [f + g for f, g in zip(self.forces, torque_forces(self, s["torques"]),
                                                   strict=True)]
+        self.contacts = []  # sliding friction (mechbook.model.friction)
+        self.forces_without_friction = list(self.forces)
+        if s.get("friction"):
+            from mechbook.model.friction import contacts
+
+            self.contacts = contacts(self, s["friction"])
+            self.forces = [f + sp.Add(*(c.force[k] for c in self.contacts))
+                           for k, f in enumerate(self.forces)]
         self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))
                             for i, c in enumerate(s.get("constraints") or [])]
         for i, (cname, f) in enumerate(self.constraints):
@@ -184,6 +198,11 @@ class System:
                 tensor = shape_inertia(inertia["shape"], m, dims)
             except ValueError as exc:
                 raise self._error(sub + ("inertia",), str(exc)) from None
+            if r.rows == 2 and tensor[2, 2] == 0 and inertia["shape"] != "point":  # own z
+                raise self._error(sub + ("inertia",), f"a planar body uses the moment about "
+                                  f"its own z axis (normal to the plane), and a "
+                                  f"{inertia['shape']}'s is 0 (its length is along its own "
+                                  "z): give the moment as a number, e.g. m*l**2/12 for a rod")
         elif isinstance(inertia, list):
             tensor = sp.Matrix([[self._parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]
                                 for i, row in enumerate(inertia)])
@@ -274,7 +293,8 @@ class System:
                                       f"{name}'s position has {r.rows}")
             else:
                 up = sp.Matrix([0] * (r.rows - 1) + [1])  # default: last axis points up
-            total += self.masses[name] * g * r.dot(up)
+            self.part_potential[name] = self.masses[name] * g * r.dot(up)
+            total += self.part_potential[name]
         return total
 
     def _springs(self) -> sp.Expr:
@@ -348,6 +368,15 @@ class System:
                 kinetic += mult * mass * self.qd[ia] * self.qd[ib] / 2
             k = a + 1
             potential += tension * (k * sp.pi / length) ** 2 * (length / 2) * self.q[ia] ** 2 / 2
+        if "field" in spec:  # u(x, t) and integrals over the string as names (model/field)
+            from mechbook.model.field import field_names
+
+            named = field_names(spec["field"], x, modes, [self.q[i] for i in amps],
+                                [self.qd[i] for i in amps])
+            for n in named:
+                if n in self.names or n in RESERVED:
+                    raise self._error(sub + ("field",), f"name {n!r} is already taken")
+            self.names.update(named)
         return kinetic, potential
 
     def _forces(self) -> list[sp.Expr]:
@@ -393,12 +422,16 @@ class System:
 
 
 def system_of(problem: Problem, name: str | None = None) -> System:
-    """The built (symbolic) system `name` of a problem, or its only one; built once and
-    kept on the problem. KeyError names the systems there are."""
+    """The built (symbolic) system `name` of a problem, or its only one (of several, the one
+    named `main`); built once and kept on the problem. KeyError names the systems there
+    are."""
     if name is None:
-        if len(problem.systems) != 1:
+        if len(problem.systems) == 1:
+            name = next(iter(problem.systems))
+        elif "main" in problem.systems:
+            name = "main"
+        else:
             raise KeyError(f"{problem.id} has several systems: {', '.join(problem.systems)}")
-        name = next(iter(problem.systems))
     if name not in problem.systems:
         raise KeyError(f"{problem.id} has no system {name!r} (has {', '.join(problem.systems)})")
     if name not in problem._cache:

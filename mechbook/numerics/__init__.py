@@ -5,6 +5,7 @@
                  interface
     monitors     drift of the conserved quantities the engine found
     measure      turning points, periods, mean rates and event times measured along a run
+    friction     integrating through stick and slip (phases ended by stop and release events)
     stiffness    time scales from the linearized equations; is a run stiff?
     accuracy     method and tolerance for a requested accuracy (a rule measured by
                  bench/work_precision.py)

@@ -78,6 +78,20 @@ def signal_functions(system, dyn, values: dict, of: sp.Expr):
     return fn
 
 
+def _integrator(model: Model):
+    """solve_ivp over (t_span, y0, events) for the model: DOP853 at TOLERANCE, through stick
+    and slip where the system has frictional contacts (mechbook.numerics.friction)."""
+    factory = getattr(model, "phases", None)
+    if factory is not None:
+        phases = getattr(model, "built_phases", None)
+        if phases is None:  # built once per model (its equations are compiled then)
+            phases = model.built_phases = factory()
+        return lambda span, y, events: phases.solve_ivp(span, y, events, rtol=TOLERANCE,
+                                                        atol=TOLERANCE)
+    return lambda span, y, events: solve_ivp(model.rhs, span, y, method="DOP853",
+                                             rtol=TOLERANCE, atol=TOLERANCE, events=events)
+
+
 def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float,
             extremes: int = EXTREMES, max_chunks: int = 400) -> Measured:
     """Integrate from (q0, q̇0) until `extremes` turning points of the signal are found.
@@ -93,9 +107,9 @@ def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float
     t0, y = 0.0, np.concatenate((q0, qd0))
     times, values, kinds, states = [], [], [], []
     nfev = 0
+    integrate = _integrator(model)
     for _ in range(max_chunks):
-        sol = solve_ivp(model.rhs, (t0, t0 + time_scale), y, method="DOP853", rtol=TOLERANCE,
-                        atol=TOLERANCE, events=[rate])
+        sol = integrate((t0, t0 + time_scale), y, [rate])
         nfev += sol.nfev
         if sol.status < 0:
             raise UnsupportedError(f"measurement: the integration failed: {sol.message}")
@@ -130,11 +144,13 @@ def first_event(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: f
     def event(t, y):
         return fn(np.concatenate(([t], y)))[0]
 
-    event.terminal = True
     t0, y = 0.0, np.concatenate((q0, qd0))
+    # an event function that is zero at the start (a height measured from the launch point)
+    # would stop every chunk where it begins: then the chunks run to their ends instead
+    event.terminal = bool(event(t0, y) != 0)
+    integrate = _integrator(model)
     for _ in range(max_chunks):
-        sol = solve_ivp(model.rhs, (t0, t0 + time_scale), y, method="DOP853", rtol=TOLERANCE,
-                        atol=TOLERANCE, events=[event])
+        sol = integrate((t0, t0 + time_scale), y, [event])
         if sol.status < 0:
             raise UnsupportedError(f"measurement: the integration failed: {sol.message}")
         hits = [(te, ye) for te, ye in zip(sol.t_events[0], sol.y_events[0], strict=True)

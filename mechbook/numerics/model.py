@@ -194,6 +194,12 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
     model = Model(list(system.coord_names), n, used, 0.0, mf, canonical, monitor_fn, names,
                   constraints=m, nonconservative=nonconservative)
     model.generation_seconds = time.perf_counter() - start
+    if system.contacts:  # stick and slip: an integrator of phases, built when first asked
+        from functools import partial
+
+        from mechbook.numerics.friction import Phases
+
+        model.phases = partial(Phases, system, dyn, values)
     return model
 
 

@@ -2,11 +2,15 @@
 (mechbook.verify.registry). A new family is a new module here and a line below."""
 
 from mechbook.verify.quantities import (  # noqa: F401 - each module registers its checks
+    access,
+    adiabatic,
     equations,
     equilibria,
     expressions,
+    extremum,
     motion,
     oscillations,
+    parts,
     perturbation,
     phase,
     response,

@@ -182,6 +182,9 @@ def asymptotic(ctx: Context, error, floor: float | None = None) -> Verdict:
     if name not in ctx.names or not isinstance(ctx.names[name], sp.Symbol):
         raise ctx.part.error(("limit", "parameter"), f"unknown parameter {name!r}")
     sym = ctx.names[name]
+    if sym in ctx.sampler.derived:
+        raise ctx.part.error(("limit", "parameter"), f"{name!r} is computed by `restrict:` "
+                             "from the others, so it cannot be walked toward the limit")
     order = spec.get("order", 0)
     to_zero = str(spec["to"]) == "0"
     base = ctx.sampler.default()

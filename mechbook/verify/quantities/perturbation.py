@@ -70,9 +70,18 @@ def _names(ctx: Context) -> tuple[dict, list[sp.Symbol]]:
     f = len(ctx.system.q)
     names = dict(ctx.names)
     idx = []
+    # the text's notation must not hide a name of the problem or key (a parameter `b` read
+    # as the friction table b(j, r), or the other way round): refused, with the way out
+    own = list(TABLES) + ["Delta", "sum", "delta"]
+    taken = [t for t in own if t in names]
+    if taken:
+        raise ctx.part.error(("quantity",), f"{', '.join(map(repr, taken))} is a name of the "
+                             "problem or key and also the text's notation here ("
+                             + ", ".join(own) + "): rename the parameter or symbol")
     for name in ctx.part.data.get("indices", ["j", "r", "s"]):
         if name in names:
-            continue
+            raise ctx.part.error(("indices",), f"index {name!r} is already a name of the "
+                                 "problem or key: choose other index names (`indices:`)")
         names[name] = sp.Symbol(name, integer=True)
         idx.append(names[name])
     for t in TABLES:

@@ -257,8 +257,9 @@ def check_event_time(ctx: Context, val) -> Verdict:
     if name is not None and name not in sys.coord_names:
         raise ctx.part.error(("advance",), f"{name!r} is not a coordinate")
     rtol = ctx.sampler.rtol if "estimate" in ctx.part.data else MEASURE_RTOL
+    points = 1 if "estimate" in ctx.part.data else MEASURED_POINTS  # an estimate: one point
     book = _book_values(ctx, val)
-    for n in range(1, MEASURED_POINTS + 1):
+    for n in range(1, points + 1):
         pt = ctx.sampler.draw()
         params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
         model = build_model(sys, ctx.dyn, params)
@@ -275,6 +276,5 @@ def check_event_time(ctx: Context, val) -> Verdict:
         ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
         if not ok:
             return Verdict(False, f"measured({n} points)", f"event: {why}")
-    return Verdict(True, f"measured({MEASURED_POINTS} points, rtol {rtol:g})",
-                   power=f"{MEASURED_POINTS} points, measured by integration to {rtol:g}")
-
+    return Verdict(True, f"measured({points} points, rtol {rtol:g})",
+                   power=f"{points} points, measured by integration to {rtol:g}")

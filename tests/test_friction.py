@@ -1,0 +1,148 @@
+"""Coulomb friction at a contact (`friction:`), through stick and slip, against closed forms:
+a block sent up an incline stops at v0/(g(sin α + μ cos α)) and then sticks (tan α < μ) or
+slides back at g(sin α − μ cos α) (tan α > μ); a disk sent sliding without spin starts to
+roll at v0/(3μg) with speed 2v0/3 and rolls on; a block pushed by a force growing like c·t
+stays stuck until c·t = μmg and then moves as c(t − t_r)³/(6m). The sliding top's Newton
+cross-check (own contact velocity) is in the books' run (Symon 11-15)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mechbook.engine.analysis import Analysis
+from mechbook.errors import SpecError
+from mechbook.model.problem import load_problem
+from mechbook.numerics.friction import Phases
+from mechbook.numerics.measure import first_event, signal_functions
+from mechbook.numerics.model import build_model
+
+G = 9.81
+
+INCLINE = """\
+id: symon-text-test-incline
+source: test
+title: block on an incline
+parameters:
+  m: {{value: 0.4}}
+  mu: {{value: {mu}}}
+  alpha: {{value: 0.3}}
+  g: {{}}
+coordinates:
+  x: {{doc: distance up the incline}}
+particles:
+  block: {{mass: m, position: [x*cos(alpha), x*sin(alpha)]}}
+gravity: {{}}
+friction:
+  - {{body: block, point: [x*cos(alpha), x*sin(alpha)], normal: [-sin(alpha), cos(alpha)],
+     mu: mu, normal_force: m*g*cos(alpha)}}
+"""
+
+DISK = """\
+id: symon-text-test-disk
+source: test
+title: disk sliding on a table
+parameters:
+  m: {value: 0.3}
+  R: {value: 0.1}
+  mu: {value: 0.2}
+  g: {}
+coordinates:
+  x: {}
+  phi: {doc: "turn of the disk, counterclockwise"}
+rigid_bodies:
+  disk: {mass: m, position: [x, R], inertia: m*R**2/2, angular_velocity: phidot}
+friction:
+  - {body: disk, point: [x, 0], mu: mu, normal_force: m*g}
+"""
+
+PUSHED = """\
+id: symon-text-test-pushed
+source: test
+title: block pushed by a growing force
+parameters:
+  m: {value: 0.5}
+  mu: {value: 0.4}
+  c: {value: 3.0}
+  g: {}
+coordinates:
+  x: {}
+particles:
+  block: {mass: m, position: [x, 0]}
+forces: {x: c*t}
+friction:
+  - {body: block, point: [x, 0], mu: mu, normal_force: m*g}
+"""
+
+
+def _analysis(tmp_path, text: str) -> Analysis:
+    name = text.split("\n", 1)[0].removeprefix("id: symon-")
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    return Analysis(load_problem(path))
+
+
+@pytest.mark.parametrize("mu", [0.5, 0.2])
+def test_block_on_an_incline_stops_then_sticks_or_slides_back(tmp_path, mu):
+    a = _analysis(tmp_path, INCLINE.format(mu=mu))
+    phases = Phases(a.system(), a.dynamics(), a.problem.values())
+    alpha, v0 = 0.3, 2.0
+    up = G * (math.sin(alpha) + mu * math.cos(alpha))
+    t_stop, x_stop = v0 / up, v0**2 / (2 * up)
+    r = phases.solve_ivp((0.0, 1.0), [0.0, v0])
+    (t_switch, _, _), = r.switches[:1]
+    assert abs(t_switch / t_stop - 1) < 1e-6
+    x_end = r.y[0, -1]
+    if math.tan(alpha) < mu:
+        assert [s[2] for s in r.switches] == ["stick"]
+        assert abs(x_end - x_stop) < 1e-7 and r.y[1, -1] == 0.0
+    else:
+        assert [s[2] for s in r.switches] == ["through"]
+        down = G * (math.sin(alpha) - mu * math.cos(alpha))
+        assert abs(x_end - (x_stop - down * (1.0 - t_stop) ** 2 / 2)) < 1e-7
+
+
+def test_a_sliding_disk_starts_to_roll(tmp_path):
+    a = _analysis(tmp_path, DISK)
+    phases = Phases(a.system(), a.dynamics(), a.problem.values())
+    v0, mu = 1.5, 0.2
+    r = phases.solve_ivp((0.0, 2.0), [0.0, 0.0, v0, 0.0])
+    assert [s[2] for s in r.switches] == ["stick"]
+    assert abs(r.switches[0][0] / (v0 / (3 * mu * G)) - 1) < 1e-6
+    xdot, phidot = r.y[2, -1], r.y[3, -1]
+    assert abs(xdot / (2 * v0 / 3) - 1) < 1e-8
+    assert abs(xdot + 0.1 * phidot) < 1e-9          # rolling: the contact at rest
+
+
+def test_a_block_breaks_free_when_the_push_exceeds_mu_m_g(tmp_path):
+    a = _analysis(tmp_path, PUSHED)
+    phases = Phases(a.system(), a.dynamics(), a.problem.values())
+    m, mu, c = 0.5, 0.4, 3.0
+    t_r = mu * m * G / c
+    r = phases.solve_ivp((0.0, 1.5), [0.0, 0.0])
+    assert [s[2] for s in r.switches] == ["slip"]
+    assert abs(r.switches[0][0] / t_r - 1) < 1e-6
+    assert abs(r.y[0, -1] / (c * (1.5 - t_r) ** 3 / (6 * m)) - 1) < 1e-6
+
+
+def test_the_measurements_integrate_through_stick_and_slip(tmp_path):
+    """first_event uses the phases: the disk slides to t_r = v0/(3μg), then rolls at 2v0/3;
+    it reaches x_r + 0.5 at t_r + 0.5/(2v0/3)."""
+    a = _analysis(tmp_path, DISK)
+    sys, dyn = a.system(), a.dynamics()
+    values = a.problem.values()
+    model = build_model(sys, dyn, values)
+    v0, mu = 1.5, 0.2
+    t_r = v0 / (3 * mu * G)
+    x_r = v0 * t_r - mu * G * t_r**2 / 2
+    fn = signal_functions(sys, dyn, values, sys.q[0] - (x_r + 0.5))
+    t, _ = first_event(model, fn, np.zeros(2), np.array([v0, 0.0]), 0.1)
+    assert abs(t / (t_r + 0.5 / (2 * v0 / 3)) - 1) < 1e-6
+
+
+def test_a_normal_force_with_accelerations_is_refused(tmp_path):
+    with pytest.raises(SpecError, match="no accelerations"):
+        _analysis(tmp_path, PUSHED.replace("normal_force: m*g", "normal_force: m*(g + xddot)")
+                  ).system()
