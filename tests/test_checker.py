@@ -30,7 +30,7 @@ from mechbook.model.problem import load_problem
 from mechbook.model.tensorexpr import kind
 from mechbook.verify.answers import AnswerKey, Part, load_answers
 from mechbook.verify.checker import check_problem
-from mechbook.verify.context import Context
+from mechbook.verify.context import Context, split_named
 from mechbook.verify.registry import quantities
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -371,13 +371,16 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
         yield "add one", f"({s}) + 1"
     elif slot.kind == "equation":
         yield from equation_mutants(s, names, coordinate)
-    elif slot.kind == "conserved":
-        body = re.sub(r"=\s*const(ant)?\s*$", "", s).strip()
-        yield "times (2 + coordinate)", f"({body})*(2 + {coordinate})"
+    elif slot.kind == "conserved":  # a named one (`p_psi = ...`): its value is mutated
+        name, body = split_named(s)
+        head = f"{name} = " if name is not None else ""
+        body = str(body).strip()
+        yield "times (2 + coordinate)", f"{head}({body})*(2 + {coordinate})"
         doubled = double_first_term(body)
         if doubled:
-            yield "double a term", doubled
-        yield from swap_names(body, names)
+            yield "double a term", head + doubled
+        for label, swapped in swap_names(body, names):
+            yield label, head + swapped
     elif slot.kind == "relation":
         flipped = flip_relation(s)
         if flipped:
@@ -482,6 +485,17 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
                 and _zero((a.lhs - a.rhs) - (b.lhs - b.rhs)))
     if slot.kind == "steady":  # another true steady motion (a symmetry: -rate, -angle, ...)
         return _also_steady(ctx, slot, part_data, new)
+    if slot.kind == "conserved":
+        sys = ctx.system
+        motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}
+        name, old_value = split_named(str(old))
+        new_name, new_value = split_named(str(new))
+        a, b = ctx.parse(old_value, slot.path), ctx.parse(new_value, slot.path)
+        if name is not None:  # a named quantity: only its own value (the energy up to a
+            # constant) means the same
+            return name == new_name and (_zero(a - b) or (
+                name in ("E", "h", "energy", "jacobi") and _free_of(b - a, motion)))
+        return _free_of(b - a, motion) or _zero(a - b) or (a != 0 and _free_of(b / a, motion))
     extra = quantities()[ctx.part.quantity].names
     if extra is not None:  # the quantity's own names (a polynomial's variable, W0(j), ...)
         names = extra(ctx)
@@ -497,11 +511,8 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
         a = ctx.parse(old, sub, equation=True)
         b = ctx.parse(new, sub, equation=True)
         return _zero(a - b) or (a != 0 and _free_of(b / a, motion))
-    if slot.kind == "conserved":
-        a = ctx.parse(re.sub(r"=\s*const(ant)?\s*$", "", str(old)), sub)
-        b = ctx.parse(new, sub)
-        return _free_of(b - a, motion) or _zero(a - b) or (a != 0 and _free_of(b / a, motion))
     if slot.kind == "form":
+
         a, b = ctx.parse(old, sub), ctx.parse(new, sub)
         return a != 0 and _free_of(b / a, motion)
     if slot.kind == "component":
