@@ -65,7 +65,39 @@ class Model:
         b = out[n * n + n + m * n:]
         return M, f, A, b
 
+    @cached_property
+    def native(self):
+        """The compiled loops' view of this model (`native.NativeModel`), or None where the
+        loop library or the LLVM kernel is unavailable (then the Python paths run)."""
+        from mechbook.numerics import native
+
+        kernel = native.kernel_pointer(self._mf)
+        lib = native.library() if kernel else None
+        if lib is None:
+            return None
+        return native.NativeModel(lib, kernel, self.n, self.constraints, keep=(self._mf,))
+
+    @cached_property
+    def native_canonical(self):
+        """Like `native`, with the canonical kernel too (the implicit midpoint loop)."""
+        from mechbook.numerics import native
+
+        kernel, canon = native.kernel_pointer(self._mf), native.kernel_pointer(self.canonical)
+        lib = native.library() if kernel and canon else None
+        if lib is None:
+            return None
+        return native.NativeModel(lib, kernel, self.n, self.constraints, canonical=canon,
+                                  keep=(self._mf, self.canonical))
+
     def accelerations(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        nat = self.native
+        if nat is not None:
+            self.stats["rhs_calls"] += 1
+            return nat.accelerations(t, q, qd)
+        return self.accelerations_python(t, q, qd)
+
+    def accelerations_python(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """The reference: kernel through its Python wrapper, NumPy solve."""
         self._buf[0] = t
         self._buf[1:self.n + 1] = q
         self._buf[self.n + 1:] = qd
@@ -86,7 +118,16 @@ class Model:
         return np.linalg.solve(big, rhs)[:n]
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        """dy/dt for y = (q, q̇) (the function `solve_ivp` integrates)."""
+        """dy/dt for y = (q, q̇) (the function `solve_ivp` integrates): one call into the
+        compiled kernel and solve where they exist, no allocation but the result."""
+        nat = self.native
+        if nat is not None:
+            self.stats["rhs_calls"] += 1
+            return nat.rhs(t, y)
+        return self.rhs_python(t, y)
+
+    def rhs_python(self, t: float, y: np.ndarray) -> np.ndarray:
+        """The reference right-hand side: kernel through its Python wrapper, NumPy solve."""
         buf = self._buf
         buf[0] = t
         buf[1:] = y
