@@ -23,6 +23,7 @@ separable ones only when the model is separable (`rhs.structure` decides).
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -347,11 +348,38 @@ class ImplicitMidpoint(FixedStep):
                          lambda t, z: (z[:n], model.velocities(t, z[:n], z[n:])), t_eval)
 
 
+class TaylorMethod(Integrator):
+    """heyoka's adaptive Taylor method (`taylor.py`): options `tol` (default machine
+    epsilon; `rtol` is taken for it when `tol` is not given), `max_points`."""
+
+    name = "taylor"
+    adaptive = True
+
+    def solve(self, model, t_span, q0, qd0, t_eval=None, events=None) -> Trajectory:
+        from mechbook.numerics import taylor
+
+        if events:
+            raise IntegratorError("the taylor method takes no solve_ivp events (its own "
+                                  "events: taylor.turning_points, taylor.first_crossing)")
+        tol = float(self.options.get("tol") or self.options.get("rtol") or taylor.DEFAULT_TOL)
+        y0 = np.concatenate((q0, qd0)).astype(float)
+        before = taylor.compile_seconds(model)
+        start = time.perf_counter()
+        t, y, ok, message, steps = taylor.propagate(
+            model, t_span, y0, tol, t_eval, int(self.options.get("max_points") or 200_001))
+        compile_s = taylor.compile_seconds(model) - before
+        n = model.n
+        settings = {"method": self.name, "tol": tol, "steps": steps,
+                    "compile_s": compile_s,
+                    "integrate_s": time.perf_counter() - start - compile_s}
+        return Trajectory(t, y[:n], y[n:], self.name, settings, 0, ok, message)
+
+
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
 FIXED: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog, "verlet": Leapfrog,
                                      "yoshida4": Yoshida4, "forest-ruth": Yoshida4,
                                      "midpoint": ImplicitMidpoint}
-METHODS = SCIPY_METHODS + tuple(FIXED)
+METHODS = SCIPY_METHODS + tuple(FIXED) + ("taylor",)
 
 
 def make_integrator(method: str, **options) -> Integrator:
@@ -362,6 +390,9 @@ def make_integrator(method: str, **options) -> Integrator:
     if method in FIXED:
         allowed = {"step", "max_points", "tol", "max_iter", "compiled"}
         return FIXED[method](**{k: v for k, v in options.items() if k in allowed})
+    if method == "taylor":
+        allowed = {"tol", "rtol", "max_points"}
+        return TaylorMethod(**{k: v for k, v in options.items() if k in allowed})
     raise IntegratorError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
 

@@ -29,6 +29,21 @@ from mechbook.errors import UnsupportedError
 
 
 @dataclass
+class EquationSource:
+    """M q̈ = f (+ A q̈ + b = 0) with the parameters as symbols and their values: what a
+    backend that compiles once per system (the Taylor backend) starts from."""
+
+    t: sp.Symbol
+    q: list
+    qd: list
+    M: list  # n×n, row-major
+    f: list
+    A: list  # m×n, row-major
+    b: list
+    values: dict  # parameter symbol -> float
+
+
+@dataclass
 class Model:
     """The numeric equations of motion of one system at fixed parameter values.
 
@@ -48,6 +63,9 @@ class Model:
     constraints: int = 0
     nonconservative: bool = False
     stats: dict = field(default_factory=lambda: {"rhs_calls": 0})
+    # () -> EquationSource: the same equations with the parameters still symbols (Taylor)
+    _source: Callable[[], EquationSource] | None = None
+    cache: dict = field(default_factory=dict)  # compiled artefacts of other backends (Taylor)
 
     def __post_init__(self) -> None:
         self._buf = np.zeros(1 + 2 * self.n)
@@ -64,6 +82,12 @@ class Model:
         A = out[n * n + n: n * n + n + m * n].reshape(m, n)
         b = out[n * n + n + m * n:]
         return M, f, A, b
+
+    @cached_property
+    def source(self) -> EquationSource:
+        if self._source is None:
+            raise UnsupportedError("this model keeps no symbolic equations")
+        return self._source()
 
     @cached_property
     def native(self):
@@ -231,9 +255,21 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
     names = list(conserved or {})
     if names:
         monitor_fn, _ = compile_exprs(args, [conserved[k].xreplace(sub) for k in names], used)
+    def source() -> EquationSource:
+        res = list(dyn.residuals)
+        Ms = [as_expr(sp.diff(e, a)) for e in res for a in qdd]
+        fs = [as_expr(-e.xreplace(zero_acc)) for e in res]
+        As, bs = [], []
+        if system.constraints:
+            As = [as_expr(x) for x in dyn.constraint_jacobian]
+            bs = [as_expr(system.dt(system.dt(c)).xreplace(zero_acc))
+                  for _, c in system.constraints]
+        return EquationSource(t, q, qd, Ms, fs, As, bs,
+                              {k: float(v) for k, v in values.items()})
+
     nonconservative = any(F != 0 for F in system.forces)
     model = Model(list(system.coord_names), n, used, 0.0, mf, canonical, monitor_fn, names,
-                  constraints=m, nonconservative=nonconservative)
+                  constraints=m, nonconservative=nonconservative, _source=source)
     model.generation_seconds = time.perf_counter() - start
     return model
 
@@ -308,5 +344,5 @@ def timed_calls(fn: Callable[[], object], seconds: float = 0.2) -> float:
             return elapsed / calls
 
 
-__all__ = ["BACKENDS", "DEFAULT_BACKEND", "Model", "Structure", "build_model",
+__all__ = ["BACKENDS", "DEFAULT_BACKEND", "EquationSource", "Model", "Structure", "build_model",
            "compile_exprs", "structure", "timed_calls"]
