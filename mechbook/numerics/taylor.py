@@ -304,7 +304,7 @@ def propagate_batch(model: Model, states: np.ndarray, t_end: float, tol: float =
         block = np.zeros((n2, lanes))
         block[:, : hi - lo] = states[lo:hi].T
         block[:, hi - lo:] = states[lo:lo + 1].T  # pad with a copy of a real run
-        ta.time[:] = 0.0
+        ta.set_time(np.zeros(lanes))
         ta.state[:] = block
         if P:
             pb = np.zeros((P, lanes))
