@@ -46,6 +46,7 @@ from mechbook.errors import MechbookError
 
 BENCH_PERIODS = 3  # the bench integrates this many periods of the slowest linear mode
 SCIPY = ("RK45", "DOP853", "Radau", "LSODA")
+ADAPTIVE = (*SCIPY, "taylor")  # methods with a tolerance (taylor: heyoka, when installed)
 
 # target: {method: (rtol = atol, worst error over the bench systems, seconds summed)}
 # measured in 2026 on the 2-core development machine by bench/work_precision.py
@@ -158,32 +159,40 @@ def _targets() -> list[float]:
 
 
 def choose(accuracy: float, *, method: str | None = None, stiff: bool = False,
-           periods: float | None = None) -> Choice:
+           periods: float | None = None, taylor_available: bool | None = None) -> Choice:
     """Method and tolerance for a run that should reach `accuracy` (see the docstring).
 
     `method` forces the method (SciPy methods only; the tolerance comes from its column);
     `stiff` picks the implicit method when none is forced; `periods` is the run's length
-    in periods of the slowest linear mode."""
+    in periods of the slowest linear mode; `taylor_available` (default: whether heyoka
+    imports) lets the taylor column compete."""
     from mechbook.numerics.stiffness import IMPLICIT
 
     if not accuracy > 0 or not math.isfinite(accuracy):
         raise MechbookError(f"--accuracy must be a positive number, got {accuracy}")
-    if method is not None and method not in SCIPY:
+    if method is not None and method not in ADAPTIVE:
         raise MechbookError(f"--accuracy chooses a tolerance for the adaptive methods "
-                            f"({', '.join(SCIPY)}), not for the fixed-step {method!r}: give "
+                            f"({', '.join(ADAPTIVE)}), not for the fixed-step {method!r}: give "
                             "--step instead")
     if not TABLE:
         raise MechbookError("no accuracy table (run bench/work_precision.py)")
+    if taylor_available is None:
+        from mechbook.numerics.taylor import available
+
+        taylor_available = available()
     wanted = accuracy
     if periods and periods > BENCH_PERIODS:
         wanted = accuracy * BENCH_PERIODS / periods
-    reachable = [t for t in _targets() if t <= wanted * (1 + 1e-9)]
+    usable = {t: {m: v for m, v in row.items() if m != "taylor" or taylor_available
+                  or method == "taylor"} for t, row in TABLE.items()}
+    usable = {t: row for t, row in usable.items() if row}
+    reachable = [t for t in sorted(usable, reverse=True) if t <= wanted * (1 + 1e-9)]
     note = ""
     if not reachable:
-        reachable = [min(TABLE)]
-        note = f"; below {min(TABLE):.0e} the bench has no data: the tightest setting"
+        reachable = [min(usable)]
+        note = f"; below {min(usable):.0e} the bench has no data: the tightest setting"
     target = reachable[0]
-    row = TABLE[target]
+    row = usable[target]
     if method is not None:
         pick, why = method, "forced"
     elif stiff:
@@ -192,13 +201,13 @@ def choose(accuracy: float, *, method: str | None = None, stiff: bool = False,
         pick = min(row, key=lambda m: row[m][2])
         why = "cheapest in the bench"
     if pick not in row:  # the method never met this target on every system
-        own = [t for t in sorted(TABLE) if pick in TABLE[t]]
+        own = [t for t in sorted(usable) if pick in usable[t]]
         if not own:
             raise MechbookError(f"{pick} met no accuracy target on every bench system")
-        target, row = own[0], TABLE[own[0]]
+        target, row = own[0], usable[own[0]]
         note += f"; {pick} met no target below {target:.0e} on every bench system"
     rtol, worst, _ = row[pick]
     return Choice(accuracy, target, pick, rtol, worst, periods, why + note)
 
 
-__all__ = ["BENCH_PERIODS", "TABLE", "Choice", "choose", "scales", "state_error"]
+__all__ = ["ADAPTIVE", "BENCH_PERIODS", "TABLE", "Choice", "choose", "scales", "state_error"]
