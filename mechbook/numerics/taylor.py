@@ -167,7 +167,9 @@ def compile_seconds(model: Model) -> float:
 
 
 def reset(ta, t0: float, y0: np.ndarray) -> None:
-    ta.time = float(t0)
+    """Rewind a cached integrator to (t0, y0), in its own floating-point type."""
+    kind = type(ta.time)  # float, or heyoka's real128
+    ta.time = kind(float(t0))
     ta.state[:] = y0
     if ta.with_events:
         ta.reset_cooldowns()
