@@ -161,3 +161,28 @@ def test_without_the_library_the_python_paths_run(tmp_path, monkeypatch):
     assert model.native is None
     traj = integrate(model, (0, 1), [1.0], [0.0], "leapfrog", step=0.01)
     assert traj.success and not traj.settings.get("compiled")
+
+
+@pytest.mark.parametrize("pid", ["symon-11-08", "lim-2034", "symon-09-07"])
+def test_rhs_is_the_reference_on_larger_systems(pid):
+    """Three and more degrees of freedom: the solve pivots at later steps too."""
+    from mechbook.engine.analysis import Analysis
+    from mechbook.model.catalog import problem_path
+    from mechbook.model.problem import load_problem
+
+    root = Path(__file__).resolve().parents[1]
+    problem = load_problem(problem_path(pid, root))
+    an = Analysis(problem)
+    name = next(iter(problem.systems))
+    model = build_model(an.system(name), an.dynamics(name), problem.values())
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for _ in range(300):
+        y = rng.uniform(-3, 3, 2 * model.n)
+        with np.errstate(all="ignore"):
+            ref = model.rhs_python(0.2, y)
+        if not np.all(np.isfinite(ref)):
+            continue
+        worst = max(worst, float(np.max(np.abs(model.rhs(0.2, y) - ref)
+                                       / (1 + np.abs(ref)))))
+    assert worst < 1e-10

@@ -198,3 +198,44 @@ def test_translator_refuses_what_it_does_not_know():
         tr(sp.Abs(x))
     with pytest.raises(UnsupportedError, match="no value"):
         tr(sp.Symbol("k") * x)
+
+
+ABS_WELL = """\
+id: lim-9204
+source: test
+title: particle in a well with an Abs term
+parameters:
+  m: {value: 1.0}
+  k: {value: 2.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*(x**2 + Abs(x)**3)
+"""
+
+
+def test_simulate_with_taylor_and_its_fallback(tmp_path):
+    from systems import load_analysis
+
+    from mechbook.numerics.simulate import simulate
+
+    an = load_analysis(tmp_path, PENDULUM, "9201")
+    sim = simulate(an, init={"theta": "1"}, t_span=(0, 20), method="taylor", points=101)
+    assert sim.trajectory.method == "taylor" and sim.trajectory.success
+    assert len(sim.trajectory.t) == 101
+    assert sim.drifts[0].relative < 1e-14
+    well = load_analysis(tmp_path, ABS_WELL, "9204")
+    sim = simulate(well, init={"x": "0.5"}, t_span=(0, 5), method="taylor")
+    assert sim.trajectory.method == "DOP853"
+    assert any("taylor method unavailable" in n and "no heyoka translation" in n
+               for n in sim.notes)
+
+
+def test_accuracy_rule_offers_taylor_only_where_installed():
+    from mechbook.numerics import accuracy
+
+    tight = min(t for t, row in accuracy.TABLE.items() if "taylor" in row)
+    assert accuracy.choose(tight, taylor_available=True).method == "taylor"
+    without = accuracy.choose(tight, taylor_available=False)
+    assert without.method != "taylor"
+    assert accuracy.choose(1e-6, method="taylor", taylor_available=True).method == "taylor"

@@ -76,11 +76,14 @@ static int lu_factor(double *a, int k, int *piv) {
 }
 
 static void lu_solve(const double *a, int k, const int *piv, double *b) {
+    /* all the interchanges first (the multipliers stored in a are in the final row order),
+     * then L y = P b, then U x = y */
     for (int j = 0; j < k; j++) {
         int p = piv[j];
         if (p != j) { double t = b[j]; b[j] = b[p]; b[p] = t; }
-        for (int i = j + 1; i < k; i++) b[i] -= a[i * k + j] * b[j];
     }
+    for (int j = 0; j < k; j++)
+        for (int i = j + 1; i < k; i++) b[i] -= a[i * k + j] * b[j];
     for (int i = k - 1; i >= 0; i--) {
         double s = b[i];
         for (int c = i + 1; c < k; c++) s -= a[i * k + c] * b[c];
