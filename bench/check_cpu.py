@@ -61,7 +61,8 @@ def run(tree: Path, pids: list[str]) -> tuple[float, dict]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("pids", nargs="*", default=list(PIDS))
-    ap.add_argument("--base", default="main")
+    ap.add_argument("--base", default="main",
+                    help="the commit to compare with (use the merge base of a branch)")
     ap.add_argument("--repeat", type=int, default=3)
     opts = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="mechbook-base-") as tmp:

@@ -336,6 +336,37 @@ def long_runs(repeat: int, quick: bool) -> tuple[list[dict], dict]:
     return rows, info
 
 
+# ---- a sweep of a trajectory quantity: frequency against amplitude -------------------------
+def amplitude_sweep(repeat: int, count: int = 64) -> dict:
+    """lim-2030's frequency at `count` amplitudes (0.01 to 2.5 rad): DOP853 one amplitude
+    at a time (crosscheck.amplitude) against one Taylor batch run, and their agreement."""
+    from mechbook.crosscheck.amplitude import amplitude_response
+    from mechbook.numerics import taylor
+
+    an, sys_, dyn, values = load("lim-2030", "main")
+    lin = an.linear("main", {sys_.q[0]: 0})
+    amps = np.linspace(0.01, 2.5, count)
+    models: dict = {}
+    amplitude_response(an, lin, values, amps[:1], models)  # the model, compiled once
+    if not taylor.available():
+        return {}
+    start = time.process_time()
+    amplitude_response(an, lin, values, amps[:1], models, method="taylor")
+    first = time.process_time() - start  # heyoka import and the batch integrator's compile
+    out = {}
+
+    def dop():
+        out["dop"] = amplitude_response(an, lin, values, amps, models)[1]
+
+    def tay():
+        out["taylor"] = amplitude_response(an, lin, values, amps, models, method="taylor")[1]
+
+    t = interleaved({"dop": dop, "taylor": tay}, repeat)
+    return {"amplitudes": count, "dop853_s": t["dop"], "taylor_batch_s": t["taylor"],
+            "ratio": t["dop"] / t["taylor"], "taylor_first_call_s": first,
+            "max_relative_difference": float(np.nanmax(np.abs(out["dop"] / out["taylor"] - 1)))}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
@@ -349,6 +380,7 @@ def main() -> None:
     began = time.perf_counter()
     calls = pd.DataFrame(rhs_calls(opts.repeat, (1, 4) if opts.quick else (1, 2, 4, 8)))
     rows, info = long_runs(opts.repeat, opts.quick)
+    sweep = amplitude_sweep(opts.repeat, 16 if opts.quick else 64)
     runs = pd.DataFrame(rows)
     print(f"# {platform.machine()}, {os.cpu_count()} cores, Python "
           f"{platform.python_version()}, process CPU time, median of {opts.repeat} "
@@ -361,6 +393,9 @@ def main() -> None:
         print(runs.to_string(index=False, float_format="{:.3g}".format))
         print("\n== DOP853 at rtol = atol = 1e-6")
         for k, v in info["dop853"].items():
+            print(f"  {k}: {v:.4g}")
+        print("\n== frequency against amplitude (a sweep of a trajectory quantity)")
+        for k, v in sweep.items():
             print(f"  {k}: {v:.4g}")
         print(f"\nreference compile (sympy cse + gcc): {info['reference_compile_s']:.3f} s; "
               f"loops.c build this process: {info['loops_build_s']:.3f} s (0: cached)")

@@ -239,3 +239,24 @@ def test_accuracy_rule_offers_taylor_only_where_installed():
     without = accuracy.choose(tight, taylor_available=False)
     assert without.method != "taylor"
     assert accuracy.choose(1e-6, method="taylor", taylor_available=True).method == "taylor"
+
+
+def test_amplitude_frequencies_in_batch_mode(tmp_path):
+    """The finite-amplitude frequency of the pendulum, ω(a) = π ω0 / (2 K(sin²(a/2))),
+    measured one amplitude at a time (DOP853) and all at once (Taylor batch)."""
+    from systems import load_analysis
+
+    from mechbook.crosscheck.amplitude import amplitude_response
+
+    an = load_analysis(tmp_path, PENDULUM, "9201")
+    sys = an.system(None)
+    lin = an.linear(None, {sys.q[0]: 0})
+    values = an.problem.values()
+    amps = np.array([0.05, 0.3, 0.8, 1.5, 2.2])
+    w0 = math.sqrt(G / LEN)
+    exact = np.array([math.pi * w0 / (2 * ellipk(math.sin(a / 2) ** 2)) for a in amps])
+    lin_d, one = amplitude_response(an, lin, values, amps)
+    lin_t, batch = amplitude_response(an, lin, values, amps, method="taylor")
+    assert lin_d[0] == pytest.approx(w0, rel=1e-12) and lin_t[0] == lin_d[0]
+    assert np.allclose(one[:, 0], exact, rtol=1e-9)
+    assert np.allclose(batch[:, 0], exact, rtol=1e-11)

@@ -323,5 +323,48 @@ def propagate_batch(model: Model, states: np.ndarray, t_end: float, tol: float =
     return out
 
 
-__all__ = ["DEFAULT_TOL", "available", "compile_seconds", "first_crossing", "integrator",
+def crossings_batch(model: Model, weights: np.ndarray, offset: tuple[float, float],
+                    states: np.ndarray, t_end: float, tol: float = DEFAULT_TOL
+                    ) -> list[np.ndarray]:
+    """Upward zero crossings of the linear signal weights·y − (a + b t), offset = (a, b),
+    from each of `states` (N × 2n) over [0, t_end], in heyoka's batch mode (all starts in
+    SIMD lanes at once): one array of crossing times per start. The period measurement of
+    `crosscheck.amplitude` for many amplitudes of one mode."""
+    hy = _hy()
+    ts = system_of(model)
+    states = np.atleast_2d(np.asarray(states, float))
+    N, n2 = states.shape
+    terms = [float(w) * v for w, v in zip(weights, ts.variables, strict=True) if w != 0]
+    a, b = map(float, offset)
+    expr = hy.sum(terms) - (a + b * hy.time) if terms else hy.expression(0.0)
+    hits: list = []
+
+    def record(ta, t, d_sgn, lane):
+        hits.append((float(t), int(lane)))
+
+    lanes = max(1, int(hy.recommended_simd_size()))
+    P = len(ts.pars)
+    ev = hy.nt_event_batch(expr, record, direction=hy.event_direction.positive)
+    ta = hy.taylor_adaptive_batch(ts.ode, np.zeros((n2, lanes)), tol=tol,
+                                  compact_mode=ts.compact, nt_events=[ev],
+                                  pars=np.tile(np.asarray(ts.pars, float)[:, None],
+                                               (1, lanes)) if P else np.zeros((0, lanes)))
+    out: list[list[float]] = [[] for _ in range(N)]
+    for lo in range(0, N, lanes):
+        hi = min(N, lo + lanes)
+        block = np.repeat(states[lo:lo + 1].T, lanes, axis=1)
+        block[:, : hi - lo] = states[lo:hi].T
+        ta.set_time(np.zeros(lanes))
+        ta.state[:] = block
+        ta.reset_cooldowns()
+        hits.clear()
+        ta.propagate_until(float(t_end))
+        for t, lane in hits:
+            if lane < hi - lo and t > 0:
+                out[lo + lane].append(t)
+    return [np.sort(np.array(x)) for x in out]
+
+
+__all__ = ["DEFAULT_TOL", "available", "compile_seconds", "crossings_batch", "first_crossing",
+           "integrator",
            "propagate", "propagate_batch", "system_of", "turning_points"]
