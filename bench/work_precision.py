@@ -343,7 +343,7 @@ def taylor_ladder(case: Case, quick: bool, repeat: int) -> list[Run]:
         start = time.perf_counter()
         try:
             taylor.integrator(case.model, tol, key="plain")
-        except UnsupportedError as exc:
+        except (UnsupportedError, ValueError, RuntimeError) as exc:
             return [Run("taylor", "unsupported", tol, 0, math.inf, math.nan, 0, 0, False,
                         str(exc))]
         compile_s = time.perf_counter() - start

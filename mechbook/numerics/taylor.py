@@ -72,7 +72,8 @@ def system_of(model: Model) -> TaylorSystem:
     start = time.perf_counter()
     src = model.source
     n, m = len(src.q), len(src.b)
-    params = sorted(src.values, key=str)
+    used = set().union(*(e.free_symbols for e in (*src.M, *src.f, *src.A, *src.b)))
+    params = sorted((p for p in src.values if p in used), key=str)  # heyoka counts par[i]
     qv = hy.make_vars(*[f"q{i}" for i in range(n)])
     vv = hy.make_vars(*[f"v{i}" for i in range(n)])
     qv = [qv] if n == 1 else list(qv)
@@ -153,7 +154,10 @@ def integrator(model: Model, tol: float = DEFAULT_TOL, *, nt_events=(), t_events
         kw["nt_events"] = list(nt_events)
     if t_events:
         kw["t_events"] = list(t_events)
-    ta = hy.taylor_adaptive(ts.ode, state, **kw)
+    try:
+        ta = hy.taylor_adaptive(ts.ode, state, **kw)
+    except (ValueError, RuntimeError, TypeError) as exc:  # heyoka refused the system
+        raise UnsupportedError(f"Taylor backend: {exc}") from None
     ts.compile_seconds.setdefault(tol, time.perf_counter() - start)
     if key is not None:
         cache[ck] = ta
