@@ -260,3 +260,28 @@ def test_amplitude_frequencies_in_batch_mode(tmp_path):
     assert lin_d[0] == pytest.approx(w0, rel=1e-12) and lin_t[0] == lin_d[0]
     assert np.allclose(one[:, 0], exact, rtol=1e-9)
     assert np.allclose(batch[:, 0], exact, rtol=1e-11)
+
+
+QUARTIC = """\
+id: lim-9205
+source: test
+title: quartic oscillator
+parameters:
+  m: {value: 1.0}
+  k: {value: 3.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*x**4/4
+"""
+
+
+def test_integer_powers_are_smooth_at_zero(tmp_path):
+    """x³ at x = 0: heyoka's pow recurrence divides by the base (NaN there); the
+    translator writes integer powers as products."""
+    model, _ = model_of(tmp_path, QUARTIC, "9205")
+    ts = np.linspace(0, 10, 11)
+    tay = integrate(model, (0, 10), [0.0], [1.0], "taylor", t_eval=ts)
+    ref = integrate(model, (0, 10), [0.0], [1.0], "DOP853", t_eval=ts, rtol=1e-13,
+                    atol=1e-14)
+    assert tay.success and np.max(np.abs(tay.y - ref.y)) < 1e-11

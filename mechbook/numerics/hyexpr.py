@@ -22,6 +22,7 @@ _UNARY = {
     sp.tanh: "tanh", sp.asinh: "asinh", sp.acosh: "acosh", sp.atanh: "atanh", sp.erf: "erf",
 }
 _RECIPROCAL = {sp.sec: "cos", sp.csc: "sin", sp.cot: "tan"}
+MAX_PRODUCT_POWER = 16  # integer powers up to this are products (see Translator._walk)
 
 
 def _hy():
@@ -83,10 +84,11 @@ class Translator:
                 return hy.sqrt(b)
             if exp == -sp.Rational(1, 2):
                 return 1.0 / hy.sqrt(b)
-            if exp.is_Integer and int(exp) == -1:
-                return 1.0 / b
-            if exp.is_Integer and int(exp) < 0:
-                return 1.0 / b ** float(-int(exp))
+            if exp.is_Integer and 0 < abs(int(exp)) <= MAX_PRODUCT_POWER:
+                # products, not pow: the Taylor recurrence of b**a divides by b, which is
+                # NaN wherever b = 0 (sin(φ)² at φ = 0), while a product is smooth there
+                p = _power(b, abs(int(exp)))
+                return p if int(exp) > 0 else 1.0 / p
             if exp.is_Number:
                 return b ** float(exp)
             if base is sp.E:
@@ -100,6 +102,18 @@ class Translator:
         if func is sp.atan2:
             return hy.atan2(self.walk(e.args[0]), self.walk(e.args[1]))
         raise UnsupportedError(f"Taylor backend: no heyoka translation for {func.__name__}")
+
+
+def _power(b, k: int):
+    """b**k by repeated squaring."""
+    out, sq = None, b
+    while k:
+        if k & 1:
+            out = sq if out is None else out * sq
+        k >>= 1
+        if k:
+            sq = sq * sq
+    return out
 
 
 def translate_all(exprs, symbols: Mapping[sp.Symbol, object]) -> list:
