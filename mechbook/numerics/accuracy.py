@@ -48,52 +48,63 @@ SCIPY = ("RK45", "DOP853", "Radau", "LSODA")
 ADAPTIVE = (*SCIPY, "taylor")  # methods with a tolerance (taylor: heyoka, when installed)
 
 # target: {method: (rtol = atol, worst error over the bench systems, seconds summed)}
-# measured in 2026 on the 2-core development machine by bench/work_precision.py
-BENCH_SYSTEMS = 33
+# measured on 2026-11-26 on the 2-core development machine by bench/work_precision.py
+# (CPU seconds; taylor's include the compile of its integrators)
+BENCH_SYSTEMS = 47
 TABLE: dict[float, dict[str, tuple[float, float, float]]] = {
     1e-03: {
-        "RK45": (1e-06, 2.7e-04, 0.195),
-        "DOP853": (1e-05, 8.0e-04, 0.111),
-        "Radau": (1e-05, 9.7e-05, 0.559),
-        "LSODA": (1e-07, 1.0e-04, 0.148),
+        'RK45': (1e-07, 2.2e-04, 0.00924),
+        'DOP853': (1e-06, 5.1e-04, 0.00556),
+        'Radau': (1e-05, 6.0e-04, 1.02),
+        'LSODA': (1e-07, 1.2e-04, 0.132),
+        'taylor': (1e-07, 4.0e-05, 3.42),
     },
     1e-04: {
-        "RK45": (1e-07, 3.0e-05, 0.285),
-        "DOP853": (1e-06, 8.9e-05, 0.139),
-        "Radau": (1e-05, 9.7e-05, 0.559),
-        "LSODA": (1e-08, 1.6e-05, 0.187),
+        'RK45': (1e-08, 2.3e-05, 0.0131),
+        'DOP853': (1e-07, 1.1e-05, 0.00649),
+        'Radau': (1e-06, 3.5e-05, 1.7),
+        'LSODA': (1e-08, 6.0e-05, 0.157),
+        'taylor': (1e-07, 4.0e-05, 3.42),
     },
     1e-05: {
-        "RK45": (1e-08, 3.2e-06, 0.43),
-        "DOP853": (1e-07, 9.9e-06, 0.165),
-        "Radau": (1e-06, 5.5e-06, 0.917),
-        "LSODA": (1e-09, 1.4e-06, 0.23),
+        'RK45': (1e-09, 2.4e-06, 0.0201),
+        'DOP853': (1e-09, 3.3e-06, 0.00985),
+        'Radau': (1e-07, 2.0e-06, 2.79),
+        'LSODA': (1e-09, 1.9e-06, 0.194),
+        'taylor': (1e-08, 9.4e-06, 4.02),
     },
     1e-06: {
-        "RK45": (1e-09, 3.3e-07, 0.682),
-        "DOP853": (1e-09, 1.1e-07, 0.255),
-        "Radau": (1e-07, 3.1e-07, 1.55),
-        "LSODA": (1e-10, 3.1e-07, 0.274),
+        'RK45': (1e-10, 2.4e-07, 0.031),
+        'DOP853': (1e-10, 8.6e-08, 0.0122),
+        'Radau': (1e-08, 1.1e-07, 4.71),
+        'LSODA': (1e-10, 3.1e-07, 0.223),
+        'taylor': (1e-09, 5.8e-07, 4.66),
     },
     1e-07: {
-        "RK45": (1e-10, 3.3e-08, 1.05),
-        "DOP853": (1e-10, 1.1e-08, 0.33),
-        "Radau": (1e-08, 1.7e-08, 2.66),
-        "LSODA": (1e-11, 5.0e-08, 0.368),
+        'RK45': (1e-11, 2.5e-08, 0.047),
+        'DOP853': (1e-10, 8.6e-08, 0.0122),
+        'Radau': (1e-09, 6.3e-09, 8.11),
+        'LSODA': (1e-11, 5.0e-08, 0.277),
+        'taylor': (1e-11, 9.3e-09, 6.26),
     },
     1e-08: {
-        "RK45": (1e-11, 3.3e-09, 1.65),
-        "DOP853": (1e-11, 1.1e-09, 0.422),
-        "Radau": (1e-09, 6.9e-10, 4.75),
-        "LSODA": (1e-12, 7.8e-09, 0.626),
+        'RK45': (1e-12, 2.5e-09, 0.0767),
+        'DOP853': (1e-11, 8.6e-09, 0.0155),
+        'Radau': (1e-09, 6.3e-09, 8.11),
+        'taylor': (1e-11, 9.3e-09, 6.26),
     },
     1e-09: {
-        "RK45": (1e-12, 3.3e-10, 2.66),
-        "DOP853": (1e-12, 1.1e-10, 0.544),
-        "Radau": (1e-09, 6.9e-10, 4.75),
+        'Radau': (1e-10, 3.0e-10, 14.3),
+        'taylor': (1e-13, 1.1e-10, 8.2),
     },
     1e-10: {
-        "Radau": (1e-10, 2.9e-11, 8.33),
+        'taylor': (1e-14, 1.7e-12, 10.6),
+    },
+    1e-11: {
+        'taylor': (1e-14, 1.7e-12, 10.6),
+    },
+    1e-12: {
+        'taylor': (1e-15, 3.0e-13, 11.8),
     },
 }
 
