@@ -154,7 +154,8 @@ class Choice:
         if self.periods and self.periods > BENCH_PERIODS:
             factor = self.periods / BENCH_PERIODS
         expect = self.expected * factor
-        text = (f"{self.method} with rtol = atol = {self.rtol:.0e} for accuracy "
+        setting = "tol" if self.method == "taylor" else "rtol = atol"
+        text = (f"{self.method} with {setting} = {self.rtol:.0e} for accuracy "
                 f"{self.accuracy:.0e} ({self.reason}); expected error {expect:.1e}")
         if factor > 1:
             text += (f" ({self.expected:.1e} measured {horizon}, scaled to this run's "
