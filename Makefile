@@ -30,6 +30,8 @@ bench: $(STAMP)  ## integrators' work-precision, symbolic cost, extreme ratios -
 	mkdir -p results/bench
 	$(BIN)/python bench/work_precision.py --out results/bench.h5 --figdir results/bench \
 		> results/bench/work_precision.txt && cat results/bench/work_precision.txt
+	$(BIN)/python bench/compiled_steps.py --csv results/bench/compiled \
+		> results/bench/compiled_steps.txt && cat results/bench/compiled_steps.txt
 	$(BIN)/python bench/symbolic.py --repeat 1 --csv results/bench/symbolic.csv \
 		> results/bench/symbolic.txt && cat results/bench/symbolic.txt
 	$(BIN)/python bench/extremes.py --csv results/bench/extremes.csv \

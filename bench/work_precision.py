@@ -72,13 +72,18 @@ from mechbook.numerics.simulate import initial_state  # noqa: E402
 from mechbook.numerics.stiffness import IMPLICIT, assess, linear_rates  # noqa: E402
 
 SCIPY = ("RK45", "DOP853", "Radau", "LSODA")
+ADAPTIVE = (*SCIPY, "taylor")
 FIXED = ("RK4", "leapfrog", "yoshida4", "midpoint")
 TOLS = tuple(10.0 ** -k for k in range(3, 13))
+TAYLOR_TOLS = tuple(10.0 ** -k for k in range(6, 17))  # heyoka: 1e-6 ... 1e-16
+QUICK_TAYLOR_TOLS = (1e-6, 1e-10, 1e-13, 1e-16)
 QUICK_TOLS = (1e-3, 1e-6, 1e-9, 1e-12)
 STEPS = tuple(2 ** k for k in range(3, 12))  # steps per period of the fastest mode
 QUICK_STEPS = (8, 32, 128, 512)
 MIDPOINT_MAX = 512  # its Newton iteration makes finer rungs too slow for the budget
-TARGETS = (1e-3, 1e-6, 1e-9, 1e-12)
+TARGETS = (1e-3, 1e-6, 1e-9, 1e-12, 1e-14)
+RULE_TARGETS = tuple(10.0 ** -k for k in range(3, 15))
+EXTENDED_TOL = 1e-30  # the float128 Taylor reference's tolerance
 PERIODS = accuracy.BENCH_PERIODS
 REFERENCE = {"rtol": 1e-13, "atol": 1e-15}
 BUDGET = 300_000  # RHS evaluations per run
@@ -125,6 +130,8 @@ class Case:
     y_ref: np.ndarray | None = None
     ref_seconds: float = 0.0
     ref_evals: int = 0
+    y_ref_dop853: np.ndarray | None = None  # DOP853 at 1e-13 (the reference without heyoka)
+    reference: str = "DOP853 rtol 1e-13 atol 1e-15"
 
 
 @dataclass
@@ -139,6 +146,7 @@ class Run:
     repeats: int
     ok: bool
     message: str = ""
+    compile_seconds: float = 0.0  # the Taylor integrator's first build at this tolerance
 
 
 # ---- finding what can be simulated ---------------------------------------------------------
@@ -210,9 +218,9 @@ def run_once(case: Case, method: str, opts: dict, t_end: float | None = None):
         model.stats = Budget(model.stats)
     model.stats.limit = model.stats["rhs_calls"] + BUDGET
     calls = model.stats["rhs_calls"]
-    t_eval = [t_end] if method in FIXED else None
-    start = time.perf_counter()
-    y, message = None, ""
+    t_eval = [t_end] if method in FIXED or method == "taylor" else None
+    start = time.process_time()  # CPU time: the 2 cores are shared with other work
+    y, message, steps = None, "", 0
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
@@ -222,13 +230,15 @@ def run_once(case: Case, method: str, opts: dict, t_end: float | None = None):
             y = end_state(traj)
         else:
             message = traj.message or "stopped early"
+        steps = int(traj.settings.get("steps", 0)) if method == "taylor" else 0
     except OverBudget:
         message = f"over budget ({BUDGET} evaluations)"
-    except (IntegratorError, np.linalg.LinAlgError, ValueError) as exc:
+    except (IntegratorError, np.linalg.LinAlgError, ValueError, UnsupportedError) as exc:
         message = str(exc)
-    seconds = time.perf_counter() - start
+    seconds = time.process_time() - start
     model.stats.limit = math.inf
-    return y, seconds, model.stats["rhs_calls"] - calls, message
+    # the Taylor method counts steps (each a Taylor expansion of order ~ -log tol / 2)
+    return y, seconds, steps or model.stats["rhs_calls"] - calls, message
 
 
 def measure(case: Case, method: str, opts: dict, setting: str, tol: float = math.nan,
@@ -255,9 +265,40 @@ def reference(case: Case) -> str:
     case.ref_evals = case.model.stats["rhs_calls"] - calls
     if not traj.success or len(traj.t) != len(samples) or not np.all(np.isfinite(traj.y)):
         return f"the reference run failed: {traj.message}"
-    case.y_ref = end_state(traj)
+    case.y_ref = case.y_ref_dop853 = end_state(traj)
     case.scale = accuracy.scales(traj.y)
+    extended = extended_reference(case)
+    if extended is not None:
+        case.y_ref = extended
+        case.reference = f"heyoka Taylor, float128, tol {EXTENDED_TOL:.0e}"
     return ""
+
+
+def extended_reference(case: Case) -> np.ndarray | None:
+    """The end state by heyoka's Taylor method in quadruple precision (float128, ~34
+    digits) on the same double-precision equations, or None where heyoka or its float128
+    is missing or the system does not translate."""
+    from mechbook.numerics import taylor
+
+    if not taylor.available():
+        return None
+    import heyoka as hy
+
+    if not hasattr(hy, "real128"):
+        return None
+    try:
+        start = time.perf_counter()
+        ta = taylor.integrator(case.model, EXTENDED_TOL, key="extended", fp_type=hy.real128)
+        y0 = np.concatenate((case.q0, case.qd0))
+        taylor.reset(ta, 0.0, np.array([hy.real128(float(v)) for v in y0], dtype=hy.real128))
+        out = ta.propagate_until(hy.real128(case.t_end))
+        if out[0] != hy.taylor_outcome.time_limit:
+            return None
+        case.ref_seconds += time.perf_counter() - start
+        return np.array([float(v) for v in ta.state])
+    except (UnsupportedError, ValueError, RuntimeError) as exc:
+        print(f"{case.label}: no float128 reference ({exc})", file=sys.stderr)
+        return None
 
 
 def ladder(case: Case, quick: bool) -> list[Run]:
@@ -270,6 +311,7 @@ def ladder(case: Case, quick: bool) -> list[Run]:
             runs.append(r)
             if r.message.startswith("over budget"):
                 break  # tighter tolerances cost more still
+    runs += taylor_ladder(case, quick, repeat)
     fast_period = 2 * math.pi / case.omega_max
     for method in FIXED:
         if case.applicable[method]:
@@ -286,6 +328,28 @@ def ladder(case: Case, quick: bool) -> list[Run]:
                 break
             if r.message.startswith("over budget"):
                 break
+    return runs
+
+
+def taylor_ladder(case: Case, quick: bool, repeat: int) -> list[Run]:
+    """The Taylor method at tol 1e-6 ... 1e-16; the compile of each tolerance's integrator
+    (a new order, new code) timed on its own before the timed runs."""
+    from mechbook.numerics import taylor
+
+    if not taylor.available():
+        return []
+    runs = []
+    for tol in QUICK_TAYLOR_TOLS if quick else TAYLOR_TOLS:
+        start = time.process_time()
+        try:
+            taylor.integrator(case.model, tol, key="plain")
+        except (UnsupportedError, ValueError, RuntimeError) as exc:
+            return [Run("taylor", "unsupported", tol, 0, math.inf, math.nan, 0, 0, False,
+                        str(exc))]
+        compile_s = time.process_time() - start
+        r = measure(case, "taylor", {"tol": tol}, f"tol={tol:.0e}", tol, repeat=repeat)
+        r.compile_seconds = compile_s
+        runs.append(r)
     return runs
 
 
@@ -375,7 +439,10 @@ def check_references(cases: list[Case]) -> list[dict]:
         if exact is None:
             continue
         rows.append({"problem": case.label, "how": how, "t_end": case.t_end,
+                     "reference": case.reference,
                      "reference_error": accuracy.state_error(case.y_ref, exact, case.scale),
+                     "dop853_reference_error": accuracy.state_error(case.y_ref_dop853, exact,
+                                                                    case.scale),
                      "seconds": time.perf_counter() - start})
         print(f"{case.label}: reference vs {how}: {rows[-1]['reference_error']:.1e}",
               file=sys.stderr)
@@ -403,19 +470,19 @@ def summary(runs: pd.DataFrame) -> pd.DataFrame:
 def derive_rule(runs: pd.DataFrame, labels: list[str]) -> dict:
     """TABLE of mechbook/simulate/accuracy.py from the adaptive runs (see its docstring)."""
     rule: dict[float, dict[str, tuple]] = {}
-    adaptive = runs[runs.method.isin(SCIPY)]
-    for k in range(3, 13):
-        target = 10.0 ** -k
+    adaptive = runs[runs.method.isin(ADAPTIVE)]
+    for target in RULE_TARGETS:
         row = {}
-        for method in SCIPY:
+        for method in ADAPTIVE:
             best = None
             for tol in sorted(adaptive.tol.unique(), reverse=True):
                 sel = adaptive[(adaptive.method == method) & (adaptive.tol == tol)]
                 if set(sel.problem) != set(labels) or not sel.ok.all():
                     continue
                 worst = float(sel.error.max())
-                if worst <= target:
-                    best = (float(tol), worst, float(sel.seconds.sum()))
+                if worst <= target:  # cost: runs plus the Taylor compiles, over the systems
+                    cost = sel.seconds.sum() + sel.compile_seconds.fillna(0).sum()
+                    best = (float(tol), worst, float(cost))
                     break
             if best is not None:
                 row[method] = best
@@ -470,16 +537,17 @@ def long_run(quick: bool) -> list[dict]:
     t_eval = np.arange(periods + 1) * period
     t_eval[-1] = t_end
     rows = []
-    settings = [("leapfrog", {"step": period / 20}, "h = T/20"),
+    settings = [("taylor", {"tol": 2.0 ** -52}, "tol = 2.2e-16"),
+                ("leapfrog", {"step": period / 20}, "h = T/20"),
                 ("yoshida4", {"step": period / 20}, "h = T/20"),
                 ("RK4", {"step": period / 20}, "h = T/20"),
                 ("RK45", {"rtol": 1e-6, "atol": 1e-6}, "rtol = atol = 1e-6"),
                 ("DOP853", {"rtol": 1e-6, "atol": 1e-6}, "rtol = atol = 1e-6")]
     for method, opts, label in settings:
         calls = model.stats["rhs_calls"]
-        start = time.perf_counter()
+        start = time.process_time()
         traj = integrate(model, (0.0, t_end), q0, qd0, method, t_eval=t_eval, **opts)
-        seconds = time.perf_counter() - start
+        seconds = time.process_time() - start
         d = next(x for x in drifts(model, traj) if x.name == "energy_function")
         dev = np.abs(d.values - d.initial) / d.scale
         tenth = max(1, len(dev) // 10)
@@ -648,11 +716,11 @@ def plot(case: Case, runs: list[Run], figdir: Path) -> Path:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
-    for method in (*SCIPY, *FIXED):
+    for method in (*ADAPTIVE, *FIXED):
         pts = [(r.seconds, max(r.error, 1e-17)) for r in runs if r.method == method and r.ok]
         if pts:
             x, y = zip(*pts, strict=True)
-            ax.loglog(x, y, "o-" if method in SCIPY else "s--", ms=4, label=method)
+            ax.loglog(x, y, "o-" if method in ADAPTIVE else "s--", ms=4, label=method)
     ax.set_xlabel("wall time per run (s; median of 3, one run above 0.25 s)")
     ax.set_ylabel("relative error of the state at the end")
     ax.set_title(f"{case.label}: {PERIODS} periods, t = {case.t_end:.3g}")
@@ -737,7 +805,8 @@ def main() -> None:
              "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()}",
              "python": platform.python_version(), "numpy": np.__version__,
              "quick": bool(opts.quick), "seconds": elapsed, "periods": PERIODS,
-             "reference": "DOP853 rtol 1e-13 atol 1e-15", "budget_evaluations": BUDGET}
+             "reference": ", ".join(sorted({c.reference for c in good})),
+             "timing": "process CPU time", "budget_evaluations": BUDGET}
     write_h5(opts.out, tables, attrs)
     for name, df in tables.items():
         df.to_csv(opts.figdir / f"{name}.csv", index=False)

@@ -73,12 +73,13 @@ def test_the_committed_table_is_consistent():
     assert accuracy.TABLE, "no accuracy table: run bench/work_precision.py"
     for target, row in accuracy.TABLE.items():
         for method, (tol, worst, seconds) in row.items():
-            assert method in accuracy.SCIPY and worst <= target and seconds > 0
-            assert 1e-13 <= tol <= 1e-2
+            assert method in accuracy.ADAPTIVE and worst <= target and seconds > 0
+            assert (1e-16 if method == "taylor" else 1e-13) <= tol <= 1e-2
 
 
 @pytest.mark.parametrize("requested, periods", [(1e-4, 3), (1e-6, 3), (1e-8, 3), (1e-10, 3),
-                                                (1e-4, 30), (1e-6, 30), (1e-8, 30)])
+                                                (1e-12, 3), (1e-4, 30), (1e-6, 30),
+                                                (1e-8, 30)])
 def test_chosen_settings_reach_the_requested_accuracy(pendulum, requested, periods):
     """Released at 1 rad (a strongly nonlinear swing): the end state and every sample agree
     with the elliptic-function solution to the accuracy asked for, measured as the table
@@ -91,7 +92,7 @@ def test_chosen_settings_reach_the_requested_accuracy(pendulum, requested, perio
     sim = simulate(pendulum, init={"theta": str(theta0)}, t_span=(0.0, t_end),
                    accuracy=requested, points=201)
     assert sim.trajectory.success
-    assert sim.trajectory.method in accuracy.SCIPY and "expected error" in sim.choice
+    assert sim.trajectory.method in accuracy.ADAPTIVE and "expected error" in sim.choice
     exact = pendulum_exact(theta0, omega0, sim.trajectory.t)
     scale = accuracy.scales(exact)
     got = sim.trajectory.y
@@ -121,8 +122,8 @@ def test_cli_accuracy_prints_method_and_expected_error(tmp_path):
                                "1e-8", "--init", "theta=0.5", "--no-store"])
     assert res.exit_code == 0, res.output
     line = next(x for x in res.output.splitlines() if x.startswith("accuracy:"))
-    assert "rtol = atol" in line and "expected error" in line
-    assert any(m in line for m in accuracy.SCIPY)
+    assert ("rtol = atol" in line or "tol =" in line) and "expected error" in line
+    assert any(m in line for m in accuracy.ADAPTIVE)
     res = runner.invoke(main, ["--root", str(tmp_path), "simulate", "lim-9301", "--accuracy",
                                "1e-8", "--rtol", "1e-6", "--no-store"])
     assert res.exit_code != 0 and "not both" in res.output

@@ -395,11 +395,13 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @click.option("--system", default=None, help="Which system of a multi-system problem.")
 @click.option("--method", default=None,
               type=click.Choice(["RK45", "DOP853", "Radau", "LSODA", "RK4", "leapfrog",
-                                 "yoshida4", "midpoint"]),
+                                 "yoshida4", "midpoint", "taylor"]),
               help="SciPy's solve_ivp methods; RK4 (fixed step); symplectic leapfrog "
                    "(Störmer–Verlet) and yoshida4 (Forest–Ruth) for separable Hamiltonians, "
-                   "midpoint (implicit, symplectic) for any conservative system. Default: "
-                   "DOP853, or Radau when the run is stiff.")
+                   "midpoint (implicit, symplectic) for any conservative system; taylor "
+                   "(heyoka's Taylor method, tolerance --rtol, default machine epsilon; "
+                   "pip install 'mechbook[taylor]'). Default: DOP853, or Radau when the run "
+                   "is stiff.")
 @click.option("--accuracy", type=opt.Finite(min=0, min_open=True, max=1, max_open=True),
               default=None,
               help="Error wanted at the end (relative to each coordinate's and velocity's "
@@ -408,7 +410,8 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
 @click.option("--param", "params", multiple=True, metavar="NAME=VALUE",
               help="Override a parameter's default value (k=1e6). Repeat for several.")
 @click.option("--rtol", type=opt.Finite(min=0, min_open=True, max=1, max_open=True),
-              default=None, help="Relative tolerance (SciPy methods; default 1e-8).")
+              default=None, help="Relative tolerance (SciPy methods; default 1e-8; the taylor "
+                                 "method's tolerance).")
 @click.option("--atol", type=opt.Finite(min=0, max=1e6), default=None,
               help="Absolute tolerance (SciPy methods; default 1e-10).")
 @click.option("--max-step", type=opt.Finite(min=0, min_open=True, max=opt.MAX_TIME),
@@ -419,8 +422,8 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
               default=10.0, show_default=True, help="End time.")
 @click.option("--points", type=click.IntRange(min=2, max=opt.MAX_POINTS), default=2001,
               show_default=True,
-              help="Samples recorded (SciPy methods; fixed-step methods record every step "
-                   "up to 200001 samples).")
+              help="Samples recorded (SciPy and taylor methods; fixed-step methods record "
+                   "every step up to 200001 samples).")
 @click.option("--init", "init", multiple=True, metavar="NAME=VALUE",
               help="Initial value of a coordinate (theta=0.1) or velocity (thetadot=0); "
                    "overrides the problem's `initial:`. Repeat for several.")

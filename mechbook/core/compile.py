@@ -83,6 +83,8 @@ def _compile_symengine(args, exprs, backend: str) -> Compiled:
     def call(x: np.ndarray) -> np.ndarray:
         return np.asarray(fn(x), dtype=float).reshape(-1)
 
+    # the LLVM object itself: mechbook.numerics.native calls its machine code directly
+    call.lambdify = fn  # type: ignore[attr-defined]
     return call
 
 

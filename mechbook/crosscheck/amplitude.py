@@ -27,12 +27,14 @@ RTOL = 1e-12
 
 
 def amplitude_response(analysis: Analysis, lin: LinearSystem, values: dict,
-                       amplitudes, models: dict | None = None
+                       amplitudes, models: dict | None = None, method: str = "DOP853"
                        ) -> tuple[np.ndarray, np.ndarray]:
     """(linear frequencies (n,), measured frequencies (len(amplitudes), n)) at `values`.
 
     A mode that does not oscillate (unstable, zero, overdamped) is NaN in both; `models`
-    caches the compiled nonlinear model per parameter point across calls."""
+    caches the compiled nonlinear model per parameter point across calls. `method`
+    "taylor" measures all the amplitudes of a mode at once in heyoka's batch mode (the
+    crossings as Taylor events; docs/performance.md has the cost of each)."""
     s = _setup(analysis, lin, values, models if models is not None else {})
     modes = _modes(s)
     linear = np.array([m["omega"] if not m["kind"] and m["omega"] > 0 else np.nan
@@ -44,9 +46,41 @@ def amplitude_response(analysis: Analysis, lin: LinearSystem, values: dict,
     for col, k in enumerate(order):
         if not np.isfinite(linear[col]):
             continue
+        period = 2 * np.pi / linear[col]
+        if method == "taylor":
+            out[:, col] = _measure_batch(s, modes[k], amplitudes, period)
+            continue
         for row, a in enumerate(amplitudes):
-            out[row, col] = _measure(s, modes[k], a, 2 * np.pi / linear[col])
+            out[row, col] = _measure(s, modes[k], a, period)
     return linear, out
+
+
+def _measure_batch(s, mode: dict, amplitudes: np.ndarray, period: float) -> np.ndarray:
+    """The frequencies at every amplitude from one Taylor batch run (same fit as _measure:
+    the first PERIODS + 1 upward crossings, within MAX_PERIODS linear periods)."""
+    from mechbook.numerics import taylor
+
+    if not np.all(amplitudes > 0):
+        raise UnsupportedError("a finite-amplitude frequency needs an amplitude > 0")
+    n_full = len(s.q_star)
+    idx = np.array(s.index)
+    nl = len(idx)
+    weights = np.real(mode["weights"])
+    c = np.zeros(2 * n_full)
+    c[idx] = weights[:nl]
+    c[n_full + idx] = weights[nl:]
+    turn = s.turn[idx] if s.turn is not None else np.zeros(nl)
+    a0 = float(weights[:nl] @ s.q_star[idx] + weights[nl:] @ s.v_star[idx])
+    b0 = float(weights[:nl] @ turn)
+    starts = np.array([_initial(s, mode, a) for a in amplitudes])
+    with np.errstate(all="ignore"):
+        hits = taylor.crossings_batch(s.model, c, (a0, b0), starts, MAX_PERIODS * period)
+    out = np.full(len(amplitudes), np.nan)
+    for i, times in enumerate(hits):
+        times = times[: PERIODS + 1]
+        if len(times) >= 3:
+            out[i] = 2 * np.pi / np.polyfit(np.arange(len(times)), times, 1)[0]
+    return out
 
 
 def _measure(s, mode: dict, amplitude: float, period: float) -> float:

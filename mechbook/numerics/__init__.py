@@ -1,8 +1,12 @@
 """Numerical integration of the full nonlinear equations of motion.
 
     model        the equations compiled once per problem (the compile layer's scalar entry)
-    integrators  SciPy's solve_ivp methods and fixed-step RK4 / symplectic methods, one
-                 interface
+    integrators  SciPy's solve_ivp methods, fixed-step RK4 / symplectic methods and the
+                 Taylor method, one interface
+    native       loops.c built once per machine, called through ctypes (Model.rhs too)
+    compiled     the compiled loops run once per integration (fixed steps, DOP853, RK45)
+    taylor       heyoka's Taylor method: integration, events, batch mode, float128
+    hyexpr       SymPy -> heyoka expressions by walking the tree; LDLᵀ solve
     monitors     drift of the conserved quantities the engine found
     measure      turning points, periods, mean rates and event times measured along a run
     friction     integrating through stick and slip (phases ended by stop and release events)

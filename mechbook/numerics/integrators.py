@@ -23,6 +23,7 @@ separable ones only when the model is separable (`rhs.structure` decides).
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -102,12 +103,24 @@ class SciPyMethod(Integrator):
     def solve(self, model, t_span, q0, qd0, t_eval=None, events=None) -> Trajectory:
         opts = {"rtol": 1e-8, "atol": 1e-10}
         opts.update({k: v for k, v in self.options.items() if v is not None})
+        compiled = opts.pop("compiled", True)
         y0 = np.concatenate((q0, qd0)).astype(float)
-        sol = solve_ivp(model.rhs, t_span, y0, method=self.name, t_eval=t_eval,
-                        events=events, **opts)
         n = model.n
         settings = {"method": self.name, **{k: v for k, v in opts.items()
                                              if isinstance(v, (int, float, bool, str))}}
+        nat = model.native if compiled and self.name in ("DOP853", "RK45") else None
+        if nat is not None and not events and not opts.get("dense_output") \
+                and not opts.get("vectorized"):
+            from mechbook.numerics import compiled as loops
+
+            t, y, code, message, evals = loops.adaptive(
+                nat, model.stats, self.name, t_span, y0, opts["rtol"], opts["atol"],
+                opts.get("max_step", math.inf), opts.get("first_step"), t_eval)
+            model.stats["rhs_calls"] += evals
+            return Trajectory(t, y[:n], y[n:], self.name, {**settings, "compiled": True},
+                              evals, code == 0, message)
+        sol = solve_ivp(model.rhs, t_span, y0, method=self.name, t_eval=t_eval,
+                        events=events, **opts)
         return Trajectory(sol.t, sol.y[:n], sol.y[n:], self.name, settings, int(sol.nfev),
                           bool(sol.success), str(sol.message), sol.sol,
                           list(sol.t_events or []), list(sol.y_events or []))
@@ -124,20 +137,53 @@ class FixedStep(Integrator):
         steps = max(1, math.ceil((t1 - t0) / h - 1e-9))
         return steps, (t1 - t0) / steps
 
+    def _wanted(self, t_span, t_eval, steps: int, h: float) -> np.ndarray:
+        """The step indices recorded: nearest to t_eval, or every stride-th step."""
+        t0 = float(t_span[0])
+        max_points = int(self.options.get("max_points") or 200_001)
+        if t_eval is not None:
+            wanted = np.round((np.asarray(t_eval, float) - t0) / h).astype(int)
+            return np.unique(np.clip(wanted, 0, steps))
+        stride = max(1, math.ceil(steps / (max_points - 1)))
+        return np.unique(np.append(np.arange(0, steps + 1, stride), steps))
+
+    def _native(self, model: Model, canonical: bool = False):
+        """The compiled loops' model, or None (option compiled=False, or unavailable)."""
+        if self.options.get("compiled") is False:
+            return None
+        return model.native_canonical if canonical else model.native
+
+    def _run_native(self, nat, model, t_span, start, t_eval, **kw) -> Trajectory:
+        """The same run as `_run`, as one call into loops.c (`compiled.fixed`)."""
+        from mechbook.numerics import compiled as loops
+
+        steps, h = self._grid(t_span)
+        t0 = float(t_span[0])
+        want = self._wanted(t_span, t_eval, steps, h)
+        method = "leapfrog" if isinstance(self, Leapfrog) else self.name
+        t, rows, kind, k, evals = loops.fixed(nat, model.stats, method, t0, h, steps, start,
+                                              want, **kw)
+        model.stats["rhs_calls"] += evals
+        n = model.n
+        settings = {**self.settings(h, steps), "compiled": True}
+        if kind == "newton":
+            raise IntegratorError(f"implicit midpoint: Newton iteration did not converge at "
+                                  f"t = {t0 + k * h:.6g} (try a smaller step)")
+        if kind:
+            why = (f"non-finite state at t = {t0 + k * h + h:.6g}" if kind == "non-finite"
+                   else "evaluation budget spent")
+            return Trajectory(t, rows[:, :n].T, rows[:, n:].T, self.name, settings, evals,
+                              False, why)
+        return Trajectory(t, rows[:, :n].T, rows[:, n:].T, self.name, settings, evals, True,
+                          "fixed steps completed")
+
     def _run(self, model, t_span, state0, advance, to_output, t_eval,
              flat: Callable = np.asarray) -> Trajectory:
         """Advance `state0` by `advance(t, state, h)`; record `to_output(t, state)`;
         stop when `flat(state)` is not finite."""
         steps, h = self._grid(t_span)
         t0 = float(t_span[0])
-        max_points = int(self.options.get("max_points") or 200_001)
-        if t_eval is not None:
-            wanted = np.round((np.asarray(t_eval, float) - t0) / h).astype(int)
-            wanted = np.unique(np.clip(wanted, 0, steps))
-        else:
-            stride = max(1, math.ceil(steps / (max_points - 1)))
-            wanted = np.unique(np.append(np.arange(0, steps + 1, stride), steps))
-        want = set(wanted.tolist())
+        want = set(self._wanted(t_span, t_eval, steps, h).tolist())
         ts, qs, vs = [], [], []
         state = state0
         calls0 = model.stats["rhs_calls"]
@@ -168,7 +214,12 @@ class RK4(FixedStep):
     name = "RK4"
 
     def solve(self, model, t_span, q0, qd0, t_eval=None, events=None) -> Trajectory:
-        n, f = model.n, model.rhs
+        n = model.n
+        nat = self._native(model)
+        if nat is not None:
+            start = np.concatenate((q0, qd0)).astype(float)
+            return self._run_native(nat, model, t_span, start, t_eval)
+        f = model.rhs_python
 
         def advance(t, y, h):
             k1 = f(t, y)
@@ -196,8 +247,13 @@ class Leapfrog(FixedStep):
         zero = np.zeros(n)
         weights = self.weights
 
+        nat = self._native(model)
+        if nat is not None:
+            start = np.concatenate((q0, qd0)).astype(float)
+            return self._run_native(nat, model, t_span, start, t_eval, weights=weights)
+
         def acc(t, q):
-            return model.accelerations(t, q, zero)
+            return model.accelerations_python(t, q, zero)
 
         def advance(t, state, h):
             q, v, a = state
@@ -256,6 +312,13 @@ class ImplicitMidpoint(FixedStep):
                 J[:, j] = (F(t, z2) - f0) / dz
             return J
 
+        nat = self._native(model, canonical=True)
+        if nat is not None:
+            t0 = float(t_span[0])
+            q0 = np.asarray(q0, float)
+            z0 = np.concatenate((q0, model.momenta(t0, q0, np.asarray(qd0, float))))
+            return self._run_native(nat, model, t_span, z0, t_eval, tol=tol,
+                                    max_iter=max_iter)
         cache: dict = {"lu": None, "age": 0}
 
         def advance(t, z, h):
@@ -285,21 +348,51 @@ class ImplicitMidpoint(FixedStep):
                          lambda t, z: (z[:n], model.velocities(t, z[:n], z[n:])), t_eval)
 
 
+class TaylorMethod(Integrator):
+    """heyoka's adaptive Taylor method (`taylor.py`): options `tol` (default machine
+    epsilon; `rtol` is taken for it when `tol` is not given), `max_points`."""
+
+    name = "taylor"
+    adaptive = True
+
+    def solve(self, model, t_span, q0, qd0, t_eval=None, events=None) -> Trajectory:
+        from mechbook.numerics import taylor
+
+        if events:
+            raise IntegratorError("the taylor method takes no solve_ivp events (its own "
+                                  "events: taylor.turning_points, taylor.first_crossing)")
+        tol = float(self.options.get("tol") or self.options.get("rtol") or taylor.DEFAULT_TOL)
+        y0 = np.concatenate((q0, qd0)).astype(float)
+        before = taylor.compile_seconds(model)
+        start = time.perf_counter()
+        t, y, ok, message, steps = taylor.propagate(
+            model, t_span, y0, tol, t_eval, int(self.options.get("max_points") or 200_001))
+        compile_s = taylor.compile_seconds(model) - before
+        n = model.n
+        settings = {"method": self.name, "tol": tol, "steps": steps,
+                    "compile_s": compile_s,
+                    "integrate_s": time.perf_counter() - start - compile_s}
+        return Trajectory(t, y[:n], y[n:], self.name, settings, 0, ok, message)
+
+
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
 FIXED: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog, "verlet": Leapfrog,
                                      "yoshida4": Yoshida4, "forest-ruth": Yoshida4,
                                      "midpoint": ImplicitMidpoint}
-METHODS = SCIPY_METHODS + tuple(FIXED)
+METHODS = SCIPY_METHODS + tuple(FIXED) + ("taylor",)
 
 
 def make_integrator(method: str, **options) -> Integrator:
     """The integrator named `method` (see the module docstring) with its options."""
     if method in SCIPY_METHODS:
-        allowed = {"rtol", "atol", "max_step", "first_step", "dense_output"}
+        allowed = {"rtol", "atol", "max_step", "first_step", "dense_output", "compiled"}
         return SciPyMethod(method, **{k: v for k, v in options.items() if k in allowed})
     if method in FIXED:
-        allowed = {"step", "max_points", "tol", "max_iter"}
+        allowed = {"step", "max_points", "tol", "max_iter", "compiled"}
         return FIXED[method](**{k: v for k, v in options.items() if k in allowed})
+    if method == "taylor":
+        allowed = {"tol", "rtol", "max_points"}
+        return TaylorMethod(**{k: v for k, v in options.items() if k in allowed})
     raise IntegratorError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
 

@@ -24,6 +24,10 @@ from mechbook.numerics.model import Model
 
 MEASURE_RTOL = 1e-7
 TOLERANCE = 1e-12
+# DOP853 by default: in `mechbook check` the measurements take ~0.1 s in all (five
+# problems), less than importing heyoka (0.3 s per worker) and compiling each system
+# (docs/performance.md); "taylor" is the choice for long or many measurements
+METHOD = "DOP853"
 EXTREMES = 5  # turning points to collect (two full periods and one more)
 
 
@@ -74,8 +78,20 @@ def signal_functions(system, dyn, values: dict, of: sp.Expr):
     acc = dict(zip(dyn.qdd, dyn.accelerations, strict=True))
     rate = system.dt(of).subs(acc)
     args = [system.t, *system.q, *system.qd]
-    fn, _ = compile_exprs(args, [of.xreplace(sub), rate.xreplace(sub)])
-    return fn
+    exprs = [of.xreplace(sub), rate.xreplace(sub)]
+    fn, _ = compile_exprs(args, exprs)
+    return Signal(fn, exprs)
+
+
+class Signal:
+    """A compiled (signal, rate) in x = (t, q, q̇), with the expressions it came from (the
+    Taylor backend's events are built from those)."""
+
+    def __init__(self, fn, exprs: list[sp.Expr]):
+        self.fn, self.exprs = fn, exprs
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        return self.fn(x)
 
 
 def _integrator(model: Model):
@@ -93,13 +109,17 @@ def _integrator(model: Model):
 
 
 def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float,
-            extremes: int = EXTREMES, max_chunks: int = 400) -> Measured:
+            extremes: int = EXTREMES, max_chunks: int = 400,
+            method: str = METHOD) -> Measured:
     """Integrate from (q0, q̇0) until `extremes` turning points of the signal are found.
 
     `fn(x)` with x = (t, q, q̇) returns (signal, d signal/dt); `time_scale` is the length
     of the first integration chunk (a guess at the period); a chunk without a turning point
-    makes the next one half as long again, so a poor guess costs a few chunks only."""
+    makes the next one half as long again, so a poor guess costs a few chunks only.
+    `method` "taylor" finds the turning points as heyoka events (`fn` a `Signal`)."""
     n = model.n
+    if method == "taylor":
+        return _measure_taylor(model, fn, q0, qd0, time_scale, extremes, max_chunks)
 
     def rate(t, y):
         return fn(np.concatenate(([t], y)))[1]
@@ -137,10 +157,41 @@ def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float
                     np.array(states).T, nfev)
 
 
+def _measure_taylor(model, fn, q0, qd0, time_scale, extremes, max_chunks) -> Measured:
+    from mechbook.numerics import taylor
+
+    y0 = np.concatenate((q0, qd0))
+    hits = taylor.turning_points(model, fn.exprs[1], y0, time_scale, extremes, TOLERANCE,
+                                 max_chunks)
+    n = model.n
+    times, values, kinds, states = [], [], [], []
+    for te, ye, direction in hits:
+        sig = fn(np.concatenate(([te], ye)))
+        if direction:
+            kind = +1 if direction < 0 else -1  # the rate falls through zero: a maximum
+        else:
+            acc = model.accelerations(te, ye[:n], ye[n:])
+            h = 1e-6 * time_scale
+            later = fn(np.concatenate(([te + h], ye + h * np.concatenate((ye[n:], acc)))))[1]
+            kind = -1 if later > 0 else +1
+        times.append(te)
+        values.append(sig[0])
+        kinds.append(kind)
+        states.append(ye)
+    return Measured(np.array(times), np.array(values), np.array(kinds),
+                    np.array(states).T, 0)
+
+
 def first_event(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float,
-                max_chunks: int = 400) -> tuple[float, np.ndarray]:
+                max_chunks: int = 400, method: str = METHOD) -> tuple[float, np.ndarray]:
     """(t, state) at the first t > 0 where the compiled `fn(x)[0]` (x = (t, q, q̇)) changes
-    sign, integrating chunk by chunk (each half as long again as the last)."""
+    sign, integrating chunk by chunk (each half as long again as the last); with `method`
+    "taylor" as a terminal heyoka event."""
+    if method == "taylor":
+        from mechbook.numerics import taylor
+
+        return taylor.first_crossing(model, fn.exprs[0], np.concatenate((q0, qd0)),
+                                     time_scale, TOLERANCE, max_chunks)
     def event(t, y):
         return fn(np.concatenate(([t], y)))[0]
 

@@ -23,9 +23,25 @@ from mechbook.core.compile import (
     DEFAULT_BACKEND,
     Compiled,
     as_expr,
+    compile_batch,
     compile_exprs,
 )
 from mechbook.errors import UnsupportedError
+
+
+@dataclass
+class EquationSource:
+    """M q̈ = f (+ A q̈ + b = 0) with the parameters as symbols and their values: what a
+    backend that compiles once per system (the Taylor backend) starts from."""
+
+    t: sp.Symbol
+    q: list
+    qd: list
+    M: list  # n×n, row-major
+    f: list
+    A: list  # m×n, row-major
+    b: list
+    values: dict  # parameter symbol -> float
 
 
 @dataclass
@@ -43,11 +59,15 @@ class Model:
     generation_seconds: float
     _mf: Compiled
     _canonical: Callable[[], Compiled]
-    _monitor_fn: Compiled | None
+    _monitor_fn: Callable[[np.ndarray], np.ndarray] | None  # batch entry
     monitor_names: list[str]
     constraints: int = 0
     nonconservative: bool = False
     stats: dict = field(default_factory=lambda: {"rhs_calls": 0})
+    # () -> EquationSource: the same equations with the parameters still symbols (Taylor)
+    _source: Callable[[], EquationSource] | None = None
+    cache: dict = field(default_factory=dict)  # compiled artefacts of other backends (Taylor)
+    _momenta_fn: Callable[[np.ndarray], np.ndarray] | None = None  # batch: (N, 1+2n) -> (N, n)
 
     def __post_init__(self) -> None:
         self._buf = np.zeros(1 + 2 * self.n)
@@ -65,7 +85,45 @@ class Model:
         b = out[n * n + n + m * n:]
         return M, f, A, b
 
+    @cached_property
+    def source(self) -> EquationSource:
+        if self._source is None:
+            raise UnsupportedError("this model keeps no symbolic equations")
+        return self._source()
+
+    @cached_property
+    def native(self):
+        """The compiled loops' view of this model (`native.NativeModel`), or None where the
+        loop library or the LLVM kernel is unavailable (then the Python paths run)."""
+        from mechbook.numerics import native
+
+        kernel = native.kernel_pointer(self._mf)
+        lib = native.library() if kernel else None
+        if lib is None:
+            return None
+        return native.NativeModel(lib, kernel, self.n, self.constraints, keep=(self._mf,))
+
+    @cached_property
+    def native_canonical(self):
+        """Like `native`, with the canonical kernel too (the implicit midpoint loop)."""
+        from mechbook.numerics import native
+
+        kernel, canon = native.kernel_pointer(self._mf), native.kernel_pointer(self.canonical)
+        lib = native.library() if kernel and canon else None
+        if lib is None:
+            return None
+        return native.NativeModel(lib, kernel, self.n, self.constraints, canonical=canon,
+                                  keep=(self._mf, self.canonical))
+
     def accelerations(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        nat = self.native
+        if nat is not None:
+            self.stats["rhs_calls"] += 1
+            return nat.accelerations(t, q, qd)
+        return self.accelerations_python(t, q, qd)
+
+    def accelerations_python(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """The reference: kernel through its Python wrapper, NumPy solve."""
         self._buf[0] = t
         self._buf[1:self.n + 1] = q
         self._buf[self.n + 1:] = qd
@@ -86,7 +144,16 @@ class Model:
         return np.linalg.solve(big, rhs)[:n]
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        """dy/dt for y = (q, q̇) (the function `solve_ivp` integrates)."""
+        """dy/dt for y = (q, q̇) (the function `solve_ivp` integrates): one call into the
+        compiled kernel and solve where they exist, no allocation but the result."""
+        nat = self.native
+        if nat is not None:
+            self.stats["rhs_calls"] += 1
+            return nat.rhs(t, y)
+        return self.rhs_python(t, y)
+
+    def rhs_python(self, t: float, y: np.ndarray) -> np.ndarray:
+        """The reference right-hand side: kernel through its Python wrapper, NumPy solve."""
         buf = self._buf
         buf[0] = t
         buf[1:] = y
@@ -121,13 +188,18 @@ class Model:
 
     # ---- monitors ----------------------------------------------------------------------
     def monitors(self, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        """Conserved quantities along a trajectory: shape (len(monitor_names), len(t))."""
+        """Conserved quantities along a trajectory: shape (len(monitor_names), len(t)), in
+        one vectorized call of the batch entry (a Python loop over 2·10⁵ samples cost ~2 s)."""
         if self._monitor_fn is None:
             return np.zeros((0, len(t)))
-        out = np.empty((len(self.monitor_names), len(t)))
-        for k in range(len(t)):
-            out[:, k] = self._monitor_fn(np.concatenate(([t[k]], q[:, k], qd[:, k])))
-        return out
+        return self._monitor_fn(_points(t, q, qd)).T
+
+    def momenta_along(self, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """p = ∂L/∂q̇ at every sample, (n, len(t)), in one vectorized call."""
+        if self._momenta_fn is None:
+            return np.array([self.momenta(tk, q[:, k], qd[:, k])
+                             for k, tk in enumerate(t)]).T.reshape(self.n, len(t))
+        return self._momenta_fn(_points(t, q, qd)).T
 
 
 @dataclass
@@ -137,6 +209,12 @@ class Structure:
     separable: bool  # H = p·M⁻¹p/2 + V(q), M constant: leapfrog / Yoshida apply
     canonical: bool  # L quadratic in q̇, no constraints, no non-conservative force
     reason: str = ""
+
+
+def _points(t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """Samples as the rows (t, q, q̇) of the batch entry's input."""
+    return np.column_stack((np.asarray(t, float), np.asarray(q, float).T,
+                            np.asarray(qd, float).T))
 
 
 def _numeric_values(values: dict) -> dict:
@@ -186,13 +264,28 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
         fn, _ = compile_exprs(args, ML + bvec + dLdq, used)
         return fn
 
-    monitor_fn = None
+    monitor_fn = momenta_fn = None
     names = list(conserved or {})
-    if names:
-        monitor_fn, _ = compile_exprs(args, [conserved[k].xreplace(sub) for k in names], used)
+    if names:  # evaluated on whole trajectories only: the batch entry
+        monitor_fn = compile_batch(args, [conserved[k].xreplace(sub) for k in names], used)
+        L = system.lagrangian.xreplace(sub)
+        momenta_fn = compile_batch(args, [sp.diff(L, v) for v in qd], used)
+    def source() -> EquationSource:
+        res = list(dyn.residuals)
+        Ms = [as_expr(sp.diff(e, a)) for e in res for a in qdd]
+        fs = [as_expr(-e.xreplace(zero_acc)) for e in res]
+        As, bs = [], []
+        if system.constraints:
+            As = [as_expr(x) for x in dyn.constraint_jacobian]
+            bs = [as_expr(system.dt(system.dt(c)).xreplace(zero_acc))
+                  for _, c in system.constraints]
+        return EquationSource(t, q, qd, Ms, fs, As, bs,
+                              {k: float(v) for k, v in values.items()})
+
     nonconservative = any(F != 0 for F in system.forces)
     model = Model(list(system.coord_names), n, used, 0.0, mf, canonical, monitor_fn, names,
-                  constraints=m, nonconservative=nonconservative)
+                  constraints=m, nonconservative=nonconservative, _source=source,
+                  _momenta_fn=momenta_fn)
     model.generation_seconds = time.perf_counter() - start
     if system.contacts:  # stick and slip: an integrator of phases, built when first asked
         from functools import partial
@@ -273,5 +366,5 @@ def timed_calls(fn: Callable[[], object], seconds: float = 0.2) -> float:
             return elapsed / calls
 
 
-__all__ = ["BACKENDS", "DEFAULT_BACKEND", "Model", "Structure", "build_model",
+__all__ = ["BACKENDS", "DEFAULT_BACKEND", "EquationSource", "Model", "Structure", "build_model",
            "compile_exprs", "structure", "timed_calls"]

@@ -67,8 +67,7 @@ def drifts(model: Model, traj: Trajectory) -> list[Drift]:
     if not model.monitor_names or len(traj.t) == 0:
         return []
     values = model.monitors(traj.t, traj.q, traj.qd)
-    momenta = np.array([model.momenta(t, traj.q[:, k], traj.qd[:, k])
-                        for k, t in enumerate(traj.t)]).T
+    momenta = model.momenta_along(traj.t, traj.q, traj.qd)
     out = []
     for name, vals in zip(model.monitor_names, values, strict=True):
         q0 = float(vals[0])

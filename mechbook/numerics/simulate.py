@@ -219,9 +219,23 @@ def simulate(analysis: Analysis, system_name: str | None = None, *,
     if warn:
         notes.append(warn)
     t_eval = None
-    if method in SCIPY_METHODS and points and points > 1:
+    if (method in SCIPY_METHODS or method == "taylor") and points and points > 1:
         t_eval = np.linspace(t_span[0], t_span[1], int(points))
-    traj = integrate(model, t_span, q0, qd0, method, t_eval=t_eval, **options)
+    try:
+        traj = integrate(model, t_span, q0, qd0, method, t_eval=t_eval, **options)
+    except UnsupportedError as exc:
+        if method != "taylor":
+            raise
+        # heyoka missing, or an expression it cannot take: the SciPy path, saying so
+        method = "DOP853"
+        if accuracy is not None:
+            picked = choose(accuracy, method=method, periods=None if not stiff.rates
+                            or not stiff.rates.period else
+                            (t_span[1] - t_span[0]) / stiff.rates.period)
+            choice = picked.describe()
+            options = {**options, "rtol": picked.rtol, "atol": picked.atol}
+        notes.append(f"taylor method unavailable ({exc.capability}): {method} instead")
+        traj = integrate(model, t_span, q0, qd0, method, t_eval=t_eval, **options)
     if source == "fallback":
         notes.append(f"no initial conditions given: started at rest, {FALLBACK_OFFSET} from "
                      "the first stable equilibrium")
