@@ -18,6 +18,7 @@ from ruamel.yaml.constructor import DuplicateKeyError
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from mechbook.errors import SpecError
+from mechbook.model.fastyaml import fast_data
 from mechbook.model.limits import (
     MAX_FILE_BYTES,
     check_events,
@@ -30,12 +31,27 @@ Path_ = tuple[str | int, ...]
 
 
 class Document:
-    """A loaded YAML file: plain data plus a way to find the line of any node."""
+    """A loaded YAML file: plain data plus a way to find the line of any node.
 
-    def __init__(self, raw: Any, file: str):
-        self.raw = raw
+    A file read by libyaml (mechbook.model.fastyaml) has no line numbers of its own: the
+    round-trip parser reads it again the first time an error needs a line."""
+
+    def __init__(self, raw: Any, file: str, data: Any = None, text: str | None = None):
+        self._raw = raw
+        self._text = text
         self.file = file
-        self.data = self._plain(raw, ())
+        self.data = self._plain(raw if text is None else data, ())
+
+    @property
+    def raw(self) -> Any:
+        """The round-trip parser's nodes (with their lines), read on first use."""
+        if self._raw is None and self._text is not None:
+            try:
+                self._raw = _round_trip(self._text, self.file)
+            except SpecError:  # libyaml read it and ruamel.yaml cannot: no lines then
+                self._raw = {}
+            self._text = None
+        return self._raw
 
     def line(self, path: Path_) -> int | None:
         """1-based line of the node at `path` (its key's line for mapping entries)."""
@@ -93,8 +109,22 @@ def load(path: str | Path) -> Document:
 
 
 def loads(text: str, file: str = "<string>") -> Document:
+    """`text` read as YAML: by libyaml when its reading is certain to be the round-trip
+    parser's (mechbook.model.fastyaml), else by the round-trip parser, whose errors name
+    the line."""
     if len(text) > MAX_FILE_BYTES:
         raise SpecError(f"text too large (more than {MAX_FILE_BYTES} characters)", file)
+    data = fast_data(text, file, check_events)
+    if data is not None:
+        return Document(None, file, data, text)
+    raw = _round_trip(text, file)
+    if raw is None:
+        raise SpecError("file is empty", file, 1)
+    return Document(raw, file)
+
+
+def _round_trip(text: str, file: str) -> Any:
+    """ruamel.yaml's round-trip reading (nodes with lines), after the event checks."""
     yaml = YAML(typ="rt")
     yaml.allow_duplicate_keys = False
     try:
@@ -112,9 +142,7 @@ def loads(text: str, file: str = "<string>") -> Document:
             from None
     except (ValueError, OverflowError, RecursionError) as exc:  # a constructor's last resort
         raise SpecError(f"YAML value cannot be read: {_first_line(exc)}", file) from None
-    if raw is None:
-        raise SpecError("file is empty", file, 1)
-    return Document(raw, file)
+    return raw
 
 
 def _first_line(exc: BaseException) -> str:
