@@ -91,6 +91,9 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
     ctx.ensure_object(dict)
     ctx.obj["root_opt"] = root_dir
     _logging()
+    from mechbook.app.quiet import install
+
+    install(lambda text: _say(text, err=True))  # warnings as one-line notes, no traceback
 
 
 def _resolve_root(ctx: click.Context) -> Path:
@@ -331,12 +334,18 @@ def validate(files: tuple[Path, ...]) -> None:
     from mechbook.app.validate import validate_file
 
     bad = 0
+    refused: set[Path] = set()  # problem files already reported invalid
     for f in files:
         try:
             _say(validate_file(f))
         except MechbookError as exc:
-            _say(f"invalid: {exc}", err=True)
             bad += 1
+            problem = getattr(exc, "problem_file", None)
+            if problem is not None and Path(problem).resolve() in refused:
+                _say(f"invalid: {f}: its problem file {problem} is invalid (above)", err=True)
+                continue
+            refused.add(Path(getattr(exc, "file", None) or f).resolve())
+            _say(f"invalid: {exc}", err=True)
     if bad:
         sys.exit(1)
 

@@ -19,6 +19,7 @@ from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from mechbook.errors import SpecError
 from mechbook.model.fastyaml import fast_data
+from mechbook.model.hints import yaml_hint
 from mechbook.model.limits import (
     MAX_FILE_BYTES,
     check_events,
@@ -136,7 +137,8 @@ def _round_trip(text: str, file: str) -> Any:
     except MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark else None
-        raise SpecError(f"YAML syntax error: {exc.problem or exc.context}", file, line) from None
+        raise SpecError(f"YAML syntax error: {yaml_hint(str(exc.problem or exc.context))}",
+                        file, line) from None
     except YAMLError as exc:  # the reader's errors (control characters) carry no mark
         raise SpecError(f"YAML error: {_first_line(exc)}", file, _position_line(exc, text)) \
             from None
