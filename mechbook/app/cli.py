@@ -66,6 +66,16 @@ def _output(path: Path | None, what: str) -> Path | None:
     return path
 
 
+def _numeric_text(key: str, arr, arrays: dict) -> str:
+    """An array of results as text; frequencies with each unstable mode's growth rate
+    instead of NaN (mechbook.engine.growth)."""
+    if key.endswith("/frequencies"):
+        from mechbook.engine.growth import describe
+
+        return describe(list(arr), arrays.get(key.replace("/frequencies", "/growth_rates")))
+    return str(arr.tolist())
+
+
 def _complete_ids(ctx: click.Context, param: click.Parameter, incomplete: str) -> list:
     """Shell completion of problem ids: the files under the tree's problems/ (no engine)."""
     from click.shell_completion import CompletionItem
@@ -171,7 +181,9 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
             for key, text in res.text.items():
                 click.echo(f"{key}:\n    {text}")
             for key, arr in res.arrays.items():
-                click.echo(f"{key} (numeric, default parameters):\n    {arr.tolist()}")
+                if not key.endswith("/growth_rates"):
+                    click.echo(f"{key} (numeric, default parameters):\n    "
+                               f"{_numeric_text(key, arr, res.arrays)}")
             for key, text in res.notes.items():
                 click.echo(f"{key}: {text}")
         if not names or any(k in problem.model.doc.data for k in ("vectors", "tensors",
@@ -407,7 +419,8 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
         for key, text in entry["symbolic"].items():
             _say(f"{key}: {text}")
         for key, arr in entry["numeric"].items():
-            _say(f"{key} (numeric): {arr.tolist()}")
+            if not key.endswith("/growth_rates"):
+                _say(f"{key} (numeric): {_numeric_text(key, arr, entry['numeric'])}")
         for key, text in entry["notes"].items():
             _say(f"{key}: {text}")
     _say("\n== checks")
