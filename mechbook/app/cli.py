@@ -701,11 +701,13 @@ def _keep_sweep(result, store: Path, label: str) -> str:
 @click.option("-j", "--jobs", type=opt.jobs(), default=0, show_default=True,
               help="Worker processes (0: one per core).")
 @click.option("--serial", is_flag=True, help="Build the pages in this process.")
-@click.option("--seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=20.0,
-              show_default=True, help="Time limit of each derivation step of a page.")
+@click.option("--seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=10.0,
+              show_default=True, help="Time limit of each step of a page that computes "
+                                      "(a simulation, an equation the check did not store).")
 @click.option("--simplify-seconds", type=opt.Finite(min=0, max=opt.MAX_STEP_SECONDS),
-              default=3.0, show_default=True,
-              help="Time limit of simplifying each expression shown (0: show unsimplified).")
+              default=0.3, show_default=True,
+              help="Time limit of simplifying each expression shown, for reading (0: show "
+                   "them as the check stored them); a page spends at most five times this.")
 @click.option("--no-simulate", is_flag=True, help="Leave out the simulated trajectories.")
 @click.option("--t-end", type=opt.Finite(min=0, min_open=True, max=1e6), default=10.0,
               show_default=True, help="End time of the simulated trajectories.")
@@ -715,8 +717,11 @@ def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, o
            no_simulate: bool, t_end: float) -> None:
     """Write a static HTML report (all problems by default): an index of every part's
     outcome with filters, errata and unsupported parts, and one page per problem with the
-    derivation as mathematics, the book's value beside the engine's, cross-checks and
-    figures. Outcomes come from the store (`mechbook check` first); works offline."""
+    derivation as mathematics, the book's value beside the engine's, cross-checks, charts
+    and an animation of a simulated motion. Outcomes and derived results come from the
+    store (`mechbook check` first): nothing the check derived is derived again. Pages are
+    written as they finish and kept by content hash: a rerun rebuilds only what changed.
+    Works offline."""
     from mechbook.app.report.build import ReportOptions, build_report
     from mechbook.app.report.page import PageOptions
 
@@ -731,8 +736,8 @@ def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, o
     store = store_path if store_path.is_absolute() else base / store_path
     out = out_dir if out_dir.is_absolute() else base / out_dir
     page = PageOptions(seconds=seconds, simplify_seconds=simplify_seconds,
-                       simplify_budget=30.0 if simplify_seconds > 0 else 0.0,
-                       simulate=not no_simulate, t_end=t_end)
+                       simplify_budget=5 * simplify_seconds, simulate=not no_simulate,
+                       t_end=t_end, simulate_seconds=seconds)
     index = build_report(base, store, out, ids, ReportOptions(jobs, serial, page),
                          log=lambda text: _say(text, err=True))
     _say(f"report written to {index}")
