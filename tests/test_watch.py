@@ -57,9 +57,12 @@ def test_watch_rechecks_on_every_save_within_a_second_of_cpu(tmp_path):
     key = tree / "answers" / "lim" / "2031.yaml"
     good = key.read_text("utf-8")
     env = dict(os.environ, PYTHONUNBUFFERED="1")
+    # a shell that ran these tests in the background ignores SIGINT for its children, and
+    # Python then never turns it into KeyboardInterrupt: restore it, as a terminal would
     proc = subprocess.Popen([sys.executable, "-m", "mechbook", "--root", str(tree), "watch",
                              "lim-2031"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, env=env)
+                            text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     lines: queue.Queue = queue.Queue()
     threading.Thread(target=_reader, args=(proc, lines), daemon=True).start()
     seen: list[str] = []

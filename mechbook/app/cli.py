@@ -764,6 +764,22 @@ def restore(ctx: click.Context, files: tuple[Path, ...], store_path: Path | None
 
 
 @main.command()
+@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
+def init(directory: Path) -> None:
+    """Start a tree of your own in DIRECTORY: books.yaml, an example problem and its answer
+    key (which `mechbook check` passes), and a Makefile. Nothing is overwritten."""
+    from mechbook.app.init import init_tree
+
+    try:
+        written = init_tree(directory)
+    except MechbookError as exc:
+        raise click.ClickException(for_terminal(str(exc))) from None
+    for path in written:
+        _say(f"wrote {path}")
+    _say(f"next: cd {directory} && mechbook check   (or: mechbook --root {directory} check)")
+
+
+@main.command()
 @click.argument("shell", type=click.Choice(SHELLS))
 def completion(shell: str) -> None:
     """Print the shell completion script (commands, options, problem ids) for SHELL.

@@ -22,11 +22,10 @@ log = logging.getLogger("mechbook.faults")
 
 
 def describe_warning(message, category: type, filename: str) -> str:
-    """'numpy warned: overflow encountered in dot' (the library the warning came from)."""
-    origin = _library(filename)
-    kind = "" if category in (UserWarning, RuntimeWarning) else f" ({category.__name__})"
+    """'RuntimeWarning in numpy: overflow encountered in dot': the kind, the library (or
+    module) whose code was running, the message's first line."""
     text = str(message).strip().splitlines()
-    return f"{origin} warned{kind}: {text[0] if text else category.__name__}"
+    return f"{category.__name__} in {_library(filename)}: {text[0] if text else ''}".rstrip()
 
 
 def _library(filename: str) -> str:

@@ -29,6 +29,7 @@ def frames(sys, traj, values: dict, max_frames: int = MAX_FRAMES) -> dict | None
         return _coordinates(sys, traj, max_frames)
     names = list(positions)
     dims = max(len(positions[n]) for n in names)
+    values = {k: sp.Float(v) for k, v in values.items()}  # xreplace keeps SymPy objects
     exprs = []
     for name in names:
         r = list(positions[name]) + [sp.S.Zero] * (dims - len(positions[name]))

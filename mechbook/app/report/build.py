@@ -136,7 +136,7 @@ def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
         page = build_page(pid, base, stored, task.page)
     if why:
         page["page_notes"].append(f"its stored outcomes are not shown: {why}")
-    page["page_notes"] += [f"not shown: {n}" for n in notes]
+    page["page_notes"] += [f"note: {n}" for n in notes]
     stage("writing the page")
     declared = books(base)
     for system in page.get("systems", []):

@@ -100,25 +100,30 @@ def _simulation(page, analysis, name: str, sys_, rows: list[dict]) -> dict | Non
     from mechbook.numerics.simulate import FALLBACK_OFFSET, simulate
 
     opts = page.options
-    init, source = None, "the problem's initial conditions"
+    init, source, seconds = None, "the problem's initial conditions", opts.simulate_seconds
     if not sys_.spec.get("initial"):
         stable = [r for r in rows if r["stability"] == "stable" and r.get("values")]
-        if not stable:
-            page.notes.append(f"simulation ({name}): not shown (no initial conditions, and "
-                              "no stable equilibrium among those the check linearized)")
-            return None
-        start = stable[0]["values"]
+        known = [r for r in rows if r.get("values")]
+        if stable:
+            start, near = stable[0]["values"], "the first stable equilibrium above"
+        elif known:
+            start, near = known[0]["values"], (f"equilibrium 1 above ({known[0]['stability']})"
+                                               if known[0]["stability"] else
+                                               "equilibrium 1 above")
+        else:
+            start = [_inside(sys_, q, analysis.problem.values()) for q in sys_.q]
+            near, seconds = "q = 0 (no equilibrium known to the check)", min(seconds, 4.0)
         # unequal offsets, so that a uniform translation is not all that moves
         init = {c: repr(x + FALLBACK_OFFSET * (1.0 if i == 0 else 0.5))
                 for i, (c, x) in enumerate(zip(sys_.coord_names, start, strict=True))}
         source = (f"at rest, {FALLBACK_OFFSET:g} ({FALLBACK_OFFSET / 2:g} in the other "
-                  "coordinates) from the first stable equilibrium above")
+                  f"coordinates) from {near}")
 
     def run():
         with np.errstate(all="ignore"):
             return simulate(analysis, name, init=init, t_span=(0.0, opts.t_end), points=601)
 
-    sim = page.step(f"simulation ({name})", run, opts.simulate_seconds)
+    sim = page.step(f"simulation ({name})", run, seconds)
     if sim is None:
         return None
     traj = sim.trajectory
@@ -143,3 +148,14 @@ def _simulation(page, analysis, name: str, sys_, rows: list[dict]) -> dict | Non
             "initial": ", ".join(f"{k} = {v:.4g}" for k, v in sim.initial.items()),
             "initial_source": source, "t_end": float(traj.t[-1]),
             "samples": len(traj.t), "notes": list(sim.notes)}
+
+
+def _inside(sys_, q, values: dict) -> float:
+    """0, or the nearest value well inside the coordinate's domain (a radius: 1)."""
+    dom = sys_.domains.get(q)
+    if dom is None or dom.contains(0.0, values) and not dom.lo_open:
+        return 0.0
+    lo, hi = dom.bounds(values)
+    if np.isfinite(lo) and np.isfinite(hi):
+        return (lo + hi) / 2
+    return lo + 1.0 if np.isfinite(lo) else hi - 1.0
