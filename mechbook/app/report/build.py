@@ -25,6 +25,7 @@ from pathlib import Path
 
 from mechbook import __version__
 from mechbook.app.report import cache
+from mechbook.errors import MechbookError, describe
 from mechbook.app.report.page import PageOptions
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
@@ -131,9 +132,16 @@ def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
     start = time.monotonic()
     stored, why = _read_one(pid, task.store)
     notes: list[str] = []
-    with warnings_as_notes(notes):
-        stage("building the page")
-        page = build_page(pid, base, stored, task.page)
+    try:
+        with warnings_as_notes(notes):
+            stage("building the page")
+            page = build_page(pid, base, stored, task.page)
+    except MechbookError as exc:  # a problem file that does not load: said on its page
+        return {"pid": pid, "failed": str(exc), "seconds": time.monotonic() - start}
+    except Exception as exc:  # noqa: BLE001 - one page must not end the report
+        describe(exc)  # the traceback to the debug log; the page says it in words
+        return {"pid": pid, "failed": "the engine could not build it (`mechbook check -v "
+                f"{pid}` shows the fault)", "seconds": time.monotonic() - start}
     if why:
         page["page_notes"].append(f"its stored outcomes are not shown: {why}")
     page["page_notes"] += [f"note: {n}" for n in notes]
