@@ -304,3 +304,19 @@ def test_screenshots_are_not_blank(report, browser):
         assert colours is not None and len(colours) > 50
         dark = sum(n for n, (r, g, b) in colours if r + g + b < 200)
         assert dark > 2000  # text and equations, not an empty page
+
+
+def test_every_page_of_a_full_report(browser):
+    """The same checks on every page of a report built elsewhere (`make report`): set
+    MECHBOOK_REPORT=results/report to run it; skipped otherwise (it takes minutes)."""
+    import os
+
+    where = os.environ.get("MECHBOOK_REPORT")
+    if not where:
+        pytest.skip("set MECHBOOK_REPORT to a report's directory to check all its pages")
+    found = []
+    for path in pages(Path(where)):
+        page, trouble = open_page(browser, path)
+        found += [f"{path.name}: {f}" for f in faults(page, trouble)]
+        page.close()
+    assert found == [], "\n".join(found[:40])
