@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test lint fuzz report bench bench-check bench-sweep bench-power clean
+.PHONY: check test test-min lint fuzz report bench bench-check bench-sweep bench-power clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -21,6 +21,23 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 
 test: $(STAMP)   ## run the test suite
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
+
+# The oldest versions pyproject.toml's ranges allow (.ci/min_versions.py), mechbook itself
+# installed as a wheel (not editable), and a short suite: the lower bounds are tested.
+MIN = .venv-min
+MIN_TESTS = tests/test_expr.py tests/test_loading.py tests/test_domains.py \
+            tests/test_author_loop.py tests/test_watch.py
+test-min:  ## the oldest dependency versions allowed, a short suite and a check (~5 min)
+	rm -rf $(MIN)
+	$(PYTHON) -m venv $(MIN)
+	$(PYTHON) .ci/min_versions.py > $(MIN)/min-constraints.txt
+	$(MIN)/bin/python -m pip install --quiet -c $(MIN)/min-constraints.txt . pytest
+	cd $(MIN) && bin/python -c "import mechbook, numpy, sympy; \
+	    print('mechbook', mechbook.__file__, 'numpy', numpy.__version__, 'sympy', sympy.__version__)"
+	$(MIN)/bin/pytest -q -p no:cacheprovider $(MIN_TESTS)
+	rm -rf $(MIN)/tree && $(MIN)/bin/mechbook init $(MIN)/tree
+	$(MIN)/bin/mechbook --root $(MIN)/tree check
+	$(MIN)/bin/mechbook check lim-2031 symon-10-05 --no-store
 
 fuzz: $(STAMP)   ## 10,000 mutated and hostile problem/answer files under time and memory limits (~30 min)
 	$(BIN)/python tests/fuzz.py --cases 10000 --seed 1 --keep results/fuzz \
@@ -58,4 +75,4 @@ lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench
 
 clean:
-	rm -rf $(VENV) results .pytest_cache
+	rm -rf $(VENV) $(MIN) results .pytest_cache

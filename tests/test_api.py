@@ -134,10 +134,11 @@ def test_results_as_dataframes(store):
 
 
 def test_mathml_dots_velocities_and_accelerations():
-    from mechbook.app.mathml import math
+    from mechbook.app.mathml import DOT_STYLE, math
 
     out = math(sp.Symbol("thetadot") + sp.Symbol("x1ddot") + sp.Symbol("omega"))
-    assert '<mover accent="true"><mi>&#952;</mi><mo>&#729;</mo></mover>' in out  # θ̇
-    assert '<msub><mover accent="true"><mi>x</mi><mo>&#168;</mo></mover><mi>1</mi></msub>' \
+    dot = f'<mo style="{DOT_STYLE}">'  # drawn large enough to read (issue 23)
+    assert f'<mover accent="true"><mi>&#952;</mi>{dot}&#729;</mo></mover>' in out  # θ̇
+    assert f'<msub><mover accent="true"><mi>x</mi>{dot}&#168;</mo></mover><mi>1</mi></msub>' \
         in out  # ẍ₁: the dots on the letter, not on the subscript
-    assert "&#969;" in out and "dot" not in out
+    assert "&#969;" in out and "ddot" not in out

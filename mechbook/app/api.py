@@ -25,6 +25,7 @@ from typing import Any
 
 import sympy as sp
 
+from mechbook.app.display import MathDict, MathList
 from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
 from mechbook.engine.analysis import Analysis
@@ -82,20 +83,20 @@ class SystemView:
         rhs = dyn.forcing
         if self._sys.constraints:
             rhs = rhs + dyn.constraint_jacobian.T * sp.Matrix(dyn.multipliers)
-        return [sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True)]
+        return MathList(sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True))
 
     @property
     def accelerations(self) -> dict[sp.Symbol, sp.Expr]:
-        return dict(self._dyn.solved)
+        return MathDict(self._dyn.solved)
 
     @property
     def momenta(self) -> dict[sp.Symbol, sp.Expr]:
-        return dict(zip(self._sys.q, self._dyn.momenta, strict=True))
+        return MathDict(zip(self._sys.q, self._dyn.momenta, strict=True), label=_momentum)
 
     @property
     def cyclic(self) -> dict[sp.Symbol, sp.Expr]:
         """Ignorable coordinates and their (conserved) momenta."""
-        return dict(self._dyn.cyclic)
+        return MathDict(self._dyn.cyclic, label=_momentum)
 
     @property
     def energy(self) -> sp.Expr:
@@ -112,8 +113,13 @@ class SystemView:
 
     @property
     def equilibria(self) -> list[dict]:
-        """The equilibria SymPy finds in closed form."""
-        return self._an.equilibria(self.name).symbolic
+        """The equilibria SymPy finds in closed form that exist at the default values (real,
+        inside the coordinates' domains: mechbook.engine.domains)."""
+        from mechbook.engine.domains import existing
+
+        points, _ = existing(self._an.equilibria(self.name).symbolic, self._sys,
+                             self.problem.model.values())
+        return MathList(MathDict(p) for p in points)
 
     def point(self, about: dict | None = None) -> dict:
         """An equilibrium as {coordinate symbol: value}: `about` ({name: text or number}),
@@ -142,7 +148,7 @@ class SystemView:
         lin = self.linear(about)
         if numeric:
             return [float(w) for w in lin.numeric_frequencies(self.problem.model.values())]
-        return [self._readable(w) for w in lin.frequencies]
+        return MathList(self._readable(w) for w in lin.frequencies)
 
     def modes(self, about: dict | None = None) -> tuple[Any, Any]:
         """(ω, mode shapes as columns) at the default parameter values."""
@@ -174,6 +180,10 @@ class SystemView:
         return (f"<p>system <b>{html.escape(self.name)}</b> of {html.escape(self.problem.id)}"
                 f"</p><p>L =</p>{math(self.lagrangian)}<p>equations of motion</p>"
                 f"{math(self.eom)}")
+
+
+def _momentum(q: sp.Symbol) -> sp.Symbol:
+    return sp.Symbol(f"p_{q}")
 
 
 class Problem:

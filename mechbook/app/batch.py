@@ -79,8 +79,10 @@ def _worker(conn: Connection, base: Path, options: Any, task: Task, run_pid: int
     """A worker's loop: receive an item, run the task on it, send stages and the result.
     It dies with the run (mechbook.app.lifeline), even one killed with -9."""
     from mechbook.app.lifeline import die_with
+    from mechbook.app.quiet import install
 
     die_with(run_pid)
+    install()  # a stray warning or unraisable exception: the debug log, not the terminal
     while True:
         try:
             item = conn.recv()

@@ -66,6 +66,16 @@ def _output(path: Path | None, what: str) -> Path | None:
     return path
 
 
+def _numeric_text(key: str, arr, arrays: dict) -> str:
+    """An array of results as text; frequencies with each unstable mode's growth rate
+    instead of NaN (mechbook.engine.growth)."""
+    if key.endswith("/frequencies"):
+        from mechbook.engine.growth import describe
+
+        return describe(list(arr), arrays.get(key.replace("/frequencies", "/growth_rates")))
+    return str(arr.tolist())
+
+
 def _complete_ids(ctx: click.Context, param: click.Parameter, incomplete: str) -> list:
     """Shell completion of problem ids: the files under the tree's problems/ (no engine)."""
     from click.shell_completion import CompletionItem
@@ -91,6 +101,9 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
     ctx.ensure_object(dict)
     ctx.obj["root_opt"] = root_dir
     _logging()
+    from mechbook.app.quiet import install
+
+    install(lambda text: _say(text, err=True))  # warnings as one-line notes, no traceback
 
 
 def _resolve_root(ctx: click.Context) -> Path:
@@ -168,7 +181,9 @@ def solve(ctx: click.Context, problem_id: str, system: str | None, no_simplify: 
             for key, text in res.text.items():
                 click.echo(f"{key}:\n    {text}")
             for key, arr in res.arrays.items():
-                click.echo(f"{key} (numeric, default parameters):\n    {arr.tolist()}")
+                if not key.endswith("/growth_rates"):
+                    click.echo(f"{key} (numeric, default parameters):\n    "
+                               f"{_numeric_text(key, arr, res.arrays)}")
             for key, text in res.notes.items():
                 click.echo(f"{key}: {text}")
         if not names or any(k in problem.model.doc.data for k in ("vectors", "tensors",
@@ -331,14 +346,49 @@ def validate(files: tuple[Path, ...]) -> None:
     from mechbook.app.validate import validate_file
 
     bad = 0
+    refused: set[Path] = set()  # problem files already reported invalid
     for f in files:
         try:
             _say(validate_file(f))
         except MechbookError as exc:
-            _say(f"invalid: {exc}", err=True)
             bad += 1
+            problem = getattr(exc, "problem_file", None)
+            if problem is not None and Path(problem).resolve() in refused:
+                _say(f"invalid: {f}: its problem file {problem} is invalid (above)", err=True)
+                continue
+            refused.add(Path(getattr(exc, "file", None) or f).resolve())
+            _say(f"invalid: {exc}", err=True)
     if bad:
         sys.exit(1)
+
+
+@main.command()
+@click.argument("problem_id", shell_complete=_complete_ids)
+@click.option("--no-crosscheck", is_flag=True, help="Check the book's answers only.")
+@click.option("--seconds", type=opt.seconds(), default=120.0, show_default=True,
+              help="CPU seconds allowed for each check.")
+@click.option("--runs", type=click.IntRange(min=0), default=0, hidden=True,
+              help="Stop after this many checks (tests).")
+@click.pass_context
+def watch(ctx: click.Context, problem_id: str, no_crosscheck: bool, seconds: float,
+          runs: int) -> None:
+    """Check a problem now and again each time its problem file or answer key is saved,
+    with the engine kept loaded (a save is answered in the time the check takes, a few
+    tenths of a second for a small problem). Ctrl-C stops; nothing is stored."""
+    from mechbook.app.watch import WatchOptions
+    from mechbook.app.watch import watch as watch_problem
+    from mechbook.model.catalog import check_id
+
+    base = _resolve_root(ctx)
+    try:
+        path = problem_path(check_id(problem_id), base)
+    except MechbookError as exc:
+        raise click.ClickException(for_terminal(str(exc))) from None
+    if not path.exists():
+        raise click.ClickException(f"no problem {problem_id} (no file {path}; "
+                                   "`mechbook list` shows the problems there are)")
+    watch_problem(problem_id, base, _say,
+                  WatchOptions(crosscheck=not no_crosscheck, seconds=seconds, runs=runs))
 
 
 @main.command()
@@ -369,7 +419,8 @@ def show(ctx: click.Context, problem_id: str, store_path: Path) -> None:
         for key, text in entry["symbolic"].items():
             _say(f"{key}: {text}")
         for key, arr in entry["numeric"].items():
-            _say(f"{key} (numeric): {arr.tolist()}")
+            if not key.endswith("/growth_rates"):
+                _say(f"{key} (numeric): {_numeric_text(key, arr, entry['numeric'])}")
         for key, text in entry["notes"].items():
             _say(f"{key}: {text}")
     _say("\n== checks")
@@ -653,11 +704,13 @@ def _keep_sweep(result, store: Path, label: str) -> str:
 @click.option("-j", "--jobs", type=opt.jobs(), default=0, show_default=True,
               help="Worker processes (0: one per core).")
 @click.option("--serial", is_flag=True, help="Build the pages in this process.")
-@click.option("--seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=20.0,
-              show_default=True, help="Time limit of each derivation step of a page.")
+@click.option("--seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=10.0,
+              show_default=True, help="Time limit of each step of a page that computes "
+                                      "(a simulation, an equation the check did not store).")
 @click.option("--simplify-seconds", type=opt.Finite(min=0, max=opt.MAX_STEP_SECONDS),
-              default=3.0, show_default=True,
-              help="Time limit of simplifying each expression shown (0: show unsimplified).")
+              default=0.3, show_default=True,
+              help="Time limit of simplifying each expression shown, for reading (0: show "
+                   "them as the check stored them); a page spends at most five times this.")
 @click.option("--no-simulate", is_flag=True, help="Leave out the simulated trajectories.")
 @click.option("--t-end", type=opt.Finite(min=0, min_open=True, max=1e6), default=10.0,
               show_default=True, help="End time of the simulated trajectories.")
@@ -667,8 +720,11 @@ def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, o
            no_simulate: bool, t_end: float) -> None:
     """Write a static HTML report (all problems by default): an index of every part's
     outcome with filters, errata and unsupported parts, and one page per problem with the
-    derivation as mathematics, the book's value beside the engine's, cross-checks and
-    figures. Outcomes come from the store (`mechbook check` first); works offline."""
+    derivation as mathematics, the book's value beside the engine's, cross-checks, charts
+    and an animation of a simulated motion. Outcomes and derived results come from the
+    store (`mechbook check` first): nothing the check derived is derived again. Pages are
+    written as they finish and kept by content hash: a rerun rebuilds only what changed.
+    Works offline."""
     from mechbook.app.report.build import ReportOptions, build_report
     from mechbook.app.report.page import PageOptions
 
@@ -683,8 +739,8 @@ def report(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path, o
     store = store_path if store_path.is_absolute() else base / store_path
     out = out_dir if out_dir.is_absolute() else base / out_dir
     page = PageOptions(seconds=seconds, simplify_seconds=simplify_seconds,
-                       simplify_budget=30.0 if simplify_seconds > 0 else 0.0,
-                       simulate=not no_simulate, t_end=t_end)
+                       simplify_budget=5 * simplify_seconds, simulate=not no_simulate,
+                       t_end=t_end, simulate_seconds=seconds)
     index = build_report(base, store, out, ids, ReportOptions(jobs, serial, page),
                          log=lambda text: _say(text, err=True))
     _say(f"report written to {index}")
@@ -708,6 +764,22 @@ def restore(ctx: click.Context, files: tuple[Path, ...], store_path: Path | None
         except MechbookError as exc:
             raise click.ClickException(for_terminal(str(exc))) from None
         _say(f"{f}: {problems} problem(s) and {simulations} simulation(s) stored")
+
+
+@main.command()
+@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
+def init(directory: Path) -> None:
+    """Start a tree of your own in DIRECTORY: books.yaml, an example problem and its answer
+    key (which `mechbook check` passes), and a Makefile. Nothing is overwritten."""
+    from mechbook.app.init import init_tree
+
+    try:
+        written = init_tree(directory)
+    except MechbookError as exc:
+        raise click.ClickException(for_terminal(str(exc))) from None
+    for path in written:
+        _say(f"wrote {path}")
+    _say(f"next: cd {directory} && mechbook check   (or: mechbook --root {directory} check)")
 
 
 @main.command()

@@ -88,6 +88,11 @@ def print_table(runs: list, verbose: bool) -> None:
         for pid, x in loose:
             info = f"{x.name}: {x.detail}"
             click.echo(f"  {pid:<16} {x.cell():<12} {info[:160] if not verbose else info}")
+    notes = [(r.pid, n) for r in runs for n in r.notes] if verbose else []
+    if notes:  # warnings turned into notes, derived results not stored ...
+        click.echo("\nnotes:")
+        for pid, note in notes:
+            click.echo(f"  {pid:<16} {note}")
     shown = [(r.pid, x) for r in runs for x in r.crosschecks if verbose or x.failed]
     if shown:
         click.echo("\ncross-check details:" if verbose else "\nfailed cross-checks:")

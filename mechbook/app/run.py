@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mechbook.app.fingerprint import file_sha256
+from mechbook.app.quiet import warnings_as_notes
 from mechbook.app.store import ProblemRecord, cached
 from mechbook.errors import FAULTS, MechbookError, describe
 from mechbook.model.catalog import answer_path, problem_path
@@ -62,8 +63,15 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
     """Check one problem against its answer key (and cross-check it), from scratch."""
     start = time.perf_counter()
     run = ProblemRun(pid)
-    with _tracebacks(run.debug):
-        _check(run, pid, base, options, stage, start)
+    reached = [""]
+
+    def staged(text: str) -> None:
+        reached[0] = text
+        stage(text)
+
+    # a NumPy or SymPy warning becomes a note naming the stage (the part) it arose in
+    with _tracebacks(run.debug), warnings_as_notes(run.notes, lambda: reached[0]):
+        _check(run, pid, base, options, staged, start)
     run.seconds = time.perf_counter() - start
     return run
 

@@ -1,12 +1,18 @@
 """`mechbook validate`: a file is checked against its schema and every expression parsed,
-without deriving anything."""
+without deriving anything.
+
+A problem file needs only the model (YAML, schema, the safe parser, the systems built from
+their declarations), so the engine and the answer quantities are imported only for an answer
+key, whose expressions are parsed in their part's context: an author's validation answers in
+well under a second.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mechbook.core.timeout import Timeout, hard_time_limit
-from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, SpecError
 from mechbook.model.catalog import problem_path, root
 from mechbook.model.declared import declared
@@ -14,10 +20,9 @@ from mechbook.model.physical import check_physical
 from mechbook.model.problem import load_problem
 from mechbook.model.system import system_of
 from mechbook.model.yamlio import load
-from mechbook.verify.answers import load_answers
-from mechbook.verify.context import Context, strip_const
-from mechbook.verify.quantities.tensors import validate_part
-from mechbook.verify.registry import quantities
+
+if TYPE_CHECKING:
+    from mechbook.engine.analysis import Analysis
 
 BUILD_SECONDS = 15.0  # CPU; `validate` runs in the caller's process, so it bounds itself
 
@@ -43,6 +48,9 @@ def validate_file(path: str | Path) -> str:
 
 
 def _validate_answers(path: Path) -> str:
+    from mechbook.engine.analysis import Analysis
+    from mechbook.verify.answers import load_answers
+
     key = load_answers(path)
     try:
         base = root(path.parent)
@@ -52,10 +60,16 @@ def _validate_answers(path: Path) -> str:
         ppath = problem_path(key.problem_id, base)
     except MechbookError as exc:
         raise key.doc.error(("problem",), str(exc)) from None
-    problem = load_problem(ppath)
     try:
+        problem = load_problem(ppath)
         with hard_time_limit(BUILD_SECONDS):  # its problem's systems are built on the way
             check_expressions(key, Analysis(problem))
+    except SpecError as exc:
+        if exc.file is None or Path(exc.file).resolve() != ppath.resolve():
+            raise
+        err = SpecError(f"its problem file is invalid: {exc}", str(path))
+        err.problem_file = str(ppath)  # the command line says so once per file
+        raise err from None
     except Timeout:
         raise SpecError(f"checking the answer key's expressions (and building its problem "
                         f"{ppath.name}) took more than {BUILD_SECONDS:g} s of CPU time (the "
@@ -91,6 +105,14 @@ def part_faults(key, analysis: Analysis) -> dict[str, str]:
 
 
 def check_part_expressions(part, analysis: Analysis) -> None:
+    """Every name the part uses resolved (mechbook.verify.keynames) and every expression of
+    it parsed in its context; SpecError (file:line) on the first fault."""
+    from mechbook.verify.context import Context
+    from mechbook.verify.keynames import check_part_names
+    from mechbook.verify.quantities.tensors import validate_part
+    from mechbook.verify.registry import quantities
+
+    check_part_names(part, analysis.problem)
     ctx = Context(analysis, part)
     if ctx.tensor_mode:  # vectors, tensors, bodies: built once, nothing judged
         validate_part(ctx)
@@ -107,7 +129,9 @@ def check_part_expressions(part, analysis: Analysis) -> None:
         _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
 
 
-def _walk(ctx: Context, value, sub: tuple, names: dict) -> None:
+def _walk(ctx, value, sub: tuple, names: dict) -> None:
+    from mechbook.verify.context import strip_const
+
     if isinstance(value, dict):
         for k, v in value.items():
             _walk(ctx, v, sub + (k,), names)

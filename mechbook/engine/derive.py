@@ -10,7 +10,9 @@ import numpy as np
 import sympy as sp
 
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import UnsupportedError
+from mechbook.engine.domains import existing
+from mechbook.engine.growth import growth_rates
+from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.declared import CACHE_KEY
 from mechbook.records import Results
 
@@ -67,8 +69,12 @@ def derive(analysis: Analysis, system: str | None = None,
     if "equilibria" in wanted or "small_oscillations" in wanted:
         def equilibria():
             eq = analysis.equilibria(sys.name)
-            points = eq.symbolic
+            points, gone = existing(eq.symbolic, sys, values)  # real, inside the domains
             res.text["equilibria"] = show(points)
+            if gone:
+                res.notes["equilibria_left_out"] = (
+                    f"{len(gone)} closed-form solution(s) do not exist at the default "
+                    "values: " + "; ".join(gone))
             if not points:
                 search = (sys.spec.get("equilibria") or {}).get("search")
                 found = eq.numeric(values, _ranges(sys, search))
@@ -129,6 +135,7 @@ def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
     res.arrays[f"{tag}/M"] = M
     res.arrays[f"{tag}/K"] = K
     res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
+    res.arrays[f"{tag}/growth_rates"] = growth_rates(M, C, K)
     if not lin.gyroscopic:
         w2, modes = lin.numeric_modes(values)
         res.arrays[f"{tag}/modes"] = modes
@@ -186,6 +193,8 @@ def computed(analysis: Analysis) -> list[Results]:
             continue
         res = Results(name)
         res.text["lagrangian"] = show(sys.lagrangian)
+        res.text["kinetic"] = show(sys.kinetic)  # built with the system: nothing derived
+        res.text["potential"] = show(sys.potential)
         dyn = analysis._dyn.get(name)
         if dyn is not None:
             for key in _DYNAMICS_TEXT:
@@ -210,7 +219,10 @@ def computed(analysis: Analysis) -> list[Results]:
                 M, C, K = lin.matrices(values)
                 res.arrays[f"{tag}/M"], res.arrays[f"{tag}/K"] = M, K
                 res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
-            except (TypeError, ValueError, UnsupportedError, np.linalg.LinAlgError) as exc:
+                res.arrays[f"{tag}/growth_rates"] = growth_rates(M, C, K)
+            except (TypeError, ValueError, MechbookError, np.linalg.LinAlgError) as exc:
+                # a point in an answer's own symbols (an orbit radius r0) has no numbers
+                # at the default values: its text is stored all the same
                 res.notes[f"{tag}/numeric"] = f"not evaluated at the default values: {exc}"
         out.append(res)
     return out

@@ -20,6 +20,7 @@ from mechbook.core.compile import compile_exprs
 from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import NotNumeric, evaluate, without_absent
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
+from mechbook.engine.domains import clip_ranges, inside
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import NotEquilibriumError, UnsupportedError
@@ -132,6 +133,7 @@ class Equilibria:
         def j_num(x):
             return jac(x).reshape(n, n)
         ranges = [search.get(v, (-np.pi, np.pi)) if search else (-np.pi, np.pi) for v in q]
+        ranges = clip_ranges(self.sys, q, ranges, values)  # only inside the coordinates' domains
         grids = [np.linspace(lo, hi, starts) for lo, hi in ranges]
         found: list[np.ndarray] = []
         mesh = np.array(np.meshgrid(*grids, indexing="ij")).reshape(len(q), -1).T
@@ -146,6 +148,8 @@ class Equilibria:
                         np.max(np.abs(f_num(sol.x))) < 1e-10):
                     continue
             x = sol.x[: len(q)]
+            if not inside(self.sys, q, x, values):
+                continue
             if not any(np.allclose(x, f, atol=1e-7) for f in found):
                 found.append(x)
         return found

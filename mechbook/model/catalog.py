@@ -22,8 +22,9 @@ def root(start: str | Path | None = None) -> Path:
     for d in (here, *here.parents):
         if (d / "problems").is_dir():
             return d
-    raise MechbookError("no problems/ directory here or above; run from a mechbook tree "
-                        "or set MECHBOOK_ROOT")
+    raise MechbookError("no problems/ directory here or above: run from a mechbook tree, "
+                        "name one with --root DIR (or set MECHBOOK_ROOT=DIR), or start one "
+                        "with `mechbook init DIR`")
 
 
 # A book's name, a dash, and the problem's name: letters, digits, '.', '_' and '-' only, so

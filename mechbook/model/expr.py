@@ -25,6 +25,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.constants import bad_constant
+from mechbook.model.hints import did_you_mean, operator_hint
 
 MAX_LENGTH = 20_000  # characters in one expression
 MAX_NODES = 5_000  # AST nodes in one expression
@@ -217,7 +218,9 @@ class _Builder:
             return CONSTANTS[name]
         if name in FUNCTIONS:
             raise self.fail(node, f"function {name!r} used without a call")
-        raise self.fail(node, f"unknown name {name!r} (declare it as a parameter or coordinate)")
+        hint = did_you_mean(name, [*self.names, *CONSTANTS])
+        raise self.fail(node, f"unknown name {name!r} ({hint + ' or ' if hint else ''}"
+                              "declare it as a parameter or coordinate)")
 
     def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Basic:
         operand = self.build(node.operand, depth, True)
@@ -225,12 +228,12 @@ class _Builder:
             return -operand
         if isinstance(node.op, ast.UAdd):
             return operand
-        raise self.fail(node, f"operator {type(node.op).__name__} is not allowed")
+        raise self.fail(node, f"operator {operator_hint(type(node.op).__name__)}")
 
     def _BinOp(self, node: ast.BinOp, depth: int) -> sp.Basic:
         op = type(node.op)
         if op not in _BINOPS:
-            raise self.fail(node, f"operator {op.__name__} is not allowed")
+            raise self.fail(node, f"operator {operator_hint(op.__name__)}")
         left = self.build(node.left, depth, True)
         right = self.build(node.right, depth, True)
         if op is ast.Pow:
@@ -256,7 +259,10 @@ class _Builder:
         name = node.func.id
         op = self.names.get(name)
         if name not in FUNCTIONS and not isinstance(op, Operator):
-            raise self.fail(node, f"call of unknown function {name!r}")
+            known = [*FUNCTIONS, *(k for k, v in self.names.items() if isinstance(v, Operator))]
+            hint = did_you_mean(name, known)
+            raise self.fail(node, f"call of unknown function {name!r}"
+                                  + (f" ({hint})" if hint else ""))
         if node.keywords:
             raise self.fail(node, f"keyword arguments are not allowed in {name}()")
         lo, hi = op.arity if isinstance(op, Operator) else ARITY.get(name, (1, 1))
@@ -282,7 +288,7 @@ class _Builder:
         rels = []
         for op, a, b in zip(node.ops, terms, terms[1:], strict=False):
             if type(op) not in _COMPARE:
-                raise self.fail(node, f"comparison {type(op).__name__} is not allowed")
+                raise self.fail(node, f"comparison {operator_hint(type(op).__name__)}")
             rels.append(_COMPARE[type(op)](a, b, evaluate=False))
         return sp.And(*rels, evaluate=False) if len(rels) > 1 else rels[0]
 

@@ -66,9 +66,11 @@ def _mass_matrix(system, values: dict) -> None:
     rng = random.Random(SEED)
     known = {str(k): float(v) for k, v in values.items()}
     coords = {str(q) for q in system.q}
+    domains = {str(q): d for q, d in getattr(system, "domains", {}).items()}
     seen = []
     for _ in range(POINTS):
-        point = {a: known[a] if a in known else rng.uniform(-2.5, 2.5) if a in coords
+        point = {a: known[a] if a in known else (domains[a].sample(rng, values) if a in domains
+                                                 else rng.uniform(-2.5, 2.5)) if a in coords
                  else rng.uniform(0.3, 1.7) * rng.choice((1, -1)) for a in args}
         try:
             m, j = _at(hess, jac, args, point)

@@ -8,6 +8,7 @@ from importlib import resources
 
 import jsonschema
 
+from mechbook.model.hints import did_you_mean
 from mechbook.model.yamlio import Document
 
 
@@ -61,12 +62,48 @@ def _relevance(error: jsonschema.ValidationError):
 
 
 def _message(error: jsonschema.ValidationError) -> str:
+    """The violation in words, with the likely fix (the nearest allowed name, or the
+    indentation when a mapping came out empty or as text)."""
     if error.validator == "additionalProperties":
-        extra = sorted(set(error.instance) - set(error.schema.get("properties", {})))
-        allowed = ", ".join(sorted(error.schema.get("properties", {})))
+        known = error.schema.get("properties", {})
+        extra = sorted(set(error.instance) - set(known))
+        empty = [k for k, v in error.instance.items() if v is None and k in known]
+        if empty:  # `parameters:` with its entries not indented under it
+            return (f"unknown key(s) {', '.join(map(repr, extra))} beside the empty "
+                    f"{empty[0]!r}: if they belong under {empty[0]!r}, indent them "
+                    "(further right than it)")
+        hint = did_you_mean(extra[0], known) if len(extra) == 1 else ""
+        if hint:
+            return f"unknown key {extra[0]!r}; {hint}"
+        allowed = ", ".join(sorted(known))
         return f"unknown key(s) {', '.join(map(repr, extra))}; allowed: {allowed}"
     if error.validator == "required":
         return error.message.replace("is a required property", "is required")
     if error.validator == "enum":
+        choices = [str(c) for c in error.validator_value]
+        hint = did_you_mean(str(error.instance), choices) if isinstance(error.instance, str) \
+            else ""
+        if hint:
+            return f"{error.instance!r} is not one of the {len(choices)} allowed; {hint}"
         return f"{error.instance!r} is not one of {error.validator_value}"
+    if error.validator == "type" and _wants_collection(error.validator_value):
+        where = str(error.absolute_path[-1]) if error.absolute_path else "the file"
+        kind = "a list" if _wants(error.validator_value, "array") and \
+            not _wants(error.validator_value, "object") else "a mapping"
+        if error.instance is None:
+            return (f"{where!r} is empty, but {kind} is expected here: if its entries "
+                    "follow, indent them under it (further right than "
+                    f"{where!r})")
+        if isinstance(error.instance, str | int | float):
+            return (f"{error.instance!r} is a single value, but {kind} is expected under "
+                    f"{where!r}: write its entries on the lines below, indented, or in "
+                    "braces {...} / brackets [...]")
     return error.message
+
+
+def _wants(types, name: str) -> bool:
+    return name == types or (isinstance(types, list) and name in types)
+
+
+def _wants_collection(types) -> bool:
+    return (_wants(types, "object") or _wants(types, "array")) and not _wants(types, "null")

@@ -18,6 +18,7 @@ from mechbook.errors import UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
 from mechbook.model.declared import declared
+from mechbook.model.domains import Domain, assumptions, domain_of
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
 
@@ -45,7 +46,8 @@ class System:
 
     def _build_symbols(self) -> None:
         coords = list(self.spec["coordinates"])
-        self.q = [sp.Symbol(c, real=True) for c in coords]
+        specs = self.spec["coordinates"]
+        self.q = [sp.Symbol(c, **assumptions(specs[c])) for c in coords]
         self.qd = [sp.Symbol(c + "dot", real=True) for c in coords]
         self.qdd = [sp.Symbol(c + "ddot", real=True) for c in coords]
         self.coord_names = coords
@@ -59,6 +61,12 @@ class System:
                 taken.add(sym.name)
                 names[sym.name] = sym
         names["t"] = T
+        self.domains: dict[sp.Symbol, Domain] = {}  # a coordinate's declared domain
+        for c, q in zip(coords, self.q, strict=True):
+            dom = domain_of(c, specs[c], lambda text, sub, c=c: self.problem.parse(
+                text, self.path + ("coordinates", c) + sub, self.problem.names()))
+            if dom is not None:
+                self.domains[q] = dom
         self.driven: dict[str, sp.Expr] = {}
         self.free_driven: list[tuple[sp.Symbol, sp.Symbol, sp.Symbol]] = []
         for name, text in (self.spec.get("driven") or {}).items():

@@ -18,6 +18,8 @@ from ruamel.yaml.constructor import DuplicateKeyError
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from mechbook.errors import SpecError
+from mechbook.model.fastyaml import fast_data
+from mechbook.model.hints import yaml_hint
 from mechbook.model.limits import (
     MAX_FILE_BYTES,
     check_events,
@@ -30,12 +32,27 @@ Path_ = tuple[str | int, ...]
 
 
 class Document:
-    """A loaded YAML file: plain data plus a way to find the line of any node."""
+    """A loaded YAML file: plain data plus a way to find the line of any node.
 
-    def __init__(self, raw: Any, file: str):
-        self.raw = raw
+    A file read by libyaml (mechbook.model.fastyaml) has no line numbers of its own: the
+    round-trip parser reads it again the first time an error needs a line."""
+
+    def __init__(self, raw: Any, file: str, data: Any = None, text: str | None = None):
+        self._raw = raw
+        self._text = text
         self.file = file
-        self.data = self._plain(raw, ())
+        self.data = self._plain(raw if text is None else data, ())
+
+    @property
+    def raw(self) -> Any:
+        """The round-trip parser's nodes (with their lines), read on first use."""
+        if self._raw is None and self._text is not None:
+            try:
+                self._raw = _round_trip(self._text, self.file)
+            except SpecError:  # libyaml read it and ruamel.yaml cannot: no lines then
+                self._raw = {}
+            self._text = None
+        return self._raw
 
     def line(self, path: Path_) -> int | None:
         """1-based line of the node at `path` (its key's line for mapping entries)."""
@@ -93,8 +110,22 @@ def load(path: str | Path) -> Document:
 
 
 def loads(text: str, file: str = "<string>") -> Document:
+    """`text` read as YAML: by libyaml when its reading is certain to be the round-trip
+    parser's (mechbook.model.fastyaml), else by the round-trip parser, whose errors name
+    the line."""
     if len(text) > MAX_FILE_BYTES:
         raise SpecError(f"text too large (more than {MAX_FILE_BYTES} characters)", file)
+    data = fast_data(text, file, check_events)
+    if data is not None:
+        return Document(None, file, data, text)
+    raw = _round_trip(text, file)
+    if raw is None:
+        raise SpecError("file is empty", file, 1)
+    return Document(raw, file)
+
+
+def _round_trip(text: str, file: str) -> Any:
+    """ruamel.yaml's round-trip reading (nodes with lines), after the event checks."""
     yaml = YAML(typ="rt")
     yaml.allow_duplicate_keys = False
     try:
@@ -106,15 +137,14 @@ def loads(text: str, file: str = "<string>") -> Document:
     except MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark else None
-        raise SpecError(f"YAML syntax error: {exc.problem or exc.context}", file, line) from None
+        raise SpecError(f"YAML syntax error: {yaml_hint(str(exc.problem or exc.context))}",
+                        file, line) from None
     except YAMLError as exc:  # the reader's errors (control characters) carry no mark
         raise SpecError(f"YAML error: {_first_line(exc)}", file, _position_line(exc, text)) \
             from None
     except (ValueError, OverflowError, RecursionError) as exc:  # a constructor's last resort
         raise SpecError(f"YAML value cannot be read: {_first_line(exc)}", file) from None
-    if raw is None:
-        raise SpecError("file is empty", file, 1)
-    return Document(raw, file)
+    return raw
 
 
 def _first_line(exc: BaseException) -> str:

@@ -29,6 +29,7 @@ from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.accuracy import choose
+from mechbook.numerics.domain import check_start, within_domains
 from mechbook.numerics.integrators import SCIPY_METHODS, Trajectory, integrate
 from mechbook.numerics.model import DEFAULT_BACKEND, Model, build_model
 from mechbook.numerics.monitors import Drift, conserved_quantities, drifts
@@ -193,6 +194,7 @@ def simulate(analysis: Analysis, system_name: str | None = None, *,
     values = parameter_values(analysis, parameters)
     dyn = analysis.dynamics(sys.name)
     q0, qd0, source = initial_state(analysis, sys.name, init or {}, values)
+    check_start(sys, q0, values)  # inside the coordinates' domains (numerics.domain)
     model = build_model(sys, dyn, values, conserved_quantities(sys, dyn), backend)
     given = {k for k in ("rtol", "atol", "step") if options.get(k) is not None}
     if accuracy is not None and given:
@@ -236,10 +238,13 @@ def simulate(analysis: Analysis, system_name: str | None = None, *,
             options = {**options, "rtol": picked.rtol, "atol": picked.atol}
         notes.append(f"taylor method unavailable ({exc.capability}): {method} instead")
         traj = integrate(model, t_span, q0, qd0, method, t_eval=t_eval, **options)
+    traj, left = within_domains(sys, traj, values)
+    if left:
+        notes.append(left)
     if source == "fallback":
         notes.append(f"no initial conditions given: started at rest, {FALLBACK_OFFSET} from "
                      "the first stable equilibrium")
-    if not traj.success:
+    if not traj.success and not left:
         notes.append(f"integration stopped early: {traj.message}")
     sim = Simulation(problem.id, sys.name, model, traj, drifts(model, traj),
                      dict(zip([*sys.coord_names, *(c + "dot" for c in sys.coord_names)],

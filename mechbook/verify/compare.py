@@ -94,8 +94,8 @@ class Sampler:
                     point[sym] = value + self.rng.uniform(-1, 1) * max(1.0, abs(value)) * spread
             for v in variables:
                 if v not in point:
-                    point[v] = self.rng.uniform(0.1, 1.0) if v.is_positive \
-                        else self.rng.uniform(-1.0, 1.0)
+                    point[v] = self.rng.uniform(0.1, 1.0) if v.is_nonnegative \
+                        else self.rng.uniform(-1.0, 1.0)  # a radius declared positive
             point = self._complete({k: sp.Float(v, DIGITS) for k, v in point.items()})
             if point is not None and all(holds(c, point) for c in self.conditions):
                 return point

@@ -2,19 +2,21 @@
 filters by book and status) and one page per problem, under one directory that works
 offline (`results/report/index.html` by default).
 
-The outcomes are read from the store that `mechbook check` wrote; a problem not in the store
-is listed as "not checked". Problem pages are computed on worker processes (each page's
-steps have their own limits, and a page that outlasts `page_timeout` is replaced by a page
-that says so); work–precision diagrams that `make bench` left in results/bench/ are copied
-beside the pages that concern them.
+It is built like `mechbook check`: the pages run on the batch machinery's worker processes
+(mechbook.app.batch: a time limit and a memory bound per page, a dead worker replaced), the
+slowest first; each worker writes its page the moment it is done, and `.pages.json` records
+the content hash each page was built from (mechbook.app.report.cache), so an interrupted
+report keeps what it finished and a rerun rebuilds only the pages whose problem, answer key,
+stored check, books.yaml or mechbook changed. Progress is a bar with ETA on a terminal, a
+line per page otherwise. The index is written last, from the store and the pages' entries.
 """
 
 from __future__ import annotations
 
-import multiprocessing as mp
 import os
 import shutil
 import sys
+import time
 from collections import Counter
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -22,6 +24,8 @@ from importlib import resources
 from pathlib import Path
 
 from mechbook import __version__
+from mechbook.app.report import cache
+from mechbook.errors import MechbookError, describe
 from mechbook.app.report.page import PageOptions
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
@@ -36,47 +40,155 @@ class ReportOptions:
     serial: bool = False  # pages in this process (tests, debugging)
     page: PageOptions = field(default_factory=PageOptions)
     page_timeout: float = 600.0  # seconds for one page, all steps together
+    memory_mb: float = 4000.0  # resident memory of one page's worker
+
+
+@dataclass(frozen=True)
+class _Task:
+    """What a worker needs to build and write a page (plain data: it crosses processes)."""
+
+    out: Path
+    store: Path
+    page: PageOptions
 
 
 def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = None,
                  options: ReportOptions = ReportOptions(), log=None) -> Path:
     """Write the report for `ids` (every problem by default) to `out`; returns index.html."""
     log = log or (lambda text: print(text, file=sys.stderr))
-    base, out = Path(base), Path(out)
+    base, out, store = Path(base), Path(out), Path(store)
     ids = list(ids or all_ids(base))
-    stored, damaged = _stored(ids, Path(store), log)
+    stored, damaged = _stored(ids, store, log)
     (out / "problems").mkdir(parents=True, exist_ok=True)
     _copy_assets(out / "assets")
-    pages = _pages(ids, base, out, stored, options, log)
-    for pid, why in damaged.items():
-        pages[pid].setdefault("page_notes", []).append(f"its stored outcomes are not shown: "
-                                                       f"{why}")
+    pages = cache.load(out)
+    keys = {pid: cache.page_key(pid, base, stored.get(pid), options.page) for pid in ids}
+    todo = [pid for pid in ids if pid in damaged
+            or not cache.still_good(out, pid, keys[pid], pages)]
+    if todo:
+        _build_pages(base, store, out, todo, keys, pages, stored, options, log)
+    else:
+        log(f"all {len(ids)} pages are up to date")
     declared = books(base)
     rows, problems_index = [], []
     for pid in ids:
-        page = pages[pid]
-        bench = _bench_figures(base, out, pid, [s["name"] for s in page.get("systems", [])])
-        for system in page.get("systems", []):
-            system["bench_figure"] = bench.get(system["name"])
-        checks = {c["part"]: c for c in (stored.get(pid) or {}).get("checks", [])}
-        for part in page.get("parts", []):
-            part["check"] = checks.get(part["part"])
-        entry = _index_entry(pid, page, stored.get(pid), declared)
+        entry = _index_entry(pid, (pages.get(pid) or {}).get("index") or {}, stored.get(pid),
+                             declared)
         problems_index.append(entry)
         rows.extend(entry["rows"])
-        _render("problem.html", out / "problems" / f"{pid}.html", page=page,
-                stored=stored.get(pid), entry=entry, version=__version__)
     counts = Counter(r["status"] for r in rows)
     book_list = [{"id": b, "label": (declared[b].label if b in declared else b),
                   "book": declared.get(b)}
                  for b in sorted({e["book"] for e in problems_index})]
     index = out / "index.html"
-    _render("index.html", index, problems=problems_index, rows=rows, books=book_list,
-            statuses=[*STATUSES, NOT_CHECKED], counts=counts, version=__version__,
-            store=str(store), date=datetime.now(UTC).isoformat(timespec="seconds"),
-            errata=[r for r in rows if r["status"] == "erratum"],
-            unsupported=[r for r in rows if r["status"] == "unsupported"])
+    render("index.html", index, problems=problems_index, rows=rows, books=book_list,
+           statuses=[*STATUSES, NOT_CHECKED], counts=counts, version=__version__,
+           store=str(store), date=datetime.now(UTC).isoformat(timespec="seconds"),
+           errata=[r for r in rows if r["status"] == "erratum"],
+           unsupported=[r for r in rows if r["status"] == "unsupported"])
     return index
+
+
+def _build_pages(base, store, out, todo, keys, pages, stored, options: ReportOptions,
+                 log) -> None:
+    from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.app.report.progress import Progress
+
+    order = sorted(todo, key=lambda pid: -_expected(pid, pages, stored))
+    progress = Progress(len(order), log)
+
+    def finished(result: dict) -> None:
+        pid = result["pid"]
+        if result.get("failed"):
+            _write_failed(base, out, pid, stored.get(pid), result["failed"])
+        pages[pid] = {"key": keys[pid] if not result.get("failed") else "",
+                      "index": result.get("index") or {}, "seconds": result["seconds"]}
+        cache.save(out, pages)
+        progress.done(pid, result["seconds"], result.get("failed"))
+
+    batch = Batch(base, BatchOptions(options.jobs, options.page_timeout, options.memory_mb,
+                                     max_tasks=25, run=_Task(out, store, options.page),
+                                     serial=options.serial),
+                  on_done=finished, task=page_task, failed=_page_failed)
+    try:
+        batch.run(order)
+    finally:
+        progress.close()
+
+
+def _expected(pid: str, pages: dict, stored: dict) -> float:
+    """A page's expected time: its last build's, else its check's (the slowest first)."""
+    last = (pages.get(pid) or {}).get("seconds")
+    if isinstance(last, int | float):
+        return float(last)
+    return float(((stored.get(pid) or {}).get("attrs") or {}).get("duration_s") or 1e6)
+
+
+def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
+    """Build one page and write it (in a worker); its entry for the index comes back."""
+    from mechbook.app.quiet import warnings_as_notes
+    from mechbook.app.report.page import build_page
+
+    start = time.monotonic()
+    stored, why = _read_one(pid, task.store)
+    notes: list[str] = []
+    try:
+        with warnings_as_notes(notes):
+            stage("building the page")
+            page = build_page(pid, base, stored, task.page)
+    except MechbookError as exc:  # a problem file that does not load: said on its page
+        return {"pid": pid, "failed": str(exc), "seconds": time.monotonic() - start}
+    except Exception as exc:  # noqa: BLE001 - one page must not end the report
+        describe(exc)  # the traceback to the debug log; the page says it in words
+        return {"pid": pid, "failed": "the engine could not build it (`mechbook check -v "
+                f"{pid}` shows the fault)", "seconds": time.monotonic() - start}
+    if why:
+        page["page_notes"].append(f"its stored outcomes are not shown: {why}")
+    page["page_notes"] += [f"note: {n}" for n in notes]
+    stage("writing the page")
+    declared = books(base)
+    for system in page.get("systems", []):
+        system["bench_figure"] = _bench_figure(base, task.out, pid, system["name"],
+                                               len(page["systems"]))
+    checks = {c["part"]: c for c in (stored or {}).get("checks", [])}
+    for part in page.get("parts", []):
+        part["check"] = checks.get(part["part"])
+    index = {"title": page.get("title", ""),
+             "parts": [{"part": p["part"], "quantity": p.get("quantity", ""),
+                        "origin": p.get("origin", ""), "cite": p.get("cite", "")}
+                       for p in page.get("parts", [])]}
+    entry = _index_entry(pid, index, stored, declared)
+    render("problem.html", task.out / "problems" / f"{pid}.html", page=page, stored=stored,
+           entry=entry, version=__version__)
+    return {"pid": pid, "index": index, "seconds": time.monotonic() - start}
+
+
+def _page_failed(pid: str, why: str, seconds: float, stage: str) -> dict:
+    return {"pid": pid, "failed": why, "seconds": seconds, "index": {}}
+
+
+def _write_failed(base: Path, out: Path, pid: str, stored: dict | None, why: str) -> None:
+    """A page that says it could not be built, and why (in words)."""
+    page = {"id": pid, "title": ((stored or {}).get("attrs") or {}).get("title", ""),
+            "source": "", "description": "", "notes_text": "", "parameters": [],
+            "conditions": [], "systems": [], "parts": [], "crosscheck_figures": {},
+            "page_notes": [f"this page could not be built: {why}"]}
+    entry = _index_entry(pid, {"title": page["title"]}, stored, books(base))
+    render("problem.html", out / "problems" / f"{pid}.html", page=page, stored=stored,
+           entry=entry, version=__version__)
+
+
+def _read_one(pid: str, store: Path) -> tuple[dict | None, str | None]:
+    from mechbook.app.store import StoreError, read
+
+    if not store.exists():
+        return None, None
+    try:
+        return read(pid, store), None
+    except KeyError:
+        return None, None
+    except (StoreError, OSError) as exc:
+        return None, str(exc)
 
 
 def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str, str]]:
@@ -103,55 +215,10 @@ def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str
     return stored, damaged
 
 
-def _pages(ids, base, out, stored, options: ReportOptions, log) -> dict[str, dict]:
-    from mechbook.app.lifeline import die_with
-    from mechbook.app.report.page import build_page
-
-    args = {pid: (pid, base, out / "figures" / pid, stored.get(pid), options.page)
-            for pid in ids}
-    pages: dict[str, dict] = {}
-    if options.serial:
-        for pid in ids:
-            pages[pid] = _guarded(build_page, *args[pid])
-            log(f"page {pid} ({pages[pid].get('seconds', 0):.1f} s)")
-        return pages
-    jobs = options.jobs or (mp.cpu_count() or 1)
-    ctx = mp.get_context("forkserver")
-    ctx.set_forkserver_preload(["mechbook.app.report.page"])
-    pool = ctx.Pool(jobs, maxtasksperchild=10, initializer=die_with, initargs=(os.getpid(),))
-    try:
-        pending = {pid: pool.apply_async(_guarded, (build_page, *args[pid])) for pid in ids}
-        for pid, job in pending.items():
-            try:
-                pages[pid] = job.get(options.page_timeout)
-            except mp.TimeoutError:
-                pages[pid] = _failed(pid, f"the page took longer than "
-                                          f"{options.page_timeout:g} s")
-            log(f"page {pid} ({pages[pid].get('seconds', 0):.1f} s)")
-    finally:
-        pool.terminate()
-        pool.join()
-    return pages
-
-
-def _guarded(fn, pid, *args) -> dict:
-    try:
-        return fn(pid, *args)
-    except Exception as exc:  # noqa: BLE001 - one problem's page must not end the report
-        return _failed(pid, f"{type(exc).__name__}: {exc}")
-
-
-def _failed(pid: str, why: str) -> dict:
-    return {"id": pid, "title": "", "source": "", "description": "", "notes_text": "",
-            "parameters": [], "conditions": [], "systems": [], "parts": [],
-            "crosscheck_figures": {}, "page_notes": [f"this page could not be built: {why}"],
-            "seconds": 0.0}
-
-
-def _index_entry(pid: str, page: dict, stored: dict | None, declared: dict) -> dict:
+def _index_entry(pid: str, index: dict, stored: dict | None, declared: dict) -> dict:
     book = split_id(pid)[0]
     attrs = (stored or {}).get("attrs", {})
-    title = page.get("title") or attrs.get("title", "")
+    title = index.get("title") or attrs.get("title", "")
     crossed: dict[str, list[dict]] = {}
     for x in (stored or {}).get("crosschecks", []):
         for p in x.get("parts") or []:
@@ -167,7 +234,7 @@ def _index_entry(pid: str, page: dict, stored: dict | None, declared: dict) -> d
                      "power": c.get("power", ""),
                      "cross": ", ".join(sorted({x.get("status", "") for x in xs}))})
     if not checks:
-        for part in page.get("parts") or [{"part": "-", "quantity": "", "cite": ""}]:
+        for part in index.get("parts") or [{"part": "-", "quantity": "", "cite": ""}]:
             rows.append({"pid": pid, "book": book, "title": title, "part": part["part"],
                          "quantity": part.get("quantity", ""), "origin": part.get("origin", ""),
                          "status": NOT_CHECKED, "cite": part.get("cite", ""), "method": "",
@@ -178,18 +245,16 @@ def _index_entry(pid: str, page: dict, stored: dict | None, declared: dict) -> d
             "counts": Counter(r["status"] for r in rows)}
 
 
-def _bench_figures(base: Path, out: Path, pid: str, systems: list[str]) -> dict[str, str]:
-    """Work–precision diagrams of `make bench` (results/bench/<id>[_<system>].png)."""
-    found = {}
-    for name in systems:
-        label = pid if len(systems) == 1 else f"{pid}_{name}"
-        src = base / "results" / "bench" / f"{label}.png"
-        if src.exists():
-            dest = out / "figures" / pid / f"work-precision-{name}.png"
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(src, dest)
-            found[name] = dest.name
-    return found
+def _bench_figure(base: Path, out: Path, pid: str, name: str, systems: int) -> str | None:
+    """The work–precision diagram `make bench` drew (results/bench/<id>[_<system>].png)."""
+    label = pid if systems == 1 else f"{pid}_{name}"
+    src = base / "results" / "bench" / f"{label}.png"
+    if not src.exists():
+        return None
+    dest = out / "figures" / pid / f"work-precision-{name}.png"
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(src, dest)
+    return dest.name
 
 
 def _copy_assets(dest: Path) -> None:
@@ -199,15 +264,20 @@ def _copy_assets(dest: Path) -> None:
             (dest / item.name).write_bytes(item.read_bytes())
 
 
-def _environment():
-    import jinja2
+_ENV = None
 
-    env = jinja2.Environment(loader=jinja2.PackageLoader("mechbook.app.report", "templates"),
-                             autoescape=jinja2.select_autoescape(["html"]),
-                             undefined=jinja2.StrictUndefined, trim_blocks=True,
-                             lstrip_blocks=True)
-    env.filters["num"] = _num
-    return env
+
+def _environment():
+    global _ENV
+    if _ENV is None:
+        import jinja2
+
+        _ENV = jinja2.Environment(
+            loader=jinja2.PackageLoader("mechbook.app.report", "templates"),
+            autoescape=jinja2.select_autoescape(["html"]), undefined=jinja2.StrictUndefined,
+            trim_blocks=True, lstrip_blocks=True)
+        _ENV.filters["num"] = _num
+    return _ENV
 
 
 def _num(x) -> str:
@@ -220,10 +290,12 @@ def _num(x) -> str:
     return f"{x:.6g}"
 
 
-def _render(template: str, path: Path, **context) -> None:
-    """Write a page; a string that cannot be UTF-8 (a lone surrogate from an old store) is
-    written as an escape instead of ending the report."""
+def render(template: str, path: Path, **context) -> None:
+    """Write a page atomically; a string that cannot be UTF-8 (a lone surrogate from an
+    old store) is written as an escape instead of ending the report."""
     from mechbook.app.text import unicode_safe
 
     text = _environment().get_template(template).render(**context)
-    path.write_text(unicode_safe(text), encoding="utf-8")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(unicode_safe(text), encoding="utf-8")
+    os.replace(tmp, path)

@@ -1,47 +1,75 @@
 """The book's value and the engine's, side by side, for one answer part of the report.
 
 The book's value is read from the answer key with the part's own names (the safe parser,
-as the checker does) and shown as mathematics. The engine's counterpart is what the engine
-derives for that quantity: the Lagrangian, Lagrange's (or the linearized) equations, the
-normal frequencies, equilibria, the stability condition, the conserved quantities. For
-quantities with no single derived value to show (a motion, a constraint force, a region of
-phase space ...) the page shows how the check compared them instead. Both values are also
-evaluated at the same admissible parameter point where they are lists of numbers.
+as the checker does) and shown as mathematics; what the part's context cannot build (an
+identity for all tensors) is drawn from its syntax (mechbook.app.report.syntax). The
+engine's counterpart is what the check derived and stored for that quantity: the
+Lagrangian, Lagrange's or the linearized equations (M, C, K), the equilibria, the
+stability condition (K positive definite), the conserved momenta and energy; the
+frequencies at the part's point come from the stored linear system's numbers. For
+quantities with no single derived value to show (a motion, a region of phase space ...)
+the page shows how the check compared them instead.
 
 Nothing here decides an outcome: the outcome is the stored check's.
 """
 
 from __future__ import annotations
 
+import html
 import re
 
 import numpy as np
+import scipy.linalg
 import sympy as sp
 
 from mechbook.app.mathml import math
-from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.app.report.derivation import StoredSystem
+from mechbook.app.report.syntax import syntax_math
+from mechbook.errors import MechbookError
 from mechbook.verify.context import Context, numbers, strip_const
 
 _RELATION = re.compile(r"<=|>=|<|>|!=")
 _EQUALS = re.compile(r"(?<![<>=!])=(?!=)")
 
 
-def book_math(ctx: Context, value, sub: tuple = ("book",)) -> str:
-    """The book's value as MathML (text it cannot parse is shown as code)."""
+def book_math(ctx: Context | None, value, sub: tuple = ("book",)) -> str:
+    """The book's value as MathML: built in the part's context, else drawn from its
+    syntax; a list of values one per row, a mapping as its key beside each value."""
     if isinstance(value, list):
-        return "".join(book_math(ctx, v, sub + (i,)) for i, v in enumerate(value))
+        return "".join(f'<div class="item">{book_math(ctx, v, sub + (i,))}</div>'
+                       for i, v in enumerate(value))
     if isinstance(value, dict):
+        shown = _equations(ctx, value, sub)
+        if shown is not None:
+            return shown
         rows = []
         for k, v in value.items():
             rows.append(f'<div class="kv"><span class="key">{_esc(k)}</span>'
-                        f'{book_math(ctx, v, sub + (k,))}</div>')
+                        f'<div class="val">{book_math(ctx, v, sub + (k,))}</div></div>')
         return "".join(rows)
     if isinstance(value, bool):
         return f"<code>{value}</code>"
+    if ctx is not None:
+        try:
+            return math(parse_shown(ctx, value, sub))
+        except (MechbookError, TypeError, ValueError):
+            pass
+    drawn = syntax_math(str(value)) if isinstance(value, str | int | float) else None
+    return drawn or f"<code>{_esc(value)}</code>"
+
+
+def _equations(ctx: Context | None, value: dict, sub: tuple) -> str | None:
+    """A mapping of names to values ({r: r0, alpha: 0}) as the equations r = r₀, α = 0."""
+    if ctx is None or not all(isinstance(k, str) and k.isidentifier() for k in value):
+        return None
+    if not all(isinstance(v, str | int | float) and not isinstance(v, bool)
+               for v in value.values()):
+        return None
     try:
-        return math(parse_shown(ctx, value, sub))
-    except MechbookError:
-        return f"<code>{_esc(value)}</code>"
+        pairs = {sp.Symbol(k): ctx.parse(v, sub + (k,)) for k, v in value.items()}
+    except (MechbookError, TypeError, ValueError):
+        return None
+    return math(pairs)
 
 
 def parse_shown(ctx: Context, value, sub: tuple):
@@ -57,60 +85,100 @@ def parse_shown(ctx: Context, value, sub: tuple):
     return ctx.parse(text, sub)
 
 
-def engine_value(ctx: Context):
-    """The engine's value for the part's quantity, or None where there is no single one."""
+def part_linear(ctx: Context, view: StoredSystem | None, values: dict):
+    """The stored linear system the part refers to (its `about:` point; without one, the
+    only equilibrium the check linearized about), or None."""
+    if view is None:
+        return None
+    data = ctx.part.data
+    steady = "steady" in data
+    if "about" in data:
+        return view.linear_at(ctx.point(), values, steady=steady)
+    plain = [lin for lin in view.linears if lin.steady is None]
+    return plain[0] if len(plain) == 1 and not steady else None
+
+
+def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
+    """The engine's value for the part's quantity from what the check stored, or None
+    where there is no single one (or the check did not store it)."""
     q = ctx.part.quantity
     data = ctx.part.data
     if q == "lagrangian":
         return ctx.system.lagrangian
+    if view is None:
+        return None
     if q == "eom":
         if "about" in data or "steady" in data:
-            return [sp.Eq(e, 0) for e in ctx.linear().equations()]
+            lin = part_linear(ctx, view, values)
+            if lin is None:
+                return None
+            return {sp.Symbol("M"): lin.M, sp.Symbol("C"): lin.C, sp.Symbol("K"): lin.K}
+        M, f = view.get("mass_matrix"), view.get("forcing")
+        if M is None or f is None:
+            return None
         dyn = ctx.dyn
-        lhs = dyn.mass_matrix * sp.Matrix(dyn.qdd)
-        rhs = dyn.forcing
+        lhs = sp.Matrix(M) * sp.Matrix(dyn.qdd)
+        rhs = sp.Matrix(f).reshape(lhs.rows, 1)
         if ctx.system.constraints:
             rhs = rhs + dyn.constraint_jacobian.T * sp.Matrix(dyn.multipliers)
         return [sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True)]
     if q in ("frequencies", "period"):
-        lin = ctx.linear()
-        try:
-            freqs = list(lin.frequencies)
-        except UnsupportedError:
-            return None
-        if q == "period":
-            return [2 * sp.pi / w for w in freqs if not w.is_zero]
-        return freqs
+        lin = part_linear(ctx, view, values)
+        if lin is None or lin.M.rows != 1 or not lin.C.is_zero_matrix:
+            return None  # several modes: their numbers at one point are shown below
+        w = sp.sqrt(lin.K[0, 0] / lin.M[0, 0])
+        return [w] if q == "frequencies" else [2 * sp.pi / w]
     if q == "equilibrium":
-        return ctx.analysis.equilibria(ctx.part.system).symbolic
+        return view.equilibria or None
     if q == "stability_condition":
-        return ctx.linear().stability_condition
+        lin = part_linear(ctx, view, values)
+        if lin is None or lin.C.is_zero_matrix is False:
+            return None
+        K = lin.K
+        if K.rows > 3:
+            return None
+        return sp.And(*[K[:k, :k].det() > 0 for k in range(1, K.rows + 1)])
     if q == "conserved":
-        dyn = ctx.dyn
-        out = {sp.Symbol(f"p_{k}"): v for k, v in dyn.cyclic.items()}
-        if dyn.energy_conserved:
-            out[sp.Symbol("h")] = dyn.energy_function
+        out = {}
+        cyclic = view.get("cyclic")
+        if isinstance(cyclic, dict):
+            out.update({sp.Symbol(f"p_{k}"): v for k, v in cyclic.items()})
+        energy = view.get("energy_function")
+        if energy is not None:
+            out[sp.Symbol("h")] = energy
         return out or None
     return None
 
 
-def numeric_pair(ctx: Context) -> tuple[list[float], list[float]] | None:
+def numeric_pair(ctx: Context, view: StoredSystem | None,
+                 values: dict) -> tuple[list[float], list[float]] | None:
     """(book, engine) values at one admissible parameter point for the quantities that are
-    lists of numbers (frequencies, periods), else None."""
+    lists of numbers (frequencies, periods), else None. The engine's are the stored linear
+    system's frequencies there."""
     q = ctx.part.quantity
     if q not in ("frequencies", "period") or "limit" in ctx.part.data:
+        return None
+    lin = part_linear(ctx, view, values)
+    if lin is None:
         return None
     book = ctx.part.data.get("book")
     items = book if isinstance(book, list) else [book]
     pt = ctx.sampler.default()
     exprs = [ctx.parse(v, ("book", i)) for i, v in enumerate(items)]
-    eng = [float(w) for w in ctx.linear().numeric_frequencies(pt)]
+    M, C, K = lin.matrices(pt)
+    with np.errstate(all="ignore"):
+        if np.any(C):
+            n = M.shape[0]
+            A = np.block([[np.zeros((n, n)), np.eye(n)],
+                          [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+            eng = sorted(np.abs(np.linalg.eigvals(A).imag))[::2]
+        else:
+            w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+            eng = [float(np.sqrt(w)) for w in w2 if w >= 0]
     if q == "period":
         eng = [2 * np.pi / w for w in eng if w > 1e-12]
-    return numbers(exprs, pt), sorted(eng)
+    return numbers(exprs, pt), sorted(float(w) for w in eng)
 
 
 def _esc(text) -> str:
-    import html
-
     return html.escape(str(text))

@@ -1,0 +1,39 @@
+"""`mechbook init DIR`: a tree of one's own to start from, which `mechbook check` passes.
+
+The starter tree (mechbook/app/starter, shipped in the package) holds books.yaml with one
+book, one example problem (a pendulum on a spring, its radius declared positive) with its
+answer key, and a Makefile with the usual targets. Nothing is overwritten: a file that
+exists already is refused, naming it.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from mechbook.errors import MechbookError
+
+FILES = {"books.yaml": "books.yaml", "problem.yaml": "problems/mybook/1.1.yaml",
+         "answers.yaml": "answers/mybook/1.1.yaml", "Makefile": "Makefile"}
+
+
+def init_tree(target: str | Path) -> list[Path]:
+    """Write the starter tree into `target` (created if needed); the files written."""
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise MechbookError(f"{target} exists and is not a directory")
+    clashes = [target / dest for dest in FILES.values() if (target / dest).exists()]
+    if clashes:
+        raise MechbookError(f"{clashes[0]} exists already: `mechbook init` writes nothing "
+                            "over an existing file (choose an empty directory)")
+    written = []
+    source = resources.files("mechbook.app").joinpath("starter")
+    for name, dest in FILES.items():
+        path = target / dest
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(source.joinpath(name).read_bytes())
+        except OSError as exc:
+            raise MechbookError(f"cannot write {path}: {exc.strerror}") from None
+        written.append(path)
+    return written

@@ -1,0 +1,85 @@
+"""Which pages of a report are still good: a content hash per page, kept beside the pages.
+
+A page depends on its problem file and answer key, on the check the store holds for it,
+on books.yaml, on mechbook itself (the engine's hash, as for the check's own cache), on the
+page options, and on the work–precision figures `make bench` left. Their hash is the page's
+key; `.pages.json` in the report's directory maps each page to its key and to what the
+index needs from it (title, parts, systems), and is rewritten (atomically) after every page,
+so an interrupted report keeps the pages it finished and a rerun builds only what changed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import asdict
+from pathlib import Path
+
+from mechbook.app.fingerprint import engine_sha256, file_sha256
+from mechbook.errors import MechbookError
+from mechbook.model.catalog import answer_path, problem_path
+
+MANIFEST = ".pages.json"
+FORMAT = 1
+
+
+def page_key(pid: str, base: Path, stored: dict | None, options) -> str:
+    """The content hash a page is built from (see the module docstring)."""
+    h = hashlib.sha256()
+    parts: list[str] = [f"format {FORMAT}", engine_sha256(), json.dumps(asdict(options),
+                                                                       sort_keys=True)]
+    for path in _inputs(pid, base):
+        try:
+            parts.append(f"{path.name} {file_sha256(path)}" if path.exists() else "-")
+        except (MechbookError, OSError):
+            parts.append("unreadable")
+    attrs = (stored or {}).get("attrs") or {}
+    parts.append(json.dumps({k: str(attrs.get(k, "")) for k in
+                             ("date", "duration_s", "problem_sha256", "answers_sha256",
+                              "engine_sha256")}, sort_keys=True))
+    for fig in sorted((base / "results" / "bench").glob(f"{pid}*.png")):
+        st = fig.stat()
+        parts.append(f"{fig.name} {st.st_size} {st.st_mtime_ns}")
+    for text in parts:
+        h.update(text.encode("utf-8", "surrogatepass"))
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def _inputs(pid: str, base: Path) -> list[Path]:
+    out = [base / "books.yaml"]
+    for where in (problem_path, answer_path):
+        try:
+            out.append(where(pid, base))
+        except MechbookError:
+            continue
+    return out
+
+
+def load(out: Path) -> dict[str, dict]:
+    """{page id: {"key", "index": ...}} of the pages already written (empty if none or
+    unreadable: then every page is built)."""
+    try:
+        data = json.loads((out / MANIFEST).read_text("utf-8"))
+    except (OSError, ValueError):
+        return {}
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        return {}
+    pages = data.get("pages")
+    return pages if isinstance(pages, dict) else {}
+
+
+def save(out: Path, pages: dict[str, dict]) -> None:
+    """Write the manifest atomically (a temporary file renamed over it)."""
+    tmp = out / f"{MANIFEST}.{os.getpid()}.tmp"
+    tmp.write_text(json.dumps({"format": FORMAT, "pages": pages}, ensure_ascii=False),
+                   "utf-8")
+    os.replace(tmp, out / MANIFEST)
+
+
+def still_good(out: Path, pid: str, key: str, pages: dict[str, dict]) -> bool:
+    """Whether the page of `pid` on disk was built from `key`."""
+    entry = pages.get(pid)
+    return (isinstance(entry, dict) and entry.get("key") == key
+            and (out / "problems" / f"{pid}.html").exists())

@@ -1,0 +1,133 @@
+"""The equilibria table of a system's section, from what the check found and linearized.
+
+Rows: the closed-form equilibria the check's SymPy search returned (those that exist at
+the default values: real and inside the coordinates' domains, mechbook.engine.domains)
+and every other point the check linearized about. For a point with a stored linear system
+the row gives, at the default values: stability, each mode's frequency or, for a mode that
+grows, its rate (mechbook.engine.growth), and the mode shapes as a matrix (columns,
+largest entry 1). The frequencies of a one-degree-of-freedom system are also given exactly,
+√(K/M).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+import sympy as sp
+
+from mechbook.app.mathml import math
+from mechbook.app.report.derivation import StoredSystem, same_point
+from mechbook.core.numeval import NotNumeric, evaluate
+from mechbook.engine.domains import existing
+from mechbook.engine.growth import growth_rates
+from mechbook.engine.linear import classify_matrices
+from mechbook.errors import MechbookError
+
+MAX_ROWS = 8
+
+
+def equilibria_rows(page, sys_, view: StoredSystem, values: dict) -> tuple[list, list]:
+    """(rows of the table, why each closed-form solution left out does not exist)."""
+    found = page.step(f"equilibria ({sys_.name})", lambda: view.equilibria) or []
+    points, left_out = existing(found, sys_, values)
+    linears = page.step(f"linear systems ({sys_.name})", lambda: view.linears) or []
+    rows, used = [], set()
+    for point in points:
+        lin = next((i for i, lin in enumerate(linears) if lin.steady is None
+                    and i not in used and same_point(lin.point, point, values)), None)
+        if lin is not None:
+            used.add(lin)
+        rows.append((point, linears[lin] if lin is not None else None))
+    for i, lin in enumerate(linears):
+        if i not in used:
+            rows.append((lin.point, lin))
+    out = []
+    for point, lin in rows[:MAX_ROWS]:
+        out.append(page.step(f"equilibrium {sys_.name} {len(out) + 1}",
+                             lambda point=point, lin=lin: _row(page, sys_, point, lin, values))
+                   or {"point": math(point), "kind": "", "stability": "", "frequencies": "",
+                       "modes": "", "exact": ""})
+    if len(rows) > MAX_ROWS:
+        page.notes.append(f"equilibria ({sys_.name}): {len(rows) - MAX_ROWS} more not shown")
+    return out, left_out
+
+
+def _row(page, sys_, point: dict, lin, values: dict) -> dict:
+    row = {"point": page.show(point), "kind": "equilibrium", "stability": "",
+           "frequencies": "", "modes": "", "exact": "", "values": _numbers(sys_, point,
+                                                                          values)}
+    if lin is None:
+        row["stability"] = "not linearized by the check"
+        return row
+    if lin.steady is not None:
+        row["kind"] = "steady motion"
+    try:
+        M, C, K = lin.matrices(values)
+    except MechbookError:
+        row["stability"] = "in the answer's own symbols: no numbers at the default values"
+        return row
+    with np.errstate(all="ignore"):
+        row["stability"] = classify_matrices(M, C, K)
+        freqs = lin.numeric.get("frequencies")
+        if freqs is None or len(freqs) != M.shape[0]:
+            freqs = _frequencies(M, C, K)
+        rates = growth_rates(M, C, K)
+    row["frequencies"] = _modes_text(freqs, rates)
+    if not np.any(C) and row["stability"] in ("stable", "marginal") and M.shape[0] > 1:
+        row["modes"] = _shapes(M, K)
+    if M.shape[0] == 1 and not np.any(C):
+        exact = page.step("exact frequency", lambda: page.readable(
+            sp.sqrt(lin.K[0, 0] / lin.M[0, 0])))
+        if exact is not None and row["stability"] == "stable":
+            row["exact"] = page.show(sp.Eq(sp.Symbol("omega_1"), exact, evaluate=False),
+                                     simplify=False)
+    return row
+
+
+def _numbers(sys_, point: dict, values: dict) -> list[float] | None:
+    """The point's coordinates as numbers at the default values (None where not)."""
+    out = []
+    for q in sys_.q:
+        v = point.get(q, sp.S.Zero)
+        try:
+            z, _ = evaluate(v, values)
+        except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return None
+        if abs(z.imag) > 1e-9 * max(1.0, abs(z.real)):
+            return None
+        out.append(z.real)
+    return out
+
+
+def _frequencies(M, C, K) -> np.ndarray:
+    n = M.shape[0]
+    if not np.any(C):
+        w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+        return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    lam = np.linalg.eigvals(A)
+    return np.sort(np.abs(lam.imag))[::2][:n]
+
+
+def _modes_text(freqs, rates) -> list[str]:
+    out = []
+    for i, w in enumerate(freqs):
+        rate = float(rates[i]) if i < len(rates) else 0.0
+        if rate > 0:
+            out.append(f"grows like e^({rate:.4g} t)")
+        elif np.isfinite(w):
+            out.append(f"ω = {float(w):.6g}")
+        else:
+            out.append("unstable")
+    return out
+
+
+def _shapes(M, K) -> str:
+    """The mode shapes (columns, largest entry 1) as a matrix."""
+    _, vecs = scipy.linalg.eigh(K, M)
+    shapes = np.real(vecs)
+    big = shapes[np.abs(shapes).argmax(axis=0), range(shapes.shape[1])]
+    shapes = shapes / np.where(big != 0, big, 1.0)
+    return math(sp.Matrix(shapes.shape[0], shapes.shape[1],
+                          [sp.Float(round(x, 4), 4) for x in shapes.flatten()]))
