@@ -75,8 +75,8 @@ class Dynamics:
     @cached_property
     def forcing(self) -> sp.Matrix:
         """f in M·q̈ = f (everything but the accelerations, moved to the right)."""
-        zero = {a: 0 for a in self.qdd}
-        return sp.Matrix([self._simp(-e.subs(zero)) for e in self.residuals])
+        zero = {a: sp.S.Zero for a in self.qdd}
+        return sp.Matrix([self._simp(-e.xreplace(zero)) for e in self.residuals])
 
     @cached_property
     def constraint_jacobian(self) -> sp.Matrix:
