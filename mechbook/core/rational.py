@@ -1,11 +1,12 @@
-"""Rational functions with rational coefficients, evaluated and tested for zero exactly in
-SymEngine.
+"""Rational functions in SymEngine: exact values, the zero test, and SymPy's `cancel`.
 
-A statement "for all tensors" is such a function of a dozen or more symbols. SymPy takes
-a second to substitute a rational point into it and usually runs out of its time limit in
-`cancel`; SymEngine does both in milliseconds with the same exact arithmetic (no rounding
-anywhere), so a point's value and the proof that the function vanishes identically mean
-exactly what they meant before, only sooner.
+A statement "for all tensors" is a rational function of a dozen or more symbols with
+rational coefficients. SymPy takes a second to substitute a rational point into it and
+usually runs out of its time limit in `cancel`; SymEngine does both in milliseconds with
+the same exact arithmetic (no rounding anywhere), so a point's value and the proof that the
+function vanishes identically mean exactly what they meant before, only sooner. Most of
+SymPy's `cancel` is expanding the numerator and denominator: `cancel` here has SymEngine
+expand them and SymPy do the rest, for the same canonical result.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ from collections.abc import Sequence
 
 import symengine as se
 import sympy as sp
+from sympy.core.exprtools import factor_terms
+from sympy.simplify.simplify import signsimp
 
 MAX_PROOF_SIZE = 400_000  # characters of a statement's text: beyond, no expansion is tried
 # (SymEngine's expansion cannot be interrupted, and its cost grows with the terms it makes)
@@ -51,3 +54,30 @@ def vanishes_identically(expr) -> bool | None:
         return None
     numerator, _ = e.as_numer_denom()
     return se.expand(numerator) == 0
+
+
+def to_sympy(e, like: sp.Basic) -> sp.Basic:
+    """A SymEngine result back in SymPy, with the symbols of `like` (SymEngine keeps no
+    assumptions: its `x` comes back as a plain Symbol('x'), another symbol than a real x)."""
+    out = e._sympy_()
+    by_name = {s.name: s for s in like.free_symbols}
+    back = {s: by_name[s.name] for s in out.free_symbols if s.name in by_name}
+    return out.xreplace(back)
+
+
+def cancel(expr: sp.Expr) -> sp.Expr:
+    """`sympy.cancel(expr)`: the same steps and canonical result (common factors of the
+    numerator and denominator polynomials removed), with their expansion in SymEngine."""
+    f = signsimp(expr)
+    if f.is_Number or not isinstance(f, sp.Expr) or not f.is_commutative \
+            or f.has(sp.Piecewise) or len({s.name for s in f.free_symbols}) \
+            != len(f.free_symbols):
+        return sp.cancel(expr)
+    f = factor_terms(f, radical=True)
+    p, q = f.as_numer_denom()
+    try:
+        p, q = (to_sympy(se.expand(se.sympify(x)), x) for x in (p, q))
+    except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's way
+        return sp.cancel(expr)
+    c, P, Q = sp.cancel((p, q), expand=False)
+    return c * (P / Q)
