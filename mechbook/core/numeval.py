@@ -14,6 +14,8 @@ from __future__ import annotations
 import mpmath
 import sympy as sp
 
+from mechbook.core.secalc import derivative
+
 _FUNCS = {
     sp.sin: mpmath.sin, sp.cos: mpmath.cos, sp.tan: mpmath.tan, sp.cot: mpmath.cot,
     sp.sec: mpmath.sec, sp.csc: mpmath.csc, sp.asin: mpmath.asin, sp.acos: mpmath.acos,
@@ -210,23 +212,11 @@ def without_absent(expr: sp.Basic, symbols) -> sp.Basic:
     equations recognisable without simplify. A symbol is kept where dropping it would
     land on a singularity."""
     for s in symbols:
-        if expr.has(s) and is_zero(derivative(expr, s)):
+        if expr.has(s) and is_zero(derivative(expr, s)):  # SymEngine's: core.secalc
             dropped = expr.xreplace({s: sp.S.Zero})
             if not dropped.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
                 expr = dropped
     return expr
-
-
-def derivative(expr: sp.Basic, s: sp.Symbol) -> sp.Basic:
-    """∂expr/∂s, differentiated by SymEngine (SymPy's diff takes 5-30 times longer on the
-    engine's large expressions); by SymPy where SymEngine does not know a function."""
-    import symengine as se
-
-    try:
-        d = se.diff(se.sympify(expr), se.sympify(s))._sympy_()
-    except Exception:  # noqa: BLE001 - any failure: SymPy's own derivative
-        return sp.diff(expr, s)
-    return sp.diff(expr, s) if d.has(sp.Derivative, sp.Subs) else d
 
 
 _RELATIONS = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,

@@ -18,6 +18,8 @@ import sympy as sp
 from sympy.core.exprtools import factor_terms
 from sympy.simplify.simplify import signsimp
 
+from mechbook.core.secalc import to_sympy
+
 MAX_PROOF_SIZE = 400_000  # characters of a statement's text: beyond, no expansion is tried
 # (SymEngine's expansion cannot be interrupted, and its cost grows with the terms it makes)
 
@@ -56,15 +58,6 @@ def vanishes_identically(expr) -> bool | None:
     return se.expand(numerator) == 0
 
 
-def to_sympy(e, like: sp.Basic) -> sp.Basic:
-    """A SymEngine result back in SymPy, with the symbols of `like` (SymEngine keeps no
-    assumptions: its `x` comes back as a plain Symbol('x'), another symbol than a real x)."""
-    out = e._sympy_()
-    by_name = {s.name: s for s in like.free_symbols}
-    back = {s: by_name[s.name] for s in out.free_symbols if s.name in by_name}
-    return out.xreplace(back)
-
-
 def cancel(expr: sp.Expr) -> sp.Expr:
     """`sympy.cancel(expr)`: the same steps and canonical result (common factors of the
     numerator and denominator polynomials removed), with their expansion in SymEngine."""
@@ -76,7 +69,7 @@ def cancel(expr: sp.Expr) -> sp.Expr:
     f = factor_terms(f, radical=True)
     p, q = f.as_numer_denom()
     try:
-        p, q = (to_sympy(se.expand(se.sympify(x)), x) for x in (p, q))
+        p, q = (to_sympy(se.expand(se.sympify(x)), x.free_symbols) for x in (p, q))
     except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's way
         return sp.cancel(expr)
     c, P, Q = sp.cancel((p, q), expand=False)
