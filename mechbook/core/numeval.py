@@ -74,11 +74,13 @@ def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits:
 
 
 def _number(v):
-    """A point's value (a SymPy number or a Python number; never text) as an mpmath number."""
+    """A point's value (a SymPy, mpmath or Python number; never text) as an mpmath number."""
     if isinstance(v, (int, float)) and not isinstance(v, bool):
         return mpmath.mpf(v)
     if isinstance(v, complex):
         return mpmath.mpc(v)
+    if isinstance(v, (mpmath.mpf, mpmath.mpc)):
+        return v
     if not isinstance(v, sp.Basic):
         raise NotNumeric(f"not a number: {type(v).__name__}")
     if isinstance(v, sp.Float):
