@@ -14,8 +14,8 @@ Backends (docs/numerics.md has the measurements that chose the default):
     symengine SymEngine's Lambdify, interpreted ("lambda" backend), with cse
     sympy     SymPy's lambdify(cse=True) printing to `math` (one point) or NumPy (batches)
 A backend that cannot translate an expression hands over to the next. Nothing here parses
-text: the inputs are SymPy objects built by the safe parser or the engine (`as_expr`
-refuses anything else).
+text: the inputs are SymPy objects built by the safe parser or the engine, or SymEngine
+objects the engine built from those (`as_expr` refuses anything else).
 """
 
 from __future__ import annotations
@@ -48,6 +48,18 @@ def as_expr(e) -> sp.Basic:
     raise TypeError(f"not an engine expression: {type(e).__name__}")
 
 
+def _checked(e):
+    """`as_expr`, but a SymEngine expression (the engine's fast algebra) passes as it is."""
+    import symengine as se
+
+    return e if isinstance(e, se.Basic) else as_expr(e)
+
+
+def _sympy(e) -> sp.Basic:
+    """A SymPy object for the SymPy backend (SymEngine's converted)."""
+    return e if isinstance(e, sp.Basic) else e._sympy_()
+
+
 def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
                   backend: str = DEFAULT_BACKEND) -> tuple[Compiled, str]:
     """Compile `exprs` (a flat list) in `args` into f(vector) -> array, with cse.
@@ -56,7 +68,7 @@ def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
     translate an expression hands over to the next in BACKENDS)."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
-    exprs = [as_expr(e) for e in exprs]
+    exprs = [_checked(e) for e in exprs]
     order = list(BACKENDS[BACKENDS.index(backend):])
     last: Exception | None = None
     for name in order:
@@ -70,9 +82,9 @@ def compile_exprs(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
 def _compile_symengine(args, exprs, backend: str) -> Compiled:
     import symengine as se
 
-    # SymPy objects converted to SymEngine ones (as_expr has refused anything but those)
-    se_args = [se.sympify(as_expr(a)) for a in args]
-    se_exprs = [se.sympify(as_expr(e)) for e in exprs]
+    # SymPy objects converted to SymEngine ones (_checked has refused anything but those)
+    se_args = [se.sympify(_checked(a)) for a in args]
+    se_exprs = [se.sympify(e) for e in exprs]
     if not exprs:
         return lambda x: np.zeros(0)
     fn = se.Lambdify(se_args, se_exprs, real=True, cse=True, backend=backend)
@@ -91,6 +103,7 @@ def _compile_symengine(args, exprs, backend: str) -> Compiled:
 def _compile_sympy(args, exprs) -> Compiled:
     if not exprs:
         return lambda x: np.zeros(0)
+    args, exprs = [_sympy(a) for a in args], [_sympy(e) for e in exprs]
     try:
         fn = sp.lambdify(args, exprs, modules="math", cse=True)
         fn(*([0.3] * len(args)))
@@ -141,7 +154,7 @@ def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
     of sample points can be filtered afterwards."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; known: {', '.join(BACKENDS)}")
-    exprs = [as_expr(e) for e in exprs]
+    exprs = [_checked(e) for e in exprs]
     width = len(exprs)
     if not width:
         return lambda X: np.zeros((np.asarray(X).shape[0], 0))
@@ -149,7 +162,8 @@ def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
     for name in BACKENDS[BACKENDS.index(backend):]:
         try:
             if name == "sympy":
-                fn = sp.lambdify(list(args), exprs, modules="numpy", cse=True)
+                fn = sp.lambdify([_sympy(a) for a in args], [_sympy(e) for e in exprs],
+                                 modules="numpy", cse=True)
                 _untranslated(fn, len(args))
 
                 def batch(X, fn=fn):
@@ -161,8 +175,8 @@ def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
             else:
                 import symengine as se
 
-                fn = se.Lambdify([se.sympify(as_expr(a)) for a in args],
-                                 [se.sympify(as_expr(e)) for e in exprs], real=True, cse=True,
+                fn = se.Lambdify([se.sympify(_checked(a)) for a in args],
+                                 [se.sympify(e) for e in exprs], real=True, cse=True,
                                  backend="llvm" if name == "llvm" else "lambda")
                 fn(np.full((2, len(args)), 0.3))  # translation errors now, not mid-run
 

@@ -14,6 +14,8 @@ from __future__ import annotations
 import mpmath
 import sympy as sp
 
+from mechbook.core.secalc import derivative
+
 _FUNCS = {
     sp.sin: mpmath.sin, sp.cos: mpmath.cos, sp.tan: mpmath.tan, sp.cot: mpmath.cot,
     sp.sec: mpmath.sec, sp.csc: mpmath.csc, sp.asin: mpmath.asin, sp.acos: mpmath.acos,
@@ -72,11 +74,13 @@ def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits:
 
 
 def _number(v):
-    """A point's value (a SymPy number or a Python number; never text) as an mpmath number."""
+    """A point's value (a SymPy, mpmath or Python number; never text) as an mpmath number."""
     if isinstance(v, (int, float)) and not isinstance(v, bool):
         return mpmath.mpf(v)
     if isinstance(v, complex):
         return mpmath.mpc(v)
+    if isinstance(v, (mpmath.mpf, mpmath.mpc)):
+        return v
     if not isinstance(v, sp.Basic):
         raise NotNumeric(f"not a number: {type(v).__name__}")
     if isinstance(v, sp.Float):
@@ -210,8 +214,8 @@ def without_absent(expr: sp.Basic, symbols) -> sp.Basic:
     equations recognisable without simplify. A symbol is kept where dropping it would
     land on a singularity."""
     for s in symbols:
-        if expr.has(s) and is_zero(sp.diff(expr, s)):
-            dropped = expr.subs(s, 0)
+        if expr.has(s) and is_zero(derivative(expr, s)):  # SymEngine's: core.secalc
+            dropped = expr.xreplace({s: sp.S.Zero})
             if not dropped.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
                 expr = dropped
     return expr

@@ -51,7 +51,6 @@ RESPONSE_QUANTITIES = ("steady_amplitude",)  # also simulated driven (crosscheck
 EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "state_identity",
                        "solution",
                        "precession_rate", "rotation_matrix")
-LOOSE_BUDGET = 3.0  # seconds for the engine's own closed-form equilibria (no part asks)
 
 # ---- one problem -------------------------------------------------------------------------------
 def _numeric_key(lin, values: dict, params: set) -> tuple:
@@ -159,7 +158,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
     for name in problem.systems:  # the engine's own stable equilibria
         stage(f"cross-check: the engine's own equilibria of {name}")
         try:
-            engine_systems = _engine_linear_systems(analysis, name)
+            engine_systems = _engine_linear_systems(analysis, name, freq)
         except Exception as exc:  # noqa: BLE001 - reported, never hidden
             freq[(name, "engine-error")] = CrossCheck(f"modes:{name}", "frequencies", name,
                                                       "error", detail=_fault(exc))
@@ -227,26 +226,40 @@ def _guarded_frequency(analysis, lin, values, name, models) -> CrossCheck:
         return CrossCheck(name, "frequencies", "", "error", detail=_fault(exc))
 
 
-def _engine_linear_systems(analysis: Analysis, name: str) -> list[tuple]:
-    """Linear systems about the closed-form equilibria the engine derives for `name` (when
-    the system asks for small oscillations), stable at the default values."""
+def _engine_linear_systems(analysis: Analysis, name: str, checked: dict) -> list[tuple]:
+    """Linear systems about the stable equilibria of `name` at the default values (when the
+    system asks for small oscillations) that no check in `checked` (tags as
+    `_numeric_key` makes them) has linearized yet. Found numerically (mechbook.engine.screen):
+    no part asks for a closed form here, and SymPy's search would mostly spend its time
+    limit on transcendental conditions and find nothing."""
+    from mechbook.engine.screen import screen, snap
+
     sys = analysis.system(name)
     compute = sys.spec.get("compute")
     if compute is not None and "small_oscillations" not in compute:
         return []
-    out = []
+    values = analysis.problem.values()
     try:
-        points = analysis.equilibria(name).within(LOOSE_BUDGET)
+        found = screen(analysis.equilibria(name), values)
     except UnsupportedError:
         return []
-    values = analysis.problem.values()
-    for point in points:
+    pv = tuple(sorted((str(k), round(float(v), 12)) for k, v in values.items()))
+    done = [tag[2] for tag in checked if len(tag) == 4 and tag[0] == name and tag[1] == ()
+            and tag[3] == pv and all(isinstance(x, float) for x in tag[2])]
+    out = []
+    for f in found.found:
+        if not (f.isolated and f.stability == "stable"):
+            continue
+        if any(found.same(f.point, d) for d in done):
+            continue
+        point = {q: snap(x) for q, x in zip(sys.q, f.point, strict=True)}
         try:
             lin = analysis.linear(name, point)
             if lin.numeric_stability(values) != "stable" and not _marginal_ok(lin, values):
                 continue
         except (UnsupportedError, TypeError, ValueError):
             continue
+        done.append(tuple(f.point))
         out.append((lin, _point_label(lin)))
     return out
 

@@ -15,15 +15,15 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import evaluate
+from mechbook.engine.screen import screen
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.integrators import integrate
 from mechbook.numerics.model import build_model
-from mechbook.numerics.simulate import initial_state
+from mechbook.numerics.simulate import FALLBACK_OFFSET, initial_state
 
 DRIFT_TOL = 1e-7  # largest relative change allowed along the run (DOP853 at rtol 1e-12)
 T_END = 3.0  # time units; long enough for the state to change, short enough to be cheap
 SAMPLES = 25
-SEARCH_SECONDS = 3.0  # for a stable equilibrium to start near (no part asked for one)
 
 
 def book_integrals(ctx) -> list[sp.Expr]:
@@ -49,6 +49,27 @@ def book_integrals(ctx) -> list[sp.Expr]:
     return []
 
 
+def _start(analysis, sys, params: dict, rng) -> tuple[np.ndarray, np.ndarray]:
+    """The problem's `initial:` state; else rest FALLBACK_OFFSET from the stable equilibrium
+    a root finder sees first at the default values (mechbook.engine.screen: no closed form
+    is needed to start near it); else a generic state."""
+    n = len(sys.q)
+    if sys.spec.get("initial"):
+        try:
+            q0, qd0, _ = initial_state(analysis, sys.name, {}, params)
+            return q0, qd0
+        except MechbookError:
+            return rng.uniform(0.4, 1.2, n), np.zeros(n)
+    try:
+        found = screen(analysis.equilibria(sys.name), params).found
+    except UnsupportedError:
+        found = []
+    stable = [f.point for f in found if f.isolated and f.stability == "stable"]
+    if stable:
+        return stable[0] + FALLBACK_OFFSET, np.zeros(n)
+    return rng.uniform(0.4, 1.2, n), np.zeros(n)
+
+
 def conserved_crosscheck(analysis, ctx, exprs: list[sp.Expr], models: dict):
     """(status, worst relative drift, detail) for the book's integrals along a trajectory."""
     sys = ctx.system
@@ -59,10 +80,7 @@ def conserved_crosscheck(analysis, ctx, exprs: list[sp.Expr], models: dict):
         models[key] = build_model(sys, ctx.dyn, params)
     model = models[key]
     rng = np.random.default_rng(20261123)
-    try:
-        q0, qd0, _ = initial_state(analysis, sys.name, {}, params, search=SEARCH_SECONDS)
-    except MechbookError:  # no `initial:` and no stable equilibrium: a generic state
-        q0, qd0 = rng.uniform(0.4, 1.2, len(sys.q)), np.zeros(len(sys.q))
+    q0, qd0 = _start(analysis, sys, params, rng)
     qd0 = qd0 + rng.uniform(-0.3, 0.3, len(qd0))  # moving, so the integral is exercised
     ts = np.linspace(0.0, T_END, SAMPLES)
     traj = integrate(model, (0.0, T_END), q0, qd0, method="DOP853", t_eval=ts,

@@ -91,7 +91,12 @@ class Analysis:
     def default_point(self, name: str | None = None) -> dict:
         """The equilibrium to expand about when a question names none: the stable one
         (among the closed-form equilibria SymPy finds within DEFAULT_POINT_BUDGET s), or
-        the origin when the system is already linear with no static equilibrium issue."""
+        the origin when the system is already linear with no static equilibrium issue.
+        Numeric first: when a root finder sees one stable equilibrium at the default values
+        and it is the origin, the origin it is, without a closed-form search."""
+        origin = self._stable_origin(name)
+        if origin is not None:
+            return origin
         try:
             stable = self.stable_equilibria(name, self.DEFAULT_POINT_BUDGET)
         except UnsupportedError:
@@ -114,6 +119,27 @@ class Analysis:
                 return origin
         raise UnsupportedError("choosing the equilibrium: the answer must name `about:` "
                                f"({len(distinct)} stable equilibria found)")
+
+
+    def _stable_origin(self, name: str | None) -> dict | None:
+        """The origin, if it is an equilibrium and the only stable one a root finder sees
+        at the default values (every other equilibrium found is unstable); else None."""
+        from mechbook.engine.screen import screen
+
+        sys = self.system(name)
+        eq = self.equilibria(name)
+        try:
+            found = screen(eq, self.problem.values()).found
+            origin = {q: sp.S.Zero for q in sys.q}
+            if not all(is_zero(c.subs(origin)) for c in eq.conditions):
+                return None
+        except UnsupportedError:
+            return None
+        maybe = [f for f in found if f.stability != "unstable"]
+        if len(maybe) == 1 and maybe[0].isolated and maybe[0].stability == "stable" \
+                and max(abs(float(x)) for x in maybe[0].point) < 1e-9:
+            return origin
+        return None
 
 
 def _key(given: dict | None) -> tuple:

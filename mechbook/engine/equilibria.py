@@ -55,10 +55,10 @@ class Equilibria:
         """E_i(q, 0, 0) with small parameters switched off (no constraint forces)."""
         if "_rest" in self.__dict__:
             return self.__dict__["_rest"]
-        zero = {v: 0 for v in self.dyn.qd + self.dyn.qdd}
-        zero.update({s: 0 for s in self.sys.small_params})
+        zero = {v: sp.S.Zero for v in self.dyn.qd + self.dyn.qdd}
+        zero.update({s: sp.S.Zero for s in self.sys.small_params})
         held = getattr(self.sys, "held", {})  # a reduced system's momenta, put back
-        conds = [without_absent(e.subs(zero).xreplace(held), [self.sys.t])
+        conds = [without_absent(e.xreplace(zero).xreplace(held), [self.sys.t])
                  for e in self.dyn.residuals]
         if any(c.has(self.sys.t) for c in conds):
             raise UnsupportedError("static equilibria of a non-autonomous system")
@@ -209,10 +209,10 @@ class Equilibria:
         # A from L at the point (a function of q̇), C and the force from L at rest,
         # B from ∂L/∂q̇ at rest
         held = getattr(self.sys, "held", {})  # Routh's held momenta: symbols until now
-        L_at, L_rest = dyn.L.subs(at), dyn.L.subs(rest)
-        b = [sp.diff(dyn.L, v).subs(rest) for v in dyn.qd]
+        L_at, L_rest = dyn.L.xreplace(at), dyn.L.xreplace(rest)
+        b = [sp.diff(dyn.L, v).xreplace(rest) for v in dyn.qd]
         dq = [sp.diff(L_rest, q) for q in dyn.q]
-        force = [g.subs(at).subs(held) for g in dq]
+        force = [g.xreplace(at).xreplace(held) for g in dq]
         bad = [g for g in force if not _is_zero(g, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
@@ -220,9 +220,10 @@ class Equilibria:
                                       "is left there")
         simp = (lambda x: try_simplify(x, 5)) if dyn.simplify else (lambda x: x)
         dv = [sp.diff(L_at, v) for v in dyn.qd]
-        A = sp.Matrix(n, n, lambda i, j: simp(sp.diff(dv[i], dyn.qd[j]).subs(rest).subs(held)))
-        B = sp.Matrix(n, n, lambda i, j: sp.diff(b[i], dyn.q[j]).subs(at).subs(held))
-        C = sp.Matrix(n, n, lambda i, j: sp.diff(dq[i], dyn.q[j]).subs(at).subs(held))
+        A = sp.Matrix(n, n, lambda i, j: simp(sp.diff(dv[i], dyn.qd[j]).xreplace(rest)
+                                              .xreplace(held)))
+        B = sp.Matrix(n, n, lambda i, j: sp.diff(b[i], dyn.q[j]).xreplace(at).xreplace(held))
+        C = sp.Matrix(n, n, lambda i, j: sp.diff(dq[i], dyn.q[j]).xreplace(at).xreplace(held))
         return LinearSystem(dyn, dict(point), A, (B - B.T).applyfunc(simp),
                             (-C).applyfunc(simp), sp.zeros(n, 1))
 
@@ -286,9 +287,9 @@ class Equilibria:
         lin = []
         zeroth = []
         for e in dyn.residuals:
-            e_sub = e.subs(sub, simultaneous=True)
-            zeroth.append(e_sub.subs(EPS, 0))
-            lin.append(sp.diff(e_sub, EPS).subs(EPS, 0))
+            e_sub = e.xreplace(sub)  # a pure replacement: xreplace, 100x cheaper than subs
+            zeroth.append(e_sub.xreplace({EPS: sp.S.Zero}))
+            lin.append(sp.diff(e_sub, EPS).xreplace({EPS: sp.S.Zero}))
         zeroth = [z.xreplace(holders) for z in zeroth]
         if velocity:  # zeroth order must vanish along the whole uniform motion
             zeroth = [z.subs(t, sp.Rational(7, 5)) for z in zeroth] + \

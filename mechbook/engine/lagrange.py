@@ -13,6 +13,8 @@ from functools import cached_property
 import sympy as sp
 
 from mechbook.core.numeval import is_zero
+from mechbook.core.secalc import Unsupported as SymEngineCannot
+from mechbook.core.secalc import euler_lagrange
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.system import System
@@ -60,7 +62,21 @@ class Dynamics:
 
     @cached_property
     def residuals(self) -> list[sp.Expr]:
-        """E_i without constraint forces (see module docstring)."""
+        """E_i without constraint forces (see module docstring), differentiated and expanded
+        by SymEngine (core.secalc, ten times sooner) where it can, else by SymPy."""
+        chains = list(zip(self.q, self.qd, strict=True)) + list(zip(self.qd, self.qdd,
+                                                                    strict=True))
+        stop = []
+        if not hasattr(self.sys, "base"):  # a System: its free driven coordinates too (a
+            # system reduced by Routh differentiates its own coordinates only)
+            for y, yd, ydd in self.sys.free_driven:
+                chains += [(y, yd), (yd, ydd)]
+                stop.append(ydd)
+        try:
+            return euler_lagrange(self.L, self.q, self.qd, chains, self.sys.t,
+                                  self.sys.forces, stop)
+        except SymEngineCannot:
+            pass
         out = []
         for q, qd, force in zip(self.q, self.qd, self.sys.forces, strict=True):
             e = self.sys.dt(sp.diff(self.L, qd)) - sp.diff(self.L, q) - force
@@ -75,8 +91,8 @@ class Dynamics:
     @cached_property
     def forcing(self) -> sp.Matrix:
         """f in M·q̈ = f (everything but the accelerations, moved to the right)."""
-        zero = {a: 0 for a in self.qdd}
-        return sp.Matrix([self._simp(-e.subs(zero)) for e in self.residuals])
+        zero = {a: sp.S.Zero for a in self.qdd}
+        return sp.Matrix([self._simp(-e.xreplace(zero)) for e in self.residuals])
 
     @cached_property
     def constraint_jacobian(self) -> sp.Matrix:

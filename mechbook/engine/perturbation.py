@@ -22,10 +22,12 @@ text's perturbations are of the potential energy, or of the friction).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import mpmath
 import sympy as sp
 
+from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.linear import LinearSystem, mp_matrix, state_matrix
 from mechbook.errors import UnsupportedError
 
@@ -159,9 +161,13 @@ def exact_damped(s: Split, mode: int) -> tuple:
 def perturbed_equilibrium(V: sp.Expr, q: list, values: dict, start: dict) -> list:
     """The equilibrium of V (at `values`) found by Newton's method from `start`, at DPS
     digits (SymPy evaluates the gradient: the systems are small)."""
+    x = [sp.Float(sp.N(sp.S(start.get(v, 0)).subs(values), DPS), DPS) for v in q]
+    try:
+        return _newton_mp(*_derivatives(V, tuple(q)), q, x, values)
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+        pass  # a function numeval does not know: SymPy evaluates
     grad = [sp.diff(V, x).subs(values) for x in q]
     hess = sp.Matrix(grad).jacobian(q)
-    x = [sp.Float(sp.N(sp.S(start.get(v, 0)).subs(values), DPS), DPS) for v in q]
     for _ in range(60):
         at = dict(zip(q, x, strict=True))
         g = sp.Matrix([sp.N(e.subs(at), DPS) for e in grad])
@@ -173,3 +179,34 @@ def perturbed_equilibrium(V: sp.Expr, q: list, values: dict, start: dict) -> lis
     else:
         raise UnsupportedError("perturbed equilibrium: Newton's method did not converge")
     return [mpmath.mpf(xi._mpf_) for xi in x]
+
+
+@lru_cache(maxsize=32)
+def _derivatives(V: sp.Expr, q: tuple) -> tuple[list, sp.Matrix]:
+    """∇V and its Hessian, symbolic (once per potential: a walk along a parameter evaluates
+    them at many parameter values)."""
+    grad = [sp.diff(V, x) for x in q]
+    return grad, sp.Matrix(grad).jacobian(list(q))
+
+
+def _newton_mp(grad: list, hess: sp.Matrix, q: list, x: list, values: dict) -> list:
+    """`perturbed_equilibrium`'s Newton iteration with the gradient and Hessian evaluated
+    by numeval's one pass over each expression (mpmath at DPS digits) instead of SymPy's
+    subs and evalf: the same steps at the same precision, ten times sooner."""
+    n = len(q)
+    with mpmath.workdps(DPS):
+        xs = [mpmath.mpf(xi._mpf_) for xi in x]
+        tol = mpmath.mpf(10) ** (-DPS + 10)
+        for _ in range(60):
+            at = dict(values)
+            at.update(zip(q, xs, strict=True))
+            g = mpmath.matrix([evaluate_mp(e, at, DPS) for e in grad])
+            H = mpmath.matrix([[evaluate_mp(hess[i, j], at, DPS) for j in range(n)]
+                               for i in range(n)])
+            if any(mpmath.im(v) != 0 for v in list(g) + list(H)):
+                raise ValueError("complex values")
+            step = mpmath.lu_solve(H, g)
+            xs = [xi - si for xi, si in zip(xs, step, strict=True)]
+            if max(abs(si) for si in step) < tol:
+                return xs
+    raise UnsupportedError("perturbed equilibrium: Newton's method did not converge")

@@ -13,6 +13,7 @@ import sympy as sp
 
 from mechbook.core.expansion import trig_canonical
 from mechbook.core.numeval import is_zero
+from mechbook.core.rational import cancel
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.errors import UnsupportedError
 from mechbook.model.system import System
@@ -127,7 +128,7 @@ def _cancel(expr: sp.Expr, seconds: float = 5.0) -> sp.Expr:
     differentiations that follow; given up (expr unchanged) after `seconds`."""
     try:
         with time_limit(seconds):
-            return sp.cancel(expr)
+            return cancel(expr)  # SymPy's cancel, its expansion done by SymEngine
     except (Timeout, sp.PolynomialError):
         return expr
 

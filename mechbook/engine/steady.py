@@ -51,7 +51,7 @@ def steady_residuals(dyn: Dynamics, rates: dict, point: dict) -> list[sp.Expr]:
     sub.update({s: sp.S.Zero for s in sys.small_params})
     out = []
     for e in dyn.residuals:
-        e = e.subs(sub, simultaneous=True)
+        e = e.xreplace(sub)
         out += [e.subs(sys.t, tv) for tv in TIMES] if e.has(sys.t) else [e]
     return out
 

@@ -14,6 +14,7 @@ import scipy.optimize
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
+from mechbook.core.numeval import NotNumeric, evaluate
 from mechbook.engine.equilibria import Equilibria
 from mechbook.engine.linear import LinearSystem, classify_matrices
 
@@ -27,19 +28,28 @@ def classify_at(eq: Equilibria, root: dict, values: dict, rates: dict | None = N
     held = getattr(dyn.sys, "held", {})
     rates = rates or {}
     sub = {v: sp.S(rates.get(q, 0)) for q, v in zip(dyn.q, dyn.qd, strict=True)}
-    sub.update({a: 0 for a in dyn.qdd})
-    sub.update({s: 0 for s in dyn.sys.small_params})
+    sub.update({a: sp.S.Zero for a in dyn.qdd})
+    sub.update({s: sp.S.Zero for s in dyn.sys.small_params})
     key = ("jacobians", tuple(sorted(map(str, rates))))
     cache = eq.__dict__.setdefault("_jacobians", {})
     if key not in cache:
         res = [e.xreplace(held) for e in dyn.residuals]
-        cache[key] = [sp.Matrix([[sp.diff(e, v) for v in vs] for e in res]).subs(sub)
+        cache[key] = [sp.Matrix([[sp.diff(e, v) for v in vs] for e in res]).xreplace(sub)
                       for vs in (dyn.qdd, dyn.qd, dyn.q)]
     at = dict(values)
     at.update({q: sp.Float(x, 30) for q, x in root.items()})
-    M, C, K = (np.array(A.subs(at).evalf(30).tolist(), dtype=complex).real.astype(float)
+    M, C, K = (np.array([[_at(x, at) for x in row] for row in A.tolist()], dtype=float)
                for A in cache[key])
     return classify_matrices(M, C, K)
+
+
+def _at(x: sp.Expr, at: dict) -> float:
+    """A matrix entry at `at` in 30-digit arithmetic (numeval's one pass over the tree;
+    SymPy's evalf where it cannot go), as a float: what `evalf(30)` gives, sooner."""
+    try:
+        return evaluate(x, at, 30)[0].real
+    except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
+        return complex(sp.N(x.subs(at), 30)).real
 
 
 def roots_in(conds: list[sp.Expr], unknowns: list[sp.Symbol], values: dict,

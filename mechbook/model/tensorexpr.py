@@ -15,6 +15,7 @@ import ast
 from collections.abc import Mapping
 
 import sympy as sp
+from sympy.matrices.utilities import dotprodsimp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import MAX_SUBSTITUTED_TENSOR, _Builder, syntax_tree
@@ -124,10 +125,16 @@ class _TensorBuilder(_Builder):
 
 def parse_tensor(text, names: Mapping[str, sp.Basic] | None = None,
                  objects: Mapping[str, object] | None = None):
-    """Parse a scalar, vector or tensor expression (bodies named in `objects`)."""
+    """Parse a scalar, vector or tensor expression (bodies named in `objects`).
+
+    Without SymPy's intermediate simplification of matrix products (`dotprodsimp`, which
+    its matrix powers and 3×3 determinants apply by default: a `cancel` of every entry,
+    seconds for rational functions of a dozen symbols); the values are the same functions,
+    left unsimplified like every other engine result."""
     names = names or {}
     text, tree = syntax_tree(text)
-    return _TensorBuilder(text, names, objects or {}).build(tree)
+    with dotprodsimp(False):
+        return _TensorBuilder(text, names, objects or {}).build(tree)
 
 
 def parse_tensor_equation(text, names: Mapping[str, sp.Basic] | None = None,

@@ -351,8 +351,9 @@ def _vec(ctx: Context, spec, sub: tuple, names: dict) -> sp.Matrix:
                'rotation, improper_rotation, orthogonal) and at random parameter points: '
                'decided on 12 random instances, exactly (rational arithmetic) when the '
                'statement is rational in them, else in 30-digit arithmetic; then proved '
-               'for the generic objects by `cancel` (2 s; `simplify` with `--prove`) '
-               'where SymPy can. The method says which: symbolic, exact(…) or numeric(…)'),
+               'for the generic objects by a polynomial normal form (the numerator '
+               'over a common denominator expanded; `simplify` with `--prove`) where that '
+               'is cheap. The method says which: symbolic, exact(…) or numeric(…)'),
           keys={"for_all": FOR_ALL}, needs_system=False)
 def check_identity(ctx: Context, val) -> Verdict:
     statements = val if isinstance(val, list) else [val]

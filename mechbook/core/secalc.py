@@ -1,0 +1,68 @@
+"""Differentiation and expansion of SymPy expressions done by SymEngine.
+
+SymPy's `diff` and `expand` dominate the derivation of a system's equations (seconds for a
+rigid body's Lagrangian); SymEngine does the same calculus in C++ in milliseconds. The
+results come back as SymPy expressions with the original symbols (SymEngine keeps no
+assumptions: its `x` would come back as another symbol than a real `x`). Where SymEngine
+does not know a function, SymPy does the work, so the answer never depends on which did.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import symengine as se
+import sympy as sp
+
+
+class Unsupported(Exception):
+    """SymEngine cannot do this one (an unknown function, a derivative left unevaluated)."""
+
+
+def to_sympy(e, symbols: Iterable[sp.Symbol]) -> sp.Basic:
+    """A SymEngine result as SymPy, its symbols replaced by those of `symbols` (by name)."""
+    out = e._sympy_()
+    if out.has(sp.Derivative, sp.Subs):
+        raise Unsupported("a derivative left unevaluated")
+    by_name = {s.name: s for s in symbols}
+    back = {s: by_name[s.name] for s in out.free_symbols
+            if s.name in by_name and by_name[s.name] is not s}
+    return out.xreplace(back) if back else out
+
+
+def derivative(expr: sp.Basic, s: sp.Symbol) -> sp.Basic:
+    """∂expr/∂s (SymPy's own where SymEngine cannot)."""
+    try:
+        return to_sympy(se.diff(se.sympify(expr), se.sympify(s)), expr.free_symbols)
+    except Exception:  # noqa: BLE001 - any failure: SymPy's derivative
+        return sp.diff(expr, s)
+
+
+def euler_lagrange(L: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+                   chains: Sequence[tuple[sp.Symbol, sp.Symbol]], t: sp.Symbol,
+                   forces: Sequence[sp.Expr], stop: Sequence[sp.Symbol] = ()) -> list[sp.Expr]:
+    """expand(d/dt(∂L/∂q̇_i) − ∂L/∂q_i − Q_i) for each i, with d/dt = ∂/∂t + Σ ẋ ∂/∂x over
+    `chains` [(x, ẋ), ...]. Raises Unsupported where SymEngine cannot do it all, or where
+    ∂L/∂q̇_i holds a symbol of `stop` (one whose time derivative is not defined)."""
+    names = set(L.free_symbols).union(*(f.free_symbols for f in forces))
+    names |= set(q) | set(qd) | {t} | {s for pair in chains for s in pair}
+    try:
+        Ls = se.sympify(L)
+        ts = se.sympify(t)
+        pairs = [(se.sympify(x), se.sympify(v)) for x, v in chains]
+        stops = {se.sympify(x) for x in stop}
+        out = []
+        for qi, vi, force in zip(q, qd, forces, strict=True):
+            p = Ls.diff(se.sympify(vi))
+            if stops & p.free_symbols:
+                raise Unsupported("a symbol without a time derivative")
+            d = p.diff(ts)
+            for x, v in pairs:
+                d += p.diff(x) * v
+            e = d - Ls.diff(se.sympify(qi)) - se.sympify(force)
+            out.append(to_sympy(se.expand(e), names))
+        return out
+    except Unsupported:
+        raise
+    except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
+        raise Unsupported(str(exc)) from None
