@@ -25,8 +25,8 @@ from pathlib import Path
 
 from mechbook import __version__
 from mechbook.app.report import cache
-from mechbook.errors import MechbookError, describe
 from mechbook.app.report.page import PageOptions
+from mechbook.errors import MechbookError, describe
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
 from mechbook.records import STATUSES
