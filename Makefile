@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test test-min lint fuzz report bench bench-check bench-sweep bench-power clean
+.PHONY: check test test-quick test-min lint fuzz report bench bench-check bench-sweep bench-power clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -19,8 +19,11 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 	-$(BIN)/mechbook check  # a failing part is shown in the report, not an end to it
 	$(BIN)/mechbook report
 
-test: $(STAMP)   ## run the test suite
+test: $(STAMP)   ## run the test suite (~15 min on two cores)
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
+
+test-quick: $(STAMP)  ## the suite without the slow tests (every answer key's 1 % mutants, moved relation boundaries)
+	$(BIN)/python -m pytest -q -n auto -m 'not slow'
 
 # The oldest versions pyproject.toml's ranges allow (.ci/min_versions.py), mechbook itself
 # installed as a wheel (not editable), and a short suite: the lower bounds are tested.
