@@ -458,7 +458,7 @@ def test_constants_textbooks_use_pass():
 def test_simulate_past_its_limits_is_stopped_and_reported(tmp_path, option, value, why):
     h5 = tmp_path / "m.h5"
     start = time.perf_counter()
-    res = run("--root", str(ROOT), "simulate", "lim-2031", "--t-end", "1000",
+    res = run("--root", str(ROOT), "simulate", "lim-2031", "--t-end", "1e6",
               option, value, "--store", str(h5))
     assert time.perf_counter() - start < 60
     assert res.exit_code == 1

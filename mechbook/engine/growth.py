@@ -33,12 +33,13 @@ def growth_rates(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
 
 
 def describe(frequencies, rates) -> str:
-    """'[2.1, unstable: grows like e^(3.4 t)]': each mode's ω, or its growth rate."""
+    """'[2.1, unstable: grows like e^(3.4 t)]': each mode's ω, or its growth rate, to the
+    stored value's full precision (`show` reads results back; it must not round them)."""
     out = []
     for i, w in enumerate(frequencies):
         rate = float(rates[i]) if rates is not None and i < len(rates) else 0.0
         if rate > 0 or not math.isfinite(float(w)):
-            out.append(f"unstable: grows like e^({rate:.6g} t)" if rate > 0 else "unstable")
+            out.append(f"unstable: grows like e^({rate!r} t)" if rate > 0 else "unstable")
         else:
-            out.append(f"{float(w):.6g}")
+            out.append(repr(float(w)))
     return "[" + ", ".join(out) + "]"
