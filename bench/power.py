@@ -331,11 +331,14 @@ def _report(args, after: list[dict], before: list[dict], started: float) -> int:
     if args.out:
         args.out.write_text(text)
     print(text)
-    if args.json and not args.from_json:
-        with open(args.json, "w") as f:
+    if args.json and not args.from_json:  # a new file, then renamed: the first copy stays
+        part = args.json.with_name(args.json.name + ".part")
+        with open(part, "w") as f:
             for r in before + after:
-                r["equivalent"] = equiv.get(_id(r), "")
+                if "label" in r:  # a mutant (a part's own record has no path or label)
+                    r["equivalent"] = equiv.get(_id(r), "")
                 f.write(json.dumps(r, default=str) + "\n")
+        part.replace(args.json)
     if args.docs:
         doc = ROOT / "docs" / "answers.md"
         body = doc.read_text()
