@@ -128,3 +128,97 @@ def test_a_key_that_does_not_apply_to_the_quantity_is_refused(tmp_path):
     with pytest.raises(SpecError, match=r"key\.yaml:7: .*'stable' does not apply to quantity "
                                         r"'frequencies'"):
         load_answers(f)
+
+
+# ---- one quantity, one registration ----------------------------------------------------------
+# registered quantity names that are also ordinary words of crosscheck/ and app/ (what else
+# they name there); they may appear, but never compared with a part's quantity
+HOMONYMS = {
+    "frequencies": "the frequency cross-check's kind, a sweep quantity, a table column",
+    "stability": "a sweep quantity, a table column, a stored array",
+    "conserved": "the first-integral cross-check's kind",
+    "period": "a measured value of the trajectory cross-check",
+    "lagrangian": "a system's `lagrangian:` key",
+    "components": "a torque's `components:` key",
+    "equilibrium": "a row kind of the report's table of equilibria",
+    "motion": "the report's animated motion",
+}
+# where a quantity's name may be spelled: its registration and the checks it registers
+OUTSIDE_REGISTRY = ("crosscheck", "app")
+
+
+def _is_part_quantity(node: ast.AST, names: set[str]) -> bool:
+    """`part.quantity`, `ctx.part.quantity`, an outcome's `.quantity` (not a sweep's
+    `spec.quantity`), or a local name assigned from one."""
+    if isinstance(node, ast.Name):
+        return node.id in names
+    if not (isinstance(node, ast.Attribute) and node.attr == "quantity"):
+        return False
+    base = node.value
+    return getattr(base, "attr", getattr(base, "id", None)) != "spec"
+
+
+def quantity_names_used(source: str, registered: set[str]) -> list[str]:
+    """Registered quantity names a module spells (other than its HOMONYMS), and every string
+    compared with a part's quantity: a choice by quantity that belongs in the registry."""
+    tree = ast.parse(source)
+    aliases = {t.id for node in ast.walk(tree) if isinstance(node, ast.Assign)
+               and _is_part_quantity(node.value, set()) for t in node.targets
+               if isinstance(t, ast.Name)}
+    found = []
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Constant) and isinstance(node.value, str)
+                and node.value in registered and node.value not in HOMONYMS):
+            found.append(f"line {node.lineno}: {node.value!r}")
+        if isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            if any(_is_part_quantity(s, aliases) for s in sides):
+                found += [f"line {node.lineno}: {c.value!r} compared with a part's quantity"
+                          for s in sides for c in ast.walk(s)
+                          if isinstance(c, ast.Constant) and isinstance(c.value, str)]
+    return found
+
+
+def _outside_registry() -> list[str]:
+    return sorted(m for m in modules() if stage(m) in OUTSIDE_REGISTRY)
+
+
+@pytest.mark.parametrize("module", _outside_registry())
+def test_no_quantity_is_named_outside_the_registry(module):
+    from mechbook.verify.registry import quantities
+
+    source = modules()[module].read_text(encoding="utf-8")
+    found = quantity_names_used(source, set(quantities()))
+    assert not found, (f"{module} names quantities: {found}; declare it in the quantity's "
+                       "registration (crosschecks=, display=, sweeps=) and read it from there")
+
+
+def test_the_quantity_name_test_can_fail():
+    from mechbook.verify.registry import quantities
+
+    assert set(HOMONYMS) <= set(quantities()), "a homonym that is no quantity any more"
+    registered = {"eom", "frequencies"}
+    assert quantity_names_used('X = ("eom",)', registered)
+    assert quantity_names_used('if part.quantity == "frequencies": pass', registered)
+    assert quantity_names_used('q = ctx.part.quantity\nok = q in ("x", "y")', registered)
+    assert not quantity_names_used('kind = "frequencies"', registered)
+    assert not quantity_names_used('ok = spec.quantity == "frequencies"', registered)
+    assert not quantity_names_used('ok = self.spec.quantity == "frequencies"', registered)
+
+
+def test_every_declared_use_of_a_quantity_is_known():
+    """Each name a registration declares is a cross-check, display or sweep that exists, and
+    each of those is declared by some quantity."""
+    from mechbook.app.report.values import DISPLAYS
+    from mechbook.app.sweep import QUANTITIES as SWEEPS
+    from mechbook.crosscheck.vouch import CROSSCHECKS
+    from mechbook.verify.registry import quantities
+
+    table = quantities().values()
+    for q in table:
+        assert set(q.crosschecks) <= set(CROSSCHECKS), (q.name, q.crosschecks)
+        assert q.display is None or q.display in DISPLAYS, (q.name, q.display)
+        assert set(q.sweeps) <= set(SWEEPS), (q.name, q.sweeps)
+    assert {c for q in table for c in q.crosschecks} == set(CROSSCHECKS)
+    assert {q.display for q in table} - {None} == set(DISPLAYS)
+    assert {s for q in table for s in q.sweeps} == set(SWEEPS) - {"drift"}  # drift: no key

@@ -56,6 +56,13 @@ class Quantity:
     # "shift" (a constant added), "scale" (a factor), "function" (a conserved quantity's
     # function), "direction" (a mode shape's length); stated in docs/answers.md
     equivalent: tuple | Callable = ()
+    # how other stages use the quantity, as plain names they map to their own code (verify
+    # imports neither): the independent checks that vouch for it (mechbook.crosscheck's
+    # CROSSCHECKS), how the report shows the engine's value (mechbook.app.report.values'
+    # DISPLAYS), the `mechbook sweep --quantity` whose grid its book value is drawn on
+    crosschecks: tuple[str, ...] = ()
+    display: str | None = None
+    sweeps: tuple[str, ...] = ()
 
 
 QUANTITIES: dict[str, Quantity] = {}
@@ -63,20 +70,25 @@ QUANTITIES: dict[str, Quantity] = {}
 
 def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
              names: Callable | None = None, literals: tuple = (), needs_system: bool = True,
-             complex_values: bool = False, equivalent: tuple | Callable = ()):
+             complex_values: bool = False, equivalent: tuple | Callable = (),
+             crosschecks: tuple[str, ...] = (), display: str | None = None,
+             sweeps: tuple[str, ...] = ()) -> Callable[[Callable], Callable]:
     """Register the decorated function as the check of quantity `name` (`names`: a function
     of the part's context giving the names its book value may use beyond the usual ones,
     e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`: words
     the book value may be instead, e.g. "stable"; `needs_system`: False for quantities of
     declared tensors and bodies, which a problem without a system can have;
     `complex_values`: its values are complex on purpose, so its expressions may hold
-    constants such as sqrt(-1), which are refused elsewhere)."""
+    constants such as sqrt(-1), which are refused elsewhere; `crosschecks`, `display`,
+    `sweeps`: names of the cross-checks that vouch for it, of how the report shows the
+    engine's value, of the sweeps that draw its book value — see `Quantity`)."""
     def register(fn):
         if name in QUANTITIES and QUANTITIES[name].check is not fn:
             raise ValueError(f"quantity {name!r} registered twice")
         QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names,
                                     tuple(literals), needs_system, complex_values,
-                                    equivalent if callable(equivalent) else tuple(equivalent))
+                                    equivalent if callable(equivalent) else tuple(equivalent),
+                                    tuple(crosschecks), display, tuple(sweeps))
         return fn
 
     return register
