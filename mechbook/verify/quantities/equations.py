@@ -7,7 +7,7 @@ import sympy as sp
 
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, linear_accelerations, split_named
-from mechbook.verify.registry import quantity
+from mechbook.verify.registration import quantity
 
 
 @quantity('lagrangian',

@@ -7,7 +7,7 @@ from mechbook.errors import MechbookError
 from mechbook.verify import boundary
 from mechbook.verify.compare import Verdict, all_vanish, combine, vanishes
 from mechbook.verify.context import Context
-from mechbook.verify.registry import quantity
+from mechbook.verify.registration import quantity
 
 
 def _engine_points(ctx: Context) -> list[dict]:

@@ -9,7 +9,7 @@ import sympy as sp
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registry import POINT, quantity
+from mechbook.verify.registration import POINT, quantity
 
 OF = ["potential", "kinetic", "quadratic_potential", "quadratic_kinetic", "energy_function",
       "hamiltonian", "momenta"]

@@ -13,7 +13,7 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.verify.compare import Verdict, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registry import EXPR, LIMIT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, quantity
 
 
 def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:

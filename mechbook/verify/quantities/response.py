@@ -17,7 +17,7 @@ from mechbook.engine import response
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
 from mechbook.verify.context import Context
-from mechbook.verify.registry import EXPR, quantity
+from mechbook.verify.registration import EXPR, quantity
 
 POINTS = 5
 RTOL = 1e-8  # eigenvalue problems: relative to the largest exponent

@@ -14,7 +14,7 @@ from mechbook.verify.compare import Verdict, value
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.quantities.steady import coordinate_map
-from mechbook.verify.registry import EXPR, POINT, REGION, quantity
+from mechbook.verify.registration import EXPR, POINT, REGION, quantity
 
 
 @quantity('stability',

@@ -22,7 +22,7 @@ from mechbook.verify import boundary
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
-from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
+from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}
 ROOT_RTOL = 1e-9

@@ -26,7 +26,7 @@ from mechbook.numerics.model import build_model
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
-from mechbook.verify.registry import ESTIMATE, EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, quantity
 
 LEVEL_RTOL = 1e-10
 LEVEL_POINTS = 6
