@@ -14,12 +14,12 @@ from pathlib import Path
 
 import click
 
-from mechbook import __version__
 from mechbook.app import options as opt
 from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, answer_path, problem_path, root
+from mechbook.version import __version__
 
 DEFAULT_PATH = DEFAULT_STORE
 SHELLS = ("bash", "zsh", "fish")
