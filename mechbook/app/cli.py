@@ -584,8 +584,8 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
               help="Resident memory (MB) allowed per cluster worker's block, and for the "
                    "sweep's arrays here (a grid whose arrays would need more is refused "
                    "before anything is computed; 0: no bound).")
-@click.option("--samples", type=click.IntRange(min=0, max=opt.MAX_SAMPLES), default=24,
-              show_default=True,
+@click.option("--samples", type=click.IntRange(min=0, max=opt.MAX_SAMPLES),
+              default=opt.SWEEP_SAMPLES, show_default=True,
               help="Points where the float64 result is checked against 30 digits.")
 @click.option("--name", default=None, help="Name of the stored sweep (default QUANTITY-AXES).")
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),
