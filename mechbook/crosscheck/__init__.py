@@ -1,6 +1,7 @@
 """Independent cross-checks of the engine, run beside the answer key's checks.
 
-None of them looks at the book's answers:
+None of them looks at the book's answers. Which of them vouch for a part is declared by its
+quantity's registration (`crosschecks=`, names in vouch.py):
     frequencies  normal frequencies measured from a simulation of the nonlinear equations
     newton       the engine's equations against Newton's and Euler's laws, with kinematics
                  computed here independently (kinematics.py)

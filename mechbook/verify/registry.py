@@ -1,7 +1,8 @@
 """Every answer quantity, registered in one place: name → check, schema fragment, doc line.
 
 A quantity is one function `check(ctx, value) -> Verdict` in a module of
-mechbook.verify.quantities, registered with `@quantity(name, book=..., how=..., keys=...)`:
+mechbook.verify.quantities, registered with `@quantity(name, book=..., how=..., keys=...)`
+(mechbook.verify.registration; this module imports every quantity module, so it sits above them):
 `book` says what the part's `book:` value holds, `how` how it is checked (both become the
 row of the table in docs/answers.md, which a test keeps equal to this registry), and `keys`
 maps the part keys this quantity reads, beyond the common ones, to their JSON-Schema
