@@ -8,7 +8,8 @@
 (and the command line's --help) does not load SymPy, NumPy or the engine.
 """
 
-__version__ = "0.1.0"
+from mechbook.version import __version__
+
 __all__ = ["Problem", "load", "results", "__version__"]
 
 _LAZY = {"load": "mechbook.app.api", "Problem": "mechbook.app.api",

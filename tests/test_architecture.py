@@ -1,5 +1,6 @@
-"""The layout: which stage may import which, no import cycles, the cross-checks independent of
-the engine's kinematics, and the docs' table of quantities equal to the registry."""
+"""The layout: which stage may import which, no import cycles (not even through imports inside
+functions), the cross-checks independent of the engine's kinematics, the docs' table of
+quantities equal to the registry, and no quantity named outside its registration."""
 
 from __future__ import annotations
 
@@ -12,10 +13,11 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "mechbook"
 
 # stage -> the stages it may import (itself always allowed); see each package's __init__
-BASE = {"errors", "records"}
+BASE = {"errors", "records", "version"}
 ALLOWED = {
     "errors": set(),
     "records": set(),
+    "version": set(),
     "core": BASE,
     "model": BASE | {"core"},
     "engine": BASE | {"core", "model"},
@@ -23,7 +25,7 @@ ALLOWED = {
     "verify": BASE | {"core", "model", "engine", "numerics"},
     "crosscheck": BASE | {"core", "model", "engine", "numerics", "verify"},
     "app": BASE | {"core", "model", "engine", "numerics", "verify", "crosscheck", "app"},
-    "__init__": {"app"},  # lazily (PEP 562): mechbook.load, mechbook.results
+    "__init__": {"app", "version"},  # app lazily (PEP 562): mechbook.load, mechbook.results
     "__main__": {"app"},
 }
 # modules a stage must not import even though the stage itself is allowed
@@ -44,10 +46,23 @@ def stage(module: str) -> str:
     return parts[1] if len(parts) > 1 else "__init__"
 
 
-def imports(path: Path, top_level_only: bool = False) -> set[str]:
-    """The mechbook modules a file imports (all of them, or only those at module level)."""
+def _type_checking_only(tree: ast.Module) -> set[ast.AST]:
+    """The imports under `if TYPE_CHECKING:` (read by type checkers, never run)."""
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and getattr(node.test, "id", None) == "TYPE_CHECKING":
+            out |= {n for stmt in node.body for n in ast.walk(stmt)}
+    return out
+
+
+def imports(path: Path, top_level_only: bool = False, runtime_only: bool = False) -> set[str]:
+    """The mechbook modules a file imports (all of them, or only those at module level;
+    `runtime_only`: without those under `if TYPE_CHECKING:`)."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
     nodes = tree.body if top_level_only else list(ast.walk(tree))
+    if runtime_only:
+        skip = _type_checking_only(tree)
+        nodes = [n for n in nodes if n not in skip]
     out = set()
     for node in nodes:
         if isinstance(node, ast.ImportFrom):
@@ -73,26 +88,57 @@ def test_each_module_imports_only_what_its_stage_may(module):
     assert not forbidden, f"{module} must not import {forbidden}"
 
 
-def test_no_import_cycles_at_module_level():
-    graph = {m: imports(p, top_level_only=True) - {m} for m, p in modules().items()}
-    state: dict[str, int] = {}
+# import cycles the test tolerates, each with why it is left (none: every cycle is broken)
+KNOWN_CYCLES: list[set[str]] = []
+
+
+def import_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected groups of more than one module (Tarjan), each sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
     stack: list[str] = []
+    on_stack: set[str] = set()
+    out = []
 
     def visit(m: str) -> None:
-        state[m] = 1
+        index[m] = low[m] = len(index)
         stack.append(m)
+        on_stack.add(m)
         for n in sorted(graph.get(m, ())):
-            if state.get(n) == 1:
-                cycle = stack[stack.index(n):] + [n]
-                pytest.fail("import cycle: " + " -> ".join(cycle))
-            if n not in state:
+            if n not in index:
                 visit(n)
-        stack.pop()
-        state[m] = 2
+                low[m] = min(low[m], low[n])
+            elif n in on_stack:
+                low[m] = min(low[m], index[n])
+        if low[m] == index[m]:
+            group = []
+            while True:
+                n = stack.pop()
+                on_stack.discard(n)
+                group.append(n)
+                if n == m:
+                    break
+            if len(group) > 1:
+                out.append(sorted(group))
 
     for m in sorted(graph):
-        if m not in state:
+        if m not in index:
             visit(m)
+    return out
+
+
+def test_no_import_cycles_even_inside_functions():
+    """Every import counts, at module level or inside a function (an import deferred into a
+    function only hides a cycle); those under `if TYPE_CHECKING:` never run."""
+    graph = {m: imports(p, runtime_only=True) - {m} for m, p in modules().items()}
+    cycles = [c for c in import_cycles(graph) if set(c) not in KNOWN_CYCLES]
+    shown = ["; ".join(f"{m} -> {sorted(graph[m] & set(c))}" for m in c) for c in cycles]
+    assert not cycles, "import cycles:\n" + "\n".join(shown)
+
+
+def test_the_cycle_test_can_fail():
+    assert import_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert import_cycles({"a": {"b"}, "b": set()}) == []
 
 
 def test_every_package_says_what_it_owns_and_may_import():
@@ -128,3 +174,97 @@ def test_a_key_that_does_not_apply_to_the_quantity_is_refused(tmp_path):
     with pytest.raises(SpecError, match=r"key\.yaml:7: .*'stable' does not apply to quantity "
                                         r"'frequencies'"):
         load_answers(f)
+
+
+# ---- one quantity, one registration ----------------------------------------------------------
+# registered quantity names that are also ordinary words of crosscheck/ and app/ (what else
+# they name there); they may appear, but never compared with a part's quantity
+HOMONYMS = {
+    "frequencies": "the frequency cross-check's kind, a sweep quantity, a table column",
+    "stability": "a sweep quantity, a table column, a stored array",
+    "conserved": "the first-integral cross-check's kind",
+    "period": "a measured value of the trajectory cross-check",
+    "lagrangian": "a system's `lagrangian:` key",
+    "components": "a torque's `components:` key",
+    "equilibrium": "a row kind of the report's table of equilibria",
+    "motion": "the report's animated motion",
+}
+# where a quantity's name may be spelled: its registration and the checks it registers
+OUTSIDE_REGISTRY = ("crosscheck", "app")
+
+
+def _is_part_quantity(node: ast.AST, names: set[str]) -> bool:
+    """`part.quantity`, `ctx.part.quantity`, an outcome's `.quantity` (not a sweep's
+    `spec.quantity`), or a local name assigned from one."""
+    if isinstance(node, ast.Name):
+        return node.id in names
+    if not (isinstance(node, ast.Attribute) and node.attr == "quantity"):
+        return False
+    base = node.value
+    return getattr(base, "attr", getattr(base, "id", None)) != "spec"
+
+
+def quantity_names_used(source: str, registered: set[str]) -> list[str]:
+    """Registered quantity names a module spells (other than its HOMONYMS), and every string
+    compared with a part's quantity: a choice by quantity that belongs in the registry."""
+    tree = ast.parse(source)
+    aliases = {t.id for node in ast.walk(tree) if isinstance(node, ast.Assign)
+               and _is_part_quantity(node.value, set()) for t in node.targets
+               if isinstance(t, ast.Name)}
+    found = []
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Constant) and isinstance(node.value, str)
+                and node.value in registered and node.value not in HOMONYMS):
+            found.append(f"line {node.lineno}: {node.value!r}")
+        if isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            if any(_is_part_quantity(s, aliases) for s in sides):
+                found += [f"line {node.lineno}: {c.value!r} compared with a part's quantity"
+                          for s in sides for c in ast.walk(s)
+                          if isinstance(c, ast.Constant) and isinstance(c.value, str)]
+    return found
+
+
+def _outside_registry() -> list[str]:
+    return sorted(m for m in modules() if stage(m) in OUTSIDE_REGISTRY)
+
+
+@pytest.mark.parametrize("module", _outside_registry())
+def test_no_quantity_is_named_outside_the_registry(module):
+    from mechbook.verify.registry import quantities
+
+    source = modules()[module].read_text(encoding="utf-8")
+    found = quantity_names_used(source, set(quantities()))
+    assert not found, (f"{module} names quantities: {found}; declare it in the quantity's "
+                       "registration (crosschecks=, display=, sweeps=) and read it from there")
+
+
+def test_the_quantity_name_test_can_fail():
+    from mechbook.verify.registry import quantities
+
+    assert set(HOMONYMS) <= set(quantities()), "a homonym that is no quantity any more"
+    registered = {"eom", "frequencies"}
+    assert quantity_names_used('X = ("eom",)', registered)
+    assert quantity_names_used('if part.quantity == "frequencies": pass', registered)
+    assert quantity_names_used('q = ctx.part.quantity\nok = q in ("x", "y")', registered)
+    assert not quantity_names_used('kind = "frequencies"', registered)
+    assert not quantity_names_used('ok = spec.quantity == "frequencies"', registered)
+    assert not quantity_names_used('ok = self.spec.quantity == "frequencies"', registered)
+
+
+def test_every_declared_use_of_a_quantity_is_known():
+    """Each name a registration declares is a cross-check, display or sweep that exists, and
+    each of those is declared by some quantity."""
+    from mechbook.app.report.values import DISPLAYS
+    from mechbook.app.sweep import QUANTITIES as SWEEPS
+    from mechbook.crosscheck.vouch import CROSSCHECKS
+    from mechbook.verify.registry import quantities
+
+    table = quantities().values()
+    for q in table:
+        assert set(q.crosschecks) <= set(CROSSCHECKS), (q.name, q.crosschecks)
+        assert q.display is None or q.display in DISPLAYS, (q.name, q.display)
+        assert set(q.sweeps) <= set(SWEEPS), (q.name, q.sweeps)
+    assert {c for q in table for c in q.crosschecks} == set(CROSSCHECKS)
+    assert {q.display for q in table} - {None} == set(DISPLAYS)
+    assert {s for q in table for s in q.sweeps} == set(SWEEPS) - {"drift"}  # drift: no key

@@ -14,12 +14,12 @@ from pathlib import Path
 
 import click
 
-from mechbook import __version__
 from mechbook.app import options as opt
 from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, answer_path, problem_path, root
+from mechbook.version import __version__
 
 DEFAULT_PATH = DEFAULT_STORE
 SHELLS = ("bash", "zsh", "fish")
@@ -584,8 +584,8 @@ def simulate(ctx: click.Context, problem_id: str, system: str | None, method: st
               help="Resident memory (MB) allowed per cluster worker's block, and for the "
                    "sweep's arrays here (a grid whose arrays would need more is refused "
                    "before anything is computed; 0: no bound).")
-@click.option("--samples", type=click.IntRange(min=0, max=opt.MAX_SAMPLES), default=24,
-              show_default=True,
+@click.option("--samples", type=click.IntRange(min=0, max=opt.MAX_SAMPLES),
+              default=opt.SWEEP_SAMPLES, show_default=True,
               help="Points where the float64 result is checked against 30 digits.")
 @click.option("--name", default=None, help="Name of the stored sweep (default QUANTITY-AXES).")
 @click.option("--store", "store_path", type=click.Path(dir_okay=False, path_type=Path),

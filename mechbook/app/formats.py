@@ -18,9 +18,9 @@ from collections import Counter
 from importlib import resources
 from pathlib import Path
 
-from mechbook import __version__
 from mechbook.app.text import for_xml
 from mechbook.records import STATUSES
+from mechbook.version import __version__
 
 CROSS_STATUSES = ("pass", "fail", "n.a.", "error")
 

@@ -19,6 +19,7 @@ MAX_STEP_SECONDS = 3600.0  # one derivation step, one proof attempt
 MAX_JOBS = 1024
 MAX_POINTS = 1_000_000  # samples of one simulation
 MAX_SAMPLES = 10_000  # accuracy samples of a sweep
+SWEEP_SAMPLES = 24  # points of a sweep's 30-digit accuracy check, by default
 MAX_TIME = 1e9  # simulated time, step sizes
 
 

@@ -54,13 +54,13 @@ from typing import TYPE_CHECKING
 import h5py
 import numpy as np
 
-from mechbook import __version__
 from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
 from mechbook.app.text import storable
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE
 from mechbook.records import CrossCheck, Outcome, Results
+from mechbook.version import __version__
 
 if TYPE_CHECKING:
     from mechbook.model.problem import Problem

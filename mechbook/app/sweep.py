@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from mechbook.app.options import SWEEP_SAMPLES
 from mechbook.core.compile import DEFAULT_BACKEND
 from mechbook.engine.sweep import UNDEFINED, Axis, Grid
 from mechbook.errors import MechbookError
@@ -41,7 +42,6 @@ QUANTITIES = ("frequencies", "stability", "drift")
 AMPLITUDE = "amplitude"
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
 DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
-SAMPLES = 24  # points of the 30-digit accuracy check
 MAX_POINTS = 10_000_000  # points of one grid: its arrays are held in this process
 BYTES_PER_VALUE = 8 * 3  # float64, the blocks and their concatenation, the book's overlay
 
@@ -296,7 +296,7 @@ class SweepResult:
 
 
 def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None = None,
-              timeout: float = 600.0, memory_mb: float = 8000.0, samples: int = SAMPLES,
+              timeout: float = 600.0, memory_mb: float = 8000.0, samples: int = SWEEP_SAMPLES,
               progress: Callable[[int, int], None] | None = None) -> SweepResult:
     """Build the sweep here (for the accuracy check and the book), evaluate every block
     where asked, and assemble the result in grid order."""

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechbook.app.sweep import SAMPLES
+from mechbook.app.options import SWEEP_SAMPLES
 from mechbook.engine.sweep import UNDEFINED
 
 
-def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SAMPLES,
+def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SWEEP_SAMPLES,
                     seed: int = 0) -> dict:
     """The float64 results at sampled points against the 30-digit path (the matrices
     substituted symbolically, the eigenproblem in mpmath)."""

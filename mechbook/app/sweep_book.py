@@ -17,6 +17,7 @@ import sympy as sp
 from mechbook.core.compile import compile_batch
 from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED, relations, truth
 from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.verify.registry import quantities
 
 
 def book_overlay(sweeper, result) -> dict:
@@ -28,9 +29,10 @@ def book_overlay(sweeper, result) -> dict:
         return out
     from mechbook.verify.context import Context
 
-    want = "stability_condition" if sweeper.spec.quantity == "stability" else "frequencies"
+    table = quantities()
     for part in key.parts:
-        if part.quantity != want or "limit" in part.data:
+        entry = table.get(part.quantity)  # the registration names the sweeps that draw it
+        if entry is None or sweeper.spec.quantity not in entry.sweeps or "limit" in part.data:
             continue
         if sweeper.spec.part is not None and part.name != sweeper.spec.part:
             continue
@@ -40,7 +42,7 @@ def book_overlay(sweeper, result) -> dict:
                 continue
             if sweeper.spec.part is None and not _same_point(ctx, sweeper):
                 continue
-            if want == "stability_condition":
+            if sweeper.spec.quantity == "stability":
                 _stability(out, ctx, part, sweeper, result)
             else:
                 _frequencies(out, ctx, part, sweeper, result)

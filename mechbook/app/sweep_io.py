@@ -21,7 +21,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mechbook import __version__
+from mechbook.version import __version__
 
 STORE_POINTS = 250_000
 

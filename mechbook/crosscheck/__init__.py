@@ -1,6 +1,7 @@
 """Independent cross-checks of the engine, run beside the answer key's checks.
 
-None of them looks at the book's answers:
+None of them looks at the book's answers. Which of them vouch for a part is declared by its
+quantity's registration (`crosschecks=`, names in vouch.py):
     frequencies  normal frequencies measured from a simulation of the nonlinear equations
     newton       the engine's equations against Newton's and Euler's laws, with kinematics
                  computed here independently (kinematics.py)
@@ -29,28 +30,15 @@ import sympy as sp
 
 from mechbook.crosscheck.frequencies import frequency_crosscheck
 from mechbook.crosscheck.inertia import inertia_crosschecks
-from mechbook.crosscheck.motion import (
-    STEADY_QUANTITIES,
-    TRAJECTORY_QUANTITIES,
-    steady_crosscheck,
-    trajectory_crosscheck,
-)
+from mechbook.crosscheck.motion import steady_crosscheck, trajectory_crosscheck
 from mechbook.crosscheck.newton import newton_crosscheck
+from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError, describe
 from mechbook.records import CrossCheck
 from mechbook.verify.answers import AnswerKey
 from mechbook.verify.context import Context  # how a part names its point
 
-FREQUENCY_QUANTITIES = ("frequencies", "period", "normal_modes", "normal_coordinates",
-                        "mode_node", "normal_transformation", "complex_modes", "exponents",
-                        "decay_rates", "characteristic_polynomial", "matrices", "stability",
-                        "stability_condition", "resonances", "steady_amplitude",
-                        "secular_growth")
-RESPONSE_QUANTITIES = ("steady_amplitude",)  # also simulated driven (crosscheck.response)
-EQUATION_QUANTITIES = ("lagrangian", "eom", "conserved", "constraint_force", "state_identity",
-                       "solution",
-                       "precession_rate", "rotation_matrix")
 
 # ---- one problem -------------------------------------------------------------------------------
 def _numeric_key(lin, values: dict, params: set) -> tuple:
@@ -101,14 +89,15 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
         if "unsupported" in part.data:
             continue
         sname = part.system or only
-        if part.quantity in EQUATION_QUANTITIES and sname in newton:
+        vouch = crosschecks_of(part.quantity)  # the names its registration declares
+        if "newton" in vouch and sname in newton:
             newton[sname].parts.append(part.name)
-        if part.quantity in ("conserved", "expression"):
+        if "first_integrals" in vouch or "energy_integral" in vouch:
             stage(f"cross-check conserved:{part.name}")
             x = _guarded_conserved(analysis, part, models)
             if x is not None:
                 out.append(x)
-        if part.quantity in STEADY_QUANTITIES:
+        if "steady" in vouch:
             tag = (sname, "steady", repr(part.data.get("about")), part.data.get("unknown"),
                    repr(part.data.get("hold")), repr(part.data.get("assume")),
                    repr(part.data.get("estimate")))
@@ -118,7 +107,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                 stage(f"cross-check steady:{part.name}")
                 measured[tag] = steady_crosscheck(analysis, part)
                 out.append(measured[tag])
-        if part.quantity in TRAJECTORY_QUANTITIES:
+        if "trajectory" in vouch:
             tag = (sname, part.quantity, repr(part.data.get("initial")),
                    part.data.get("coordinate"), part.data.get("rate"))
             if tag in measured:
@@ -127,7 +116,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                 stage(f"cross-check measured:{part.name}")
                 measured[tag] = trajectory_crosscheck(analysis, part)
                 out.append(measured[tag])
-        if part.quantity not in FREQUENCY_QUANTITIES:
+        if "modes" not in vouch:
             continue
         try:
             ctx = Context(analysis, part)
@@ -145,7 +134,7 @@ def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
                                    detail=_fault(exc))
             freq[tag].parts.append(part.name)
             continue
-        if part.quantity in RESPONSE_QUANTITIES:
+        if "response" in vouch:
             stage(f"cross-check response:{part.name}")
             out.append(_guarded_response(analysis, ctx, lin, values, part, models))
         label = _point_label(lin)

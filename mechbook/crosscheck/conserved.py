@@ -15,6 +15,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import evaluate
+from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.screen import screen
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.integrators import integrate
@@ -34,11 +35,12 @@ def book_integrals(ctx) -> list[sp.Expr]:
     if "about" in data or "steady" in data or "at" in data or "erratum" in data:
         return []
     val = data.get("book")
-    if part.quantity == "conserved":  # a named one (`p_psi = ...`): its value
+    vouch = crosschecks_of(part.quantity)
+    if "first_integrals" in vouch:  # a named one (`p_psi = ...`): its value
         vals = val if isinstance(val, list) else [val]
         return [ctx.parse(split_named(v)[1], ("book", i) if isinstance(val, list) else ("book",))
                 for i, v in enumerate(vals)]
-    if part.quantity == "expression" and data.get("of") in ("hamiltonian", "energy_function"):
+    if "energy_integral" in vouch and data.get("of") in ("hamiltonian", "energy_function"):
         if ctx.system.lagrangian.has(ctx.system.t) or any(f != 0 for f in ctx.system.forces):
             return []  # h is conserved only for an autonomous, conservative system
         e = ctx.parse(val, ("book",))

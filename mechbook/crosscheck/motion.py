@@ -21,6 +21,7 @@ import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
 
+from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL
 from mechbook.numerics.model import build_model
@@ -29,8 +30,6 @@ from mechbook.records import CrossCheck
 STEADY_TOL = 1e-8
 STEADY_TURNS = 3
 MAX_TURNS = 2000
-TRAJECTORY_QUANTITIES = ("turning_points", "excursion", "motion_frequency", "mean_rate")
-STEADY_QUANTITIES = ("steady_rates", "steady_exists")
 
 
 def steady_crosscheck(analysis, part) -> CrossCheck:
@@ -103,10 +102,10 @@ def trajectory_crosscheck(analysis, part) -> CrossCheck:
         measured = motion.measured(values)
         lo, hi = (float(v) for v in orbit.turning_points)
         pairs = [("low", lo, measured.low), ("high", hi, measured.high)]
-        q = part.quantity
-        if q in ("motion_frequency", "mean_rate"):
+        vouch = crosschecks_of(part.quantity)
+        if "trajectory_period" in vouch:
             pairs.append(("period", float(orbit.period), measured.period()))
-        if q == "mean_rate":
+        if "trajectory_advance" in vouch:
             c = ctx.system.q[ctx.system.coord_names.index(part.data["rate"])]
             pairs.append(("advance", float(orbit.advance(c)),
                           measured.advance(ctx.system.q.index(c))))

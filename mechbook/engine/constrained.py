@@ -32,6 +32,7 @@ import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate
 from mechbook.engine.linear import LinearSystem
+from mechbook.engine.residual import is_zero, show_point
 from mechbook.errors import NotEquilibriumError, UnsupportedError
 
 
@@ -117,21 +118,20 @@ def linearize_on_manifold(eq, point: dict, velocity: dict | None = None,
     cons = constraint_functions(sys)
     at = {q: sp.S(point.get(q, 0)) for q in dyn.q}
     values = sys.numeric_values()
-    from mechbook.engine.equilibria import _is_zero, _show
 
     def restricted(x: sp.Expr) -> sp.Expr:
         return x.subs(given) if given else x
 
-    off = [c for c in cons if not _is_zero(restricted(c.subs(at)), values)]
+    off = [c for c in cons if not is_zero(restricted(c.subs(at)), values)]
     if off:
-        raise NotEquilibriumError(f"the point {_show(point)} violates the constraint "
+        raise NotEquilibriumError(f"the point {show_point(point)} violates the constraint "
                                   f"{sp.sstr(off[0])} = 0")
     zeroth, M, C, K, F = eq.expand(point, None, None)
     A = dyn.constraint_jacobian.subs(at)
     lam, tangential = multipliers_at(zeroth, A)
-    bad = [r for r in tangential if not _is_zero(restricted(r), values)]
+    bad = [r for r in tangential if not is_zero(restricted(r), values)]
     if bad:
-        raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium: a force "
+        raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium: a force "
                                   f"along the constraint manifold {sp.sstr(bad[0])[:120]} is "
                                   "left there")
     n, m = len(dyn.q), len(cons)

@@ -18,11 +18,12 @@ import sympy as sp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.core.expansion import EPS, expand_lagrangian
-from mechbook.core.numeval import NotNumeric, evaluate, without_absent
+from mechbook.core.numeval import without_absent
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
 from mechbook.engine.domains import clip_ranges, inside
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
+from mechbook.engine.residual import is_zero, show_point
 from mechbook.errors import NotEquilibriumError, UnsupportedError
 
 
@@ -213,10 +214,11 @@ class Equilibria:
         b = [sp.diff(dyn.L, v).xreplace(rest) for v in dyn.qd]
         dq = [sp.diff(L_rest, q) for q in dyn.q]
         force = [g.xreplace(at).xreplace(held) for g in dq]
-        bad = [g for g in force if not _is_zero(g, self.sys.numeric_values())]
+        bad = [g for g in force if not is_zero(g, self.sys.numeric_values())]
         if bad:
-            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
-                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
+            raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium "
+                                      f"(or steady motion): a generalized force "
+                                      f"{sp.sstr(bad[0])[:120]} "
                                       "is left there")
         simp = (lambda x: try_simplify(x, 5)) if dyn.simplify else (lambda x: x)
         dv = [sp.diff(L_at, v) for v in dyn.qd]
@@ -245,10 +247,11 @@ class Equilibria:
         if not velocity and not given and self._conservative():
             return self._linearize_lagrangian(point)
         zeroth, M, C, K, F = self.expand(point, velocity, given)
-        bad = [z for z in zeroth if not _is_zero(z, self.sys.numeric_values())]
+        bad = [z for z in zeroth if not is_zero(z, self.sys.numeric_values())]
         if bad:
-            raise NotEquilibriumError(f"the point {_show(point)} is not an equilibrium (or steady "
-                                      f"motion): a generalized force {sp.sstr(bad[0])[:120]} "
+            raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium "
+                                      f"(or steady motion): a generalized force "
+                                      f"{sp.sstr(bad[0])[:120]} "
                                       "is left there")
         return LinearSystem(self.dyn, dict(point), M, C, K, F, dict(velocity or {}))
 
@@ -319,41 +322,3 @@ class Equilibria:
             raise UnsupportedError("linearization about a uniform motion whose linear "
                                    "equations have time-dependent coefficients")
         return zeroth, M, C, K, F
-
-
-def _is_zero(expr: sp.Expr, values: dict, points: int = 5) -> bool:
-    """Zero symbolically, or (when SymPy cannot tell) to 25 digits at random points around
-    the default values; a residual left by a numerically found point is zero to 1e-9."""
-    if expr == 0:
-        return True
-    if _numerically_zero(expr, values):
-        return True
-    rng = np.random.default_rng(7)
-    for _ in range(points):
-        env = {}
-        for sym in expr.free_symbols:
-            base = values.get(sym, 1.0)
-            factor = float(np.exp(rng.uniform(-0.3, 0.3)))
-            env[sym] = sp.Float(base * factor if sym.is_positive or sym not in values
-                                else base + rng.uniform(-0.3, 0.3), 40)
-        try:
-            v, scale = evaluate(expr, env, 40)
-        except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
-            return False
-        if not abs(v) <= 1e-25 * max(scale, 1e-300):
-            return False
-    return True
-
-
-def _numerically_zero(expr: sp.Expr, values: dict) -> bool:
-    """A residual left by a numerically found point (floats), zero to rounding."""
-    if not expr.has(sp.Float):
-        return False
-    try:
-        return abs(evaluate(expr, {k: sp.Float(v, 30) for k, v in values.items()})[0]) < 1e-9
-    except (NotNumeric, TypeError, ValueError, ZeroDivisionError, OverflowError):
-        return False
-
-
-def _show(point: dict) -> str:
-    return "{" + ", ".join(f"{k} = {sp.sstr(v)}" for k, v in point.items()) + "}"

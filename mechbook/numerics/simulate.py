@@ -24,7 +24,6 @@ from datetime import UTC, datetime
 import numpy as np
 import sympy as sp
 
-from mechbook import __version__
 from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
@@ -34,6 +33,7 @@ from mechbook.numerics.integrators import SCIPY_METHODS, Trajectory, integrate
 from mechbook.numerics.model import DEFAULT_BACKEND, Model, build_model
 from mechbook.numerics.monitors import Drift, conserved_quantities, drifts
 from mechbook.numerics.stiffness import IMPLICIT, Stiffness, assess, fixed_step_warning
+from mechbook.version import __version__
 
 FALLBACK_OFFSET = 0.1
 FALLBACK_SEARCH = 20.0  # seconds for finding a stable equilibrium to start near

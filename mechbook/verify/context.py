@@ -20,9 +20,9 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
 from mechbook.model.declared import declared
 from mechbook.records import NUMERIC, ProofPolicy
-from mechbook.verify.answers import Part
 from mechbook.verify.compare import Sampler, value, vanishes
-from mechbook.verify.registry import quantities
+from mechbook.verify.part import Part
+from mechbook.verify.registration import registered
 
 
 @dataclass
@@ -34,7 +34,7 @@ class Context:
 
     def __post_init__(self):
         problem = self.analysis.problem
-        self.tensor_mode = not quantities()[self.part.quantity].needs_system
+        self.tensor_mode = not registered(self.part.quantity).needs_system
         if self.part.system is None and (self.tensor_mode or not problem.systems):
             self.system = None  # a tensor or body quantity, or a problem without a system
             decl = declared(problem)

@@ -23,13 +23,13 @@ from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
 
-from mechbook import __version__
 from mechbook.app.report import cache
 from mechbook.app.report.page import PageOptions
 from mechbook.errors import MechbookError, describe
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
 from mechbook.records import STATUSES
+from mechbook.version import __version__
 
 NOT_CHECKED = "not checked"
 

@@ -27,6 +27,18 @@ from mechbook.app.report.derivation import StoredSystem
 from mechbook.app.report.syntax import syntax_math
 from mechbook.errors import MechbookError
 from mechbook.verify.context import Context, numbers, strip_const
+from mechbook.verify.registry import quantities
+
+# the names a registration's `display=` may hold: what the page shows beside the book's value
+DISPLAYS = {
+    "system_lagrangian": "the system's Lagrangian",
+    "equations_of_motion": "Lagrange's equations, or M, C, K about the part's point",
+    "frequency_list": "√(K/M) of one degree of freedom, and the frequencies at one point",
+    "period_list": "2π/√(K/M) of one degree of freedom, and the periods at one point",
+    "equilibrium_points": "the equilibria the check found",
+    "sylvester_criterion": "K's leading principal minors positive (up to 3 coordinates)",
+    "momenta_and_energy": "the conserved momenta and the energy function",
+}
 
 _RELATION = re.compile(r"<=|>=|<|>|!=")
 _EQUALS = re.compile(r"(?<![<>=!])=(?!=)")
@@ -101,13 +113,13 @@ def part_linear(ctx: Context, view: StoredSystem | None, values: dict):
 def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
     """The engine's value for the part's quantity from what the check stored, or None
     where there is no single one (or the check did not store it)."""
-    q = ctx.part.quantity
+    shown = display_of(ctx.part.quantity)
     data = ctx.part.data
-    if q == "lagrangian":
+    if shown == "system_lagrangian":
         return ctx.system.lagrangian
     if view is None:
         return None
-    if q == "eom":
+    if shown == "equations_of_motion":
         if "about" in data or "steady" in data:
             lin = part_linear(ctx, view, values)
             if lin is None:
@@ -122,15 +134,15 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         if ctx.system.constraints:
             rhs = rhs + dyn.constraint_jacobian.T * sp.Matrix(dyn.multipliers)
         return [sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True)]
-    if q in ("frequencies", "period"):
+    if shown in ("frequency_list", "period_list"):
         lin = part_linear(ctx, view, values)
         if lin is None or lin.M.rows != 1 or not lin.C.is_zero_matrix:
             return None  # several modes: their numbers at one point are shown below
         w = sp.sqrt(lin.K[0, 0] / lin.M[0, 0])
-        return [w] if q == "frequencies" else [2 * sp.pi / w]
-    if q == "equilibrium":
+        return [w] if shown == "frequency_list" else [2 * sp.pi / w]
+    if shown == "equilibrium_points":
         return view.equilibria or None
-    if q == "stability_condition":
+    if shown == "sylvester_criterion":
         lin = part_linear(ctx, view, values)
         if lin is None or lin.C.is_zero_matrix is False:
             return None
@@ -138,7 +150,7 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         if K.rows > 3:
             return None
         return sp.And(*[K[:k, :k].det() > 0 for k in range(1, K.rows + 1)])
-    if q == "conserved":
+    if shown == "momenta_and_energy":
         out = {}
         cyclic = view.get("cyclic")
         if isinstance(cyclic, dict):
@@ -155,8 +167,8 @@ def numeric_pair(ctx: Context, view: StoredSystem | None,
     """(book, engine) values at one admissible parameter point for the quantities that are
     lists of numbers (frequencies, periods), else None. The engine's are the stored linear
     system's frequencies there."""
-    q = ctx.part.quantity
-    if q not in ("frequencies", "period") or "limit" in ctx.part.data:
+    shown = display_of(ctx.part.quantity)
+    if shown not in ("frequency_list", "period_list") or "limit" in ctx.part.data:
         return None
     lin = part_linear(ctx, view, values)
     if lin is None:
@@ -175,9 +187,15 @@ def numeric_pair(ctx: Context, view: StoredSystem | None,
         else:
             w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
             eng = [float(np.sqrt(w)) for w in w2 if w >= 0]
-    if q == "period":
+    if shown == "period_list":
         eng = [2 * np.pi / w for w in eng if w > 1e-12]
     return numbers(exprs, pt), sorted(float(w) for w in eng)
+
+
+def display_of(quantity: str) -> str | None:
+    """How the registration of `quantity` says its engine value is shown (DISPLAYS)."""
+    entry = quantities().get(quantity)
+    return entry.display if entry is not None else None
 
 
 def _esc(text) -> str:

@@ -26,7 +26,7 @@ from mechbook.engine.access import Access
 from mechbook.verify import boundary
 from mechbook.verify.compare import Sampler, Verdict, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registry import POINT, quantity
+from mechbook.verify.registration import POINT, quantity
 
 INTEGRALS = {"type": "object", "minProperties": 1,
              "propertyNames": {"pattern": "^[A-Za-z][A-Za-z0-9_]*$"},

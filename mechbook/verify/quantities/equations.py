@@ -7,7 +7,7 @@ import sympy as sp
 
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, linear_accelerations, split_named
-from mechbook.verify.registry import quantity
+from mechbook.verify.registration import quantity
 
 
 @quantity('lagrangian',
@@ -15,7 +15,8 @@ from mechbook.verify.registry import quantity
           how=("the difference from the engine's L has identically vanishing Lagrange "
                'expressions (equal up to a total time derivative). With `about`, against'
                " the engine's L expanded to second order"),
-          equivalent=("gauge",))
+          equivalent=("gauge",),
+          crosschecks=("newton",), display="system_lagrangian")
 def check_lagrangian(ctx: Context, val) -> Verdict:
     """Equal up to a total time derivative: the difference has vanishing Lagrange expressions.
     With `about:`, the engine's Lagrangian is first expanded to second order there."""
@@ -34,7 +35,8 @@ def check_lagrangian(ctx: Context, val) -> Verdict:
           book='list of equations',
           how=("each holds once the engine's solved accelerations are substituted "
                '(linearized ones with `about`); so any nonzero multiple of an equation '
-               'is accepted, and each must contain an acceleration'))
+               'is accepted, and each must contain an acceleration'),
+          crosschecks=("newton",), display="equations_of_motion")
 def check_eom(ctx: Context, val) -> Verdict:
     """Each book equation holds once the engine's accelerations are substituted
     (the linearized ones when `about` is given)."""
@@ -67,7 +69,8 @@ ENERGY_NAMES = ("energy", "jacobi", "E", "h")  # the energy function (Jacobi's i
                '"this is conserved" is a claim any function of it satisfies too (so its '
                'multiples pass), and the verdict says so'),
           names=lambda ctx: _with_energy_names(ctx),
-          equivalent=("function",))
+          equivalent=("function",),
+          crosschecks=("newton", "first_integrals"), display="momenta_and_energy")
 def check_conserved(ctx: Context, val) -> Verdict:
     """d/dt of each book expression vanishes along the motion ('= const' may be written);
     a named one (`p_psi = ...`) is also compared with the engine's quantity of that name."""

@@ -7,7 +7,7 @@ from mechbook.errors import MechbookError
 from mechbook.verify import boundary
 from mechbook.verify.compare import Verdict, all_vanish, combine, vanishes
 from mechbook.verify.context import Context
-from mechbook.verify.registry import quantity
+from mechbook.verify.registration import quantity
 
 
 def _engine_points(ctx: Context) -> list[dict]:
@@ -19,7 +19,8 @@ def _engine_points(ctx: Context) -> list[dict]:
           how=('`at`: the equilibrium conditions vanish there; `where`: an engine '
                'equilibrium satisfies the equations. `stable: true/false` also checks '
                'stability'),
-          keys={"stable": {"type": "boolean"}})
+          keys={"stable": {"type": "boolean"}},
+          display="equilibrium_points")
 def check_equilibrium(ctx: Context, val) -> Verdict:
     """`at:` the point satisfies the equilibrium conditions; `where:` some engine equilibrium
     satisfies the book's equations. `stable:` also checks the stability there."""
@@ -71,7 +72,8 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
                'every place where the relation changes truth (found to 30 digits) the '
                'engine\'s verdict, in 40-digit arithmetic, agrees a relative 1e-8 inside and '
                'outside; tangencies are judged on both sides. A boundary moved by more than '
-               '1e-8 fails'))
+               '1e-8 fails'),
+          crosschecks=("modes",), display="sylvester_criterion", sweeps=("stability",))
 def check_stability_condition(ctx: Context, val) -> Verdict:
     """The book's condition holds exactly where the engine finds the point stable, compared
     at the condition's boundary (mechbook.verify.boundary) and widely along rays."""

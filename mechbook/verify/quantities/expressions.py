@@ -9,7 +9,7 @@ import sympy as sp
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registry import POINT, quantity
+from mechbook.verify.registration import POINT, quantity
 
 OF = ["potential", "kinetic", "quadratic_potential", "quadratic_kinetic", "energy_function",
       "hamiltonian", "momenta"]
@@ -31,7 +31,8 @@ def _potential_shift(data: dict) -> tuple:
                'checked as the Legendre transform without inverting p(q̇): H(q, ∂L/∂q̇) '
                '= h(q, q̇) and ∂H/∂p = q̇'),
           keys={"of": {"enum": OF}, "at": POINT},
-          equivalent=_potential_shift)
+          equivalent=_potential_shift,
+          crosschecks=("energy_integral",))
 def check_expression(ctx: Context, val) -> Verdict:
     """An engine quantity named by `of:`; potentials compare up to an additive constant.
     At a state (`at:` coordinates and velocities, or a steady motion named by `steady:` and
@@ -141,7 +142,8 @@ def _at(ctx: Context, expr: sp.Basic, state: dict | None) -> sp.Basic:
           keys={"constraint": {"type": "string"},
                 "coordinate": {"type": "string"},
                 "at": POINT,
-                "released": POINT})
+                "released": POINT},
+          crosschecks=("newton",))
 def check_constraint_force(ctx: Context, val) -> Verdict:
     """The generalized force λ·∂f/∂q that constraint `constraint` exerts on `coordinate`, as
     a function of the state; `at:` fixes coordinates and velocities the constraint pins

@@ -38,7 +38,7 @@ from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.quantities.parts import energy_at, linear_motion, part_energy_expr
-from mechbook.verify.registry import EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, POINT, quantity
 
 POINTS = 3
 DPS = 60

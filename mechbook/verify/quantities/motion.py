@@ -12,7 +12,7 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registry import POINT, quantity
+from mechbook.verify.registration import POINT, quantity
 
 
 def _time_functions(ctx: Context, val, sub) -> dict[sp.Symbol, sp.Expr]:

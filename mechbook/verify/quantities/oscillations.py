@@ -13,7 +13,7 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.verify.compare import Verdict, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registry import EXPR, LIMIT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, quantity
 
 
 def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:
@@ -27,7 +27,8 @@ def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:
                'symbolic with `--prove` where SymPy confirms; `partial: true` for a '
                'subset; `limit: {parameter, to: 0 or oo, order}` for asymptotic formulas'),
           keys={"partial": {"type": "boolean"},
-                "limit": LIMIT})
+                "limit": LIMIT},
+          crosschecks=("modes",), display="frequency_list", sweeps=("frequencies",))
 def check_frequencies(ctx: Context, val) -> Verdict:
     """Multiset of normal angular frequencies (numeric eigh at random points; symbolic where
     SymPy can); `partial: true` allows the book to list a subset; `limit:` compares an
@@ -237,7 +238,8 @@ def asymptotic(ctx: Context, error, floor: float | None = None) -> Verdict:
 
 @quantity('period',
           book='expression',
-          how="2π/ω for one of the engine's nonzero frequencies")
+          how="2π/ω for one of the engine's nonzero frequencies",
+          crosschecks=("modes",), display="period_list")
 def check_period(ctx: Context, val) -> Verdict:
     """2π/ω for one of the engine's nonzero frequencies."""
     period = ctx.parse(val, ("book",))
@@ -280,7 +282,8 @@ def _eig_residual(K: np.ndarray, M: np.ndarray, w2: float, u: np.ndarray) -> flo
                'approach an engine mode (frequency and the angle between shapes) as the '
                'parameter goes to its limit'),
           keys={"limit": LIMIT},
-          equivalent=("direction",))
+          equivalent=("direction",),
+          crosschecks=("modes",))
 def check_normal_modes(ctx: Context, val) -> Verdict:
     """Each (frequency, shape) satisfies (K − ω²M)·u = 0: shape up to scale and sign, and any
     vector of a degenerate eigenspace is accepted."""
@@ -371,7 +374,8 @@ def _near(values, x, rtol=1e-8):
           book='list of `{coordinate: linear form, frequency?}`',
           how=('c·q is a normal coordinate iff M⁻¹c is a mode (with velocity terms C, also '
                'an eigenvector of M⁻¹C: then C does not couple it)'),
-          equivalent=("scale", "shift"))
+          equivalent=("scale", "shift"),
+          crosschecks=("modes",))
 def check_normal_coordinates(ctx: Context, val) -> Verdict:
     """A linear form c·q is a normal coordinate iff u = M⁻¹c is a mode: (K − ω²M)u = 0."""
     lin = ctx.linear()
@@ -423,7 +427,8 @@ def check_mode_count(ctx: Context, val) -> Verdict:
           how=('the point (`position:`, linear in the displacements) does not move in '
                'the mode of `frequency:`'),
           keys={"position": EXPR,
-                "frequency": EXPR})
+                "frequency": EXPR},
+          crosschecks=("modes",))
 def check_mode_node(ctx: Context, val) -> Verdict:
     """A point whose position (linear in the small displacements) stays put in the mode of a
     given frequency: ∇position · u = 0. The book's value fixes the point's parameter."""

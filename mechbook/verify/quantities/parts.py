@@ -16,7 +16,7 @@ from mechbook.core.numeval import evaluate_mp
 from mechbook.engine.parts import LinearMotion, quadratic_part_energy
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
-from mechbook.verify.registry import POINT, quantity
+from mechbook.verify.registration import POINT, quantity
 
 POINTS = 4
 TIMES = (0.37, 1.3, 2.9, 7.1)

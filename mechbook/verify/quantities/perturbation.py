@@ -50,7 +50,7 @@ from mechbook.errors import UnsupportedError
 from mechbook.model.expr import Operator
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.oscillations import asymptotic
-from mechbook.verify.registry import EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, POINT, quantity
 
 KINDS = ("squared_frequency", "component", "exponent", "damped_component", "equilibrium",
          "stiffness", "group")

@@ -17,7 +17,7 @@ from mechbook.engine import response
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
 from mechbook.verify.context import Context
-from mechbook.verify.registry import EXPR, quantity
+from mechbook.verify.registration import EXPR, quantity
 
 POINTS = 5
 RTOL = 1e-8  # eigenvalue problems: relative to the largest exponent
@@ -68,7 +68,8 @@ def _matrix(ctx: Context, rows, sub) -> sp.Matrix:
           how=('each given matrix of the linearized equations M·δq̈ + C·δq̇ + K·δq = F equals '
                "the engine's, entry by entry (rows and columns in the problem's coordinate "
                'order); B is the symmetric (friction) part of C, G its antisymmetric '
-               '(gyroscopic) part'))
+               '(gyroscopic) part'),
+          crosschecks=("modes",))
 def check_matrices(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
     lin = ctx.linear()
@@ -111,7 +112,8 @@ def _exponent_map(ctx: Context):
           keys={"variable": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
                 "exponent": EXPR},
           names=lambda ctx: _exponent_map(ctx)[1],
-          complex_values=True)
+          complex_values=True,
+          crosschecks=("modes",))
 def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
     var, names, exponent = _exponent_map(ctx)
     poly_expr = ctx.part.parse(val, ("book",), names)
@@ -149,7 +151,8 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
           how=('multiset equality with the 2n exponents p of e^{pt} solutions (roots of '
                'det(Mp² + Cp + K) = 0) at 5 points; `partial: true` for a subset'),
           keys={"partial": {"type": "boolean"}},
-          complex_values=True)
+          complex_values=True,
+          crosschecks=("modes",))
 def check_exponents(ctx: Context, val) -> Verdict:
     return _multiset_at_points(ctx, val, lambda lin, pt: list(response.exponents(lin, pt)))
 
@@ -159,7 +162,8 @@ def check_exponents(ctx: Context, val) -> Verdict:
           how=('multiset equality with −Re p over the exponents, one per oscillating mode '
                '(conjugate pair) and one per real exponent, at 5 points; `partial: true` '
                'for a subset'),
-          keys={"partial": {"type": "boolean"}})
+          keys={"partial": {"type": "boolean"}},
+          crosschecks=("modes",))
 def check_decay_rates(ctx: Context, val) -> Verdict:
     return _multiset_at_points(
         ctx, val, lambda lin, pt: [complex(x) for x in response.decay_rates(lin, pt)])
@@ -194,7 +198,8 @@ def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
                "book's shape u (relative residual 1e-8; any vector of a degenerate "
                'eigenspace passes), at 5 points'),
           complex_values=True,
-          equivalent=("direction",))
+          equivalent=("direction",),
+          crosschecks=("modes",))
 def check_complex_modes(ctx: Context, val) -> Verdict:
     lin = ctx.linear()
     modes = []
@@ -257,7 +262,8 @@ def _driving(ctx: Context, pt: dict) -> float:
                'X = (K − ω²M + iωC)⁻¹F̂, at 5 points (so a real A is the signed amplitude '
                'in phase with the force)'),
           keys={"frequency": EXPR},
-          complex_values=True)
+          complex_values=True,
+          crosschecks=("modes", "response"))
 def check_steady_amplitude(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
     book = {c: ctx.parse(v, ("book", c)) for c, v in val.items()}
@@ -290,7 +296,8 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
                'eigenspace the force reaches (F̂, evaluated with the driving-frequency '
                'parameter `driving:` set to ω, has a component along a mode of ω in the '
                'mass metric): where the steady amplitude is unbounded'),
-          keys={"driving": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"}})
+          keys={"driving": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"}},
+          crosschecks=("modes",))
 def check_resonances(ctx: Context, val) -> Verdict:
     book = _book_list(ctx, val)
     lin = ctx.linear()
@@ -358,7 +365,8 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
           how=('x = A·η (the normal coordinates η are answer symbols): AᵀMA = 1 and AᵀKA '
                'diagonal (T = Σ η̇²/2, V = Σ ω²η²/2), entrywise to 1e-9 at 5 points; '
                '`frequencies: {η: ω}` also checks the diagonal'),
-          keys={"frequencies": {"type": "object", "additionalProperties": EXPR}})
+          keys={"frequencies": {"type": "object", "additionalProperties": EXPR}},
+          crosschecks=("modes",))
 def check_normal_transformation(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
     names = ctx.linear().coord_names

@@ -14,7 +14,7 @@ import sympy as sp
 from mechbook.model.attitude import rotation_matrix
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registry import ESTIMATE, quantity
+from mechbook.verify.registration import ESTIMATE, quantity
 
 BODY = {"type": "string"}
 VECTOR = {"oneOf": [{"enum": ["omega", "L", "e1", "e2", "e3", "x", "y", "z"]},
@@ -53,7 +53,8 @@ def with_momenta(ctx: Context, expr: sp.Expr) -> sp.Expr:
           how=('entry by entry at random attitudes: `transform: space_to_body` (default; '
                'a_ij carries space components to body components, Rᵀ) or `body_to_space` '
                "(R), R the product of the body's chain of rotations"),
-          keys={"body": BODY, "transform": {"enum": ["space_to_body", "body_to_space"]}})
+          keys={"body": BODY, "transform": {"enum": ["space_to_body", "body_to_space"]}},
+          crosschecks=("newton",))
 def check_rotation_matrix(ctx: Context, val) -> Verdict:
     name = _body(ctx)
     R = rotation_matrix(ctx.system.attitudes[name])
@@ -93,7 +94,8 @@ def _vector(ctx: Context, name: str, spec, frame: str, key: str) -> sp.Matrix:
                'states; `vector:`/`axis:` are omega, L, e1, e2, e3 (body axes), x, y, z '
                '(space axes) or three components in `frame:`\'s axes'),
           keys={"body": BODY, "vector": VECTOR, "axis": VECTOR,
-                "frame": {"enum": ["body", "space"]}, "estimate": ESTIMATE})
+                "frame": {"enum": ["body", "space"]}, "estimate": ESTIMATE},
+          crosschecks=("newton",))
 def check_precession_rate(ctx: Context, val) -> Verdict:
     name = _body(ctx)
     data = ctx.part.data
@@ -113,7 +115,8 @@ def check_precession_rate(ctx: Context, val) -> Verdict:
           how=('each holds at random states (momenta `p_<q>` are ∂L/∂q̇, accelerations the '
                "engine's): kinematic relations such as a polhode's projection, or the rate "
                'names of a body'),
-          keys={})
+          keys={},
+          crosschecks=("newton",))
 def check_state_identity(ctx: Context, val) -> Verdict:
     vals = val if isinstance(val, list) else [val]
     out = []
@@ -134,7 +137,8 @@ def check_state_identity(ctx: Context, val) -> Verdict:
                'rates (linear in the velocities): at random t, coordinates and constants, '
                'the velocities that give those rates make the engine\'s d(rate)/dt equal '
                'to the book\'s (Euler\'s equations, in Euler angles)'),
-          keys={})
+          keys={},
+          crosschecks=("newton",))
 def check_solution(ctx: Context, val) -> Verdict:
     sys = ctx.system
     funcs = ctx.as_map(val, ("book",))

@@ -14,7 +14,7 @@ from mechbook.verify.compare import Verdict, value
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.quantities.steady import coordinate_map
-from mechbook.verify.registry import EXPR, POINT, REGION, quantity
+from mechbook.verify.registration import EXPR, POINT, REGION, quantity
 
 
 @quantity('stability',
@@ -26,7 +26,8 @@ from mechbook.verify.registry import EXPR, POINT, REGION, quantity
                'needed. A marginal point (a zero frequency without gyroscopic terms) counts '
                'against `stable` and `unstable`; zero exponents of a symmetry are neutral. A '
                'relation is checked as `stability_condition`'),
-          literals=("stable", "unstable", "marginal"))
+          literals=("stable", "unstable", "marginal"),
+          crosschecks=("modes",))
 def check_stability(ctx: Context, val) -> Verdict:
     if isinstance(val, str) and ("<" in val or ">" in val):  # a condition after all
         return check_stability_condition(ctx, val)
@@ -142,7 +143,8 @@ def _fmt(pt: dict) -> str:
                'double root with one mode; ranks of (A − pI)^j in mpmath at 40 digits, 3 '
                'points'),
           keys={"exponent": EXPR},
-          complex_values=True)
+          complex_values=True,
+          crosschecks=("modes",))
 def check_secular_growth(ctx: Context, val) -> Verdict:
     if not isinstance(val, int) or isinstance(val, bool) or val < 0:
         raise ctx.part.error(("book",), "expected a non-negative integer")

@@ -22,7 +22,7 @@ from mechbook.verify import boundary
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
-from mechbook.verify.registry import ESTIMATE, LIMIT, NAME, quantity
+from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}
 ROOT_RTOL = 1e-9
@@ -90,7 +90,8 @@ def _rate_symbol(ctx: Context, fam: SteadyFamily) -> sp.Symbol:
                'frequencies). `hold:` fixes the other cyclic rates; `estimate:` compares '
                'at the book\'s numbers to its precision'),
           keys={**STEADY_KEYS, "partial": {"type": "boolean"}, "limit": LIMIT,
-                "estimate": ESTIMATE})
+                "estimate": ESTIMATE},
+          crosschecks=("steady",))
 def check_steady_rates(ctx: Context, val) -> Verdict:
     fam = family(ctx)
     xdot = _rate_symbol(ctx, fam)
@@ -208,7 +209,8 @@ def _vanishes_at_rates(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
                'to 1e-20 of its terms counts as zero; the roots are checked on every '
                'condition). The minimum spin of a top, the region where circular orbits '
                'exist'),
-          keys=STEADY_KEYS)
+          keys=STEADY_KEYS,
+          crosschecks=("steady",))
 def check_steady_exists(ctx: Context, val) -> Verdict:
     fam = family(ctx)
     cond = ctx.parse(val, ("book",), relation=True)

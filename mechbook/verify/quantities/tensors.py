@@ -27,7 +27,7 @@ from mechbook.verify.instances import (
     is_variable,
     rational_point,
 )
-from mechbook.verify.registry import ESTIMATE, NAME, quantities, quantity
+from mechbook.verify.registration import ESTIMATE, NAME, quantity, registered
 
 TENSOR = {"type": "string"}
 FOR_ALL = {"type": "object", "minProperties": 1,
@@ -463,8 +463,8 @@ def validate_part(ctx: Context) -> None:
     built once, at a random instance, and not judged."""
     ctx.validate_only = True
     try:
-        quantities()[ctx.part.quantity].check(ctx, ctx.part.data.get("book"))
+        registered(ctx.part.quantity).check(ctx, ctx.part.data.get("book"))
         if "erratum" in ctx.part.data:
-            quantities()[ctx.part.quantity].check(ctx, ctx.part.data["erratum"]["corrected"])
+            registered(ctx.part.quantity).check(ctx, ctx.part.data["erratum"]["corrected"])
     finally:
         ctx.validate_only = False

@@ -26,7 +26,7 @@ from mechbook.numerics.model import build_model
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.quantities.oscillations import asymptotic
-from mechbook.verify.registry import ESTIMATE, EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, quantity
 
 LEVEL_RTOL = 1e-10
 LEVEL_POINTS = 6
@@ -175,7 +175,8 @@ KEYS = {**START, "partial": {"type": "boolean"}, "limit": LIMIT, "estimate": EST
                'set of the first integrals (50 digits, rtol 1e-10) or, with other '
                'non-cyclic coordinates, measured by integration (rtol 1e-7); a subset with '
                '`partial: true`'),
-          keys={**KEYS, "signal": EXPR})
+          keys={**KEYS, "signal": EXPR},
+          crosschecks=("trajectory",))
 def check_turning_points(ctx: Context, val) -> Verdict:
     motion = Motion(ctx)
     return _compare(ctx, motion, _book_values(ctx, val), lambda pt: _extremes(motion, pt),
@@ -185,7 +186,8 @@ def check_turning_points(ctx: Context, val) -> Verdict:
 @quantity('excursion',
           book='expression: greatest minus least value of the coordinate (or of `signal:`)',
           how='as `turning_points`, the difference of the two (its own relative error)',
-          keys={**KEYS, "signal": EXPR})
+          keys={**KEYS, "signal": EXPR},
+          crosschecks=("trajectory",))
 def check_excursion(ctx: Context, val) -> Verdict:
     motion = Motion(ctx)
 
@@ -203,7 +205,8 @@ def check_excursion(ctx: Context, val) -> Verdict:
           book='expression: 2π over the period of the oscillation of the coordinate',
           how=('2π/T for the period T of the nonlinear oscillation of the coordinate from '
                '`initial:` (level-set quadrature, or measured by integration)'),
-          keys=KEYS)
+          keys=KEYS,
+          crosschecks=("trajectory", "trajectory_period"))
 def check_motion_frequency(ctx: Context, val) -> Verdict:
     motion = Motion(ctx)
 
@@ -220,7 +223,8 @@ def check_motion_frequency(ctx: Context, val) -> Verdict:
           how=('how far the coordinate `rate:` advances over one period of the oscillating '
                '`coordinate:`, divided by the period (level-set quadratures, or measured by '
                'integration)'),
-          keys={**KEYS, "rate": {"type": "string"}})
+          keys={**KEYS, "rate": {"type": "string"}},
+          crosschecks=("trajectory", "trajectory_period", "trajectory_advance"))
 def check_mean_rate(ctx: Context, val) -> Verdict:
     motion = Motion(ctx)
     name = ctx.part.data.get("rate")

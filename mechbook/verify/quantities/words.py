@@ -7,7 +7,7 @@ from __future__ import annotations
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
-from mechbook.verify.registry import quantity
+from mechbook.verify.registration import quantity
 
 
 @quantity('force',
