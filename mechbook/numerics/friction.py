@@ -19,6 +19,7 @@ status, nfev, message), so the trajectory measurements use it unchanged
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,6 +28,7 @@ from scipy.integrate import solve_ivp as scipy_solve_ivp
 
 from mechbook.core.compile import as_expr, compile_exprs
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.model import _gesv
 
 EPS = 1e-9  # a sliding speed this small (relative to the velocity scale) is a stop
 
@@ -46,6 +48,17 @@ class Result:
     @property
     def success(self) -> bool:
         return self.status >= 0
+
+
+def _norm(v: np.ndarray) -> float:
+    """np.linalg.norm of a vector, to the bit (it is sqrt(v·v) there too), without its
+    checks and dispatch: a few hundred ns instead of a microsecond."""
+    return math.sqrt(v.dot(v))
+
+
+def _same(a: float, b: float) -> bool:
+    """a and b the same float to the bit (0.0 and -0.0 told apart; NaN never the same)."""
+    return a == b and (a != 0.0 or math.copysign(1.0, a) == math.copysign(1.0, b))
 
 
 def _tangent_basis(n: np.ndarray) -> np.ndarray:
@@ -97,58 +110,86 @@ class Phases:
         self._fn, _ = compile_exprs([system.t] + q + qd, exprs)
         self.nfev = 0
         self.eps = [0.0] * len(self.contacts)
+        # the compiled function writes into one buffer, of which M, f0 and every contact's
+        # v_t, J and bias are views made once here (no slicing or reshaping per call);
+        # `_x` holds the (t, y) of the values in `_out` while `_fresh` is true
+        self._x = np.zeros(1 + 2 * self.n)
+        self._out = np.zeros(len(exprs))
+        self._fresh = False
+        raw = getattr(self._fn, "lambdify", None)  # SymEngine's Lambdify: writes in place
+        self._into = None
+        if raw is not None:
+            try:
+                raw(self._x, out=self._out)
+                self._into = raw
+            except TypeError:  # no `out` argument: copied from what the wrapper returns
+                pass
+        n, out = self.n, self._out
+        self._M = out[: n * n].reshape(n, n)
+        self._f0 = out[n * n: n * n + n]
+        self._views = []
+        for _, d, k, T in self.contacts:
+            self._views.append((out[k: k + d], out[k + d: k + d + d * n].reshape(d, n),
+                                out[k + d + d * n: k + 2 * d + d * n], k + 2 * d + d * n, T))
 
     # ---- pieces at a state ----------------------------------------------------------------
-    def _parts(self, t: float, y: np.ndarray):
-        n = self.n
-        out = np.asarray(self._fn(np.concatenate(([t], y))), float)
+    def _parts(self, t: float, y: np.ndarray, reuse: bool = False):
+        """M, f0 and per contact (v_t, J, bias, μ, N, T) at (t, y). The arrays are views of
+        one buffer, valid until the next call (no caller keeps them longer). With `reuse`,
+        a (t, y) the last call had to the bit (an event at the state the integrator has just
+        evaluated the right-hand side at) returns the values kept, without a second
+        compiled call: the same numbers, since the function is deterministic."""
         self.nfev += 1
-        M = out[: n * n].reshape(n, n)
-        f0 = out[n * n: n * n + n]
-        contacts = []
-        for _, d, start, T in self.contacts:
-            k = start
-            vt = out[k: k + d]
-            J = out[k + d: k + d + d * n].reshape(d, n)
-            bias = out[k + d + d * n: k + 2 * d + d * n]
-            mu, N = out[k + 2 * d + d * n], out[k + 2 * d + d * n + 1]
-            contacts.append((vt, J, bias, mu, N, T))
-        return M, f0, contacts
+        x = self._x
+        if not (reuse and self._fresh and _same(t, float(x[0]))
+                and np.asarray(y, float).tobytes() == x[1:].tobytes()):
+            self._fresh = False
+            x[0] = t
+            x[1:] = y
+            if self._into is not None:
+                self._into(x, out=self._out)
+            else:
+                self._out[:] = self._fn(x)
+            self._fresh = True
+        out = self._out
+        return self._M, self._f0, [(vt, J, bias, float(out[k]), float(out[k + 1]), T)
+                                   for vt, J, bias, k, T in self._views]
 
-    def _accelerations(self, t, y, modes: list, directions: list):
+    def _accelerations(self, t, y, modes: list, directions: list, reuse: bool = False):
         """(q̈, the stuck contacts' tangential forces λ (Cartesian), the parts)."""
-        M, f0, contacts = self._parts(t, y)
-        f = f0.copy()
+        parts = self._parts(t, y, reuse)
+        M, f, contacts = parts
         rows, rhs, stuck = [], [], []
         for i, ((vt, J, bias, mu, N, T), mode) in enumerate(zip(contacts, modes, strict=True)):
             if mode == "slip":
-                speed = np.linalg.norm(vt)
+                speed = _norm(vt)
                 # just released, or through a stop: the way it is pushed, until it moves
                 if directions[i] is not None and speed <= 10 * self.eps[i]:
                     u = directions[i]
                 else:
                     u = vt / speed if speed > 0 else np.zeros_like(vt)
-                f = f - mu * N * (J.T @ u)
+                f = f - mu * N * (J.T @ u)  # a new array: the buffer's f0 is not written
             else:
                 rows.append(T @ J)
                 rhs.append(-(T @ bias))
                 stuck.append(i)
+        n = self.n
         if not rows:
-            return np.linalg.solve(M, f), {}, (M, f0, contacts)
+            return _gesv(M, f), {}, parts
         A = np.vstack(rows)
         m = A.shape[0]
-        big = np.zeros((self.n + m, self.n + m))
-        big[: self.n, : self.n], big[: self.n, self.n:], big[self.n:, : self.n] = M, -A.T, A
-        sol = np.linalg.solve(big, np.concatenate((f, np.concatenate(rhs))))
-        lam, forces, k = sol[self.n:], {}, 0
+        big = np.zeros((n + m, n + m))
+        big[:n, :n], big[:n, n:], big[n:, :n] = M, -A.T, A
+        sol = _gesv(big, np.concatenate((f, np.concatenate(rhs))))
+        lam, forces, k = sol[n:], {}, 0
         for i in stuck:
             T = contacts[i][5]
             forces[i] = T.T @ lam[k: k + T.shape[0]]
             k += T.shape[0]
-        return sol[: self.n], forces, (M, f0, contacts)
+        return sol[:n], forces, parts
 
     def rhs(self, t, y, modes, directions):
-        acc, _, _ = self._accelerations(t, y, modes, directions)
+        acc = self._accelerations(t, y, modes, directions)[0]
         return np.concatenate((y[self.n:], acc))
 
     # ---- modes ----------------------------------------------------------------------------
@@ -195,15 +236,16 @@ class Phases:
         for i, mode in enumerate(modes):
             if mode == "slip":
                 def stop(t, y, i=i):
-                    _, _, contacts = self._parts(t, y)
-                    return np.linalg.norm(contacts[i][0]) - eps[i]
+                    _, _, contacts = self._parts(t, y, reuse=True)
+                    return _norm(contacts[i][0]) - eps[i]
 
                 stop.terminal, stop.direction = True, -1
                 events.append(stop)
             else:
                 def release(t, y, i=i):
-                    _, forces, (_, _, contacts) = self._accelerations(t, y, modes, directions)
-                    return contacts[i][3] * contacts[i][4] - np.linalg.norm(forces[i])
+                    _, forces, (_, _, contacts) = self._accelerations(t, y, modes, directions,
+                                                                      reuse=True)
+                    return contacts[i][3] * contacts[i][4] - _norm(forces[i])
 
                 release.terminal, release.direction = True, -1
                 events.append(release)
