@@ -10,7 +10,13 @@ parameter values, as the event_time check does (mechbook.numerics.measure via th
                the measurement's tolerance): RHS calls, CPU time, µs per call, and the end
                state in hex (to compare two trees bit for bit)
 
-with time.process_time (CPU time of this process). `--tree DIR` imports mechbook from
+with time.process_time (CPU time of this process); with --event also
+
+    event      the check's whole measurement (measure.first_event to theta = theta1/1000,
+               the rise of the top, ~23 s of motion): CPU time, RHS calls, the time found
+               and the state there in hex
+
+ `--tree DIR` imports mechbook from
 another tree (e.g. a `git archive` of the base commit) to measure the before figure with
 the same script.
 
@@ -32,6 +38,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     ap.add_argument("-N", type=int, default=20000, help="calls timed (rhs, stop)")
     ap.add_argument("--span", type=float, default=0.05, help="time integrated")
+    ap.add_argument("--event", action="store_true", help="time the whole measurement")
     ap.add_argument("--tree", type=Path, default=ROOT, help="the mechbook tree imported")
     args = ap.parse_args(argv)
     sys.path.insert(0, str(args.tree.resolve()))
@@ -43,7 +50,8 @@ def main(argv=None) -> int:
     from mechbook.model.catalog import problem_path
     from mechbook.model.problem import load_problem
     from mechbook.numerics.friction import Phases
-    from mechbook.numerics.measure import TOLERANCE
+    from mechbook.numerics.measure import TOLERANCE, first_event, signal_functions
+    from mechbook.numerics.model import build_model
 
     print(f"mechbook from {Path(mechbook.__file__).parent.parent}")
     a = Analysis(load_problem(problem_path("symon-11-15", args.tree.resolve())))
@@ -82,9 +90,22 @@ def main(argv=None) -> int:
     res = phases.solve_ivp((0.0, args.span), y0, rtol=TOLERANCE, atol=TOLERANCE)
     cpu = time.process_time() - start
     calls = phases.nfev - start_nfev
-    print(f"integrate  {args.span} s: {calls} compiled calls, {cpu:.3f} s CPU,"
+    print(f"integrate  {args.span} s: {calls} evaluations, {cpu:.3f} s CPU,"
           f" {1e6 * cpu / calls:7.2f} µs/call, status {res.status}")
     print("end state  " + " ".join(float(x).hex() for x in res.y[:, -1]))
+
+    if args.event:
+        model = build_model(system, dyn, values)
+        theta = next(q for q in system.q if str(q) == "theta")
+        fn = signal_functions(system, dyn, values, theta - theta1 / 1000)
+        n = len(names)
+        start = time.process_time()
+        t, y = first_event(model, fn, y0[:n], y0[n:], 1.0 / (1.0 + float(np.max(np.abs(y0[n:])))))
+        cpu = time.process_time() - start
+        calls = model.built_phases.nfev
+        print(f"event      t = {t!r} ({float(t).hex()}): {calls} evaluations,"
+              f" {cpu:.2f} s CPU, {1e6 * cpu / calls:.2f} µs per evaluation")
+        print("state      " + " ".join(float(x).hex() for x in y))
     return 0
 
 
