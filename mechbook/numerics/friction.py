@@ -141,7 +141,9 @@ class Phases:
         self.eps = [0.0] * len(self.contacts)
         # the compiled function writes into one buffer, of which M, f0 and every contact's
         # v_t, J, Jᵀ and bias are views made once here (no slicing or reshaping per call);
-        # `_x` holds the (t, y) of the values in `_out` while `_fresh` is true
+        # `_x` holds the (t, y) of the values in `_out` while `_fresh` is true. The kernel
+        # holds the two buffers' addresses: a Phases is built where it is used, never
+        # copied or pickled
         n = self.n
         self._x = np.zeros(1 + 2 * n)
         self._out = out = np.zeros(len(exprs))
