@@ -146,3 +146,54 @@ def test_a_normal_force_with_accelerations_is_refused(tmp_path):
     with pytest.raises(SpecError, match="no accelerations"):
         _analysis(tmp_path, PUSHED.replace("normal_force: m*g", "normal_force: m*(g + xddot)")
                   ).system()
+
+
+def _reference(phases: Phases, t: float, y: np.ndarray, mode: str):
+    """The accelerations (and a stuck contact's force) as first written: the compiled
+    function's own result sliced, np.linalg.solve and np.linalg.norm (one contact)."""
+    n = phases.n
+    out = np.asarray(phases._fn(np.concatenate(([t], y))), float)
+    M, f = out[: n * n].reshape(n, n), out[n * n: n * n + n].copy()
+    _, d, k, T = phases.contacts[0]
+    vt, J = out[k: k + d], out[k + d: k + d + d * n].reshape(d, n)
+    bias, mu, N = out[k + d + d * n: k + 2 * d + d * n], out[k + 2 * d + d * n], out[-1]
+    if mode == "slip":
+        return np.linalg.solve(M, f - mu * N * (J.T @ (vt / np.linalg.norm(vt)))), None
+    A = T @ J
+    m = A.shape[0]
+    big = np.zeros((n + m, n + m))
+    big[:n, :n], big[:n, n:], big[n:, :n] = M, -A.T, A
+    sol = np.linalg.solve(big, np.concatenate((f, -(T @ bias))))
+    return sol[:n], T.T @ sol[n:]
+
+
+@pytest.mark.parametrize("backend", ["llvm", "symengine", "sympy"])
+def test_the_right_hand_side_is_the_reference_to_the_bit(tmp_path, monkeypatch, backend):
+    """The kernel writing into a buffer, LAPACK's dgesv and sqrt(v·v) give what the compiled
+    function, np.linalg.solve and np.linalg.norm give, to the bit, with every compile
+    backend, sliding and stuck; a state evaluated last is reused only when it is the same."""
+    import functools
+
+    import mechbook.numerics.friction as friction
+    from mechbook.core.compile import compile_exprs
+
+    monkeypatch.setattr(friction, "compile_exprs",
+                        functools.partial(compile_exprs, backend=backend))
+    a = _analysis(tmp_path, DISK)
+    phases = Phases(a.system(), a.dynamics(), a.problem.values())
+    for y in np.random.default_rng(1).normal(size=(20, 4)):
+        t = float(y[0])
+        acc, _ = _reference(phases, t, y, "slip")
+        assert phases.rhs(t, y, ["slip"], [None]).tobytes() == np.concatenate(
+            (y[2:], acc)).tobytes()
+        acc, force = _reference(phases, t, y, "stick")
+        got, forces = phases._accelerations(t, y, ["stick"], [None])
+        assert got.tobytes() == acc.tobytes() and forces[0].tobytes() == force.tobytes()
+        kept = phases._out.copy()
+        phases._evaluate(t, y, reuse=True)
+        assert phases._out.tobytes() == kept.tobytes()
+        moved = y.copy()
+        moved[2] += 1.0
+        phases._evaluate(t, moved, reuse=True)  # not the last state: evaluated anew
+        assert phases._out.tobytes() == np.asarray(
+            phases._fn(np.concatenate(([t], moved))), float).tobytes()

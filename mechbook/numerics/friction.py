@@ -19,6 +19,8 @@ status, nfev, message), so the trajectory measurements use it unchanged
 
 from __future__ import annotations
 
+import ctypes
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,6 +29,8 @@ from scipy.integrate import solve_ivp as scipy_solve_ivp
 
 from mechbook.core.compile import as_expr, compile_exprs
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.model import _gesv
+from mechbook.numerics.native import kernel_pointer
 
 EPS = 1e-9  # a sliding speed this small (relative to the velocity scale) is a stop
 
@@ -46,6 +50,44 @@ class Result:
     @property
     def success(self) -> bool:
         return self.status >= 0
+
+
+def _norm(v: np.ndarray) -> float:
+    """np.linalg.norm of a vector, to the bit (it is sqrt(v·v) there too), without its
+    checks and dispatch: a few hundred ns instead of a microsecond."""
+    return math.sqrt(v.dot(v))
+
+
+def _same(a: float, b: float) -> bool:
+    """a and b the same float to the bit (0.0 and -0.0 told apart; NaN never the same)."""
+    return a == b and (a != 0.0 or math.copysign(1.0, a) == math.copysign(1.0, b))
+
+
+def _kernel(fn, x: np.ndarray, out: np.ndarray):
+    """fn(x) into `out`, as a function of nothing: the LLVM machine code behind a SymEngine
+    Lambdify (mechbook.numerics.native.kernel_pointer) called through ctypes with the two
+    buffers' addresses (~0.3 µs against ~2 µs through Lambdify's own wrapper: the same
+    code, the same numbers), else Lambdify writing into `out`; None for a backend that can
+    do neither (then `fn`'s result is copied)."""
+    raw = getattr(fn, "lambdify", None)
+    if raw is None:
+        return None
+    pointer = kernel_pointer(fn)
+    if pointer is not None:
+        address, user = pointer
+        call = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p)(address)
+        xa, oa = x.ctypes.data, out.ctypes.data
+        keep = (raw, x, out)  # the machine code's owner and the buffers live as long
+
+        def kernel(call=call, keep=keep):
+            call(oa, xa, user)
+
+        return kernel
+    try:  # not the LLVM backend: Lambdify's own call
+        raw(x, out=out)
+    except TypeError:
+        return None
+    return lambda: raw(x, out=out)
 
 
 def _tangent_basis(n: np.ndarray) -> np.ndarray:
@@ -97,59 +139,94 @@ class Phases:
         self._fn, _ = compile_exprs([system.t] + q + qd, exprs)
         self.nfev = 0
         self.eps = [0.0] * len(self.contacts)
+        # the compiled function writes into one buffer, of which M, f0 and every contact's
+        # v_t, J, Jᵀ and bias are views made once here (no slicing or reshaping per call);
+        # `_x` holds the (t, y) of the values in `_out` while `_fresh` is true. The kernel
+        # holds the two buffers' addresses: a Phases is built where it is used, never
+        # copied or pickled
+        n = self.n
+        self._x = np.zeros(1 + 2 * n)
+        self._out = out = np.zeros(len(exprs))
+        self._fresh = False
+        self._kernel = _kernel(self._fn, self._x, out)
+        self._M = out[: n * n].reshape(n, n)
+        self._f0 = out[n * n: n * n + n]
+        self._views = []
+        for _, d, k, T in self.contacts:
+            J = out[k + d: k + d + d * n].reshape(d, n)
+            self._views.append((out[k: k + d], J, J.T, out[k + d + d * n: k + 2 * d + d * n],
+                                k + 2 * d + d * n, T))
 
     # ---- pieces at a state ----------------------------------------------------------------
-    def _parts(self, t: float, y: np.ndarray):
-        n = self.n
-        out = np.asarray(self._fn(np.concatenate(([t], y))), float)
+    def _evaluate(self, t: float, y: np.ndarray, reuse: bool = False) -> None:
+        """The compiled expressions at (t, y), into the buffer `_out` (its views M, f0, ...
+        valid until the next call). With `reuse`, a (t, y) the last evaluation had to the
+        bit (an event at the state the integrator has just evaluated the right-hand side
+        at) keeps the values there, without a second compiled call: the same numbers, since
+        the function is deterministic."""
         self.nfev += 1
-        M = out[: n * n].reshape(n, n)
-        f0 = out[n * n: n * n + n]
-        contacts = []
-        for _, d, start, T in self.contacts:
-            k = start
-            vt = out[k: k + d]
-            J = out[k + d: k + d + d * n].reshape(d, n)
-            bias = out[k + d + d * n: k + 2 * d + d * n]
-            mu, N = out[k + 2 * d + d * n], out[k + 2 * d + d * n + 1]
-            contacts.append((vt, J, bias, mu, N, T))
-        return M, f0, contacts
+        x = self._x
+        if reuse and self._fresh and _same(t, float(x[0])) \
+                and np.asarray(y, float).tobytes() == x[1:].tobytes():
+            return
+        self._fresh = False
+        x[0] = t
+        x[1:] = y
+        if self._kernel is not None:
+            self._kernel()
+        else:
+            self._out[:] = self._fn(x)
+        self._fresh = True
 
-    def _accelerations(self, t, y, modes: list, directions: list):
-        """(q̈, the stuck contacts' tangential forces λ (Cartesian), the parts)."""
-        M, f0, contacts = self._parts(t, y)
-        f = f0.copy()
+    def _contacts(self) -> list:
+        """Per contact (v_t, J, bias, μ, N, T) of the last evaluation (views of the buffer)."""
+        out = self._out
+        return [(vt, J, bias, float(out[k]), float(out[k + 1]), T)
+                for vt, J, _, bias, k, T in self._views]
+
+    def _parts(self, t: float, y: np.ndarray, reuse: bool = False):
+        """M, f0 and the contacts' parts (`_contacts`) at (t, y): views of the buffer, valid
+        until the next evaluation (no caller keeps them longer)."""
+        self._evaluate(t, y, reuse)
+        return self._M, self._f0, self._contacts()
+
+    def _accelerations(self, t, y, modes: list, directions: list, reuse: bool = False):
+        """(q̈, the stuck contacts' tangential forces λ (Cartesian)); the parts at (t, y)
+        are left in the buffer (`_contacts`)."""
+        self._evaluate(t, y, reuse)
+        out, n = self._out, self.n
+        f = self._f0
         rows, rhs, stuck = [], [], []
-        for i, ((vt, J, bias, mu, N, T), mode) in enumerate(zip(contacts, modes, strict=True)):
+        for i, ((vt, J, JT, bias, k, T), mode) in enumerate(zip(self._views, modes,
+                                                                 strict=True)):
             if mode == "slip":
-                speed = np.linalg.norm(vt)
+                speed = _norm(vt)
                 # just released, or through a stop: the way it is pushed, until it moves
                 if directions[i] is not None and speed <= 10 * self.eps[i]:
                     u = directions[i]
                 else:
                     u = vt / speed if speed > 0 else np.zeros_like(vt)
-                f = f - mu * N * (J.T @ u)
+                f = f - out[k] * out[k + 1] * (JT @ u)  # new: the buffer's f0 is kept
             else:
                 rows.append(T @ J)
                 rhs.append(-(T @ bias))
                 stuck.append(i)
         if not rows:
-            return np.linalg.solve(M, f), {}, (M, f0, contacts)
+            return _gesv(self._M, f), {}
         A = np.vstack(rows)
         m = A.shape[0]
-        big = np.zeros((self.n + m, self.n + m))
-        big[: self.n, : self.n], big[: self.n, self.n:], big[self.n:, : self.n] = M, -A.T, A
-        sol = np.linalg.solve(big, np.concatenate((f, np.concatenate(rhs))))
-        lam, forces, k = sol[self.n:], {}, 0
+        big = np.zeros((n + m, n + m))
+        big[:n, :n], big[:n, n:], big[n:, :n] = self._M, -A.T, A
+        sol = _gesv(big, np.concatenate((f, np.concatenate(rhs))))
+        lam, forces, k = sol[n:], {}, 0
         for i in stuck:
-            T = contacts[i][5]
+            T = self._views[i][5]
             forces[i] = T.T @ lam[k: k + T.shape[0]]
             k += T.shape[0]
-        return sol[: self.n], forces, (M, f0, contacts)
+        return sol[:n], forces
 
     def rhs(self, t, y, modes, directions):
-        acc, _, _ = self._accelerations(t, y, modes, directions)
-        return np.concatenate((y[self.n:], acc))
+        return np.concatenate((y[self.n:], self._accelerations(t, y, modes, directions)[0]))
 
     # ---- modes ----------------------------------------------------------------------------
     def _decide(self, t, y, modes: list, eps: list) -> tuple[list, list]:
@@ -162,7 +239,8 @@ class Phases:
             if modes[i] == "slip" and np.linalg.norm(vt) <= 2 * eps[i]:  # the root's slack
                 modes[i] = "stick"
         for _ in range(len(modes) + 1):
-            _, forces, (_, _, contacts) = self._accelerations(t, y, modes, directions)
+            _, forces = self._accelerations(t, y, modes, directions)
+            contacts = self._contacts()
             # at the limit within the release event's root (1e-9 of μN) it lets go
             over = [(np.linalg.norm(F) / max(contacts[i][3] * contacts[i][4], 1e-300), i)
                     for i, F in forces.items()
@@ -195,15 +273,16 @@ class Phases:
         for i, mode in enumerate(modes):
             if mode == "slip":
                 def stop(t, y, i=i):
-                    _, _, contacts = self._parts(t, y)
-                    return np.linalg.norm(contacts[i][0]) - eps[i]
+                    self._evaluate(t, y, reuse=True)
+                    return _norm(self._views[i][0]) - eps[i]
 
                 stop.terminal, stop.direction = True, -1
                 events.append(stop)
             else:
                 def release(t, y, i=i):
-                    _, forces, (_, _, contacts) = self._accelerations(t, y, modes, directions)
-                    return contacts[i][3] * contacts[i][4] - np.linalg.norm(forces[i])
+                    _, forces = self._accelerations(t, y, modes, directions, reuse=True)
+                    _, _, _, _, k, _ = self._views[i]
+                    return float(self._out[k]) * float(self._out[k + 1]) - _norm(forces[i])
 
                 release.terminal, release.direction = True, -1
                 events.append(release)
