@@ -51,3 +51,39 @@ def test_nothing_is_left_armed():
             pass
     assert signal.getitimer(signal.ITIMER_VIRTUAL) == (0.0, 0.0)
     assert signal.getsignal(signal.SIGVTALRM) in (signal.SIG_DFL, 0)
+
+
+def test_a_limit_inside_a_spent_one_shot_limit_still_has_a_timer():
+    """A search catches the outer one-shot limit's Timeout and goes on; a limit opened after
+    that (an integral's 10 s) must still stop its block, not defer to the spent outer one
+    (which would leave the block unbounded: a SymPy integral that never finished)."""
+    with time_limit(0.2):
+        try:
+            spin(3)
+        except Timeout:
+            pass  # the outer limit's alarm, swallowed
+        start = cpu_time()
+        with pytest.raises(Timeout):
+            with time_limit(0.3):
+                spin(4)
+        assert cpu_time() - start < 1.5
+    assert signal.getitimer(signal.ITIMER_VIRTUAL) == (0.0, 0.0)
+    assert signal.getsignal(signal.SIGVTALRM) in (signal.SIG_DFL, 0)
+
+
+def test_an_entry_left_behind_does_not_disable_later_limits():
+    """An expired entry without an alarm (as a signal between the bookkeeping and the
+    block could leave) must not make every later limit of the process a no-op."""
+    from mechbook.core import timeout
+
+    timeout._ACTIVE.append((cpu_time() - 1.0, 0.0, object()))
+    try:
+        start = cpu_time()
+        with pytest.raises(Timeout):
+            with time_limit(0.3):
+                spin(4)
+        assert cpu_time() - start < 1.5
+    finally:
+        timeout._ACTIVE.clear()
+        signal.setitimer(signal.ITIMER_VIRTUAL, 0)
+        signal.signal(signal.SIGVTALRM, signal.SIG_DFL)

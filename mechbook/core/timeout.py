@@ -39,7 +39,7 @@ def cpu_time() -> float:
 
 
 # The limits now running, outermost first: (deadline in CPU seconds, repeat interval).
-_ACTIVE: list[tuple[float, float]] = []
+_ACTIVE: list[tuple[float, float, object]] = []
 
 
 def _raise(signum, frame):
@@ -61,30 +61,48 @@ def _arm(deadline: float, interval: float) -> None:
 def _limit(seconds: float, interval: float) -> Iterator[None]:
     """Nested limits: the inner one counts while it is the sooner; when it is left, the
     outer one's timer is set again to what remains of it (at once if it has run out, so
-    an inner `except Timeout` that swallowed the outer's alarm does not outlive it)."""
+    an inner `except Timeout` that swallowed the outer's alarm does not outlive it).
+
+    A limit that has run out with its alarm spent (a one-shot limit whose Timeout a search
+    caught and went on, or an entry a signal at the wrong moment left behind) no longer
+    governs: it is dropped, so a new limit inside it has a timer of its own. Without that,
+    every later limit of the process deferred to it and none was armed: an integral that
+    SymPy never finishes ran unbounded."""
     if math.isnan(seconds):  # NaN compares false with everything: it would be no limit
         raise ValueError("a time limit of NaN seconds")
     if seconds <= 0 or math.isinf(seconds) or not _usable():  # 0 or infinite: no limit
         yield
         return
-    deadline = cpu_time() + seconds
+    now = cpu_time()
+    deadline = now + seconds
+    with _quiet():
+        _drop_spent(now)
     if _ACTIVE and _ACTIVE[-1][0] <= deadline:
         yield  # an outer limit runs out first and governs
         return
+    entry = (deadline, interval, object())  # told apart by identity when it is left
     with _quiet():  # the bookkeeping is not interrupted by an outer limit's alarm
         previous = signal.signal(_SIGNAL, _raise) if not _ACTIVE else None
-        _ACTIVE.append((deadline, interval))
+        _ACTIVE.append(entry)
         _arm(deadline, interval)
     try:
         yield
     finally:
         with _quiet():
-            _ACTIVE.pop()
+            if any(e is entry for e in _ACTIVE):
+                _ACTIVE[:] = [e for e in _ACTIVE if e is not entry]
             if _ACTIVE:
-                _arm(*_ACTIVE[-1])
+                _arm(*_ACTIVE[-1][:2])
             else:
                 signal.setitimer(_TIMER, 0)
-                signal.signal(_SIGNAL, previous)
+                if previous is not None:
+                    signal.signal(_SIGNAL, previous)
+
+
+def _drop_spent(now: float) -> None:
+    """Drop the innermost limits that have run out while no alarm is pending for them."""
+    while _ACTIVE and _ACTIVE[-1][0] < now and signal.getitimer(_TIMER)[0] == 0:
+        _ACTIVE.pop()
 
 
 @contextmanager

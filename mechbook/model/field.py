@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from mechbook.core.timeout import Timeout, time_limit
+from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.model.expr import Operator
 
 INTEGRAL_SECONDS = 10
@@ -29,7 +29,7 @@ def _integral(x: sp.Symbol):
         from sympy.simplify.fu import TR8
 
         try:
-            with time_limit(INTEGRAL_SECONDS):
+            with hard_time_limit(INTEGRAL_SECONDS):
                 out = sp.integrate(sp.expand(TR8(sp.expand(f))), (x, lo, hi))
         except Timeout:
             raise ValueError(f"no closed form within {INTEGRAL_SECONDS} s") from None
