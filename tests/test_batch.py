@@ -18,6 +18,8 @@ from click.testing import CliRunner
 
 from mechbook.app.cli import main
 
+pytestmark = pytest.mark.slow  # worker-spawning batch runs
+
 ROOT = Path(__file__).resolve().parents[1]
 MECHBOOK = [sys.executable, "-m", "mechbook"]  # this tree's mechbook, whatever is installed
 

@@ -48,6 +48,7 @@ def test_version():
     assert __version__ in result.output
 
 
+@pytest.mark.slow
 def test_list():
     result = run("--root", str(ROOT), "list")
     assert result.exit_code == 0, result.output
@@ -67,6 +68,7 @@ def test_list_marks_invalid_files(tmp_path):
     assert "no answer key" in result.output
 
 
+@pytest.mark.slow
 def test_check_lim_2031_writes_store(tmp_path):
     path = tmp_path / "out.h5"
     result = run("--root", str(ROOT), "check", "lim-2031", "--store", str(path))
@@ -89,6 +91,7 @@ def test_check_lim_2031_writes_store(tmp_path):
     assert "a-lagrangian" in shown.output
 
 
+@pytest.mark.slow
 def test_check_no_store(tmp_path):
     path = tmp_path / "out.h5"
     result = run("--root", str(ROOT), "check", "lim-2031", "--store", str(path), "--no-store")
@@ -165,6 +168,7 @@ def test_validate_needs_a_file():
     assert result.exit_code != 0
 
 
+@pytest.mark.slow
 def test_solve(tmp_path):
     result = run("--root", str(ROOT), "solve", "lim-2031", "--no-simplify")
     assert result.exit_code == 0, result.output
@@ -179,6 +183,7 @@ def test_solve_unknown_problem():
     assert "Error" in result.output
 
 
+@pytest.mark.slow
 def test_every_committed_file_validates():
     """Every problem and answer file in the tree passes `validate` (a first integral written
     "... = constant" included)."""
