@@ -702,17 +702,6 @@ def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
 
 
 # ---- (b) the mutation test ------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def analyses() -> dict:
-    return {}
-
-
-def _analysis_for(analyses: dict, pid: str) -> Analysis:
-    if pid not in analyses:
-        analyses[pid] = Analysis(load_problem(problem_path(pid, ROOT)))
-    return analyses[pid]
-
-
 # The quick tier (`-m 'not slow'`) mutates a small fixed sample of answer keys: both books,
 # every chapter, and scalar, tensor, constraint-force, turning-point and stability
 # quantities; `make test` mutates every key.
@@ -731,9 +720,9 @@ assert QUICK_MUTANT_KEYS <= {f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES},
 
 
 @pytest.mark.parametrize("answer_file", [_mutation_param(p) for p in ANSWER_FILES])
-def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict):
+def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, repo_analysis):
     key = load_answers(answer_file)
-    analysis = _analysis_for(analyses, key.problem_id)
+    analysis = repo_analysis(key.problem_id)
     originals = check_problem(analysis, key)
     names = sorted(analysis.problem.parameters) + sorted(
         key.doc.data.get("abbreviations") or {})
@@ -844,8 +833,8 @@ def _part_of(pid: str, name: str, **changes) -> dict:
 
 
 @pytest.fixture(scope="module")
-def vessel_analysis() -> Analysis:
-    return Analysis(load_problem(ROOT / "problems" / "lim" / "2040.yaml"))
+def vessel_analysis(repo_analysis) -> Analysis:
+    return repo_analysis("lim-2040")
 
 
 @pytest.mark.parametrize("name", ["a-energy", "b"])
@@ -898,8 +887,8 @@ WRONG = "omega*sqrt(1 + g**2/(b**2*omega**4))"
 
 
 @pytest.fixture(scope="module")
-def hoop_analysis() -> Analysis:
-    return Analysis(load_problem(ROOT / "problems" / "lim" / "2031.yaml"))
+def hoop_analysis(repo_analysis) -> Analysis:
+    return repo_analysis("lim-2031")
 
 
 def test_erratum_whose_book_value_agrees_is_a_fail(tmp_path, hoop_analysis):

@@ -8,7 +8,6 @@ types) or the error message must be the same.
 from __future__ import annotations
 
 import random
-import sys
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,6 @@ from mechbook.model.fastyaml import fast_data
 from mechbook.model.limits import check_events
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
 
 
 def _typed(x):
