@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -125,12 +126,13 @@ parts:
 
 def test_check_exits_nonzero_on_fail(tmp_path):
     base = _tree_with_answer(tmp_path, WRONG_KEY)
-    result = run("--root", str(base), "check", "lim-2031", "--no-store")
+    result = run("--root", str(base), "check", "lim-2031", "--no-store", "--format", "json")
     assert result.exit_code == 1
-    rows = {ln.split()[1]: ln for ln in result.output.splitlines() if ln.startswith("lim-2031 ")}
-    assert " fail " in rows["wrong"]
-    assert " pass " in rows["right"]
-    assert "1 failure(s)" in result.output
+    (problem,) = json.loads(result.stdout)["problems"]
+    statuses = {p["part"]: p["status"] for p in problem["parts"]}
+    assert statuses["wrong"] == "fail"
+    assert statuses["right"] == "pass"
+    assert "1 failure(s)" in result.stderr
 
 
 def test_check_unknown_problem(tmp_path):
