@@ -22,7 +22,7 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 test: $(STAMP)   ## run the test suite (~15 min on two cores)
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
 
-test-quick: $(STAMP)  ## the suite without the slow tests (every answer key's 1 % mutants, moved relation boundaries)
+test-quick: $(STAMP)  ## the suite without the slow tests, for every change (~30 s, 1270 of 1689 tests, on two cores)
 	$(BIN)/python -m pytest -q -n auto -m 'not slow'
 
 # The oldest versions pyproject.toml's ranges allow (.ci/min_versions.py), mechbook itself

@@ -115,6 +115,7 @@ def test_choose_rules():
         accuracy.choose(0.0)
 
 
+@pytest.mark.slow
 def test_cli_accuracy_prints_method_and_expected_error(tmp_path):
     write(tmp_path, PENDULUM)
     runner = CliRunner()
@@ -221,6 +222,7 @@ def test_parameter_overrides_are_checked(two_masses):
     assert sim.values["k2"] == 6.0
 
 
+@pytest.mark.slow
 def test_hard_time_limit_outlasts_a_swallowed_timeout():
     """The fallback start's equilibrium search is bounded even though the engine catches a
     Timeout as its own limit and goes on (lim-2057/planar searched for 130 s that way)."""

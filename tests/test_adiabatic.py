@@ -85,12 +85,14 @@ def check(analysis, tmp_path, book, coordinate, slow, about):
     ("A*r", "fail"),
     ("A**4*r**3*theta", "fail"),         # not a law in the amplitude and r
 ])
+@pytest.mark.slow
 def test_pendulum_drawn_in(pendulum, tmp_path, book, status):
     got, detail = check(pendulum, tmp_path, book, "theta", {"r": ["s0", "s0/2"]},
                         {"theta": 0})
     assert got == status, detail
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("book, status", [
     ("A**4*k", "pass"),
     ("A**2*k", "fail"),                  # energy over stiffness is not kept
@@ -101,6 +103,7 @@ def test_spring_stiffening(spring, tmp_path, book, status):
     assert got == status, detail
 
 
+@pytest.mark.slow
 def test_simulated_slow_change_gives_the_closed_form_amplitude(pendulum, spring):
     """Independently of any answer key: the amplitude after the change against the
     closed forms A0·(r0/r1)^(3/4) and A0·(k0/k1)^(1/4), to the small-amplitude correction."""

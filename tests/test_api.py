@@ -53,6 +53,7 @@ def test_frequencies_about_a_named_point(hoop):
         hoop.frequencies(about={"theta": "__import__('os')"})
 
 
+@pytest.mark.slow
 def test_check_and_its_views(hoop):
     result = hoop.check(crosscheck=False)
     assert result.ok and result.error is None
@@ -98,6 +99,7 @@ def store(tmp_path_factory, hoop):
     return path, run, run.store(path, "test-run")
 
 
+@pytest.mark.slow
 def test_simulation_drift_and_store(store):
     path, run, where = store
     assert run.t[-1] == pytest.approx(3.0) and run.q.shape == (1, 301)

@@ -8,6 +8,7 @@ import json
 import shutil
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 
 from mechbook.app.cli import main
@@ -115,6 +116,7 @@ def test_validate_refuses_a_name_the_problem_does_not_declare(tmp_path):
         assert res.exit_code == 1 and needle in res.output, res.output
 
 
+@pytest.mark.slow
 def test_every_committed_answer_key_resolves_its_names():
     from mechbook.app.validate import validate_file
 

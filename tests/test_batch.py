@@ -3,6 +3,7 @@ after a kill, progress on a terminal, and one part's trouble kept in its part.""
 
 from __future__ import annotations
 
+import json
 import os
 import pty
 import shutil
@@ -17,6 +18,8 @@ import pytest
 from click.testing import CliRunner
 
 from mechbook.app.cli import main
+
+pytestmark = pytest.mark.slow  # worker-spawning batch runs
 
 ROOT = Path(__file__).resolve().parents[1]
 MECHBOOK = [sys.executable, "-m", "mechbook"]  # this tree's mechbook, whatever is installed
@@ -41,16 +44,19 @@ def test_parallel_run_matches_serial_run_and_keeps_the_given_order(tmp_path):
     ids = ["lim-2031", "lim-2028", "lim-2040"]
     base = tree(tmp_path, ids)
     runner = CliRunner()
-    par = runner.invoke(main, ["--root", str(base), "check", *ids, "-j", "2", "--no-store"])
-    ser = runner.invoke(main, ["--root", str(base), "check", *ids, "--serial", "--no-store"])
+    par = runner.invoke(main, ["--root", str(base), "check", *ids, "-j", "2", "--no-store",
+                               "--format", "json"])
+    ser = runner.invoke(main, ["--root", str(base), "check", *ids, "--serial", "--no-store",
+                               "--format", "json"])
     assert par.exit_code == 0 and ser.exit_code == 0, par.output + ser.output
 
-    def rows(out: str) -> list[str]:
-        return [" ".join(ln.split()[:4]) for ln in out.splitlines() if ln.startswith("lim-")]
+    def rows(out: str) -> list[tuple]:
+        return [(pr["id"], p["part"], p["quantity"], p["status"])
+                for pr in json.loads(out)["problems"] for p in pr["parts"]]
 
-    assert rows(par.output) == rows(ser.output)
-    firsts = [r.split()[0] for r in rows(par.output)]
-    assert sorted(set(firsts), key=firsts.index) == ids  # the table follows the given order
+    assert rows(par.stdout) == rows(ser.stdout)
+    firsts = [r[0] for r in rows(par.stdout)]
+    assert sorted(set(firsts), key=firsts.index) == ids  # the output follows the given order
 
 
 def test_a_problem_over_the_time_limit_is_an_error_naming_its_stage(tmp_path):

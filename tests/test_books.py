@@ -80,6 +80,7 @@ def run(*args: str):
     return CliRunner().invoke(main, list(args))
 
 
+@pytest.mark.slow
 def test_the_repository_declares_every_book_it_holds():
     declared = books(ROOT)
     assert {"lim", "symon"} <= set(declared)

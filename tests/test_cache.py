@@ -5,6 +5,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 
 from mechbook.app.cli import main
@@ -19,6 +20,7 @@ def _tree(tmp_path: Path) -> Path:
     return tmp_path
 
 
+@pytest.mark.slow
 def test_second_run_is_cached_and_a_changed_key_is_not(tmp_path):
     tree = _tree(tmp_path)
     runner = CliRunner()

@@ -702,22 +702,27 @@ def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
 
 
 # ---- (b) the mutation test ------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def analyses() -> dict:
-    return {}
+# The quick tier (`-m 'not slow'`) mutates a small fixed sample of answer keys: both books,
+# every chapter, and scalar, tensor, constraint-force, turning-point and stability
+# quantities; `make test` mutates every key.
+QUICK_MUTANT_KEYS = {"lim-2041", "symon-09-12", "symon-10-15", "symon-11-03", "symon-11-22",
+                     "symon-12-21"}
 
 
-def _analysis_for(analyses: dict, pid: str) -> Analysis:
-    if pid not in analyses:
-        analyses[pid] = Analysis(load_problem(problem_path(pid, ROOT)))
-    return analyses[pid]
+def _mutation_param(path: Path):
+    name = f"{path.parent.name}-{path.stem}"
+    marks = () if name in QUICK_MUTANT_KEYS else (pytest.mark.slow,)
+    return pytest.param(path, id=name, marks=marks)
 
 
-@pytest.mark.parametrize("answer_file", ANSWER_FILES,
-                         ids=[f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES])
-def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, analyses: dict):
+assert QUICK_MUTANT_KEYS <= {f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES}, \
+    "a key of the quick mutation sample is gone: pick another"
+
+
+@pytest.mark.parametrize("answer_file", [_mutation_param(p) for p in ANSWER_FILES])
+def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, repo_analysis):
     key = load_answers(answer_file)
-    analysis = _analysis_for(analyses, key.problem_id)
+    analysis = repo_analysis(key.problem_id)
     originals = check_problem(analysis, key)
     names = sorted(analysis.problem.parameters) + sorted(
         key.doc.data.get("abbreviations") or {})
@@ -828,8 +833,8 @@ def _part_of(pid: str, name: str, **changes) -> dict:
 
 
 @pytest.fixture(scope="module")
-def vessel_analysis() -> Analysis:
-    return Analysis(load_problem(ROOT / "problems" / "lim" / "2040.yaml"))
+def vessel_analysis(repo_analysis) -> Analysis:
+    return repo_analysis("lim-2040")
 
 
 @pytest.mark.parametrize("name", ["a-energy", "b"])
@@ -882,8 +887,8 @@ WRONG = "omega*sqrt(1 + g**2/(b**2*omega**4))"
 
 
 @pytest.fixture(scope="module")
-def hoop_analysis() -> Analysis:
-    return Analysis(load_problem(ROOT / "problems" / "lim" / "2031.yaml"))
+def hoop_analysis(repo_analysis) -> Analysis:
+    return repo_analysis("lim-2031")
 
 
 def test_erratum_whose_book_value_agrees_is_a_fail(tmp_path, hoop_analysis):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -48,6 +49,7 @@ def test_version():
     assert __version__ in result.output
 
 
+@pytest.mark.slow
 def test_list():
     result = run("--root", str(ROOT), "list")
     assert result.exit_code == 0, result.output
@@ -67,6 +69,7 @@ def test_list_marks_invalid_files(tmp_path):
     assert "no answer key" in result.output
 
 
+@pytest.mark.slow
 def test_check_lim_2031_writes_store(tmp_path):
     path = tmp_path / "out.h5"
     result = run("--root", str(ROOT), "check", "lim-2031", "--store", str(path))
@@ -89,6 +92,7 @@ def test_check_lim_2031_writes_store(tmp_path):
     assert "a-lagrangian" in shown.output
 
 
+@pytest.mark.slow
 def test_check_no_store(tmp_path):
     path = tmp_path / "out.h5"
     result = run("--root", str(ROOT), "check", "lim-2031", "--store", str(path), "--no-store")
@@ -122,12 +126,13 @@ parts:
 
 def test_check_exits_nonzero_on_fail(tmp_path):
     base = _tree_with_answer(tmp_path, WRONG_KEY)
-    result = run("--root", str(base), "check", "lim-2031", "--no-store")
+    result = run("--root", str(base), "check", "lim-2031", "--no-store", "--format", "json")
     assert result.exit_code == 1
-    rows = {ln.split()[1]: ln for ln in result.output.splitlines() if ln.startswith("lim-2031 ")}
-    assert " fail " in rows["wrong"]
-    assert " pass " in rows["right"]
-    assert "1 failure(s)" in result.output
+    (problem,) = json.loads(result.stdout)["problems"]
+    statuses = {p["part"]: p["status"] for p in problem["parts"]}
+    assert statuses["wrong"] == "fail"
+    assert statuses["right"] == "pass"
+    assert "1 failure(s)" in result.stderr
 
 
 def test_check_unknown_problem(tmp_path):
@@ -165,6 +170,7 @@ def test_validate_needs_a_file():
     assert result.exit_code != 0
 
 
+@pytest.mark.slow
 def test_solve(tmp_path):
     result = run("--root", str(ROOT), "solve", "lim-2031", "--no-simplify")
     assert result.exit_code == 0, result.output
@@ -179,6 +185,7 @@ def test_solve_unknown_problem():
     assert "Error" in result.output
 
 
+@pytest.mark.slow
 def test_every_committed_file_validates():
     """Every problem and answer file in the tree passes `validate` (a first integral written
     "... = constant" included)."""

@@ -12,11 +12,14 @@ import threading
 from pathlib import Path
 
 import h5py
+import pytest
 from click.testing import CliRunner
 
 from mechbook.app import store
 from mechbook.app.cli import main
 from mechbook.records import Outcome
+
+pytestmark = pytest.mark.slow  # concurrent check processes and writers
 
 ROOT = Path(__file__).resolve().parents[1]
 # quick problems (about a second each), paired so both runs write at about the same time

@@ -151,6 +151,7 @@ def test_crosscheck_roundtrip_dict():
     assert x.cell() == "pass 1e-16" and not x.failed
 
 
+@pytest.mark.slow
 def test_check_table_has_the_column_and_a_crosscheck_fail_exits_1(monkeypatch):
     runner = CliRunner()
     res = runner.invoke(main, ["--root", str(ROOT), "check", "lim-2031", "--no-store"])
@@ -189,6 +190,7 @@ def test_conserved_by_simulation_passes_a_true_integral_and_fails_a_false_one(tm
     assert results["wrong"].status == "fail"
 
 
+@pytest.mark.slow
 def test_independent_kinematics_agree_with_the_engine_and_catch_a_wrong_one():
     """The Newton check's own kinematics (ω from Rᵀ·dR/dt, inertia by integration over the
     shape) agree with the engine's closed forms for every standard shape — and would

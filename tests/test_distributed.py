@@ -22,6 +22,8 @@ from mechbook.app.sweep import make_spec, run_sweep  # noqa: E402
 from mechbook.engine.sweep import parse_axis  # noqa: E402
 from mechbook.errors import MechbookError  # noqa: E402
 
+pytestmark = pytest.mark.slow  # a Dask cluster
+
 ROOT = Path(__file__).resolve().parents[1]
 TREE = Path(__file__).resolve().parent / "sweeptree"
 

@@ -8,7 +8,6 @@ types) or the error message must be the same.
 from __future__ import annotations
 
 import random
-import sys
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,6 @@ from mechbook.model.fastyaml import fast_data
 from mechbook.model.limits import check_events
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
 
 
 def _typed(x):
@@ -54,6 +52,7 @@ def _new(text: str):
         return ("error", str(exc))
 
 
+@pytest.mark.slow
 def test_every_committed_file_is_read_fast_and_the_same():
     files = [*sorted(ROOT.glob("problems/*/*.yaml")), *sorted(ROOT.glob("answers/*/*.yaml")),
              ROOT / "books.yaml"]
@@ -96,6 +95,7 @@ def test_lines_are_found_when_an_error_needs_them():
     assert err.line == 4 and str(err).startswith("f.yaml:4: b/d: bad")
 
 
+@pytest.mark.slow
 def test_mutated_and_hostile_files_read_the_same_both_ways():
     import fuzz
 

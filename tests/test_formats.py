@@ -147,6 +147,7 @@ def test_cli_answers_without_the_engine(args):
     assert _imported_after(code) == []
 
 
+@pytest.mark.slow
 def test_import_mechbook_is_light_and_load_is_lazy():
     assert _imported_after("import mechbook\nmechbook.__version__") == []
     assert "sympy" in _imported_after("import mechbook\nmechbook.load")

@@ -18,6 +18,7 @@ from mechbook.model.expr import parse
 SAMPLE = 120  # cases in `make test` (all kinds); `make fuzz` runs 10,000
 
 
+@pytest.mark.slow
 def test_a_sample_of_the_fuzz_run_has_no_traceback_hang_or_bomb(tmp_path):
     results = fuzz(SAMPLE, seed=20260101, jobs=2, keep=tmp_path / "kept", chunk=SAMPLE)
     assert len(results) == SAMPLE
@@ -28,6 +29,7 @@ def test_a_sample_of_the_fuzz_run_has_no_traceback_hang_or_bomb(tmp_path):
     assert {"ok", "refused"} <= statuses  # the generator makes good and bad files
 
 
+@pytest.mark.slow
 def test_every_kind_is_generated_and_deterministic():
     pool = seeds()
     cases = [generate(i, 5, pool, list(KINDS)) for i in range(400)]
@@ -36,6 +38,7 @@ def test_every_kind_is_generated_and_deterministic():
     assert again.files == cases[17].files and again.kind == cases[17].kind
 
 
+@pytest.mark.slow
 def test_the_harness_reports_a_hang_and_a_crash(tmp_path, monkeypatch):
     """The harness can fail: a case that runs past the limit on the real batch machinery is
     a hang, one that raises a plain exception is a crash, one that raises a MechbookError
@@ -138,6 +141,7 @@ def test_the_store_kind_reports_silent_data_loss(tmp_path, monkeypatch):
     assert status == "lost" and "not stored and not kept" in message
 
 
+@pytest.mark.slow
 def test_the_symlink_kind_reports_a_leak(tmp_path, monkeypatch):
     """Problem files followed wherever their links go: the marker outside is read."""
     import fuzz_faults as faults

@@ -16,6 +16,8 @@ from pathlib import Path
 import pytest
 from hostile import ROOT
 
+pytestmark = pytest.mark.slow  # kills real worker-spawning runs
+
 GRACE = 2.0  # seconds the issue allows
 
 

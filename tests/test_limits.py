@@ -108,6 +108,7 @@ def test_billion_laughs_is_refused_in_well_under_two_seconds(tmp_path):
     assert f"{path}:1:" in out  # the first anchor's line
 
 
+@pytest.mark.slow
 def test_billion_laughs_from_a_fresh_process(tmp_path):
     """The whole command, interpreter start and imports included (the unfixed loader ran
     until killed)."""
@@ -500,6 +501,7 @@ def test_zero_to_a_symbolic_power_does_not_crash_the_numeric_zero_test(tmp_path)
     assert "Traceback" not in res.output and res.exit_code in (0, 1)
 
 
+@pytest.mark.slow
 def test_a_recursion_error_in_the_numeric_zero_test_is_not_a_crash(tmp_path, monkeypatch):
     """make fuzz, cases 9216 and 9482: positions such as
     -acosh(Abs(exp(exp(1/2))/(k/s1 + 2 - t))) made mpmath/SymPy recurse past Python's
@@ -546,6 +548,7 @@ def _ringed_planet_off_its_circle(tmp_path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_an_average_that_is_not_a_trig_polynomial_is_refused_within_seconds(tmp_path):
     from mechbook.app.validate import validate_file
 
@@ -557,6 +560,7 @@ def test_an_average_that_is_not_a_trig_polynomial_is_refused_within_seconds(tmp_
     assert time.process_time() - start < 15  # was 63 s before the polynomial test
 
 
+@pytest.mark.slow
 def test_validate_bounds_its_own_cpu_time(tmp_path, monkeypatch):
     from mechbook.app import validate
 
@@ -571,6 +575,7 @@ def test_validate_bounds_its_own_cpu_time(tmp_path, monkeypatch):
     assert time.process_time() - start < 3
 
 
+@pytest.mark.slow
 def test_an_orbit_on_a_circle_averages_as_a_trig_polynomial(monkeypatch):
     """sqrt(r²cos²α + r²sin²α) is r: the ringed planet's averages need no integral."""
     from mechbook.model import loads

@@ -3,6 +3,7 @@ and errors that name the file and the line."""
 
 from __future__ import annotations
 
+import json
 import textwrap
 from pathlib import Path
 
@@ -299,9 +300,12 @@ def test_hostile_answer_key_rejected(tmp_path, no_pwned):
     assert result.exit_code == 1
     assert f"{key}:{line_of(key, 'book: ')}" in result.output
     result = CliRunner().invoke(main, ["--root", str(tmp_path), "check", "lim-2031",
-                                       "--no-store"])
+                                       "--no-store", "--format", "json"])
     assert result.exit_code == 1
-    rows = {ln.split()[1]: ln for ln in result.output.splitlines() if ln.startswith("lim-2031 ")}
-    assert " error " in rows["a"] and f"{key}:{line_of(key, 'book: ')}" in rows["a"]
-    assert " error " in rows["b"] and f"{key}:{line_of(key, '__class__')}" in rows["b"]
+    (problem,) = json.loads(result.stdout)["problems"]
+    parts = {p["part"]: p for p in problem["parts"]}
+    assert parts["a"]["status"] == "error"
+    assert f"{key}:{line_of(key, 'book: ')}" in parts["a"]["detail"]
+    assert parts["b"]["status"] == "error"
+    assert f"{key}:{line_of(key, '__class__')}" in parts["b"]["detail"]
     assert not marker.exists()

@@ -105,6 +105,7 @@ def test_a_sign_in_the_potential_is_a_message_not_a_name_error(tmp_path):
     assert modes and all(x.status == "n.a." and "DiracDelta" in x.detail for x in modes)
 
 
+@pytest.mark.slow
 def test_validating_an_answer_key_is_time_limited_like_its_problem(tmp_path, monkeypatch):
     """The issue: an answer key whose problem holds diff(diff(diff(diff(tan(x),x,6)...)))
     validated for over 10 minutes (the problem alone was stopped at 15 s)."""

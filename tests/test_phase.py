@@ -165,6 +165,7 @@ def test_oscillator_area(tmp_path, book, status):
     assert out.status == status, (out.status, out.detail)
 
 
+@pytest.mark.slow
 def test_oscillator_region(tmp_path):
     an = analysis(tmp_path, OSCILLATOR)
     wrong = [OSC_BOOK[0].replace("- p_x*sin", "+ p_x*sin"), OSC_BOOK[1]]
@@ -195,6 +196,7 @@ def _run_doc(tmp_path, an, doc, part, **changes):
     return check_problem(an, load_answers(path))[0]
 
 
+@pytest.mark.slow
 def test_free_fall_symon_9_33(tmp_path):
     an, doc = _symon_33()
     assert _run_doc(tmp_path, an, doc, "region").status == "pass"
@@ -249,6 +251,7 @@ def test_damped_region_is_found(tmp_path):
 
 
 
+@pytest.mark.slow
 def test_two_degrees_of_freedom_region(tmp_path):
     """A projectile in the plane: the 4-dimensional box is sheared in x and y and shifted
     in p_y; a region check runs in n = 2, and the area check says it needs n = 1."""

@@ -25,6 +25,8 @@ from test_books import third_book_tree
 
 from mechbook.app.cli import main
 
+pytestmark = pytest.mark.slow  # builds a whole report of the repository; browser checks
+
 ROOT = Path(__file__).resolve().parents[1]
 ARTIFACTS = ROOT / "results" / "test-artifacts" / "report"
 CHROMIUM = Path("/usr/bin/chromium")

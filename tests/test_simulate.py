@@ -99,6 +99,7 @@ def test_fallback_start_near_a_stable_equilibrium():
     assert any("no initial conditions" in n for n in sim.notes)
 
 
+@pytest.mark.slow
 def test_cli_simulate_done_criterion(tmp_path):
     """`mechbook simulate lim-2031 --method DOP853 --rtol 1e-10 --plot out.png` plots,
     stores the trajectory and prints the energy-function drift."""
@@ -117,6 +118,7 @@ def test_cli_simulate_done_criterion(tmp_path):
     assert rec["attrs"]["rhs_backend"] == "llvm"
 
 
+@pytest.mark.slow
 def test_cli_symplectic_method_refused_when_not_separable(tmp_path):
     res = CliRunner().invoke(main, ["--root", str(ROOT), "simulate", "lim-2036", "--method",
                                     "leapfrog", "--init", "theta1=0.2", "--no-store"])
@@ -128,6 +130,7 @@ def test_cli_symplectic_method_refused_when_not_separable(tmp_path):
     assert "drift of energy_function" in res.output
 
 
+@pytest.mark.slow
 def test_check_run_keeps_simulations_and_simulation_keeps_checks(tmp_path):
     h5 = tmp_path / "m.h5"
     for p in ("problems/lim/2031.yaml", "answers/lim/2031.yaml"):

@@ -47,6 +47,7 @@ def test_uniform_string_is_exact(tmp_path):
     assert w == pytest.approx(exact, rel=1e-13)
 
 
+@pytest.mark.slow
 def test_truncation_accuracy_for_the_density_bump(tmp_path):
     """sigma0 + alpha*sin(pi*x/l) with alpha = 0.3*sigma0: the lowest frequency with 8 modes
     against 16 modes (the problem file of Symon 12-19 uses 8)."""

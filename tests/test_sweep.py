@@ -263,6 +263,7 @@ def test_store_and_netcdf_keep_named_dimensions(tmp_path):
         write_store(result, "../x", tmp_path / "store.h5")
 
 
+@pytest.mark.slow
 def test_sweep_command_prints_stores_and_plots(tmp_path):
     plot = tmp_path / "map.png"
     store = tmp_path / "store.h5"

@@ -208,6 +208,7 @@ parts:
 """
 
 
+@pytest.mark.slow
 def test_a_problem_without_a_system_loads_checks_stores_and_is_listed(tmp_path):
     tree(tmp_path, "10-94", BODY, KEY)
     problem = load_problem(tmp_path / "problems" / "symon" / "10-94.yaml")

@@ -31,6 +31,7 @@ def test_an_inner_limit_shorter_than_the_outer_one_governs():
     assert 0.15 < inner < 1.0, inner
 
 
+@pytest.mark.slow
 def test_the_outer_limit_survives_an_inner_search_that_swallows_its_alarm():
     for inner in (0.1, 10):  # shorter than the outer limit, and longer
         start = cpu_time()

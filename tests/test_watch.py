@@ -19,6 +19,8 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 CHECKED = re.compile(r"checked in ([0-9.]+) s, CPU ([0-9.]+) s")
 
@@ -52,6 +54,7 @@ def _until(lines: queue.Queue, pattern: str, seen: list[str], timeout: float = 1
     raise AssertionError(f"no line matching {pattern!r}; output:\n" + "\n".join(seen))
 
 
+@pytest.mark.slow
 def test_watch_rechecks_on_every_save_within_a_second_of_cpu(tmp_path):
     tree = _tree(tmp_path)
     key = tree / "answers" / "lim" / "2031.yaml"
