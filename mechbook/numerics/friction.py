@@ -29,7 +29,7 @@ from scipy.integrate import solve_ivp as scipy_solve_ivp
 
 from mechbook.core.compile import as_expr, compile_exprs
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.model import _gesv
+from mechbook.numerics.lapack import solve_small as _gesv
 from mechbook.numerics.native import kernel_pointer
 
 EPS = 1e-9  # a sliding speed this small (relative to the velocity scale) is a stop

@@ -17,7 +17,6 @@ from functools import cached_property
 
 import numpy as np
 import sympy as sp
-from scipy.linalg.lapack import dgesv as _DGESV
 
 from mechbook.core.compile import (
     BACKENDS,
@@ -28,6 +27,7 @@ from mechbook.core.compile import (
     compile_exprs,
 )
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.lapack import solve_small as _gesv
 
 
 @dataclass
@@ -201,16 +201,6 @@ class Model:
             return np.array([self.momenta(tk, q[:, k], qd[:, k])
                              for k, tk in enumerate(t)]).T.reshape(self.n, len(t))
         return self._momenta_fn(_points(t, q, qd)).T
-
-
-def _gesv(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """np.linalg.solve(a, b) for one small system: the same LAPACK routine (dgesv, the same
-    result to the bit), called without NumPy's generalized-ufunc set-up, which costs twice
-    the solve itself at n = 2 or 3, on every right-hand side an integrator asks for."""
-    _, _, x, info = _DGESV(a, b)
-    if info:
-        raise np.linalg.LinAlgError("Singular matrix")
-    return x
 
 
 @dataclass
