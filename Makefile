@@ -19,7 +19,7 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 	-$(BIN)/mechbook check  # a failing part is shown in the report, not an end to it
 	$(BIN)/mechbook report
 
-test: $(STAMP)   ## run the test suite (~15 min on two cores)
+test: $(STAMP)   ## run the whole test suite (~7 min on two cores)
 	$(BIN)/python -m pytest -q -n auto  # the mutation test is long; one worker per core
 
 test-quick: $(STAMP)  ## the suite without the slow tests, for every change (~30 s, 1270 of 1689 tests, on two cores)

@@ -4,6 +4,9 @@ survives an inner search that swallows its alarm, and nothing is left armed."""
 from __future__ import annotations
 
 import signal
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -54,37 +57,60 @@ def test_nothing_is_left_armed():
     assert signal.getsignal(signal.SIGVTALRM) in (signal.SIG_DFL, 0)
 
 
+# The two below run in a fresh interpreter: what they test is the state a process is left
+# in, which the tests run before them in the same worker must not decide.
+SPENT = """
+import signal, sys
+sys.path.insert(0, {tests!r})
+from test_timeout import spin
+from mechbook.core import timeout
+from mechbook.core.timeout import Timeout, cpu_time, time_limit
+{setup}
+start = cpu_time()
+try:
+    with time_limit(0.3):
+        spin(4)
+except Timeout:
+    used = cpu_time() - start
+    print("timeout", used)
+    sys.exit(0 if used < 1.5 and signal.getitimer(signal.ITIMER_VIRTUAL) == (0.0, 0.0) else 3)
+print("no timeout")
+sys.exit(2)
+"""
+
+
+def _fresh(setup: str) -> subprocess.CompletedProcess:
+    code = SPENT.format(tests=str(Path(__file__).parent), setup=setup)
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+
+
 def test_a_limit_inside_a_spent_one_shot_limit_still_has_a_timer():
     """A search catches the outer one-shot limit's Timeout and goes on; a limit opened after
     that (an integral's 10 s) must still stop its block, not defer to the spent outer one
     (which would leave the block unbounded: a SymPy integral that never finished)."""
-    with time_limit(0.2):
-        try:
-            spin(3)
-        except Timeout:
-            pass  # the outer limit's alarm, swallowed
-        start = cpu_time()
-        with pytest.raises(Timeout):
-            with time_limit(0.3):
-                spin(4)
-        assert cpu_time() - start < 1.5
-    assert signal.getitimer(signal.ITIMER_VIRTUAL) == (0.0, 0.0)
-    assert signal.getsignal(signal.SIGVTALRM) in (signal.SIG_DFL, 0)
+    setup = """
+outer = time_limit(0.2)
+outer.__enter__()
+try:
+    spin(3)
+except Timeout:
+    pass  # the outer limit's alarm, swallowed; the outer block goes on
+"""
+    res = _fresh(setup)
+    assert res.returncode == 0, res.stdout + res.stderr
 
 
 def test_an_entry_left_behind_does_not_disable_later_limits():
     """An expired entry without an alarm (as a signal between the bookkeeping and the
     block could leave) must not make every later limit of the process a no-op."""
-    from mechbook.core import timeout
+    res = _fresh("timeout._ACTIVE.append((cpu_time() - 1.0, 0.0, object()))")
+    assert res.returncode == 0, res.stdout + res.stderr
 
-    timeout._ACTIVE.append((cpu_time() - 1.0, 0.0, object()))
-    try:
-        start = cpu_time()
-        with pytest.raises(Timeout):
-            with time_limit(0.3):
-                spin(4)
-        assert cpu_time() - start < 1.5
-    finally:
-        timeout._ACTIVE.clear()
-        signal.setitimer(signal.ITIMER_VIRTUAL, 0)
-        signal.signal(signal.SIGVTALRM, signal.SIG_DFL)
+
+def test_a_timer_of_ours_left_running_is_taken_over():
+    """Our handler installed and the timer running with no limit open (left behind): the
+    next limit takes the timer over instead of running without one."""
+    res = _fresh("signal.signal(signal.SIGVTALRM, timeout._raise)\n"
+                 "signal.setitimer(signal.ITIMER_VIRTUAL, 500.0)")
+    assert res.returncode == 0, res.stdout + res.stderr

@@ -47,10 +47,12 @@ def _raise(signum, frame):
 
 
 def _usable() -> bool:
-    """A limit can be set: POSIX, main thread, and the timer not held by someone else."""
+    """A limit can be set: POSIX, main thread, and the timer not held by someone else (a
+    timer left running with our own handler installed is ours, left behind: taken over)."""
     if _TIMER is None or threading.current_thread() is not threading.main_thread():
         return False
-    return bool(_ACTIVE) or signal.getitimer(_TIMER)[0] == 0
+    return (bool(_ACTIVE) or signal.getitimer(_TIMER)[0] == 0
+            or signal.getsignal(_SIGNAL) is _raise)
 
 
 def _arm(deadline: float, interval: float) -> None:
