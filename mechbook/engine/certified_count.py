@@ -142,7 +142,7 @@ def _root_inside(g, x, h, lo, hi, boxes, dens, unknowns) -> int | None:
         if lo == hi:
             return None
         mid = (lo + hi) / 2
-        if poly.eval(mid) == 0:
+        if poly(mid) == 0:  # the polynomial's value at the midpoint (exact rationals)
             lo = hi = mid
         elif poly.count_roots(lo, mid) == 1:
             hi = mid

@@ -41,7 +41,11 @@ class Translator:
         self._memo: dict[sp.Basic, object] = {}
 
     def __call__(self, e: sp.Basic):
-        return self.walk(sp.sympify(e) if not isinstance(e, sp.Basic) else e)
+        if isinstance(e, sp.Basic):
+            return self.walk(e)
+        if isinstance(e, (int, float)) and not isinstance(e, bool):  # a bare number
+            return self.number(e)
+        raise TypeError(f"not a SymPy expression: {type(e).__name__} (never parsed as text)")
 
     def number(self, x) -> object:
         return self.hy.expression(float(x))

@@ -154,6 +154,23 @@ class Context:
             return val
         raise self.part.error(sub, "expected a mapping")
 
+    def initial(self) -> tuple[dict[int, sp.Expr], dict[int, sp.Expr]]:
+        """The part's `initial:` as ({coordinate index: value}, {index: velocity}): keys are
+        coordinates (x) and their velocities (xdot); anything else is an error at its key."""
+        init = self.as_map(self.part.data["initial"], ("initial",))
+        names = list(self.system.coord_names)
+        q0, v0 = {}, {}
+        for k, text in init.items():
+            x = self.parse(text, ("initial", k))
+            if k in names:
+                q0[names.index(k)] = x
+            elif k.endswith("dot") and k[:-3] in names:
+                v0[names.index(k[:-3])] = x
+            else:
+                raise self.part.error(("initial", k), "initial values are given for "
+                                      "coordinates (x) and their velocities (xdot)")
+        return q0, v0
+
     def mode_shape(self, shape, sub) -> sp.Matrix:
         """A mode shape over the linear system's coordinates (a steady motion reduced by
         Routh has lost its cyclic ones); a coordinate left out is 0. On a constraint

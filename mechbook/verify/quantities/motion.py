@@ -96,7 +96,7 @@ def check_motion(ctx: Context, val) -> Verdict:
     funcs = _time_functions(ctx, val, ("book",))
     if "initial" not in ctx.part.data:
         return _residual_of_motion(ctx, lin, funcs)
-    init = ctx.as_map(ctx.part.data["initial"], ("initial",))
+    given_q, given_v = ctx.initial()
     sys = ctx.system
     define = ctx.part.data.get("define") or {}
     forms = {k: ctx.parse(v, ("define", k)) for k, v in define.items()}
@@ -106,15 +106,10 @@ def check_motion(ctx: Context, val) -> Verdict:
         pt = ctx.sampler.draw()
         q0 = np.zeros(len(sys.q))
         v0 = np.zeros(len(sys.q))
-        for k, text in init.items():
-            x = numbers([ctx.parse(text, ("initial", k))], pt)[0]
-            if k in sys.coord_names:
-                q0[sys.coord_names.index(k)] = x
-            elif k.endswith("dot") and k[:-3] in sys.coord_names:
-                v0[sys.coord_names.index(k[:-3])] = x
-            else:
-                raise ctx.part.error(("initial", k), "initial values are given for coordinates "
-                                     "(x) and their velocities (xdot)")
+        for i, x in given_q.items():
+            q0[i] = numbers([x], pt)[0]
+        for i, x in given_v.items():
+            v0[i] = numbers([x], pt)[0]
         eq0 = np.array(numbers([lin.point.get(q, 0) for q in sys.q], pt))
         turn = np.array(numbers([sp.S(lin.velocity.get(q, 0)) for q in sys.q], pt))  # steady rates
         path = response.motion(lin, pt, q0 - eq0, v0 - turn, times)

@@ -44,18 +44,10 @@ def linear_motion(ctx: Context, pt: dict) -> LinearMotion:
     if "initial" not in ctx.part.data:
         raise ctx.part.error((), "a motion needs `initial:` (coordinates and velocities at "
                              "t = 0; the others at the equilibrium, at rest)")
-    init = ctx.as_map(ctx.part.data["initial"], ("initial",))
     eq = [sp.S(lin.point.get(q, 0)) for q in sys.q]
-    q0, v0 = list(eq), [sp.S.Zero] * len(sys.q)
-    for k, text in init.items():
-        x = ctx.parse(text, ("initial", k))
-        if k in sys.coord_names:
-            q0[sys.coord_names.index(k)] = x
-        elif k.endswith("dot") and k[:-3] in sys.coord_names:
-            v0[sys.coord_names.index(k[:-3])] = x
-        else:
-            raise ctx.part.error(("initial", k), "initial values are given for coordinates "
-                                 "(x) and their velocities (xdot)")
+    given_q, given_v = ctx.initial()
+    q0 = [given_q.get(i, e) for i, e in enumerate(eq)]
+    v0 = [given_v.get(i, sp.S.Zero) for i in range(len(sys.q))]
     if lin.coord_names != list(sys.coord_names):
         raise ctx.part.error(("initial",), "a part's energy along a motion needs every "
                              "coordinate in the linear system (no constraint or reduction)")
