@@ -66,3 +66,23 @@ def euler_lagrange(L: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
         raise
     except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
         raise Unsupported(str(exc)) from None
+
+
+def total_derivative(expr: sp.Basic, t: sp.Symbol,
+                     chains: Sequence[tuple[sp.Symbol, sp.Symbol]]) -> sp.Basic:
+    """∂expr/∂t + Σ ẋ·∂expr/∂x over `chains` [(x, ẋ), ...], not expanded. Raises
+    Unsupported where SymEngine cannot do it (then the caller differentiates with SymPy)."""
+    names = set(expr.free_symbols) | {t} | {s for pair in chains for s in pair}
+    try:
+        e = se.sympify(expr)
+        present = e.free_symbols
+        out = e.diff(se.sympify(t))
+        for x, v in chains:
+            sx = se.sympify(x)
+            if sx in present:
+                out += e.diff(sx) * se.sympify(v)
+        return to_sympy(out, names)
+    except Unsupported:
+        raise
+    except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
+        raise Unsupported(str(exc)) from None

@@ -6,6 +6,9 @@ not asked for ("the engine computes only what the problem asks for").
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TypeVar
+
 import sympy as sp
 
 from mechbook.core.numeval import is_zero
@@ -17,6 +20,8 @@ from mechbook.errors import UnsupportedError
 from mechbook.model.problem import Problem
 from mechbook.model.system import System, system_of
 
+T = TypeVar("T")
+
 
 class Analysis:
     def __init__(self, problem: Problem, simplify: bool = False):
@@ -25,6 +30,7 @@ class Analysis:
         self._dyn: dict[str, Dynamics] = {}
         self._eq: dict[str, Equilibria] = {}
         self._lin: dict[tuple, LinearSystem] = {}
+        self._reused: dict[tuple, object] = {}
 
     def system(self, name: str | None = None) -> System:
         return system_of(self.problem, name)
@@ -34,6 +40,14 @@ class Analysis:
         if sys.name not in self._dyn:
             self._dyn[sys.name] = Dynamics(sys, self.simplify)
         return self._dyn[sys.name]
+
+    def reuse(self, key: tuple, compute: Callable[[], T]) -> T:
+        """compute() once per analysis for `key` (which must name everything the result
+        depends on): two parts that ask the same question of the same motion (its event
+        time, and how far a coordinate has moved by then) share one integration."""
+        if key not in self._reused:
+            self._reused[key] = compute()
+        return self._reused[key]  # type: ignore[return-value]
 
     def equilibria(self, name: str | None = None) -> Equilibria:
         sys = self.system(name)

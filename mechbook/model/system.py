@@ -14,6 +14,8 @@ import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
 from mechbook.core.numeval import is_zero, without_absent
+from mechbook.core.secalc import Unsupported as SymEngineCannot
+from mechbook.core.secalc import total_derivative
 from mechbook.errors import UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
@@ -406,6 +408,16 @@ class System:
         """Total time derivative along the motion: d/dt = ∂t + Σ qdot ∂q + Σ qddot ∂qdot."""
         if isinstance(expr, sp.MatrixBase):
             return expr.applyfunc(self.dt)
+        drivers = [ydd for _, _, ydd in self.free_driven]
+        if isinstance(expr, sp.Basic) and not any(expr.has(ydd) for ydd in drivers):
+            # SymEngine's calculus (core.secalc: the same derivative, ten times sooner)
+            chains = [pair for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True)
+                      for pair in ((q, qd), (qd, qdd))]
+            chains += [pair for y, yd, ydd in self.free_driven for pair in ((y, yd), (yd, ydd))]
+            try:
+                return total_derivative(expr, T, chains)
+            except SymEngineCannot:
+                pass
         out = sp.diff(expr, T)
         for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True):
             out += sp.diff(expr, q) * qd + sp.diff(expr, qd) * qdd

@@ -10,6 +10,8 @@ from collections.abc import Callable
 
 import sympy as sp
 
+from mechbook.core.secalc import derivative
+
 
 def _holds_matrix(expr) -> bool:
     """A scalar expression with a matrix inside it (sin of a tensor, 2**T): refused."""
@@ -158,7 +160,10 @@ def _diff(x, s):
     if not isinstance(s, sp.Symbol):
         raise TypeError("differentiate with respect to a plain symbol (a parameter, or a "
                         "`for_all` scalar)")
-    return _im(x.diff(s)) if isinstance(x, sp.MatrixBase) else sp.diff(x, s)
+    if isinstance(x, sp.MatrixBase):  # entry by entry (SymPy's Matrix.diff goes through
+        # its array-derivative machinery, several times slower for the same entries)
+        return _im(x.applyfunc(lambda e: derivative(e, s)))
+    return derivative(x, s) if isinstance(x, sp.Basic) else sp.diff(x, s)
 
 
 def _coordinates(r) -> list[sp.Symbol]:

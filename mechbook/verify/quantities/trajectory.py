@@ -265,13 +265,20 @@ def check_event_time(ctx: Context, val) -> Verdict:
     book = _book_values(ctx, val)
     for n in range(1, points + 1):
         pt = ctx.sampler.draw()
-        params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
-        model = build_model(sys, ctx.dyn, params)
-        fn = signal_functions(sys, ctx.dyn, pt, event.subs(pt))
         st = {k: v.subs(pt) for k, v in start.items()}
         q0 = np.array([float(st[q]) for q in sys.q])
         qd0 = np.array([float(st[v]) for v in sys.qd])
-        t, y = first_event(model, fn, q0, qd0, 1.0 / (1.0 + float(np.max(np.abs(qd0)))))
+        signal = event.subs(pt)
+
+        def run(pt=pt, signal=signal, q0=q0, qd0=qd0):
+            params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
+            model = build_model(sys, ctx.dyn, params)
+            fn = signal_functions(sys, ctx.dyn, pt, signal)
+            return first_event(model, fn, q0, qd0, 1.0 / (1.0 + float(np.max(np.abs(qd0)))))
+
+        key = ("first_event", sys.name, sp.srepr(signal), q0.tobytes(), qd0.tobytes(),
+               tuple(sorted((str(k), sp.srepr(sp.S(v))) for k, v in pt.items())))
+        t, y = ctx.analysis.reuse(key, run)
         if name is None:
             engine = t
         else:
