@@ -207,8 +207,7 @@ class LinearSweep:
         self.n = len(lin.q)
         mats = (lin.M, lin.C, lin.K)
         free = set().union(*(m.free_symbols for m in mats))
-        t = getattr(lin.dyn.sys, "t", None)
-        if t is not None and t in free:
+        if lin.dyn.sys.t in free:
             raise UnsupportedError("a sweep of a linear system with time-dependent "
                                    "coefficients (not autonomous)")
         unknown = sorted(str(s) for s in free - set(self.symbols))
@@ -219,7 +218,7 @@ class LinearSweep:
         # the point itself (and a steady motion's momenta): where they are not real, the
         # equilibrium does not exist, whatever finite values M, C, K take there
         where = [sp.S(v) for v in lin.point.values()]
-        where += [sp.S(v) for v in (getattr(lin.dyn.sys, "momenta", None) or {}).values()]
+        where += [sp.S(v) for v in lin.dyn.sys.held_momenta.values()]
         where = [w for w in where if w.free_symbols]
         unknown = sorted(str(s) for s in set().union(set(), *(w.free_symbols for w in where))
                          - set(self.symbols))

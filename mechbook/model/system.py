@@ -21,10 +21,12 @@ from mechbook.model.declared import declared
 from mechbook.model.domains import Domain, assumptions, domain_of
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
+from mechbook.model.protocol import SystemLike
 
 
-class System:
-    """Symbols and the Lagrangian of one system of a problem."""
+class System(SystemLike):
+    """Symbols and the Lagrangian of one system of a problem (the full system: nothing
+    reduced, no momenta held; mechbook.model.protocol)."""
 
     def __init__(self, problem: Problem, spec: SystemSpec):
         self.problem = problem
@@ -427,6 +429,22 @@ class System:
     def numeric_values(self) -> dict[sp.Symbol, float]:
         return self.problem.values()
 
+    # ---- the contract's kind (mechbook.model.protocol) -----------------------------------
+    @property
+    def reduced(self) -> bool:
+        return False
+
+    @property
+    def full(self) -> System:
+        return self
+
+    @property
+    def held_momenta(self) -> dict[sp.Symbol, sp.Expr]:
+        return {}
+
+    @property
+    def held(self) -> dict[sp.Symbol, sp.Expr]:
+        return {}
 
 
 def system_of(problem: Problem, name: str | None = None) -> System:
