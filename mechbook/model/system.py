@@ -14,7 +14,7 @@ import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
 from mechbook.core.numeval import is_zero, without_absent
-from mechbook.errors import UnsupportedError
+from mechbook.errors import NotFoundError, UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
 from mechbook.model.declared import declared
@@ -449,17 +449,19 @@ class System(SystemLike):
 
 def system_of(problem: Problem, name: str | None = None) -> System:
     """The built (symbolic) system `name` of a problem, or its only one (of several, the one
-    named `main`); built once and kept on the problem. KeyError names the systems there
-    are."""
+    named `main`); built once and kept on the problem. NotFoundError (a KeyError too)
+    names the systems there are."""
     if name is None:
         if len(problem.systems) == 1:
             name = next(iter(problem.systems))
         elif "main" in problem.systems:
             name = "main"
         else:
-            raise KeyError(f"{problem.id} has several systems: {', '.join(problem.systems)}")
+            raise NotFoundError(f"{problem.id} has several systems: "
+                                f"{', '.join(problem.systems)}")
     if name not in problem.systems:
-        raise KeyError(f"{problem.id} has no system {name!r} (has {', '.join(problem.systems)})")
+        raise NotFoundError(f"{problem.id} has no system {name!r} (has "
+                            f"{', '.join(problem.systems)})")
     if name not in problem._cache:
         problem._cache[name] = System(problem, problem.systems[name])
     return problem._cache[name]
