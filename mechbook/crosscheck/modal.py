@@ -10,6 +10,7 @@ modes' growth.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -196,7 +197,7 @@ def defective(lam: np.ndarray, V: np.ndarray, j: int, scale: float) -> bool:
     return False
 
 
-def mode_signal(s: ModalSetup, mode: dict):
+def mode_signal(s: ModalSetup, mode: dict) -> Callable[[float, np.ndarray], float]:
     """w·(y − y*) on the linear system's coordinates, as a function of the model state."""
     n_full = len(s.q_star)
     idx = np.array(s.index)
@@ -213,7 +214,8 @@ def mode_signal(s: ModalSetup, mode: dict):
     return g
 
 
-def complex_mode_signal(s: ModalSetup, mode: dict):
+def complex_mode_signal(s: ModalSetup,
+                        mode: dict) -> Callable[[float, np.ndarray], complex]:
     """The complex modal amplitude w·(y − y*(t)) (its modulus decays like e^{Re p t})."""
     n_full = len(s.q_star)
     idx = np.array(s.index)
