@@ -32,6 +32,21 @@ class SpecError(MechbookError):
         super().__init__(f"{where}: {message}")
 
 
+class NotFoundError(MechbookError, KeyError):
+    """A name the user gave that is not there (a system, a particle or body, a declared
+    body, a coordinate); the message names those there are. Also a KeyError, so callers
+    that catch one keep working; its text is the message itself (a KeyError's would be
+    quoted)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+class InputError(MechbookError, ValueError):
+    """A value the user gave (on the command line or to the Python API) that is not valid;
+    the message says what is expected. Also a ValueError, for callers that catch one."""
+
+
 class UnsupportedError(MechbookError):
     """The engine cannot compute this yet; names the capability that is missing."""
 

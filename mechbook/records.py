@@ -8,11 +8,28 @@ run answered from the store, never import the engine.
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-STATUSES = ("pass", "fail", "erratum", "unsupported", "error")
+
+class Status(enum.StrEnum):
+    """An outcome: of an answer part, of a cross-check, or of one mode a cross-check
+    measured. A `str` (its value) everywhere text is made of it: JSON, HDF5 (written as
+    `str(status)`: h5py takes plain strings only), the table, f-strings."""
+
+    PASS = "pass"
+    FAIL = "fail"
+    ERRATUM = "erratum"  # the book's value fails, the key's corrected value passes
+    UNSUPPORTED = "unsupported"  # the engine cannot compute it yet; never a pass
+    ERROR = "error"  # could not be evaluated (or the check could not run): counts as a fail
+    NA = "n.a."  # a cross-check that does not apply, with the reason
+
+
+# the outcomes of a part, and of a cross-check, in the order tables count them
+STATUSES = (Status.PASS, Status.FAIL, Status.ERRATUM, Status.UNSUPPORTED, Status.ERROR)
+CROSSCHECK_STATUSES = (Status.PASS, Status.FAIL, Status.NA, Status.ERROR)
 
 
 @dataclass(frozen=True)
@@ -41,12 +58,15 @@ class Outcome:
     part: str
     quantity: str
     cite: str
-    status: str
+    status: Status
     method: str = ""
     detail: str = ""
     seconds: float = 0.0
     origin: str = "book"  # 'derived': no printed answer; the value is an independent derivation
     power: str = ""  # what the pass is worth: the smallest wrong answer it rejects, in words
+
+    def __post_init__(self) -> None:
+        self.status = Status(self.status)  # a stored or sent string read back
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -59,12 +79,15 @@ class CrossCheck:
     name: str
     kind: str  # "frequencies", "newton", "conserved", "inertia" or "none" (n.a.)
     system: str
-    status: str = "error"  # pass | fail | n.a. | error
+    status: Status = Status.ERROR  # pass | fail | n.a. | error
     error: float = float("nan")  # largest relative error measured
     detail: str = ""
     parts: list[str] = field(default_factory=list)
     seconds: float = 0.0
     modes: list[dict] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.status = Status(self.status)  # a stored or sent string read back
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -76,11 +99,11 @@ class CrossCheck:
 
     @property
     def failed(self) -> bool:
-        return self.status in ("fail", "error")
+        return self.status in (Status.FAIL, Status.ERROR)
 
     def cell(self) -> str:
         """The table's cross-check column."""
-        if self.status in ("pass", "fail") and math.isfinite(self.error):
+        if self.status in (Status.PASS, Status.FAIL) and math.isfinite(self.error):
             return f"{self.status} {self.error:.0e}"
         return self.status
 

@@ -151,3 +151,52 @@ def test_scipy_methods_agree(pendulum, method):
     traj = integrate(pendulum, (0, 3.0), [0.4], [0.0], method, rtol=1e-10, atol=1e-12)
     ref = integrate(pendulum, (0, 3.0), [0.4], [0.0], "yoshida4", step=1e-3)
     assert traj.q[0, -1] == pytest.approx(ref.q[0, -1], abs=1e-7)
+
+
+@pytest.mark.parametrize("method, option, value, why", [
+    ("leapfrog", "rtol", 1e-10, "no tolerance"),
+    ("RK4", "atol", 1e-10, "RK4"),
+    ("DOP853", "step", 0.01, "chooses its own steps"),
+    ("RK45", "tol", 1e-12, "rtol"),
+    ("yoshida4", "max_iter", 10, "only the implicit midpoint rule iterates"),
+    ("taylor", "atol", 1e-12, "relative only"),
+    ("taylor", "compiled", False, "always compiled"),
+])
+def test_an_option_that_cannot_apply_is_refused_not_dropped(pendulum, method, option, value,
+                                                             why):
+    """An option the method does not take would have no effect: refused, naming the option,
+    the method and why (issue: contracts by imitation, item 4)."""
+    from mechbook.errors import MechbookError
+    from mechbook.numerics.integrators import make_integrator
+
+    with pytest.raises(IntegratorError, match=rf"option '{option}' does not apply to method "
+                                              rf"'{method}' \(.*{why}") as info:
+        make_integrator(method, **{option: value})
+    assert isinstance(info.value, MechbookError)
+
+
+def test_options_given_as_none_and_those_a_method_takes_are_kept(pendulum):
+    from mechbook.numerics.integrators import make_integrator
+
+    # the command line passes every option, None when not given
+    scipy = make_integrator("DOP853", rtol=1e-9, atol=None, step=None, max_step=None)
+    assert scipy.options == {"rtol": 1e-9, "atol": None, "max_step": None}
+    fixed = make_integrator("leapfrog", step=0.01, rtol=None, atol=None, max_step=None)
+    assert fixed.options == {"step": 0.01}
+    assert make_integrator("midpoint", tol=1e-12, max_iter=20).options == {
+        "tol": 1e-12, "max_iter": 20}
+    assert make_integrator("taylor", rtol=1e-14, atol=None).options == {"rtol": 1e-14}
+
+
+def test_cli_refuses_an_option_the_method_does_not_take():
+    from click.testing import CliRunner
+
+    from mechbook.app.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    res = CliRunner().invoke(main, ["--root", str(root), "simulate", "lim-2031", "--method",
+                                    "leapfrog", "--rtol", "1e-10", "--t-end", "0.1",
+                                    "--no-store"])
+    assert res.exit_code != 0
+    assert "option 'rtol' does not apply to method 'leapfrog'" in res.output
+    assert "Traceback" not in res.output

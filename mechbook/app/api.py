@@ -29,6 +29,7 @@ from mechbook.app.display import MathDict, MathList
 from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
 from mechbook.engine.analysis import Analysis
+from mechbook.errors import NotFoundError
 from mechbook.model.books import Book, book_of
 from mechbook.model.catalog import problem_path, root
 from mechbook.model.problem import Problem as Model
@@ -131,7 +132,7 @@ class SystemView:
         for name, val in about.items():
             key = str(name)
             if key not in sys.coord_names:
-                raise KeyError(f"{key!r} is not a coordinate of {self.problem.id} "
+                raise NotFoundError(f"{key!r} is not a coordinate of {self.problem.id} "
                                f"({', '.join(sys.coord_names)})")
             if isinstance(val, str):
                 val = self.problem.model.parse(val, (), dict(sys.names))
@@ -223,10 +224,10 @@ class Problem:
             elif "main" in self.model.systems:
                 name = "main"  # of several systems, the one named main is the default
             else:
-                raise KeyError(f"{self.id} has several systems ({', '.join(self.systems)}): "
+                raise NotFoundError(f"{self.id} has several systems ({', '.join(self.systems)}): "
                                "choose one with p.system(name)")
         if name not in self.model.systems:
-            raise KeyError(f"{self.id} has no system {name!r} ({', '.join(self.systems)})")
+            raise NotFoundError(f"{self.id} has no system {name!r} ({', '.join(self.systems)})")
         if name not in self._views:
             self._views[name] = SystemView(self, name)
         return self._views[name]

@@ -354,7 +354,7 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     for i, o in enumerate(rec.outcomes):
         c = checks.create_group(o.part)
         c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
-                        "cite": storable(o.cite), "status": o.status,
+                        "cite": storable(o.cite), "status": str(o.status),
                         "method": storable(o.method), "detail": storable(o.detail),
                         "seconds": float(o.seconds), "power": storable(o.power)})
     if rec.crosschecks:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from mechbook.crosscheck.frequencies import _initial, _modes, _setup, _signal
+from mechbook.crosscheck.modal import modal_setup, mode_signal, normal_modes, start_state
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
@@ -35,8 +35,8 @@ def amplitude_response(analysis: Analysis, lin: LinearSystem, values: dict,
     caches the compiled nonlinear model per parameter point across calls. `method`
     "taylor" measures all the amplitudes of a mode at once in heyoka's batch mode (the
     crossings as Taylor events; docs/performance.md has the cost of each)."""
-    s = _setup(analysis, lin, values, models if models is not None else {})
-    modes = _modes(s)
+    s = modal_setup(analysis, lin, values, models if models is not None else {})
+    modes = normal_modes(s)
     linear = np.array([m["omega"] if not m["kind"] and m["omega"] > 0 else np.nan
                        for m in modes])
     order = np.argsort(linear)  # ascending, like the engine's frequencies; NaN last
@@ -72,7 +72,7 @@ def _measure_batch(s, mode: dict, amplitudes: np.ndarray, period: float) -> np.n
     turn = s.turn[idx] if s.turn is not None else np.zeros(nl)
     a0 = float(weights[:nl] @ s.q_star[idx] + weights[nl:] @ s.v_star[idx])
     b0 = float(weights[:nl] @ turn)
-    starts = np.array([_initial(s, mode, a) for a in amplitudes])
+    starts = np.array([start_state(s, mode, a) for a in amplitudes])
     with np.errstate(all="ignore"):
         hits = taylor.crossings_batch(s.model, c, (a0, b0), starts, MAX_PERIODS * period)
     out = np.full(len(amplitudes), np.nan)
@@ -86,10 +86,10 @@ def _measure_batch(s, mode: dict, amplitudes: np.ndarray, period: float) -> np.n
 def _measure(s, mode: dict, amplitude: float, period: float) -> float:
     if not amplitude > 0:
         raise UnsupportedError("a finite-amplitude frequency needs an amplitude > 0")
-    g = _signal(s, mode)
+    g = mode_signal(s, mode)
     g.direction = 1.0
     g.terminal = PERIODS + 1
-    y0 = _initial(s, mode, amplitude)
+    y0 = start_state(s, mode, amplitude)
     scale = np.maximum(np.abs(y0), 1.0)
     with np.errstate(all="ignore"):
         sol = solve_ivp(s.model.rhs, (0.0, MAX_PERIODS * period), y0, method="DOP853",

@@ -15,6 +15,7 @@ from __future__ import annotations
 import sympy as sp
 
 from mechbook.crosscheck.kinematics import cone_apex_to_centre, inertia_of_shape
+from mechbook.errors import NotFoundError
 from mechbook.model.problem import Problem
 from mechbook.model.tensorexpr import parse_tensor
 
@@ -59,7 +60,8 @@ def composite_inertia(problem: Problem, body: str) -> tuple[sp.Expr, sp.Matrix, 
     """(mass, centre of mass, inertia tensor about it) of a declared body, in its axes."""
     spec = (problem.doc.data.get("bodies") or {}).get(body)
     if spec is None:
-        raise KeyError(f"no body {body!r} declared")
+        raise NotFoundError(f"no body {body!r} declared (declared: "
+                            f"{', '.join(problem.doc.data.get('bodies') or {}) or 'none'})")
     names = _names(problem)
     values = problem.values()
     total_m, first, second = sp.S.Zero, sp.zeros(3, 1), sp.zeros(3, 3)

@@ -15,22 +15,38 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import evaluate
+from mechbook.crosscheck.guard import guarded
+from mechbook.crosscheck.partview import PartView, split_named
 from mechbook.crosscheck.vouch import crosschecks_of
+from mechbook.engine.analysis import Analysis
 from mechbook.engine.screen import screen
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.integrators import integrate
 from mechbook.numerics.model import build_model
 from mechbook.numerics.simulate import FALLBACK_OFFSET, initial_state
+from mechbook.records import CrossCheck, Status
+from mechbook.verify.answers import Part
 
 DRIFT_TOL = 1e-7  # largest relative change allowed along the run (DOP853 at rtol 1e-12)
 T_END = 3.0  # time units; long enough for the state to change, short enough to be cheap
 SAMPLES = 25
 
 
-def book_integrals(ctx) -> list[sp.Expr]:
-    """The part's conserved expressions in (q, q̇, t), or [] when it states none."""
-    from mechbook.verify.context import split_named
+def conserved_part(analysis: Analysis, part: Part, models: dict) -> CrossCheck | None:
+    """The simulation cross-check of a part's first integral (None: the part states none)."""
+    x = CrossCheck(f"conserved:{part.name}", "conserved", part.system or "", Status.ERROR,
+                   parts=[part.name])
+    with guarded(x):
+        view = PartView(analysis, part)
+        exprs = book_integrals(view)
+        if not exprs:
+            return None
+        x.status, x.error, x.detail = conserved_crosscheck(analysis, view, exprs, models)
+    return x
 
+
+def book_integrals(ctx: PartView) -> list[sp.Expr]:
+    """The part's conserved expressions in (q, q̇, t), or [] when it states none."""
     part, data = ctx.part, ctx.part.data
     if "about" in data or "steady" in data or "at" in data or "erratum" in data:
         return []
@@ -72,10 +88,11 @@ def _start(analysis, sys, params: dict, rng) -> tuple[np.ndarray, np.ndarray]:
     return rng.uniform(0.4, 1.2, n), np.zeros(n)
 
 
-def conserved_crosscheck(analysis, ctx, exprs: list[sp.Expr], models: dict):
+def conserved_crosscheck(analysis: Analysis, ctx: PartView, exprs: list[sp.Expr],
+                         models: dict) -> tuple[Status, float, str]:
     """(status, worst relative drift, detail) for the book's integrals along a trajectory."""
     sys = ctx.system
-    values = {k: v for k, v in ctx.sampler.default().items()}
+    values = {k: v for k, v in ctx.values().items()}
     params = {k: float(v) for k, v in values.items() if k in set(analysis.problem.values())}
     key = (sys.name, tuple(sorted((str(k), v) for k, v in params.items())))
     if key not in models:
@@ -105,6 +122,8 @@ def conserved_crosscheck(analysis, ctx, exprs: list[sp.Expr], models: dict):
         drift = float(np.max(np.abs(series - series[0]))) / max(scale, 1e-300)
         worst = max(worst, drift)
         if drift > DRIFT_TOL:
-            return "fail", worst, (f"{sp.sstr(e)[:60]} changes by {drift:.2g} (relative) over "
-                                   f"t in [0, {T_END}] from q0={np.round(q0, 4).tolist()}")
-    return "pass", worst, f"{len(exprs)} integral(s) constant to {worst:.1g} over t in [0, {T_END}]"
+            return Status.FAIL, worst, (f"{sp.sstr(e)[:60]} changes by {drift:.2g} (relative) "
+                                        f"over t in [0, {T_END}] from "
+                                        f"q0={np.round(q0, 4).tolist()}")
+    return Status.PASS, worst, (f"{len(exprs)} integral(s) constant to {worst:.1g} over t in "
+                                f"[0, {T_END}]")

@@ -16,13 +16,12 @@ are computed here their own way (mechbook.crosscheck.kinematics), never by the e
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.crosscheck.assembly import composite_inertia
+from mechbook.crosscheck.guard import guarded
 from mechbook.crosscheck.kinematics import (
     body_angular_velocity,
     chain_angular_velocity,
@@ -31,7 +30,7 @@ from mechbook.crosscheck.kinematics import (
 )
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
-from mechbook.records import CrossCheck
+from mechbook.records import CrossCheck, Status
 
 NEWTON_TOL = 1e-9
 
@@ -39,16 +38,10 @@ NEWTON_TOL = 1e-9
 def newton_crosscheck(analysis: Analysis, system_name: str | None = None,
                       samples: int = 6) -> CrossCheck:
     """Lagrange's equations of the engine against Newton's (and Euler's) in Cartesian form."""
-    start = time.perf_counter()
     sys = analysis.system(system_name)
     out = CrossCheck(f"newton:{sys.name}", "newton", sys.name)
-    try:
+    with guarded(out):
         _newton(analysis, sys, out, samples)
-    except UnsupportedError as exc:
-        out.status, out.detail = "n.a.", exc.capability
-    except (MechbookError, ValueError, TypeError, np.linalg.LinAlgError) as exc:
-        out.status, out.detail = "error", f"{type(exc).__name__}: {exc}"
-    out.seconds = time.perf_counter() - start
     return out
 
 
@@ -67,45 +60,10 @@ def _newton_residual(sys) -> list[sp.Expr]:
     parse = sys._parse  # the system's own safe parser, at the file's paths
     q, qd = sys.q, sys.qd
     n = len(q)
-    forces: dict[str, sp.Matrix] = {}
     positions = {name: sys.positions[name] for name in list(particles) + list(bodies)}
     masses = {name: sys.masses[name] for name in positions}
-    for name, r in positions.items():
-        forces[name] = sp.zeros(r.rows, 1)
-    if "gravity" in spec:
-        grav = spec["gravity"] or {}
-        g = parse(grav["g"], ("gravity", "g")) if "g" in grav else sys.params["g"].symbol
-        for name, r in positions.items():
-            up = (sp.Matrix([parse(x, ("gravity", "up", i)) for i, x in enumerate(grav["up"])])
-                  if "up" in grav else sp.Matrix([0] * (r.rows - 1) + [1]))
-            forces[name] += -masses[name] * g * up
-    rest = sp.S.Zero  # Lagrangian terms not given as particles or bodies
-    for i, spring in enumerate(spec.get("springs") or []):
-        k = parse(spring["k"], ("springs", i, "k"))
-        natural = (parse(spring["natural_length"], ("springs", i, "natural_length"))
-                   if "natural_length" in spring else sp.S.Zero)
-        if "length" in spring:
-            length = parse(spring["length"], ("springs", i, "length"))
-            rest -= k * (length - natural) ** 2 / 2
-            continue
-        ends = []
-        for j, end in enumerate(spring["between"]):
-            ends.append((end, positions[end]) if isinstance(end, str) else
-                        (None, sp.Matrix([parse(x, ("springs", i, "between", j, m))
-                                          for m, x in enumerate(end)])))
-        d = ends[0][1] - ends[1][1]
-        length = sp.sqrt(d.dot(d))
-        pull = -k * (length - natural) / length * d  # force on the first end
-        if ends[0][0] is not None:
-            forces[ends[0][0]] += pull
-        if ends[1][0] is not None:
-            forces[ends[1][0]] -= pull
-    for key in ("kinetic", "lagrangian"):
-        if key in spec:
-            rest += parse(spec[key], (key,))
-    for key in ("potential", "velocity_potential"):
-        if key in spec:
-            rest -= parse(spec[key], (key,))
+    forces = _gravity(sys, spec, positions, masses, parse)
+    rest = _springs(spec, positions, forces, parse) + _given_terms(spec, parse)
     res = [sp.S.Zero] * n
     for name, r in positions.items():
         acc = sys.dt(sys.dt(r))
@@ -130,6 +88,59 @@ def _newton_residual(sys) -> list[sp.Expr]:
         res[i] += sys.dt(sp.diff(rest, qd[i])) - sp.diff(rest, q[i]) - sys.declared_forces[i]
         res[i] -= attractor_q[i] + torque_q[i] + friction_q[i]
     return res
+
+
+def _gravity(sys, spec: dict, positions: dict, masses: dict, parse) -> dict[str, sp.Matrix]:
+    """The Cartesian force of gravity on each particle and body (zero without `gravity:`)."""
+    forces = {name: sp.zeros(r.rows, 1) for name, r in positions.items()}
+    if "gravity" in spec:
+        grav = spec["gravity"] or {}
+        g = parse(grav["g"], ("gravity", "g")) if "g" in grav else sys.params["g"].symbol
+        for name, r in positions.items():
+            up = (sp.Matrix([parse(x, ("gravity", "up", i)) for i, x in enumerate(grav["up"])])
+                  if "up" in grav else sp.Matrix([0] * (r.rows - 1) + [1]))
+            forces[name] += -masses[name] * g * up
+    return forces
+
+
+def _springs(spec: dict, positions: dict, forces: dict, parse) -> sp.Expr:
+    """Two-ended springs as Cartesian forces (added to `forces`); the Lagrangian terms of
+    springs given by their `length` (returned)."""
+    rest = sp.S.Zero
+    for i, spring in enumerate(spec.get("springs") or []):
+        k = parse(spring["k"], ("springs", i, "k"))
+        natural = (parse(spring["natural_length"], ("springs", i, "natural_length"))
+                   if "natural_length" in spring else sp.S.Zero)
+        if "length" in spring:
+            length = parse(spring["length"], ("springs", i, "length"))
+            rest -= k * (length - natural) ** 2 / 2
+            continue
+        ends = []
+        for j, end in enumerate(spring["between"]):
+            ends.append((end, positions[end]) if isinstance(end, str) else
+                        (None, sp.Matrix([parse(x, ("springs", i, "between", j, m))
+                                          for m, x in enumerate(end)])))
+        d = ends[0][1] - ends[1][1]
+        length = sp.sqrt(d.dot(d))
+        pull = -k * (length - natural) / length * d  # force on the first end
+        if ends[0][0] is not None:
+            forces[ends[0][0]] += pull
+        if ends[1][0] is not None:
+            forces[ends[1][0]] -= pull
+    return rest
+
+
+def _given_terms(spec: dict, parse) -> sp.Expr:
+    """The Lagrangian terms the file gives directly (`kinetic`, `lagrangian`, `potential`,
+    `velocity_potential`)."""
+    rest = sp.S.Zero
+    for key in ("kinetic", "lagrangian"):
+        if key in spec:
+            rest += parse(spec[key], (key,))
+    for key in ("potential", "velocity_potential"):
+        if key in spec:
+            rest -= parse(spec[key], (key,))
+    return rest
 
 
 def _friction(sys, spec: dict, positions: dict, frames: dict, parse) -> list[sp.Expr]:
@@ -288,9 +299,12 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
         raise MechbookError("Newton cross-check: the equations do not evaluate at random "
                             "states")
     out.error = worst
-    out.status = "pass" if worst < NEWTON_TOL else "fail"
+    out.status = Status.PASS if worst < NEWTON_TOL else Status.FAIL
+    out.detail = _what_was_compared(sys.spec, used, worst)
+
+
+def _what_was_compared(spec: dict, used: int, worst: float) -> str:
     what = []
-    spec = sys.spec
     if spec.get("particles"):
         what.append("particles")
     if spec.get("rigid_bodies"):
@@ -305,8 +319,6 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
                          "dissipation") if k in spec]
     if any("length" in s for s in spec.get("springs") or []):
         other.append("length springs")
-    out.detail = (f"E = Jᵀ(m r̈ − F) over {' and '.join(what)} at {used} random states, "
-                  f"max relative difference {worst:.1e}"
-                  + (f"; as generalized forces: {', '.join(other)}" if other else ""))
-
-
+    return (f"E = Jᵀ(m r̈ − F) over {' and '.join(what)} at {used} random states, "
+            f"max relative difference {worst:.1e}"
+            + (f"; as generalized forces: {', '.join(other)}" if other else ""))

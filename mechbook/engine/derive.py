@@ -210,9 +210,8 @@ def computed(analysis: Analysis) -> list[Results]:
         for i, lin in enumerate(linears):
             tag = f"linear_{i}"
             res.text[f"{tag}/point"] = show(lin.point)
-            steady = getattr(lin.dyn.sys, "momenta", None)
-            if isinstance(steady, dict):
-                res.text[f"{tag}/steady_momenta"] = show(steady)
+            if lin.dyn.sys.reduced:
+                res.text[f"{tag}/steady_momenta"] = show(lin.dyn.sys.held_momenta)
             for m in ("M", "C", "K"):
                 res.text[f"{tag}/{m}"] = show(getattr(lin, m).tolist())
             try:

@@ -34,7 +34,7 @@ def why_not(point: dict, sys, values: dict) -> str | None:
             return f"{q} = {sp.sstr(v)} is not finite at the default values"
         if abs(z.imag) > 1e-9 * max(1.0, abs(z.real)):
             return f"{q} = {sp.sstr(v)} is not real at the default values ({_num(z)})"
-    return outside(point, getattr(sys, "domains", {}), values)
+    return outside(point, sys.domains, values)
 
 
 def existing(points: list[dict], sys, values: dict) -> tuple[list[dict], list[str]]:
@@ -52,7 +52,7 @@ def existing(points: list[dict], sys, values: dict) -> tuple[list[dict], list[st
 def clip_ranges(sys, qs: list, ranges: list[tuple[float, float]],
                 values: dict) -> list[tuple]:
     """Search intervals (one per coordinate of `qs`, in order) narrowed to the domains."""
-    domains = getattr(sys, "domains", {})
+    domains = sys.domains
     out = []
     for q, (lo, hi) in zip(qs, ranges, strict=True):
         dom = domains.get(q)
@@ -62,7 +62,7 @@ def clip_ranges(sys, qs: list, ranges: list[tuple[float, float]],
 
 def inside(sys, qs: list, x: np.ndarray, values: dict) -> bool:
     """Whether the values `x` of the coordinates `qs` lie in their domains at `values`."""
-    domains = getattr(sys, "domains", {})
+    domains = sys.domains
     return all(domains[q].contains(float(v), values) for q, v in zip(qs, x, strict=False)
                if q in domains)
 

@@ -58,7 +58,7 @@ class Equilibria:
             return self.__dict__["_rest"]
         zero = {v: sp.S.Zero for v in self.dyn.qd + self.dyn.qdd}
         zero.update({s: sp.S.Zero for s in self.sys.small_params})
-        held = getattr(self.sys, "held", {})  # a reduced system's momenta, put back
+        held = self.sys.held  # a reduced system's momenta, put back
         conds = [without_absent(e.xreplace(zero).xreplace(held), [self.sys.t])
                  for e in self.dyn.residuals]
         if any(c.has(self.sys.t) for c in conds):
@@ -209,7 +209,7 @@ class Equilibria:
         # each second derivative from the smallest expression that still holds it:
         # A from L at the point (a function of q̇), C and the force from L at rest,
         # B from ∂L/∂q̇ at rest
-        held = getattr(self.sys, "held", {})  # Routh's held momenta: symbols until now
+        held = self.sys.held  # Routh's held momenta: symbols until now
         L_at, L_rest = dyn.L.xreplace(at), dyn.L.xreplace(rest)
         b = [sp.diff(dyn.L, v).xreplace(rest) for v in dyn.qd]
         dq = [sp.diff(L_rest, q) for q in dyn.q]
@@ -266,7 +266,7 @@ class Equilibria:
         # a point or rate given by a long expression (an orbit parametrized by an answer's
         # symbol) stands in as a plain symbol while differentiating, and is put back at the
         # end: differentiating through it would multiply its size many times over
-        holders: dict[sp.Symbol, sp.Expr] = dict(getattr(self.sys, "held", {}))
+        holders: dict[sp.Symbol, sp.Expr] = dict(self.sys.held)
 
         def held(value, tag: str) -> sp.Expr:
             value = sp.S(value)

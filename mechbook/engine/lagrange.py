@@ -17,7 +17,7 @@ from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.core.secalc import euler_lagrange
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.errors import MechbookError, UnsupportedError
-from mechbook.model.system import System
+from mechbook.model.protocol import SystemLike
 
 
 class SingularMassError(MechbookError):
@@ -43,8 +43,8 @@ def solve_accelerations(M: sp.Matrix, rhs: sp.Matrix, unknowns: list) -> sp.Matr
 class Dynamics:
     """Equations of motion, momenta, conserved quantities and the Hamiltonian of a system."""
 
-    def __init__(self, system: System, simplify: bool = False):
-        self.sys = system
+    def __init__(self, system: SystemLike, simplify: bool = False):
+        self.sys: SystemLike = system  # a System, or one reduced by Routh
         self.simplify = simplify
         self.q, self.qd, self.qdd = system.q, system.qd, system.qdd
         self.L = system.lagrangian
@@ -67,7 +67,7 @@ class Dynamics:
         chains = list(zip(self.q, self.qd, strict=True)) + list(zip(self.qd, self.qdd,
                                                                     strict=True))
         stop = []
-        if not hasattr(self.sys, "base"):  # a System: its free driven coordinates too (a
+        if not self.sys.reduced:  # a System: its free driven coordinates too (a
             # system reduced by Routh differentiates its own coordinates only)
             for y, yd, ydd in self.sys.free_driven:
                 chains += [(y, yd), (yd, ydd)]

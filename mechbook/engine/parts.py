@@ -23,18 +23,18 @@ import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
 from mechbook.engine.linear import LinearSystem, mp_matrix, state_matrix
-from mechbook.errors import UnsupportedError
+from mechbook.errors import NotFoundError, UnsupportedError
 from mechbook.model.system import System
 
 DPS = 40
 
 
 def part_energy(sys: System, name: str) -> sp.Expr:
-    """Kinetic plus gravitational energy of particle or body `name` (KeyError with the
-    names there are)."""
+    """Kinetic plus gravitational energy of particle or body `name` (NotFoundError, a
+    KeyError too, with the names there are)."""
     if name not in sys.part_kinetic:
         known = ", ".join(sorted(sys.part_kinetic)) or "none"
-        raise KeyError(f"no particle or rigid body {name!r} in system {sys.name!r} "
+        raise NotFoundError(f"no particle or rigid body {name!r} in system {sys.name!r} "
                        f"(its parts: {known})")
     return sys.part_kinetic[name] + sys.part_potential.get(name, sp.S.Zero)
 

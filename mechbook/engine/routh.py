@@ -16,13 +16,15 @@ from mechbook.core.numeval import is_zero
 from mechbook.core.rational import cancel
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.errors import UnsupportedError
+from mechbook.model.protocol import SystemLike
 from mechbook.model.system import System
 
 
-class ReducedSystem:
+class ReducedSystem(SystemLike):
     """The system left after fixing the momenta of some cyclic coordinates.
 
-    It offers the attributes of `System` that Dynamics and Equilibria use.
+    It keeps the contract of a system (mechbook.model.protocol.SystemLike): `reduced` is
+    True, `full` the system it came from, `held_momenta` and `held` the fixed momenta.
     """
 
     def __init__(self, base: System, rates: dict[sp.Symbol, sp.Expr], point: dict,
@@ -33,11 +35,15 @@ class ReducedSystem:
         momenta_given = momenta
         self.base = base
         self.problem = base.problem
+        self.name = base.name
         self.t = base.t
         self.small_params = base.small_params
         self.free_driven = base.free_driven
         self.constraints = []
         self.spec = base.spec
+        # the remaining coordinates' declared domains are not checked in a reduced system
+        # (its equilibria are searched everywhere, as they always were)
+        self.domains = {}
         cyc = list(rates)
         idx = [base.q.index(c) for c in cyc]
         for i, c in zip(idx, cyc, strict=True):
@@ -75,8 +81,33 @@ class ReducedSystem:
         routh = sum((P * v for P, v in zip(symbols, cyc_rates, strict=True)), sp.S.Zero)
         reduced = (L - routh).subs(rate_of)
         self.lagrangian = simp(_smaller(reduced, _cancel(reduced)))
-        self.held: dict[sp.Symbol, sp.Expr] = dict(zip(symbols, p_values, strict=True))
-        self.momenta = dict(zip(cyc, p_values, strict=True))
+        self._held: dict[sp.Symbol, sp.Expr] = dict(zip(symbols, p_values, strict=True))
+        self._held_momenta = dict(zip(cyc, p_values, strict=True))
+
+    @property
+    def reduced(self) -> bool:
+        return True
+
+    @property
+    def full(self) -> System:
+        return self.base
+
+    @property
+    def held_momenta(self) -> dict[sp.Symbol, sp.Expr]:
+        """{cyclic coordinate taken out: its fixed momentum}."""
+        return self._held_momenta
+
+    @property
+    def held(self) -> dict[sp.Symbol, sp.Expr]:
+        """{P_held_<coordinate>: the momentum's value}: the held momenta stay symbols in
+        the reduced Lagrangian until the linear system is formed."""
+        return self._held
+
+    @property
+    def momenta(self) -> dict[sp.Symbol, sp.Expr]:
+        """`held_momenta` under its former name (read by mechbook.app until it asks the
+        contract)."""
+        return self._held_momenta
 
     def dt(self, expr):
         out = sp.diff(expr, self.t)

@@ -83,7 +83,7 @@ def screen(eq: Equilibria, values: dict, ranges: dict | None = None) -> Screen:
     num = {se.sympify(k): float(v) for k, v in values.items()}
     rest = {se.sympify(v): 0 for v in dyn.qd + dyn.qdd}
     rest.update({se.sympify(s): 0 for s in sys.small_params})
-    held = {se.sympify(k): se.sympify(v) for k, v in getattr(sys, "held", {}).items()}
+    held = {se.sympify(k): se.sympify(v) for k, v in sys.held.items()}
     residuals = [se.sympify(e) for e in dyn.residuals]
     conds = [e.subs(rest).subs(held).subs(num) for e in residuals]
     if any(c.has(se.sympify(sys.t)) for c in conds) or sys.free_driven:

@@ -25,7 +25,7 @@ def classify_at(eq: Equilibria, root: dict, values: dict, rates: dict | None = N
     the derivatives of the equations of motion there, taken symbolically once and
     evaluated at the numbers (a numeric root is no exact equilibrium for `linearize`)."""
     dyn = eq.dyn
-    held = getattr(dyn.sys, "held", {})
+    held = dyn.sys.held
     rates = rates or {}
     sub = {v: sp.S(rates.get(q, 0)) for q, v in zip(dyn.q, dyn.qd, strict=True)}
     sub.update({a: sp.S.Zero for a in dyn.qdd})

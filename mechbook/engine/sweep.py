@@ -28,7 +28,7 @@ import sympy as sp
 
 from mechbook.core.compile import DEFAULT_BACKEND, compile_batch
 from mechbook.engine.linear import ZERO_TOL, LinearSystem
-from mechbook.errors import UnsupportedError
+from mechbook.errors import InputError, UnsupportedError
 
 STABLE, MARGINAL, UNSTABLE, UNDEFINED = 1, 0, -1, -2
 STABILITY_NAMES = {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable",
@@ -64,18 +64,18 @@ def parse_axis(text: str) -> Axis:
     name, sep, rng = text.partition("=")
     bits = rng.split(":")
     if not sep or not name.strip() or len(bits) not in (3, 4):
-        raise ValueError(f"{text!r}: expected NAME=LO:HI:N (or NAME=LO:HI:N:log)")
+        raise InputError(f"{text!r}: expected NAME=LO:HI:N (or NAME=LO:HI:N:log)")
     try:
         lo, hi, n = float(bits[0]), float(bits[1]), int(bits[2])
     except ValueError:
-        raise ValueError(f"{text!r}: LO and HI must be numbers, N an integer") from None
+        raise InputError(f"{text!r}: LO and HI must be numbers, N an integer") from None
     log = len(bits) == 4
     if log and bits[3].strip() != "log":
-        raise ValueError(f"{text!r}: the fourth field may only be 'log'")
+        raise InputError(f"{text!r}: the fourth field may only be 'log'")
     if n < 1 or not (np.isfinite(lo) and np.isfinite(hi)):
-        raise ValueError(f"{text!r}: N must be at least 1 and LO, HI finite")
+        raise InputError(f"{text!r}: N must be at least 1 and LO, HI finite")
     if log and (lo <= 0 or hi <= 0):
-        raise ValueError(f"{text!r}: a log axis needs LO, HI > 0")
+        raise InputError(f"{text!r}: a log axis needs LO, HI > 0")
     return Axis(name.strip(), lo, hi, n, log)
 
 
@@ -93,16 +93,16 @@ class Grid:
         names = [str(s) for s in self.symbols]
         for a in self.axes:
             if a.name not in names:
-                raise ValueError(f"{a.name!r} is not a parameter here (parameters: "
+                raise InputError(f"{a.name!r} is not a parameter here (parameters: "
                                  f"{', '.join(names)})")
         if len({a.name for a in self.axes}) != len(self.axes):
-            raise ValueError("a parameter is swept twice")
+            raise InputError("a parameter is swept twice")
         self._cols = [names.index(a.name) for a in self.axes]
         self._values = [a.values() for a in self.axes]
         swept = {names[c] for c in self._cols}
         missing = [str(s) for s in self.symbols if str(s) not in swept and s not in self.fixed]
         if missing:
-            raise ValueError(f"no value for {', '.join(missing)}")
+            raise InputError(f"no value for {', '.join(missing)}")
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -207,8 +207,7 @@ class LinearSweep:
         self.n = len(lin.q)
         mats = (lin.M, lin.C, lin.K)
         free = set().union(*(m.free_symbols for m in mats))
-        t = getattr(lin.dyn.sys, "t", None)
-        if t is not None and t in free:
+        if lin.dyn.sys.t in free:
             raise UnsupportedError("a sweep of a linear system with time-dependent "
                                    "coefficients (not autonomous)")
         unknown = sorted(str(s) for s in free - set(self.symbols))
@@ -219,7 +218,7 @@ class LinearSweep:
         # the point itself (and a steady motion's momenta): where they are not real, the
         # equilibrium does not exist, whatever finite values M, C, K take there
         where = [sp.S(v) for v in lin.point.values()]
-        where += [sp.S(v) for v in (getattr(lin.dyn.sys, "momenta", None) or {}).values()]
+        where += [sp.S(v) for v in lin.dyn.sys.held_momenta.values()]
         where = [w for w in where if w.free_symbols]
         unknown = sorted(str(s) for s in set().union(set(), *(w.free_symbols for w in where))
                          - set(self.symbols))

@@ -10,6 +10,8 @@
     books     books.yaml: the declared books, problem ids <book>-<number>
     catalog   where problem and answer files live, problem ids checked (check_id)
     problem   a problem file: parameters, conditions, its systems as data
+    protocol  SystemLike: what a system offers the engine (kept by System and by Routh's
+              reduced system: `reduced`, `full`, `held_momenta`, `held`)
     system    one system built: coordinates, T, V, L, forces, constraints
     declared  a problem's named vectors, bodies made of parts, named tensors
     bodies    rigid bodies: standard shapes' inertia, bodies of parts, kinetic energy

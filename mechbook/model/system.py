@@ -16,17 +16,19 @@ from mechbook.core.expansion import expand_lagrangian
 from mechbook.core.numeval import is_zero, without_absent
 from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.core.secalc import total_derivative
-from mechbook.errors import UnsupportedError
+from mechbook.errors import NotFoundError, UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
 from mechbook.model.declared import declared
 from mechbook.model.domains import Domain, assumptions, domain_of
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
+from mechbook.model.protocol import SystemLike
 
 
-class System:
-    """Symbols and the Lagrangian of one system of a problem."""
+class System(SystemLike):
+    """Symbols and the Lagrangian of one system of a problem (the full system: nothing
+    reduced, no momenta held; mechbook.model.protocol)."""
 
     def __init__(self, problem: Problem, spec: SystemSpec):
         self.problem = problem
@@ -439,21 +441,39 @@ class System:
     def numeric_values(self) -> dict[sp.Symbol, float]:
         return self.problem.values()
 
+    # ---- the contract's kind (mechbook.model.protocol) -----------------------------------
+    @property
+    def reduced(self) -> bool:
+        return False
+
+    @property
+    def full(self) -> System:
+        return self
+
+    @property
+    def held_momenta(self) -> dict[sp.Symbol, sp.Expr]:
+        return {}
+
+    @property
+    def held(self) -> dict[sp.Symbol, sp.Expr]:
+        return {}
 
 
 def system_of(problem: Problem, name: str | None = None) -> System:
     """The built (symbolic) system `name` of a problem, or its only one (of several, the one
-    named `main`); built once and kept on the problem. KeyError names the systems there
-    are."""
+    named `main`); built once and kept on the problem. NotFoundError (a KeyError too)
+    names the systems there are."""
     if name is None:
         if len(problem.systems) == 1:
             name = next(iter(problem.systems))
         elif "main" in problem.systems:
             name = "main"
         else:
-            raise KeyError(f"{problem.id} has several systems: {', '.join(problem.systems)}")
+            raise NotFoundError(f"{problem.id} has several systems: "
+                                f"{', '.join(problem.systems)}")
     if name not in problem.systems:
-        raise KeyError(f"{problem.id} has no system {name!r} (has {', '.join(problem.systems)})")
+        raise NotFoundError(f"{problem.id} has no system {name!r} (has "
+                            f"{', '.join(problem.systems)})")
     if name not in problem._cache:
         problem._cache[name] = System(problem, problem.systems[name])
     return problem._cache[name]

@@ -18,7 +18,7 @@ from mechbook.errors import MechbookError
 def check_start(sys, q0: np.ndarray, values: dict) -> None:
     """MechbookError when the initial coordinates `q0` lie outside a domain."""
     for q, x in zip(sys.q, q0, strict=True):
-        dom = getattr(sys, "domains", {}).get(q)
+        dom = sys.domains.get(q)
         if dom is not None and not dom.contains(float(x), values):
             raise MechbookError(f"the initial value {q} = {float(x):.6g} is outside the "
                                 f"coordinate's domain {dom.text}")
@@ -26,7 +26,7 @@ def check_start(sys, q0: np.ndarray, values: dict) -> None:
 
 def within_domains(sys, traj, values: dict):
     """(the trajectory up to its last sample inside every domain, a note or None)."""
-    domains = getattr(sys, "domains", {})
+    domains = sys.domains
     if not domains or not len(traj.t):
         return traj, None
     bad = np.zeros(len(traj.t), dtype=bool)

@@ -17,7 +17,9 @@
 Fixed-step methods take `step` (default: the span over 10,000 steps). A symplectic method
 keeps the energy error bounded (oscillating, no secular growth) over very long runs, which
 an explicit Runge–Kutta method does not; they apply only to conservative systems, and the
-separable ones only when the model is separable (`rhs.structure` decides).
+separable ones only when the model is separable (`rhs.structure` decides). An option a
+method does not take (`rtol` for a fixed-step method, `step` for an adaptive one) would have
+no effect, so it is refused (IntegratorError, saying why), never dropped.
 """
 
 from __future__ import annotations
@@ -382,18 +384,51 @@ FIXED: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog, "verlet":
 METHODS = SCIPY_METHODS + tuple(FIXED) + ("taylor",)
 
 
+# the options each kind of method takes (None for an option means it is not given)
+SCIPY_OPTIONS = frozenset({"rtol", "atol", "max_step", "first_step", "dense_output",
+                           "compiled"})
+FIXED_OPTIONS = frozenset({"step", "max_points", "compiled"})
+MIDPOINT_OPTIONS = FIXED_OPTIONS | {"tol", "max_iter"}  # its Newton iteration's
+TAYLOR_OPTIONS = frozenset({"tol", "rtol", "max_points"})
+# why an option another kind of method takes has no effect on this kind
+_NO_EFFECT = {
+    "rtol": "a fixed-step method has no tolerance: give `step`",
+    "atol": "{method}'s tolerance is relative only (`rtol` or `tol`)",
+    "max_step": "a fixed-step method takes `step`",
+    "first_step": "a fixed-step method takes `step`",
+    "dense_output": "only SciPy's methods have a dense output",
+    "step": "an adaptive method chooses its own steps: give `rtol` (and `atol`), or "
+            "`max_step` to bound them",
+    "max_points": "SciPy's methods record the times asked for (`t_eval`)",
+    "tol": "only the implicit midpoint rule (its iteration) and the taylor method take a "
+           "`tol`; SciPy's methods take `rtol` and `atol`",
+    "max_iter": "only the implicit midpoint rule iterates",
+    "compiled": "the taylor method is always compiled (heyoka)",
+}
+
+
 def make_integrator(method: str, **options) -> Integrator:
-    """The integrator named `method` (see the module docstring) with its options."""
+    """The integrator named `method` (see the module docstring) with its options.
+    IntegratorError for an unknown method, and for an option given (not None) that the
+    method does not take: it would have no effect, so it is refused, saying why."""
     if method in SCIPY_METHODS:
-        allowed = {"rtol", "atol", "max_step", "first_step", "dense_output", "compiled"}
-        return SciPyMethod(method, **{k: v for k, v in options.items() if k in allowed})
+        return SciPyMethod(method, **_applicable(method, SCIPY_OPTIONS, options))
     if method in FIXED:
-        allowed = {"step", "max_points", "tol", "max_iter", "compiled"}
-        return FIXED[method](**{k: v for k, v in options.items() if k in allowed})
+        allowed = MIDPOINT_OPTIONS if FIXED[method] is ImplicitMidpoint else FIXED_OPTIONS
+        return FIXED[method](**_applicable(method, allowed, options))
     if method == "taylor":
-        allowed = {"tol", "rtol", "max_points"}
-        return TaylorMethod(**{k: v for k, v in options.items() if k in allowed})
+        return TaylorMethod(**_applicable(method, TAYLOR_OPTIONS, options))
     raise IntegratorError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+
+
+def _applicable(method: str, allowed: frozenset, options: dict) -> dict:
+    """The options `method` takes; IntegratorError naming one given that it does not."""
+    for name, value in options.items():
+        if value is not None and name not in allowed:
+            why = _NO_EFFECT.get(name, "no method takes it").format(method=method)
+            raise IntegratorError(f"option {name!r} does not apply to method {method!r} "
+                                  f"({why}); it takes: {', '.join(sorted(allowed))}")
+    return {k: v for k, v in options.items() if k in allowed}
 
 
 def integrate(model: Model, t_span: tuple[float, float], q0: Sequence[float],

@@ -17,7 +17,7 @@ from mechbook.errors import (
     WrongAnswerError,
     describe,
 )
-from mechbook.records import Outcome
+from mechbook.records import Outcome, Status
 from mechbook.verify.answers import AnswerKey, Part
 from mechbook.verify.compare import NUMERIC, ProofPolicy
 from mechbook.verify.context import Context
@@ -26,11 +26,11 @@ from mechbook.verify.registry import quantities
 
 def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) -> Outcome:
     start = time.perf_counter()
-    out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], "error",
+    out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], Status.ERROR,
                   origin=part.data.get("origin", "book"))
     try:
         if "unsupported" in part.data:
-            out.status, out.detail = "unsupported", part.data["unsupported"]
+            out.status, out.detail = Status.UNSUPPORTED, part.data["unsupported"]
             return out
         ctx = Context(analysis, part, policy)
         fn = quantities()[part.quantity].check
@@ -38,30 +38,30 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) ->
         if "erratum" in part.data:
             corrected = fn(ctx, part.data["erratum"]["corrected"])
             if verdict.ok:
-                out.status = "fail"
+                out.status = Status.FAIL
                 out.detail = "an erratum is recorded but the book's value agrees with the engine"
             elif not corrected.ok:
-                out.status = "fail"
+                out.status = Status.FAIL
                 out.detail = f"the corrected value fails too: {corrected.detail}"
             else:
-                out.status, out.method = "erratum", corrected.method
+                out.status, out.method = Status.ERRATUM, corrected.method
                 out.detail = f"book value fails ({verdict.detail}); corrected value passes"
                 out.power = _power(part, corrected)
         else:
-            out.status = "pass" if verdict.ok else "fail"
+            out.status = Status.PASS if verdict.ok else Status.FAIL
             out.method, out.detail = verdict.method, verdict.detail
             if verdict.ok:
                 out.power = _power(part, verdict)
     except UnsupportedError as exc:
-        out.status, out.detail = "unsupported", exc.capability
+        out.status, out.detail = Status.UNSUPPORTED, exc.capability
     except WrongAnswerError as exc:  # the answer's point, steady rate or shape is wrong
-        out.status, out.detail = "fail", str(exc)
+        out.status, out.detail = Status.FAIL, str(exc)
     except SpecError as exc:
-        out.status, out.detail = "error", str(exc)
+        out.status, out.detail = Status.ERROR, str(exc)
     except MechbookError as exc:
-        out.status, out.detail = "error", str(exc)
+        out.status, out.detail = Status.ERROR, str(exc)
     except Exception as exc:  # an engine fault must not hide the other parts
-        out.status = "error"
+        out.status = Status.ERROR
         out.detail = describe(exc)  # a message; the traceback goes to the debug log
     finally:
         out.seconds = time.perf_counter() - start
