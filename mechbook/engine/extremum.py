@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import mpmath
+import numpy as np
 
 DPS = 60  # working digits of a located extremum
 GRID = 48  # scan points over the interval
@@ -116,22 +117,32 @@ def _derivatives(f: Callable, x, h) -> tuple:
     return (fp - fm) / (2 * h), (fp - 2 * f0 + fm) / h**2
 
 
-def torus_maximum(F: Callable, n: int, dps: int = 40, grid: int | None = None
-                  ) -> tuple[list, mpmath.mpf]:
+def torus_maximum(F: Callable, n: int, dps: int = 40, grid: int | None = None,
+                  scan: Callable | None = None) -> tuple[list, mpmath.mpf]:
     """(phases, value) of the maximum of F over the n-torus [0, 2π)^n (F maps a list of n
     mpf phases to an mpf): the best node of a grid, then Newton's method with the gradient
-    and Hessian by central differences (resolution 10^-(dps-5))."""
+    and Hessian by central differences (resolution 10^-(dps-5)). `scan`, the same function
+    in double precision on an (N, n) array of phases (N values), picks the best node at
+    once (thousands of nodes in microseconds, where F takes ~0.1 ms each); the node only
+    starts Newton's method, which works on F."""
     if n == 0:
         return [], mpmath.mpf(F([]))
     grid = grid or {1: 96, 2: 48, 3: 20}.get(n, 8)
     with mpmath.workdps(dps):
         step = 2 * mpmath.pi / grid
-        best, fbest = None, -mpmath.inf
-        for node in itertools.product(range(grid), repeat=n):
-            th = [k * step for k in node]
-            v = _safe(lambda t: F(t), th)
-            if v > fbest:
-                best, fbest = th, v
+        nodes = list(itertools.product(range(grid), repeat=n))
+        if scan is not None:
+            values = np.asarray(scan(np.array(nodes, dtype=float) * (2 * np.pi / grid)))
+            if values.shape != (len(nodes),) or not np.all(np.isfinite(values)):
+                raise NoValue("no finite value at some node of the torus")
+            best = [k * step for k in nodes[int(np.argmax(values))]]
+        else:
+            best, fbest = None, -mpmath.inf
+            for node in nodes:
+                th = [k * step for k in node]
+                v = _safe(lambda t: F(t), th)
+                if v > fbest:
+                    best, fbest = th, v
         th = list(best)
         h = mpmath.mpf(10) ** (-(dps - 5) / 4)
         for _ in range(30):

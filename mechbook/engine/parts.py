@@ -19,6 +19,7 @@ rationally independent, which they are at random parameter points.
 from __future__ import annotations
 
 import mpmath
+import numpy as np
 import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
@@ -80,8 +81,10 @@ class LinearMotion:
             return [mpmath.re(x) for x in y]
 
     def torus(self):
-        """(number of phases, y(phases)): the motion with each distinct frequency's phase
-        free. UnsupportedError for a damped or growing motion, or one that drifts (a zero
+        """(number of phases, y(phases), W): the motion with each distinct frequency's phase
+        free; W (phases × 2n, complex, double precision) the same motion as
+        y = 2·Re(Σ_k W_k·exp(i·phase_k)), for scanning many phases at once.
+        UnsupportedError for a damped or growing motion, or one that drifts (a zero
         exponent the start excites)."""
         tiny = mpmath.mpf(10) ** (-(self.dps - 10)) * self.scale
         size = max([abs(x) for _, w in self.terms for x in w] + [mpmath.mpf(10) ** -300])
@@ -112,4 +115,6 @@ class LinearMotion:
                     y = [y[i] + 2 * mpmath.re(w[i] * e) for i in range(2 * self.n)]
             return y
 
-        return len(groups), at
+        W = np.array([[complex(sum((w[i] for w in ws), mpmath.mpc(0)))
+                       for i in range(2 * self.n)] for _, ws in groups], dtype=complex)
+        return len(groups), at, W.reshape(len(groups), 2 * self.n)

@@ -328,9 +328,10 @@ def _over_motion(ctx: Context, kind: str, spec: dict, book: dict) -> Verdict:
 
     def extreme(pt):
         motion = linear_motion(ctx, pt)
-        n, y = motion.torus()
+        n, y, W = motion.torus()
         at = energy_at(ctx, energy, pt)
-        _, v = torus_maximum(lambda th: s * at(y(th)), n)
+        _, v = torus_maximum(lambda th: s * at(y(th)), n,
+                             scan=lambda th: s * at.scan(2 * np.real(np.exp(1j * th) @ W)))
         return s * v
 
     def error(pt) -> float:

@@ -10,6 +10,7 @@ of a part's energy over all later times.
 from __future__ import annotations
 
 import mpmath
+import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import evaluate_mp
@@ -78,6 +79,14 @@ def energy_at(ctx: Context, energy: sp.Expr, pt: dict):
         return sum(g[i] * dy[i] for i in range(m)) + sum(
             H[i][j] * dy[i] * dy[j] for i in range(m) for j in range(m)) / 2
 
+    gf = np.array([float(x) for x in g])
+    Hf = np.array([[float(x) for x in row] for row in H])
+
+    def scan(dy: np.ndarray) -> np.ndarray:
+        """The same energy in double precision at many states (rows of dy) at once."""
+        return dy @ gf + np.einsum("ki,ij,kj->k", dy, Hf, dy) / 2
+
+    at.scan = scan
     return at
 
 
