@@ -32,6 +32,14 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from mechbook.errors import MechbookError
+from mechbook.numerics.methods import (  # noqa: F401 - the names, re-exported
+    ALIASES,
+    FIXED_METHODS,
+    METHODS,
+    OPTIONS,
+    SCIPY_METHODS,
+    TAYLOR,
+)
 from mechbook.numerics.model import Model, structure
 
 
@@ -375,23 +383,24 @@ class TaylorMethod(Integrator):
         return Trajectory(t, y[:n], y[n:], self.name, settings, 0, ok, message)
 
 
-SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
-FIXED: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog, "verlet": Leapfrog,
-                                     "yoshida4": Yoshida4, "forest-ruth": Yoshida4,
-                                     "midpoint": ImplicitMidpoint}
-METHODS = SCIPY_METHODS + tuple(FIXED) + ("taylor",)
+_FIXED_CLASSES: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog,
+                                              "yoshida4": Yoshida4,
+                                              "midpoint": ImplicitMidpoint}
+FIXED: dict[str, type[FixedStep]] = {m: _FIXED_CLASSES[ALIASES.get(m, m)]
+                                     for m in FIXED_METHODS}  # names: numerics.methods
 
 
 def make_integrator(method: str, **options) -> Integrator:
-    """The integrator named `method` (see the module docstring) with its options."""
+    """The integrator named `method` (see the module docstring) with the options its kind
+    takes (mechbook.numerics.methods.OPTIONS)."""
     if method in SCIPY_METHODS:
-        allowed = {"rtol", "atol", "max_step", "first_step", "dense_output", "compiled"}
+        allowed = OPTIONS["scipy"]
         return SciPyMethod(method, **{k: v for k, v in options.items() if k in allowed})
     if method in FIXED:
-        allowed = {"step", "max_points", "tol", "max_iter", "compiled"}
+        allowed = OPTIONS["fixed"]
         return FIXED[method](**{k: v for k, v in options.items() if k in allowed})
-    if method == "taylor":
-        allowed = {"tol", "rtol", "max_points"}
+    if method == TAYLOR:
+        allowed = OPTIONS["taylor"]
         return TaylorMethod(**{k: v for k, v in options.items() if k in allowed})
     raise IntegratorError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
