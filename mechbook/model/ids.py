@@ -28,7 +28,8 @@ def split_id(pid: object) -> tuple[str, str]:
     m = ID.fullmatch(pid) if isinstance(pid, str) else None
     if m is None:
         raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, {EXAMPLES}: "
-                            "letters, digits, '.', '_' and '-' only, a lower-case book)")
+                            "a book of lower-case letters and digits, a number of letters "
+                            "and digits with single '.', '_' or '-' between them)")
     return m.group(1), m.group(2)
 
 
