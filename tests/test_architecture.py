@@ -5,6 +5,7 @@ quantities equal to the registry, and no quantity named outside its registration
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -268,3 +269,78 @@ def test_every_declared_use_of_a_quantity_is_known():
     assert {c for q in table for c in q.crosschecks} == set(CROSSCHECKS)
     assert {q.display for q in table} - {None} == set(DISPLAYS)
     assert {s for q in table for s in q.sweeps} == set(SWEEPS) - {"drift"}  # drift: no key
+
+
+# ---- size: modules and functions short enough to read ---------------------------------------
+MAX_MODULE_LINES = 400
+MAX_FUNCTION_LINES = 60  # from `def` to the last line of the body (decorators not counted)
+SIZED = ("app", "crosscheck")  # the stages held to the limits
+# too long and allowed for now (none today). An entry that is no longer too long fails the
+# test below: take it out, so the list cannot go stale.
+KNOWN_LONG: set[str] = set()
+
+
+def too_long(path: Path) -> dict[str, int]:
+    """{'<file>' or '<file>:<function>': lines} of a module over MAX_MODULE_LINES and each
+    function (or method, nested ones too) over MAX_FUNCTION_LINES."""
+    source = path.read_text(encoding="utf-8")
+    name = path.relative_to(ROOT).as_posix() if path.is_relative_to(ROOT) else path.name
+    out = {}
+    lines = len(source.splitlines())
+    if lines > MAX_MODULE_LINES:
+        out[name] = lines
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            length = node.end_lineno - node.lineno + 1
+            if length > MAX_FUNCTION_LINES:
+                out[f"{name}:{node.name}"] = length
+    return out
+
+
+def _sized_files() -> list[Path]:
+    return sorted(p for stage_ in SIZED for p in (PACKAGE / stage_).rglob("*.py"))
+
+
+def test_no_module_or_function_too_long():
+    found = {k: v for p in _sized_files() for k, v in too_long(p).items()}
+    new = {k: v for k, v in found.items() if k not in KNOWN_LONG}
+    assert not new, (f"over {MAX_MODULE_LINES} lines a module or {MAX_FUNCTION_LINES} a "
+                     f"function: {new}; split it by job")
+    stale = sorted(KNOWN_LONG - set(found))
+    assert not stale, f"no longer too long, take them out of KNOWN_LONG: {stale}"
+
+
+def test_the_size_test_can_fail(tmp_path):
+    path = tmp_path / "probe.py"
+    path.write_text("def f():\n" + "    x = 1\n" * MAX_FUNCTION_LINES
+                    + "\n" * (MAX_MODULE_LINES - MAX_FUNCTION_LINES), encoding="utf-8")
+    assert set(too_long(path)) == {"probe.py", "probe.py:f"}
+    path.write_text("def f():\n    pass\n", encoding="utf-8")
+    assert too_long(path) == {}
+
+
+# ---- the docs' table names every module of the application ----------------------------------
+def _documented_app_modules() -> str:
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    row = next(ln for ln in text.splitlines() if ln.startswith("| `mechbook.app` |"))
+    return row
+
+
+def test_docs_table_names_every_app_module():
+    """Each module of mechbook/app (and of its packages, named as `package/` with its
+    modules) is named in the `mechbook.app` row of docs/architecture.md's table."""
+    row = _documented_app_modules()
+    words = set(re.findall(r"[A-Za-z_]+", row))
+    missing = []
+    for path in sorted((PACKAGE / "app").rglob("*.py")):
+        rel = path.relative_to(PACKAGE / "app")
+        if rel.name == "__init__.py":
+            rel = rel.parent
+            if rel == Path("."):
+                continue
+            if f"{rel.as_posix()}/" not in row:
+                missing.append(f"{rel.as_posix()}/")
+            continue
+        if rel.stem not in words:
+            missing.append(rel.as_posix())
+    assert not missing, f"docs/architecture.md's table does not name: {missing}"

@@ -167,3 +167,32 @@ def test_a_wrong_answer_in_the_third_book_fails(tmp_path):
     row = next(ln for ln in checked.output.splitlines() if ln.startswith("toy-3.2 ")
                and " c " in ln)
     assert " fail " in row
+
+
+# ---- one id grammar (mechbook.model.ids), used by the catalog, books.yaml and the schema ----
+GOOD_IDS = ["lim-2031", "symon-09-12", "symon-text-9-7-rotating-hoop", "toy-3.2", "x-a_b",
+            "a" * 40 + "-1", "x-" + "1" * 80]
+BAD_IDS = ["lim", "lim-", "-2031", "Lim-2031", "lim-../2031", "lim-20/31", "lim-2031.",
+           "lim-.2031", "lim-20..31", "", "lim 2031", "lim_x-1", "lim-20__31", "lim-2031\n",
+           "a" * 41 + "-1", "x-" + "1" * 81, "lim-a\\b", "/etc/passwd", "x-_1"]
+
+
+@pytest.mark.parametrize("pid", GOOD_IDS + BAD_IDS)
+def test_one_id_grammar_everywhere(pid):
+    """The catalog's check, the books' split and the problem schema's pattern accept and
+    refuse the same ids (before, catalog took '_' in a book and '..'-free runs of
+    separators that books then refused: two messages for one mistake)."""
+    import re
+
+    from mechbook.model.catalog import check_id
+    from mechbook.model.schema import bundled
+
+    good = pid in GOOD_IDS
+    pattern = bundled("problem")["properties"]["id"]["pattern"]
+    assert bool(re.search(pattern, pid)) == good
+    for check in (check_id, split_id):
+        if good:
+            check(pid)
+        else:
+            with pytest.raises(MechbookError, match="bad problem id"):
+                check(pid)

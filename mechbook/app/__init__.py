@@ -1,17 +1,22 @@
 """The application on top: checking problems in batches, the HDF5 store, the command line.
 
+    service      one check of many problems: ids resolved once, the store's valid outcomes,
+                 the longest first on the pool or the cluster, each written at once
     run          checking one problem (what a worker does), plain data out
     batch        a pool of worker processes with time and memory limits (any task)
     simrun       `mechbook simulate` in a worker, under the same limits
     distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
     sweep        `mechbook sweep`: a result over a grid of parameters (sweep_accuracy:
                  float64 against 30 digits; sweep_book: the book's answer on the grid;
-                 sweep_io: store and netCDF; sweep_plot; sweep_text: what it prints)
-    store        the HDF5 store, written atomically under a lock
+                 sweep_io: store and netCDF; sweep_plot; sweep_text: what it prints;
+                 sweep_spec: a sweep's definition, without NumPy)
+    store        the HDF5 store, written atomically under a lock (store_read: reading;
+                 store_cache: the warm-run cache; store_repair: a damaged store rebuilt)
     fingerprint  content hashes for the warm-run cache
     validate     `mechbook validate`
     limits       the batch's default limits (light: the command line's --help shows them)
-    cli          the `mechbook` command (imports the engine only inside commands)
+    cli/         the `mechbook` command: the entry (group `main`), common options, one
+                 module per command (imports the engine only inside commands)
     api          the Python API: mechbook.load(id) -> derived results as SymPy objects
     mathml       SymPy expressions as MathML (the report, notebooks)
     formats      check results as JSON (schemas/check-result.json) and JUnit XML

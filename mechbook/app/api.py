@@ -255,14 +255,12 @@ class Problem:
         return self.system(system).simulate(t_end, **options)
 
     def check(self, crosscheck: bool = True, store: str | Path | None = None) -> CheckResult:
-        """Check the problem against its answer key in this process (and cross-check it);
-        `store` also writes the run to that HDF5 file."""
-        from mechbook.app.run import RunOptions, run_problem
-        from mechbook.app.store import write
+        """Check the problem as loaded against its answer key in this process (and
+        cross-check it); `store` also writes the run to that HDF5 file."""
+        from mechbook.app.run import RunOptions
+        from mechbook.app.service import check_loaded
 
-        run = run_problem(self.id, self.base, RunOptions(crosscheck=crosscheck))
-        if store is not None and run.record is not None:
-            write([run.record], store)
+        run = check_loaded(self.model, self.base, RunOptions(crosscheck=crosscheck), store)
         return CheckResult(self.id, run.outcomes, run.crosschecks, run.error, run.seconds)
 
     def _repr_latex_(self) -> str:

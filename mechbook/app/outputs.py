@@ -175,3 +175,10 @@ def _sync_directory(directory: Path) -> None:
         pass
     finally:
         os.close(dfd)
+
+
+def resolve_path(base: Path, path: str | Path) -> Path:
+    """`path` as given when absolute, else relative to the tree's root `base` (where every
+    command's --store, --out and the like are read from)."""
+    path = Path(path)
+    return path if path.is_absolute() else Path(base) / path

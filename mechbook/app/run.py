@@ -17,8 +17,9 @@ import logging
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mechbook.app.fingerprint import file_sha256
 from mechbook.app.quiet import warnings_as_notes
@@ -26,6 +27,9 @@ from mechbook.app.store import ProblemRecord, cached
 from mechbook.errors import FAULTS, MechbookError, describe
 from mechbook.model.catalog import answer_path, problem_path
 from mechbook.records import NUMERIC, Outcome, ProofPolicy
+
+if TYPE_CHECKING:
+    from mechbook.model.problem import Problem
 
 Stage = Callable[[str], None]
 
@@ -59,8 +63,12 @@ class RunOptions:
 
 
 def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
-                stage: Stage = _quiet) -> ProblemRun:
-    """Check one problem against its answer key (and cross-check it), from scratch."""
+                stage: Stage = _quiet, problem: Problem | None = None) -> ProblemRun:
+    """Check one problem against its answer key (and cross-check it), from scratch.
+    `problem`: the problem file already loaded (the Python API's), checked on a fresh
+    cache of its own, so what the run stores is what this check derived."""
+    if problem is not None:
+        problem = replace(problem, _cache={})
     start = time.perf_counter()
     run = ProblemRun(pid)
     reached = [""]
@@ -71,7 +79,7 @@ def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
 
     # a NumPy or SymPy warning becomes a note naming the stage (the part) it arose in
     with _tracebacks(run.debug), warnings_as_notes(run.notes, lambda: reached[0]):
-        _check(run, pid, base, options, staged, start)
+        _check(run, pid, base, options, staged, start, problem)
     run.seconds = time.perf_counter() - start
     return run
 
@@ -105,7 +113,7 @@ def _tracebacks(into: list[str]) -> Iterator[None]:
 
 
 def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: Stage,
-           start: float) -> None:
+           start: float, loaded: Problem | None = None) -> None:
     from mechbook.app.validate import build_systems, part_faults
     from mechbook.crosscheck import crosscheck_problem
     from mechbook.engine.analysis import (
@@ -118,7 +126,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
 
     try:
         stage("loading")
-        problem = load_problem(problem_path(pid, base))
+        problem = loaded if loaded is not None else load_problem(problem_path(pid, base))
         apath = answer_path(pid, base)
         if not apath.exists():
             raise MechbookError(f"{apath}: no answer key for {pid}")

@@ -22,8 +22,6 @@ where they disagree (mechbook.app.sweep_book).
 
 from __future__ import annotations
 
-import hashlib
-import math
 import os
 import time
 from collections.abc import Callable
@@ -34,72 +32,19 @@ import numpy as np
 import sympy as sp
 
 from mechbook.app.options import SWEEP_SAMPLES
-from mechbook.core.compile import DEFAULT_BACKEND
-from mechbook.engine.sweep import UNDEFINED, Axis, Grid
+from mechbook.app.sweep_spec import (  # noqa: F401 - re-exported: a sweep's definition
+    AMPLITUDE,
+    MAX_POINTS,
+    QUANTITIES,
+    SweepSpec,
+    check_grid,
+    make_spec,
+)
+from mechbook.engine.sweep import UNDEFINED, Grid
 from mechbook.errors import MechbookError
 
-QUANTITIES = ("frequencies", "stability", "drift")
-AMPLITUDE = "amplitude"
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
 DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
-MAX_POINTS = 10_000_000  # points of one grid: its arrays are held in this process
-BYTES_PER_VALUE = 8 * 3  # float64, the blocks and their concatenation, the book's overlay
-
-
-def check_grid(axes: list[Axis], memory_mb: float = 0.0, modes: int = 1) -> int:
-    """The grid's size, refused (MechbookError) before anything is allocated when it has
-    more than MAX_POINTS points or its arrays would need more than `memory_mb` MB (0: no
-    bound): a sweep is bounded in memory like a check."""
-    points = math.prod(a.n for a in axes)
-    if points > MAX_POINTS:
-        raise MechbookError(f"the grid has {points:,} points; at most {MAX_POINTS:,} (use "
-                            "fewer points per axis)")
-    need = points * (2 * modes + 4) * BYTES_PER_VALUE / 2**20
-    if memory_mb and need > memory_mb:
-        raise MechbookError(f"the grid's {points:,} points x {modes} mode(s) would need about "
-                            f"{need:,.0f} MB, more than the memory bound of {memory_mb:g} MB "
-                            "(--memory): use fewer points or raise the bound")
-    return points
-
-
-@dataclass(frozen=True)
-class SweepSpec:
-    """Everything that defines a sweep, as plain data (it travels to cluster workers)."""
-
-    pid: str
-    files: tuple[tuple[str, bytes], ...]  # the problem's and answer key's files
-    quantity: str
-    axes: tuple[Axis, ...]
-    system: str | None = None
-    about: tuple[tuple[str, str], ...] = ()
-    steady: tuple[tuple[str, str], ...] = ()
-    part: str | None = None
-    backend: str = DEFAULT_BACKEND
-
-    @property
-    def key(self) -> str:
-        h = hashlib.sha256(repr((self.pid, self.quantity, self.axes, self.system, self.about,
-                                 self.steady, self.part, self.backend)).encode())
-        for name, data in self.files:
-            h.update(name.encode() + b"\0" + data)
-        return h.hexdigest()
-
-
-def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
-              system: str | None = None, about: dict | None = None,
-              steady: dict | None = None, part: str | None = None,
-              backend: str = DEFAULT_BACKEND) -> SweepSpec:
-    from mechbook.app.distributed import tree_files
-
-    if quantity not in QUANTITIES:
-        raise MechbookError(f"unknown quantity {quantity!r}; known: {', '.join(QUANTITIES)}")
-    check_grid(axes)
-    files = tree_files(pid, base)
-    if not files:
-        raise MechbookError(f"no problem {pid} under {base}")
-    return SweepSpec(pid, tuple(sorted(files.items())), quantity, tuple(axes), system,
-                     tuple((about or {}).items()), tuple((steady or {}).items()), part,
-                     backend)
 
 
 class Sweeper:
@@ -109,7 +54,6 @@ class Sweeper:
         from mechbook.engine.analysis import Analysis
         from mechbook.engine.sweep import LinearSweep
         from mechbook.model.catalog import answer_path, problem_path
-        from mechbook.model.expr import parse
         from mechbook.model.problem import load_problem
         from mechbook.verify.answers import load_answers
 
@@ -120,66 +64,18 @@ class Sweeper:
         self.key = load_answers(apath) if apath.exists() else None
         fixed = dict(self.problem.values())
         symbols = list(fixed)
+        self.context = None
         if spec.part is not None:
-            from mechbook.verify.context import Context
-
-            part = self._part(spec.part)
-            self.context = Context(self.analysis, part)
-            self.system = self.context.system
-            self.lin = self.context.linear()
-            fixed.update(self.key.symbol_values)
-            symbols += [s for s in self.key.symbol_values if s not in symbols]
+            self._linearize_at_part(fixed, symbols)
         else:
-            self.context = None
-            try:
-                self.system = self.analysis.system(spec.system)
-            except KeyError as exc:
-                raise MechbookError(str(exc.args[0]) + "; name it with --system") from None
-            names = dict(self.system.names)
-
-            def point(pairs, what):
-                out = {}
-                for name, text in pairs:
-                    if name not in self.system.coord_names:
-                        raise MechbookError(f"--{what} {name}=...: {name!r} is not a coordinate "
-                                            f"of {spec.pid} (coordinates: "
-                                            f"{', '.join(self.system.coord_names)})")
-                    q = self.system.q[self.system.coord_names.index(name)]
-                    out[q] = parse(text, names)
-                return out
-
-            about, steady = point(spec.about, "about"), point(spec.steady, "steady")
-            if steady:
-                self.lin = self.analysis.steady_linear(self.system.name, steady, about)
-            elif about:
-                self.lin = self.analysis.linear(self.system.name, about)
-            else:
-                self.lin = self.analysis.linear(self.system.name,
-                                                self.analysis.default_point(self.system.name))
+            self._linearize_at_point()
         self.steady = dict(getattr(self.lin.dyn.sys, "momenta", None) or {})
-        self.amplitude = None
-        names = [str(s) for s in symbols]
-        if spec.quantity == "drift":
-            if AMPLITUDE in names:
-                raise MechbookError(f"{spec.pid} has a parameter named {AMPLITUDE!r}: a drift "
-                                    "sweep cannot tell it from the amplitude")
-            if AMPLITUDE not in [a.name for a in spec.axes]:
-                raise MechbookError(f"a drift sweep needs --param {AMPLITUDE}=LO:HI:N (the "
-                                    "largest coordinate displacement of the start)")
-            self.amplitude = sp.Symbol(AMPLITUDE)
-            symbols.append(self.amplitude)
+        self.amplitude = self._amplitude(symbols)
         try:
             self.grid = Grid(list(spec.axes), symbols, fixed)
         except ValueError as exc:
             raise MechbookError(str(exc)) from None
-        for a in spec.axes:  # SymPy simplified with these assumptions: honour them
-            sym = symbols[names.index(a.name)] if a.name in names else self.amplitude
-            if (sym.is_positive or sym is self.amplitude) and min(a.lo, a.hi) <= 0:
-                raise MechbookError(f"--param {a.text()}: {a.name} is positive; sweep it over "
-                                    "positive values")
-            if sym.is_nonzero and min(a.lo, a.hi) <= 0 <= max(a.lo, a.hi):
-                raise MechbookError(f"--param {a.text()}: {a.name} is nonzero; keep 0 out of "
-                                    "its range")
+        self._check_ranges(symbols)
         self.lin_symbols = [s for s in symbols if s is not self.amplitude]
         self.linear = LinearSweep(self.lin, self.lin_symbols, spec.backend)
         # the problem's conditions, and a part's `assume:`: points outside are undefined
@@ -190,6 +86,75 @@ class Sweeper:
         if loose:
             raise MechbookError(f"the conditions use {', '.join(loose)}, which has no value")
         self._models: dict = {}
+
+    def _linearize_at_part(self, fixed: dict, symbols: list) -> None:
+        """--part: the part's system, point and values (its own symbols join the grid's)."""
+        from mechbook.verify.context import Context
+
+        self.context = Context(self.analysis, self._part(self.spec.part))
+        self.system = self.context.system
+        self.lin = self.context.linear()
+        fixed.update(self.key.symbol_values)
+        symbols += [s for s in self.key.symbol_values if s not in symbols]
+
+    def _linearize_at_point(self) -> None:
+        """--about / --steady, or the system's stable equilibrium."""
+        spec = self.spec
+        try:
+            self.system = self.analysis.system(spec.system)
+        except KeyError as exc:
+            raise MechbookError(str(exc.args[0]) + "; name it with --system") from None
+        about, steady = self._point(spec.about, "about"), self._point(spec.steady, "steady")
+        if steady:
+            self.lin = self.analysis.steady_linear(self.system.name, steady, about)
+        elif about:
+            self.lin = self.analysis.linear(self.system.name, about)
+        else:
+            self.lin = self.analysis.linear(self.system.name,
+                                            self.analysis.default_point(self.system.name))
+
+    def _point(self, pairs, what: str) -> dict:
+        """{coordinate: value} from the option's NAME=EXPR pairs (the safe parser)."""
+        from mechbook.model.expr import parse
+
+        names = dict(self.system.names)
+        out = {}
+        for name, text in pairs:
+            if name not in self.system.coord_names:
+                raise MechbookError(f"--{what} {name}=...: {name!r} is not a coordinate "
+                                    f"of {self.spec.pid} (coordinates: "
+                                    f"{', '.join(self.system.coord_names)})")
+            q = self.system.q[self.system.coord_names.index(name)]
+            out[q] = parse(text, names)
+        return out
+
+    def _amplitude(self, symbols: list):
+        """A drift sweep's pseudo-parameter `amplitude`, appended to `symbols` (None for
+        the other quantities)."""
+        spec = self.spec
+        if spec.quantity != "drift":
+            return None
+        if AMPLITUDE in [str(s) for s in symbols]:
+            raise MechbookError(f"{spec.pid} has a parameter named {AMPLITUDE!r}: a drift "
+                                "sweep cannot tell it from the amplitude")
+        if AMPLITUDE not in [a.name for a in spec.axes]:
+            raise MechbookError(f"a drift sweep needs --param {AMPLITUDE}=LO:HI:N (the "
+                                "largest coordinate displacement of the start)")
+        amplitude = sp.Symbol(AMPLITUDE)
+        symbols.append(amplitude)
+        return amplitude
+
+    def _check_ranges(self, symbols: list) -> None:
+        """SymPy simplified with the parameters' assumptions: a swept range honours them."""
+        names = [str(s) for s in symbols]
+        for a in self.spec.axes:
+            sym = symbols[names.index(a.name)] if a.name in names else self.amplitude
+            if (sym.is_positive or sym is self.amplitude) and min(a.lo, a.hi) <= 0:
+                raise MechbookError(f"--param {a.text()}: {a.name} is positive; sweep it over "
+                                    "positive values")
+            if sym.is_nonzero and min(a.lo, a.hi) <= 0 <= max(a.lo, a.hi):
+                raise MechbookError(f"--param {a.text()}: {a.name} is nonzero; keep 0 out of "
+                                    "its range")
 
     def _part(self, name: str):
         if self.key is None:
@@ -308,33 +273,14 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
     ranges = [(s, min(s + step, size)) for s in range(0, size, step)]
     progress = progress or (lambda done, total: None)
     t1 = time.perf_counter()
-    parts: dict[int, dict] = {}
     if scheduler:
-        from dask.distributed import as_completed
-
-        from mechbook.app.distributed import connect
-
-        with connect(scheduler) as client:
-            futures = {client.submit(cluster_block, spec, a, b, timeout, memory_mb,
-                                     pure=False): a for a, b in ranges}
-            for fut in as_completed(futures):
-                parts[futures[fut]] = fut.result()
-                progress(len(parts), len(ranges))
+        parts = _on_cluster(spec, ranges, scheduler, timeout, memory_mb, progress)
         where = f"Dask cluster at {scheduler}"
     elif jobs > 1 and len(ranges) > 1:
-        from concurrent.futures import ProcessPoolExecutor, as_completed
-
-        from mechbook.app.batch import _context
-        from mechbook.app.lifeline import die_with
-
-        with ProcessPoolExecutor(jobs, mp_context=_context(), initializer=die_with,
-                                 initargs=(os.getpid(),)) as pool:
-            futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
-            for fut in as_completed(futures):
-                parts[futures[fut]] = fut.result()
-                progress(len(parts), len(ranges))
+        parts = _on_local_processes(spec, ranges, jobs, progress)
         where = f"{jobs} local processes"
     else:
+        parts = {}
         for a, b in ranges:
             parts[a] = sweeper.block(a, b)
             progress(len(parts), len(ranges))
@@ -353,6 +299,57 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         "where": where, "blocks": len(ranges), "build_seconds": built,
         "evaluate_seconds": seconds, "points_per_second": size / max(seconds, 1e-9),
         "accuracy_seconds": time.perf_counter() - t2,
+        **_provenance(sweeper, parts, accuracy),
+    }
+    if spec.part:
+        attrs["part"] = spec.part
+    result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
+    from mechbook.app.sweep_book import book_overlay
+
+    result.book = book_overlay(sweeper, result)
+    return result
+
+
+def _on_cluster(spec: SweepSpec, ranges: list[tuple[int, int]], scheduler: str,
+                timeout: float, memory_mb: float, progress: Callable[[int, int], None]) -> dict:
+    """Every block on the Dask cluster, each under the limits on its worker."""
+    from dask.distributed import as_completed
+
+    from mechbook.app.distributed import connect
+
+    parts: dict[int, dict] = {}
+    with connect(scheduler) as client:
+        futures = {client.submit(cluster_block, spec, a, b, timeout, memory_mb,
+                                 pure=False): a for a, b in ranges}
+        for fut in as_completed(futures):
+            parts[futures[fut]] = fut.result()
+            progress(len(parts), len(ranges))
+    return parts
+
+
+def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: int,
+                        progress: Callable[[int, int], None]) -> dict:
+    """Every block on a pool of `jobs` local processes (that die with this one)."""
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    from mechbook.app.batch import _context
+    from mechbook.app.lifeline import die_with
+
+    parts: dict[int, dict] = {}
+    with ProcessPoolExecutor(jobs, mp_context=_context(), initializer=die_with,
+                             initargs=(os.getpid(),)) as pool:
+        futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
+        for fut in as_completed(futures):
+            parts[futures[fut]] = fut.result()
+            progress(len(parts), len(ranges))
+    return parts
+
+
+def _provenance(sweeper: Sweeper, parts: dict, accuracy: dict) -> dict:
+    """What the stored sweep says about its numbers: conditioning, the 30-digit check, the
+    conditions and fixed values it was computed under, the problem file's hash."""
+    spec = sweeper.spec
+    return {
         "ill_conditioned": int(sum(int(p["ill"][0]) for p in parts.values())),
         "precise_50_digits": int(sum(int(p["precise"][0]) for p in parts.values())),
         "accuracy_samples": accuracy["samples"],
@@ -363,13 +360,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
                   if str(s) not in {a.name for a in spec.axes}},
         "problem_sha256": sweeper.problem.sha256,
     }
-    if spec.part:
-        attrs["part"] = spec.part
-    result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
-    from mechbook.app.sweep_book import book_overlay
-
-    result.book = book_overlay(sweeper, result)
-    return result
 
 
 def _assemble(sweeper: Sweeper, parts: list[dict]) -> tuple[dict, dict]:

@@ -17,18 +17,7 @@ def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SWEEP
     substituted symbolically, the eigenproblem in mpmath)."""
     rng = np.random.default_rng(seed)
     shape = sweeper.grid.shape
-    if sweeper.spec.quantity == "stability":
-        codes = arrays["stability"]
-        defined = np.flatnonzero(codes.reshape(-1) != UNDEFINED)
-        edge = _boundary(codes)
-    elif sweeper.spec.quantity == "frequencies":
-        defined = np.flatnonzero(np.any(np.isfinite(arrays["frequencies"]), axis=-1)
-                                 .reshape(-1))
-        edge = np.zeros(0, dtype=int)
-    else:
-        defined = np.flatnonzero(np.any(np.isfinite(arrays["linear"]), axis=-1)
-                                 .reshape(-1))
-        edge = np.zeros(0, dtype=int)
+    defined, edge = _candidates(sweeper, arrays)
     if not len(defined):
         return {"samples": 0, "max_rel_diff": float("nan"), "disagree": 0}
     chosen = list(rng.choice(edge, min(len(edge), samples // 3), replace=False)) \
@@ -44,37 +33,50 @@ def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SWEEP
                  zip(sweeper.grid.axes, (sweeper.grid.coords()[a.name][i] for a, i in
                                       zip(sweeper.grid.axes, idx, strict=True)), strict=True)}
         try:
-            if sweeper.spec.quantity == "stability":
-                code, ref = sweeper.linear.precise_stability(values)
-                if code != arrays["stability"][idx]:
-                    disagree.append(where)
-                    continue
-                X = np.array([[values[s] for s in sweeper.linear.symbols]])
-                got = sweeper.linear.spectrum(X)[0]
-                scale = float(np.max(np.abs(ref))) or 1.0
-                # each exact eigenvalue against the nearest float64 one
-                rel = float(np.max(np.min(np.abs(ref[:, None] - got[None, :]), axis=1)))
-                if rel / scale >= worst:
-                    worst, worst_at = rel / scale, where
-                continue
-            else:
-                ref = sweeper.linear.precise_frequencies(values)
-                name = "frequencies" if sweeper.spec.quantity == "frequencies" else "linear"
-                got = arrays[name][idx]
-                if not np.array_equal(np.isfinite(ref), np.isfinite(got)):
-                    disagree.append(where)
-                    continue
-                scale = float(np.nanmax(np.abs(ref))) if np.any(np.isfinite(ref)) else 1.0
+            rel = _relative_difference(sweeper, arrays, values, idx)
         except (ValueError, ZeroDivisionError, TypeError, ArithmeticError) as exc:
             disagree.append({**where, "error": str(exc)[:80]})
             continue
-        diff = np.abs(np.nan_to_num(got) - np.nan_to_num(ref))
-        rel = float(np.max(diff)) / scale if scale > 0 and np.any(diff) else 0.0
-        if rel >= worst:
+        if rel is None:
+            disagree.append(where)
+        elif rel >= worst:
             worst, worst_at = rel, where
     return {"samples": len(chosen), "boundary_samples": min(len(edge), samples // 3),
             "max_rel_diff": worst, "worst_at": worst_at, "disagree": len(disagree),
             "disagree_at": disagree[:5]}
+
+
+def _candidates(sweeper, arrays: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(flat indices where the result is defined, those beside a stability boundary)."""
+    if sweeper.spec.quantity == "stability":
+        codes = arrays["stability"]
+        return np.flatnonzero(codes.reshape(-1) != UNDEFINED), _boundary(codes)
+    name = "frequencies" if sweeper.spec.quantity == "frequencies" else "linear"
+    defined = np.flatnonzero(np.any(np.isfinite(arrays[name]), axis=-1).reshape(-1))
+    return defined, np.zeros(0, dtype=int)
+
+
+def _relative_difference(sweeper, arrays: dict[str, np.ndarray], values: dict,
+                         idx: tuple) -> float | None:
+    """The float64 result at one point against the 30-digit one, relative to its scale;
+    None where the two disagree in kind (a stability class, which frequencies exist)."""
+    if sweeper.spec.quantity == "stability":
+        code, ref = sweeper.linear.precise_stability(values)
+        if code != arrays["stability"][idx]:
+            return None
+        X = np.array([[values[s] for s in sweeper.linear.symbols]])
+        got = sweeper.linear.spectrum(X)[0]
+        scale = float(np.max(np.abs(ref))) or 1.0
+        # each exact eigenvalue against the nearest float64 one
+        return float(np.max(np.min(np.abs(ref[:, None] - got[None, :]), axis=1))) / scale
+    ref = sweeper.linear.precise_frequencies(values)
+    name = "frequencies" if sweeper.spec.quantity == "frequencies" else "linear"
+    got = arrays[name][idx]
+    if not np.array_equal(np.isfinite(ref), np.isfinite(got)):
+        return None
+    scale = float(np.nanmax(np.abs(ref))) if np.any(np.isfinite(ref)) else 1.0
+    diff = np.abs(np.nan_to_num(got) - np.nan_to_num(ref))
+    return float(np.max(diff)) / scale if scale > 0 and np.any(diff) else 0.0
 
 
 def _boundary(codes: np.ndarray) -> np.ndarray:

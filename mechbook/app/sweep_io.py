@@ -91,7 +91,7 @@ def write_store(result, name: str, path: str | Path) -> Path:
 def read_store(pid: str, name: str, path: str | Path) -> dict:
     """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; KeyError if
     absent, StoreError naming what is damaged."""
-    from mechbook.app.store import StoreError, _opened, _reason
+    from mechbook.app.store_read import StoreError, _opened, _reason
 
     with _opened(path) as f:
         try:
@@ -118,7 +118,7 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
     """(name, one-line description) of a problem's stored sweeps (a damaged entry is one
     line that says so)."""
-    from mechbook.app.store import _reason
+    from mechbook.app.store_read import _reason
 
     out = []
     try:

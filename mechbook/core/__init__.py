@@ -1,6 +1,7 @@
 """Foundations shared by every stage: time limits (timeout), fast numeric evaluation with a
 cancellation scale and numeric zero tests (numeval), the compile layer turning SymPy
-expressions into fast functions (compile), and Taylor expansion of a Lagrangian (expansion).
+expressions into fast functions (compile; its backends' names: backends), and Taylor
+expansion of a Lagrangian (expansion).
 
 May import: mechbook.errors, mechbook.records. Nothing else of mechbook.
 """

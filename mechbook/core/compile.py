@@ -26,10 +26,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import sympy as sp
 
+from mechbook.core.backends import BACKENDS, DEFAULT_BACKEND  # the names' owner
 from mechbook.errors import UnsupportedError
-
-BACKENDS = ("llvm", "symengine", "sympy")
-DEFAULT_BACKEND = "llvm"
 
 Compiled = Callable[[np.ndarray], np.ndarray]
 

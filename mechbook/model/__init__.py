@@ -7,8 +7,9 @@
     constants is a constant finite and real? (in double precision: cannot hang)
     tensorexpr  the same parser for vectors and tensors (and bodies' functions)
     tensorfuncs the whitelisted functions of tensor expressions
-    books     books.yaml: the declared books, problem ids <book>-<number>
-    catalog   where problem and answer files live, problem ids checked (check_id)
+    ids       problem ids <book>-<number>: the one grammar (split_id, check_id)
+    books     books.yaml: the declared books, an id's book and number checked against them
+    catalog   where problem and answer files live (an id parsed once per lookup)
     problem   a problem file: parameters, conditions, its systems as data
     protocol  SystemLike: what a system offers the engine (kept by System and by Routh's
               reduced system: `reduced`, `full`, `held_momenta`, `held`)

@@ -1,11 +1,10 @@
 """Books declared in data (`books.yaml` at the tree's root) and problem ids `<book>-<number>`.
 
-A problem id is a book id (lower-case letters and digits) and the book's own problem number
-(letters and digits, with single '.', '-' or '_' between them: never a path), joined by the
-first '-'. `books.yaml` declares each book: title, author, edition, and a regular expression
-its numbers follow (`numbers`, matched in full; `example` is one number that must match, so a
-broken expression is caught when the file is read). Adding a book is an entry there and the
-files under problems/<book>/ and answers/<book>/; no code changes.
+A problem id is a book id and the book's own problem number joined by the first '-' (the
+grammar: mechbook.model.ids). `books.yaml` declares each book: title, author, edition, and
+a regular expression its numbers follow (`numbers`, matched in full; `example` is one number
+that must match, so a broken expression is caught when the file is read). Adding a book is
+an entry there and the files under problems/<book>/ and answers/<book>/; no code changes.
 
 With books.yaml present, an id whose book it does not declare, or whose number does not look
 like that book's, is refused with the reason. A tree without books.yaml (a scratch tree in a
@@ -19,10 +18,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mechbook.errors import MechbookError
+from mechbook.model.ids import ID, split_id  # noqa: F401 - the id grammar, for readers here
 
 FILE = "books.yaml"
-ID = re.compile(r"([a-z][a-z0-9]*)-([A-Za-z0-9]+(?:[._-][A-Za-z0-9]+)*)")
-ID_EXAMPLES = "e.g. lim-2031 or symon-09-12"
 
 
 @dataclass(frozen=True)
@@ -48,14 +46,6 @@ class Book:
 
     def as_dict(self) -> dict:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
-
-
-def split_id(pid: str) -> tuple[str, str]:
-    """'lim-2031' -> ('lim', '2031'); 'symon-09-12' -> ('symon', '09-12')."""
-    m = ID.fullmatch(pid) if isinstance(pid, str) else None
-    if m is None:
-        raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, {ID_EXAMPLES})")
-    return m.group(1), m.group(2)
 
 
 _CACHE: dict[Path, tuple[tuple, dict[str, Book]]] = {}
@@ -109,7 +99,11 @@ def load_books(path: str | Path) -> dict[str, Book]:
 def book_of(pid: str, base: str | Path) -> Book | None:
     """The declared book of problem `pid`, checking the id against books.yaml (None when the
     tree declares no books); MechbookError says what is wrong with the id."""
-    book, number = split_id(pid)
+    return declared_book(pid, *split_id(pid), base)
+
+
+def declared_book(pid: str, book: str, number: str, base: str | Path) -> Book | None:
+    """`book_of` for an id already split (by mechbook.model.ids.split_id)."""
     declared = books(base)
     if not declared:
         return None

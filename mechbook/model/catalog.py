@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 
 from mechbook.errors import MechbookError
-from mechbook.model.books import book_of
-from mechbook.model.books import split_id as _split_id
+from mechbook.model.books import declared_book
+from mechbook.model.ids import check_id, split_id  # noqa: F401 - the id grammar, re-exported
 
 DEFAULT_STORE = Path("results/mechbook.h5")  # relative to the tree's root
 
@@ -25,25 +24,6 @@ def root(start: str | Path | None = None) -> Path:
     raise MechbookError("no problems/ directory here or above: run from a mechbook tree, "
                         "name one with --root DIR (or set MECHBOOK_ROOT=DIR), or start one "
                         "with `mechbook init DIR`")
-
-
-# A book's name, a dash, and the problem's name: letters, digits, '.', '_' and '-' only, so
-# an id can never name a path outside the tree (no '/', no '..', nothing absolute).
-_ID = re.compile(r"[a-z][a-z0-9_]{0,39}-[A-Za-z0-9][A-Za-z0-9._-]{0,79}")
-
-
-def check_id(pid: object) -> str:
-    """`pid` if it is a well-formed problem id; MechbookError otherwise. The one place that
-    decides which ids may become file paths (problems/<book>/<rest>.yaml)."""
-    if not isinstance(pid, str) or not _ID.fullmatch(pid) or ".." in pid:
-        raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, e.g. lim-2031 "
-                            "or symon-09-12: letters, digits, '.', '_' and '-' only)")
-    return pid
-
-
-def split_id(pid: str) -> tuple[str, str]:
-    """'lim-2031' -> ('lim', '2031'); 'symon-09-12' -> ('symon', '09-12')."""
-    return _split_id(check_id(pid))
 
 
 def _inside(base: Path, folder: str, book: str, rest: str) -> Path:
@@ -79,16 +59,22 @@ def _stays_inside(path: Path, top: Path) -> Path:
     return path
 
 
+def _tree_file(folder: str, pid: str, base: Path) -> Path:
+    """<folder>/<book>/<number>.yaml: the id parsed once (mechbook.model.ids), checked
+    against the tree's books.yaml, and the path kept inside the tree."""
+    book, number = split_id(pid)
+    declared_book(pid, book, number, base)
+    return _inside(base, folder, book, number)
+
+
 def problem_path(pid: str, base: Path) -> Path:
-    """problems/<book>/<number>.yaml; the id checked (check_id) and against the tree's
-    books.yaml, and the path kept inside the tree."""
-    book_of(check_id(pid), base)
-    return _inside(base, "problems", *split_id(pid))
+    """problems/<book>/<number>.yaml (see _tree_file)."""
+    return _tree_file("problems", pid, base)
 
 
 def answer_path(pid: str, base: Path) -> Path:
-    book_of(check_id(pid), base)
-    return _inside(base, "answers", *split_id(pid))
+    """answers/<book>/<number>.yaml (see _tree_file)."""
+    return _tree_file("answers", pid, base)
 
 
 def all_ids(base: Path) -> list[str]:

@@ -9,6 +9,8 @@ from importlib import resources
 import jsonschema
 
 from mechbook.model.hints import did_you_mean
+from mechbook.model.ids import BOOK
+from mechbook.model.ids import PATTERN as ID_PATTERN
 from mechbook.model.yamlio import Document
 
 
@@ -18,7 +20,12 @@ def bundled(name: str) -> dict:
     mechbook.verify.registry completes with the registered quantities)."""
     text = resources.files("mechbook.model").joinpath("schemas", f"{name}.json") \
         .read_text("utf-8")
-    return json.loads(text)
+    schema = json.loads(text)
+    if name == "problem":  # the id grammar has one owner (mechbook.model.ids)
+        schema["properties"]["id"]["pattern"] = f"^{ID_PATTERN}$"
+    elif name == "books":
+        schema["$defs"]["book"]["properties"]["id"]["pattern"] = f"^{BOOK}$"
+    return schema
 
 
 def validate(doc: Document, schema: dict | str) -> None:

@@ -1,6 +1,7 @@
 """Numerical integration of the full nonlinear equations of motion.
 
     model        the equations compiled once per problem (the compile layer's scalar entry)
+    methods      the integration methods' names and the options each kind takes
     integrators  SciPy's solve_ivp methods, fixed-step RK4 / symplectic methods and the
                  Taylor method, one interface
     native       loops.c built once per machine, called through ctypes (Model.rhs too)

@@ -34,6 +34,15 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from mechbook.errors import MechbookError
+from mechbook.numerics.methods import (  # noqa: F401 - the names, re-exported
+    ALIASES,
+    FIXED_METHODS,
+    METHODS,
+    OPTIONS,
+    SCIPY_METHODS,
+    TAYLOR,
+    kind,
+)
 from mechbook.numerics.model import Model, structure
 
 
@@ -377,19 +386,13 @@ class TaylorMethod(Integrator):
         return Trajectory(t, y[:n], y[n:], self.name, settings, 0, ok, message)
 
 
-SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
-FIXED: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog, "verlet": Leapfrog,
-                                     "yoshida4": Yoshida4, "forest-ruth": Yoshida4,
-                                     "midpoint": ImplicitMidpoint}
-METHODS = SCIPY_METHODS + tuple(FIXED) + ("taylor",)
+_FIXED_CLASSES: dict[str, type[FixedStep]] = {"RK4": RK4, "leapfrog": Leapfrog,
+                                              "yoshida4": Yoshida4,
+                                              "midpoint": ImplicitMidpoint}
+FIXED: dict[str, type[FixedStep]] = {m: _FIXED_CLASSES[ALIASES.get(m, m)]
+                                     for m in FIXED_METHODS}  # names: numerics.methods
 
 
-# the options each kind of method takes (None for an option means it is not given)
-SCIPY_OPTIONS = frozenset({"rtol", "atol", "max_step", "first_step", "dense_output",
-                           "compiled"})
-FIXED_OPTIONS = frozenset({"step", "max_points", "compiled"})
-MIDPOINT_OPTIONS = FIXED_OPTIONS | {"tol", "max_iter"}  # its Newton iteration's
-TAYLOR_OPTIONS = frozenset({"tol", "rtol", "max_points"})
 # why an option another kind of method takes has no effect on this kind
 _NO_EFFECT = {
     "rtol": "a fixed-step method has no tolerance: give `step`",
@@ -411,17 +414,17 @@ def make_integrator(method: str, **options) -> Integrator:
     """The integrator named `method` (see the module docstring) with its options.
     IntegratorError for an unknown method, and for an option given (not None) that the
     method does not take: it would have no effect, so it is refused, saying why."""
-    if method in SCIPY_METHODS:
-        return SciPyMethod(method, **_applicable(method, SCIPY_OPTIONS, options))
-    if method in FIXED:
-        allowed = MIDPOINT_OPTIONS if FIXED[method] is ImplicitMidpoint else FIXED_OPTIONS
-        return FIXED[method](**_applicable(method, allowed, options))
-    if method == "taylor":
-        return TaylorMethod(**_applicable(method, TAYLOR_OPTIONS, options))
+    family = kind(method)  # the options each kind takes: mechbook.numerics.methods.OPTIONS
+    if family == "scipy":
+        return SciPyMethod(method, **_applicable(method, OPTIONS[family], options))
+    if family in ("fixed", "midpoint"):
+        return FIXED[method](**_applicable(method, OPTIONS[family], options))
+    if family == "taylor":
+        return TaylorMethod(**_applicable(method, OPTIONS[family], options))
     raise IntegratorError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
 
-def _applicable(method: str, allowed: frozenset, options: dict) -> dict:
+def _applicable(method: str, allowed: tuple[str, ...], options: dict) -> dict:
     """The options `method` takes; IntegratorError naming one given that it does not."""
     for name, value in options.items():
         if value is not None and name not in allowed:

@@ -1,0 +1,55 @@
+"""The `mechbook` command line: the group `main` and its commands, one module each (check,
+listing, solve, validate, watch, show, simulate, sweep, report, restore, init, completion);
+what they share (printing, the tree's root, option decorators) is in `common`.
+
+Only click and a few small modules are imported at the top of every module here: --help,
+list, shell completion and argument errors answer without loading SymPy, NumPy or the
+engine, which each command imports when it runs (a test keeps it so; docs/performance.md
+has the timing). The entry point is `mechbook.app.cli:main`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from mechbook.app.cli import (
+    check,
+    completion,
+    init,
+    listing,
+    report,
+    restore,
+    show,
+    simulate,
+    solve,
+    sweep,
+    validate,
+    watch,
+)
+from mechbook.app.cli.common import say, set_logging
+from mechbook.version import __version__
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="mechbook")
+@click.option("--root", "root_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=None,
+              help="Tree holding problems/ and answers/ (default: nearest parent, or "
+                   "$MECHBOOK_ROOT).")
+@click.pass_context
+def main(ctx: click.Context, root_dir: Path | None) -> None:
+    """mechbook: textbook mechanics problems as Lagrangian systems, checked against the book."""
+    ctx.ensure_object(dict)
+    ctx.obj["root_opt"] = root_dir
+    set_logging()
+    from mechbook.app.quiet import install
+
+    install(lambda text: say(text, err=True))  # warnings as one-line notes, no traceback
+
+
+# one module per command (`mechbook --help` lists them by name)
+for _module in (listing, solve, check, validate, watch, show, simulate, sweep, report, restore,
+                init, completion):
+    main.add_command(_module.command)

@@ -1,0 +1,27 @@
+"""`mechbook init`: a tree of one's own to start from (mechbook.app.init)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from mechbook.app.cli.common import say
+from mechbook.app.text import for_terminal
+from mechbook.errors import MechbookError
+
+
+@click.command("init")
+@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
+def command(directory: Path) -> None:
+    """Start a tree of your own in DIRECTORY: books.yaml, an example problem and its answer
+    key (which `mechbook check` passes), and a Makefile. Nothing is overwritten."""
+    from mechbook.app.init import init_tree
+
+    try:
+        written = init_tree(directory)
+    except MechbookError as exc:
+        raise click.ClickException(for_terminal(str(exc))) from None
+    for path in written:
+        say(f"wrote {path}")
+    say(f"next: cd {directory} && mechbook check   (or: mechbook --root {directory} check)")

@@ -1,0 +1,73 @@
+"""`mechbook show`: a problem's results and checks read back from the HDF5 store."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from mechbook.app.cli.common import (
+    in_tree,
+    numeric_text,
+    problem_id_argument,
+    say,
+    store_option,
+)
+from mechbook.app.text import for_terminal
+from mechbook.errors import MechbookError
+from mechbook.model.catalog import check_id
+
+
+@click.command("show")
+@problem_id_argument()
+@store_option("HDF5 file to read.")
+@click.pass_context
+def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
+    """Print a problem's stored results and checks, read back from the HDF5 store."""
+    from mechbook.app.store import read
+
+    path = in_tree(ctx, store_path)
+    try:
+        rec = read(check_id(problem_id), path)
+    except MechbookError as exc:
+        raise click.ClickException(for_terminal(str(exc))) from None
+    except (FileNotFoundError, KeyError) as exc:
+        raise click.ClickException(str(exc).strip("'\"")) from None
+    _results(problem_id, rec)
+    _checks(rec)
+    for name in rec.get("simulations", []):
+        say(f"simulation stored: /problems/{problem_id}/simulations/{name}")
+    from mechbook.app.sweep_io import stored_sweeps
+
+    for name, text in stored_sweeps(problem_id, path):  # a damaged entry is said so
+        say(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")
+
+
+def _results(problem_id: str, rec: dict) -> None:
+    a = rec["attrs"]
+    say(f"{problem_id}: {a.get('title')}  [{a.get('source')}]")
+    say(f"stored {a.get('date')} by mechbook {a.get('mechbook')} (SymPy {a.get('sympy')}, "
+        f"NumPy {a.get('numpy')}); {a.get('duration_s', 0):.1f} s; problem sha256 "
+        f"{str(a.get('problem_sha256'))[:12]}")
+    for sname, entry in rec["systems"].items():
+        say(f"\n== system {sname}")
+        for key, text in entry["symbolic"].items():
+            say(f"{key}: {text}")
+        for key, arr in entry["numeric"].items():
+            if not key.endswith("/growth_rates"):
+                say(f"{key} (numeric): {numeric_text(key, arr, entry['numeric'])}")
+        for key, text in entry["notes"].items():
+            say(f"{key}: {text}")
+
+
+def _checks(rec: dict) -> None:
+    say("\n== checks")
+    for c in rec["checks"]:
+        say(f"{c['part']:<16} {c['quantity']:<20} {c['status']:<12} {c['method']} "
+            f"{c['detail']}".rstrip())
+    if rec.get("crosschecks"):
+        say("\n== cross-checks")
+        for x in rec["crosschecks"]:
+            parts = ", ".join(x.get("parts") or []) or "-"
+            say(f"{x['name']} [{x['status']}, error {x.get('error', float('nan')):.1e}; "
+                f"parts: {parts}] {x.get('detail', '')}")

@@ -1,0 +1,104 @@
+"""The warm-run cache: which stored outcomes are still valid (problem file, answer key and
+engine unchanged), and each problem's last duration (a batch starts the longest first).
+Both read the store once and never fail: an unreadable record or store is no hit.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+
+from mechbook.app.fingerprint import engine_sha256
+from mechbook.app.store_read import DEFAULT_PATH, _crosschecks, _member, _plain, _reason
+from mechbook.records import CrossCheck, Outcome
+
+log = logging.getLogger("mechbook.store")
+
+
+@dataclass
+class Cached:
+    """A problem's stored outcomes and cross-checks, still valid for this run."""
+
+    outcomes: list[Outcome]
+    crosschecks: list[CrossCheck]
+    duration: float
+
+
+def cached(wanted: dict[str, tuple[str, str]], path: str | Path = DEFAULT_PATH,
+           crosschecks: bool = True) -> dict[str, Cached]:
+    """The stored results of the problems in `wanted` ({id: (problem sha256, answers
+    sha256)}) whose problem file, answer key and engine are unchanged since they were
+    stored (and, with `crosschecks`, that were cross-checked). One read of the file. A
+    record that cannot be read is not a hit (the problem is checked again); a store that
+    cannot be read gives no hits (its first write moves it aside and rebuilds it)."""
+    path = Path(path)
+    out: dict[str, Cached] = {}
+    if not path.is_file():
+        return out
+    engine = engine_sha256()
+    try:
+        with h5py.File(path, "r") as f:
+            root = _member(f, "problems")
+            for pid, shas in wanted.items():
+                try:
+                    hit = _cached_one(root, pid, shas, engine, crosschecks)
+                except Exception as exc:  # noqa: BLE001 - damaged: check it again
+                    log.debug("stored record of %s in %s unreadable: %s", pid, path,
+                              _reason(exc))
+                    continue
+                if hit is not None:
+                    out[pid] = hit
+    except Exception as exc:  # noqa: BLE001 - a damaged store: no hits
+        log.debug("store %s unreadable: %s", path, _reason(exc))
+        return {}
+    return out
+
+
+def _cached_one(root, pid: str, shas: tuple[str, str], engine: str,
+                crosschecks: bool) -> Cached | None:
+    if pid not in root:
+        return None
+    g = root[pid]
+    a = {k: _plain(v) for k, v in g.attrs.items()}
+    if (a.get("problem_sha256"), a.get("answers_sha256"), a.get("engine_sha256")) != \
+            (*shas, engine):
+        return None
+    crossed = [CrossCheck.from_dict(d) for d in _crosschecks(g)]
+    if crosschecks and not crossed:
+        return None
+    return Cached(_outcomes(pid, g), crossed if crosschecks else [],
+                  float(a.get("duration_s", 0.0)))
+
+
+def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
+    """Each stored problem's last cold duration (seconds): a batch starts the longest first
+    (an unreadable store or record just gives no duration)."""
+    path = Path(path)
+    if not path.is_file():
+        return {}
+    out = {}
+    try:
+        with h5py.File(path, "r") as f:
+            root = _member(f, "problems")
+            for pid in root:
+                try:
+                    out[pid] = float(root[pid].attrs.get("duration_s", 0.0))
+                except Exception:  # noqa: BLE001 - damaged: no duration known
+                    continue
+    except Exception:  # noqa: BLE001 - damaged store: no durations
+        return out
+    return out
+
+
+def _outcomes(pid: str, g: h5py.Group) -> list[Outcome]:
+    fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin", "power")
+    rows = []
+    checks = _member(g, "checks")
+    for part in checks:
+        a = {k: _plain(v) for k, v in checks[part].attrs.items()}
+        rows.append((a.get("index", 0), Outcome(pid, part, **{k: a[k] for k in fields
+                                                              if k in a})))
+    return [o for _, o in sorted(rows, key=lambda r: r[0])]

@@ -1,0 +1,84 @@
+"""Rebuilding a damaged store: every problem, sweep and top-level entry that still reads
+whole is copied into a new file (mechbook.app.store moves the damaged one aside first).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+
+from mechbook.app.store_read import _SCALE_ATTRS, _decoded, _read_all, _walk
+
+
+def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
+    """Copy every problem, sweep and top-level entry of the damaged file at `path` that
+    reads whole into `out`; ([kept], [lost]) by name."""
+    kept: list[str] = []
+    lost: list[str] = []
+    try:
+        src = h5py.File(path, "r")
+    except Exception:  # noqa: BLE001 - nothing readable at all: an empty store
+        return kept, ["the whole file"]
+    with src:
+        try:
+            tops = list(src.keys())
+        except Exception:  # noqa: BLE001
+            return kept, ["the whole file"]
+        for top in tops:
+            try:
+                children = list(src[top].keys()) if isinstance(src[top], h5py.Group) else None
+            except Exception:  # noqa: BLE001
+                lost.append(f"/{top}")
+                continue
+            for name in (children if children is not None else [None]):
+                where = f"/{top}/{name}" if name is not None else f"/{top}"
+                try:
+                    obj = src[where]
+                    if isinstance(obj, h5py.Group):
+                        _read_all(obj)
+                        _copy_group(obj, out.require_group(top).create_group(
+                            name, track_order=True) if name is not None
+                            else out.create_group(top, track_order=True))
+                    else:
+                        _copy_dataset(obj, out.require_group(top) if name else out,
+                                      name or top)
+                    kept.append(where)
+                except Exception:  # noqa: BLE001 - that entry is damaged: left out
+                    if where in out:
+                        del out[where]
+                    lost.append(where)
+    return kept, lost
+
+
+def _copy_group(src: h5py.Group, dst: h5py.Group) -> None:
+    """Copy a subtree between files as plain data (object references, which dimension
+    scales are made of, do not survive a copy between files: the scales are re-attached by
+    their paths inside the subtree)."""
+    dst.attrs.update(_raw_attrs(src))
+    scales, links = [], []
+    for name, obj in _walk(src):
+        if isinstance(obj, h5py.Group):
+            dst.create_group(name, track_order=True).attrs.update(_raw_attrs(obj))
+            continue
+        _copy_dataset(obj, dst, name)
+        if obj.is_scale:
+            scales.append((name, obj.attrs.get("NAME", b"")))
+        for i, dim in enumerate(obj.dims):
+            for scale in dim.values():
+                links.append((name, i, scale.name[len(src.name):].lstrip("/")))
+    for name, label in scales:
+        dst[name].make_scale(_decoded(label) or name.rsplit("/", 1)[-1])
+    for name, i, scale in links:
+        if scale in dst:
+            dst[name].dims[i].attach_scale(dst[scale])
+
+
+def _copy_dataset(obj: h5py.Dataset, dst: h5py.Group, name: str) -> None:
+    d = dst.create_dataset(name, data=obj[()], dtype=obj.dtype,
+                           compression=obj.compression)
+    d.attrs.update(_raw_attrs(obj))
+
+
+def _raw_attrs(obj) -> dict:
+    return {k: obj.attrs[k] for k in obj.attrs if k not in _SCALE_ATTRS}
