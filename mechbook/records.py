@@ -30,6 +30,8 @@ class Status(enum.StrEnum):
 # the outcomes of a part, and of a cross-check, in the order tables count them
 STATUSES = (Status.PASS, Status.FAIL, Status.ERRATUM, Status.UNSUPPORTED, Status.ERROR)
 CROSSCHECK_STATUSES = (Status.PASS, Status.FAIL, Status.NA, Status.ERROR)
+# the outcomes (of a part or a cross-check) that count as a fail: `mechbook check` exits 1
+FAILING = (Status.FAIL, Status.ERROR)
 
 
 @dataclass(frozen=True)
@@ -99,7 +101,7 @@ class CrossCheck:
 
     @property
     def failed(self) -> bool:
-        return self.status in (Status.FAIL, Status.ERROR)
+        return self.status in FAILING
 
     def cell(self) -> str:
         """The table's cross-check column."""

@@ -34,7 +34,7 @@ from mechbook.model.books import Book, book_of
 from mechbook.model.catalog import problem_path, root
 from mechbook.model.problem import Problem as Model
 from mechbook.model.problem import load_problem
-from mechbook.records import CrossCheck, Outcome
+from mechbook.records import FAILING, CrossCheck, Outcome
 
 
 def load(problem_id: str, root_dir: str | Path | None = None,
@@ -293,7 +293,7 @@ class CheckResult:
     @property
     def ok(self) -> bool:
         """No part failed or errored, no cross-check failed, and the problem ran."""
-        return (self.error is None and all(o.status not in ("fail", "error")
+        return (self.error is None and all(o.status not in FAILING
                                            for o in self.outcomes)
                 and not any(x.failed for x in self.crosschecks))
 

@@ -8,7 +8,11 @@ from collections import Counter
 
 import click
 
-STATUS_ORDER = ("pass", "erratum", "unsupported", "fail", "error")
+from mechbook.records import FAILING, Status
+
+# the order a summary counts outcomes in: of the parts, and of the cross-checks
+STATUS_ORDER = (Status.PASS, Status.ERRATUM, Status.UNSUPPORTED, Status.FAIL, Status.ERROR)
+CROSS_ORDER = (Status.PASS, Status.NA, Status.FAIL, Status.ERROR)
 
 
 class Progress:
@@ -28,7 +32,7 @@ class Progress:
         self.done += 1
         if self.bar is not None:
             self.bar.update(1, run.pid)
-            if run.error or any(o.status in ("fail", "error") for o in run.outcomes):
+            if run.error or any(o.status in FAILING for o in run.outcomes):
                 click.echo(f"\n{run.pid}: {_summary(run)}", err=True)
         else:
             click.echo(f"[{self.done}/{self.total}] {run.pid} ({run.seconds:.1f} s): "
@@ -56,7 +60,7 @@ def print_table(runs: list, verbose: bool) -> None:
     for run in runs:
         if run.error:
             click.echo(f"{run.pid:<16} {'-':<16} {'-':<20} {'ERROR':<12} {'-':<12} {run.error}")
-            total["error"] += 1
+            total[Status.ERROR] += 1
             continue
         by_part: dict[str, list] = {}
         for x in run.crosschecks:
@@ -66,7 +70,7 @@ def print_table(runs: list, verbose: bool) -> None:
         for o in run.outcomes:
             total[o.status] += 1
             info = o.method
-            if o.status in ("fail", "error", "unsupported", "erratum") or verbose:
+            if o.status != Status.PASS or verbose:
                 info = f"{o.method} {o.detail}".strip()
             if verbose and o.power:
                 info = f"[{o.power}] {info}"
@@ -80,8 +84,7 @@ def print_table(runs: list, verbose: bool) -> None:
                ", ".join(f"{total[s]} {s}" for s in STATUS_ORDER if total[s]))
     if crossed:
         click.echo(f"cross-checks: {sum(crossed.values())}: " +
-                   ", ".join(f"{crossed[s]} {s}" for s in ("pass", "n.a.", "fail", "error")
-                             if crossed[s]))
+                   ", ".join(f"{crossed[s]} {s}" for s in CROSS_ORDER if crossed[s]))
     loose = [(r.pid, x) for r in runs for x in r.crosschecks if not x.parts]
     if loose:  # the engine's own equilibria, systems no answer part refers to
         click.echo("\ncross-checks no answer part refers to:")

@@ -19,10 +19,8 @@ from importlib import resources
 from pathlib import Path
 
 from mechbook.app.text import for_xml
-from mechbook.records import STATUSES
+from mechbook.records import CROSSCHECK_STATUSES, FAILING, STATUSES, Status
 from mechbook.version import __version__
-
-CROSS_STATUSES = ("pass", "fail", "n.a.", "error")
 
 
 def schema() -> dict:
@@ -41,7 +39,7 @@ def failures(runs: list) -> int:
     """What makes `mechbook check` exit 1: problems not checked, parts that failed or
     errored, cross-checks that failed."""
     return (sum(1 for r in runs if r.error)
-            + sum(1 for r in runs for o in r.outcomes if o.status in ("fail", "error"))
+            + sum(1 for r in runs for o in r.outcomes if o.status in FAILING)
             + sum(1 for r in runs for x in r.crosschecks if x.failed))
 
 
@@ -74,7 +72,7 @@ def to_json(runs: list, root: Path, store: Path | None, store_error: str | None 
     summary = {"problems": len(runs), "parts": sum(parts.values()),
                **{s: parts[s] for s in STATUSES},
                "problem_errors": sum(1 for r in runs if r.error),
-               "crosschecks": {s: crossed[s] for s in CROSS_STATUSES},
+               "crosschecks": {s: crossed[s] for s in CROSSCHECK_STATUSES},
                "failures": bad, "ok": bad == 0}
     if store_error:
         summary["ok"] = False
@@ -103,28 +101,28 @@ def junit_xml(runs: list) -> ET.ElementTree:
             if o.power:
                 ET.SubElement(case, "properties").append(
                     ET.Element("property", name="power", value=o.power))
-            if o.status == "fail":
+            if o.status == Status.FAIL:
                 ET.SubElement(case, "failure", message=o.detail[:500] or "fail").text = text
                 counts["failures"] += 1
-            elif o.status == "error":
+            elif o.status == Status.ERROR:
                 ET.SubElement(case, "error", message=o.detail[:500] or "error").text = text
                 counts["errors"] += 1
-            elif o.status == "unsupported":
+            elif o.status == Status.UNSUPPORTED:
                 ET.SubElement(case, "skipped", message=f"unsupported: {o.detail}"[:500])
                 counts["skipped"] += 1
-            elif o.status == "erratum":
+            elif o.status == Status.ERRATUM:
                 ET.SubElement(case, "system-out").text = f"erratum: {o.detail}"
         for x in run.crosschecks:
             case = ET.SubElement(suite, "testcase", classname=run.pid,
                                  name=f"cross-check {x.name}", time=f"{x.seconds:.3f}")
             counts["tests"] += 1
-            if x.status == "fail":
+            if x.status == Status.FAIL:
                 ET.SubElement(case, "failure", message=x.detail[:500] or "fail").text = x.detail
                 counts["failures"] += 1
-            elif x.status == "error":
+            elif x.status == Status.ERROR:
                 ET.SubElement(case, "error", message=x.detail[:500] or "error").text = x.detail
                 counts["errors"] += 1
-            elif x.status == "n.a.":
+            elif x.status == Status.NA:
                 ET.SubElement(case, "skipped", message=f"n.a.: {x.detail}"[:500])
                 counts["skipped"] += 1
         suite.set("time", f"{run.seconds:.3f}")

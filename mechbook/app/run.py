@@ -26,7 +26,7 @@ from mechbook.app.quiet import warnings_as_notes
 from mechbook.app.store import ProblemRecord, cached
 from mechbook.errors import FAULTS, MechbookError, describe
 from mechbook.model.catalog import answer_path, problem_path
-from mechbook.records import NUMERIC, Outcome, ProofPolicy
+from mechbook.records import NUMERIC, Outcome, ProofPolicy, Status
 
 if TYPE_CHECKING:
     from mechbook.model.problem import Problem
@@ -139,7 +139,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
         build_systems(problem)
         faults = part_faults(key, analysis)
         if faults:  # each malformed part says where; the others are not checked
-            run.outcomes = [Outcome(problem.id, p.name, p.quantity, p.data["cite"], "error",
+            run.outcomes = [Outcome(problem.id, p.name, p.quantity, p.data["cite"], Status.ERROR,
                                     detail=faults[p.name], origin=p.data.get("origin", "book"))
                             for p in key.parts if p.name in faults]
             run.notes.append("the answer key is malformed: its other parts were not checked "

@@ -19,7 +19,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from mechbook.app.console import STATUS_ORDER
 from mechbook.errors import MechbookError
+from mechbook.records import Status
 
 POLL_SECONDS = 0.1
 
@@ -64,11 +66,10 @@ def report_lines(run, seconds: float, cpu: float) -> list[str]:
     if run.error:
         return [f"{run.pid}: {run.error}", f"  ({seconds:.2f} s, CPU {cpu:.2f} s)"]
     counts = Counter(o.status for o in run.outcomes)
-    order = ("pass", "erratum", "unsupported", "fail", "error")
-    summary = ", ".join(f"{counts[s]} {s}" for s in order if counts[s]) or "no parts"
+    summary = ", ".join(f"{counts[s]} {s}" for s in STATUS_ORDER if counts[s]) or "no parts"
     lines = [f"{run.pid}: {summary}  (checked in {seconds:.2f} s, CPU {cpu:.2f} s)"]
     for o in run.outcomes:
-        if o.status != "pass":
+        if o.status != Status.PASS:
             lines.append(f"  {o.part:<16} {o.quantity:<20} {o.status:<12} "
                          f"{(o.method + ' ' + o.detail).strip()}")
     for x in run.crosschecks:

@@ -28,7 +28,7 @@ from mechbook.app.report.page import PageOptions
 from mechbook.errors import MechbookError, describe
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
-from mechbook.records import STATUSES
+from mechbook.records import STATUSES, Status
 from mechbook.version import __version__
 
 NOT_CHECKED = "not checked"
@@ -84,8 +84,8 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
     render("index.html", index, problems=problems_index, rows=rows, books=book_list,
            statuses=[*STATUSES, NOT_CHECKED], counts=counts, version=__version__,
            store=str(store), date=datetime.now(UTC).isoformat(timespec="seconds"),
-           errata=[r for r in rows if r["status"] == "erratum"],
-           unsupported=[r for r in rows if r["status"] == "unsupported"])
+           errata=[r for r in rows if r["status"] == Status.ERRATUM],
+           unsupported=[r for r in rows if r["status"] == Status.UNSUPPORTED])
     return index
 
 

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from mechbook.records import Status
+
 
 def _pyplot():
     import matplotlib
@@ -58,7 +60,7 @@ def crosscheck_frequencies(modes: list[dict], title: str, path: Path) -> Path | 
     lo, hi = min(lin.min(), meas.min()) * 0.9, max(lin.max(), meas.max()) * 1.1
     ax.plot([lo, hi], [lo, hi], color="grey", lw=0.8, label="measured = linear")
     for (w, m, status) in points:
-        ax.plot(w, m, "o", color="tab:green" if status == "pass" else "tab:red")
+        ax.plot(w, m, "o", color="tab:green" if status == Status.PASS else "tab:red")
     ax.set_xlabel("ω of the linear system (engine)")
     ax.set_ylabel("ω measured in the simulation")
     ax.legend(fontsize=8, loc="upper left")
