@@ -69,7 +69,7 @@ class Sweeper:
             self._linearize_at_part(fixed, symbols)
         else:
             self._linearize_at_point()
-        self.steady = dict(getattr(self.lin.dyn.sys, "momenta", None) or {})
+        self.steady = dict(self.lin.dyn.sys.held_momenta)  # {} about an equilibrium
         self.amplitude = self._amplitude(symbols)
         try:
             self.grid = Grid(list(spec.axes), symbols, fixed)

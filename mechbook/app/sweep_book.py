@@ -63,8 +63,8 @@ def _same_point(ctx, sweeper) -> bool:
     mine = sweeper.lin
     if set(lin.point) != set(mine.point) or [str(q) for q in lin.q] != [str(q) for q in mine.q]:
         return False
-    steady_a = dict(getattr(lin.dyn.sys, "momenta", None) or {})
-    steady_b = dict(getattr(mine.dyn.sys, "momenta", None) or {})
+    steady_a = dict(lin.dyn.sys.held_momenta)  # {} about an equilibrium
+    steady_b = dict(mine.dyn.sys.held_momenta)
     if set(steady_a) != set(steady_b):
         return False
     pairs = [(lin.point[q], mine.point[q]) for q in lin.point]
