@@ -103,12 +103,6 @@ class ReducedSystem(SystemLike):
         the reduced Lagrangian until the linear system is formed."""
         return self._held
 
-    @property
-    def momenta(self) -> dict[sp.Symbol, sp.Expr]:
-        """`held_momenta` under its former name (read by mechbook.app until it asks the
-        contract)."""
-        return self._held_momenta
-
     def dt(self, expr):
         out = sp.diff(expr, self.t)
         for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True):
