@@ -92,3 +92,70 @@ def test_the_sweep_command_says_what_an_axis_should_look_like(tmp_path):
               "theta=pi", "--param", "omega=1:2", "--no-store")
     assert res.exit_code != 0 and "expected NAME=LO:HI:N" in res.output
     assert "Traceback" not in res.output
+
+
+# ---- the store: a problem, a simulation or a sweep that is not there -----------------------
+def _store(tmp_path, *groups: str):
+    import h5py
+
+    path = tmp_path / "s.h5"
+    with h5py.File(path, "w") as f:
+        for g in groups:
+            f.create_group(g)
+    return path
+
+
+def test_a_problem_not_in_the_store_names_those_that_are(tmp_path):
+    from mechbook.app.store import read
+
+    path = _store(tmp_path, "problems/lim-2031", "problems/lim-2032")
+    with pytest.raises(NotFoundError) as info:
+        read("lim-2033", path)
+    assert isinstance(info.value, KeyError)  # old callers too
+    assert str(info.value) == (f"lim-2033 is not in {path} (problems stored: lim-2031, "
+                               "lim-2032); run `mechbook check lim-2033`")
+    with pytest.raises(NotFoundError, match=r"\(no problem is stored\)"):
+        read("lim-2033", _store(tmp_path))
+
+
+def test_a_simulation_or_sweep_not_in_the_store_names_those_that_are(tmp_path):
+    from mechbook.app.store import read_simulation
+    from mechbook.app.sweep_io import read_store
+
+    path = _store(tmp_path, "problems/lim-2031/simulations/main-RK45", "sweeps/lim-2031/map")
+    with pytest.raises(NotFoundError, match=r"^no simulation 'main-DOP853' of lim-2031 in .*"
+                                            r" \(simulations stored: main-RK45\)$"):
+        read_simulation("lim-2031", "main-DOP853", path)
+    with pytest.raises(NotFoundError, match=r"\(no simulation is stored\)$"):
+        read_simulation("lim-2032", "main-RK45", path)
+    with pytest.raises(NotFoundError, match=r"^no sweep 'mop' of lim-2031 in .* \(sweeps "
+                                            r"stored: map\)$"):
+        read_store("lim-2031", "mop", path)
+    with pytest.raises(NotFoundError, match=r"\(no sweep is stored\)$"):
+        read_store("lim-2032", "map", path)
+
+
+def test_many_stored_names_are_counted_and_the_nearest_named():
+    from mechbook.app.store_read import there
+
+    names = [f"lim-20{n}" for n in range(28, 68)]
+    assert there("lim-2063x", names, "problem") == "40 problems stored; did you mean 'lim-2063'?"
+    assert there("xyz", names, "problem") == "40 problems stored"
+
+
+def test_show_of_a_problem_not_in_the_store_is_a_clean_message(tmp_path):
+    path = _store(tmp_path, "problems/lim-2031")
+    res = run("--root", ROOT, "show", "lim-2032", "--store", path)
+    assert res.exit_code == 1
+    assert res.output == (f"Error: lim-2032 is not in {path} (problems stored: lim-2031); "
+                          "run `mechbook check lim-2032`\n")
+
+
+def test_check_of_a_problem_with_no_file_is_not_found(tmp_path):
+    from mechbook.app.service import resolve_ids
+
+    with pytest.raises(NotFoundError, match=r"^no problem lim-2013 \(no file .*2013\.yaml\)$"):
+        resolve_ids(["lim-2013"], ROOT)
+    res = run("--root", ROOT, "check", "lim-2013", "--no-store")
+    assert res.exit_code != 0 and "Traceback" not in res.output
+    assert res.output.startswith("Error: no problem lim-2013 (no file ")

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.outputs import OutputError, output_file, resolve_path
 from mechbook.app.run import ProblemRun, RunOptions, cached_runs, run_problem
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, problem_path
 
 if TYPE_CHECKING:
@@ -99,7 +99,7 @@ def resolve_ids(ids: Sequence[str], base: Path) -> tuple[list[str], dict[str, Pr
             refused[pid] = ProblemRun(pid, error=str(exc))
             continue
         if not path.exists():
-            raise MechbookError(f"no problem {pid} (no file {path})")
+            raise NotFoundError(f"no problem {pid} (no file {path})")
     return out, refused
 
 

@@ -15,8 +15,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE
+from mechbook.model.hints import MAX_LISTED, did_you_mean
 
 DEFAULT_PATH = DEFAULT_STORE
 _SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
@@ -63,17 +64,31 @@ def _damaged(path: str | Path, what: str, exc: BaseException) -> StoreError:
                       "into this store moves it aside and rebuilds it", "read")
 
 
+def there(name: str, names: list[str], what: str) -> str:
+    """What a store holds instead of `name`: '{what}s stored: a, b', 'no {what} is stored',
+    or for many how many, and the nearest."""
+    if not names:
+        return f"no {what} is stored"
+    if len(names) <= MAX_LISTED:
+        return f"{what}s stored: {', '.join(names)}"
+    close = did_you_mean(name, names)
+    return f"{len(names)} {what}s stored" + (f"; {close}" if close else "")
+
+
 def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
-    """One problem's record as plain Python data (KeyError if absent, FileNotFoundError if
-    there is no store, StoreError naming what is damaged)."""
+    """One problem's record as plain Python data (NotFoundError, also a KeyError, naming
+    those stored if it is absent; FileNotFoundError if there is no store; StoreError naming
+    what is damaged)."""
     path = Path(path)
     with _opened(path) as f:
         try:
             present = "problems" in f and pid in f["problems"]
+            stored = [] if present else _names(f, "problems")
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, "the list of problems", exc) from None
         if not present:
-            raise KeyError(f"{pid} is not in {path}; run `mechbook check {pid}`")
+            raise NotFoundError(f"{pid} is not in {path} ({there(pid, stored, 'problem')}); "
+                                f"run `mechbook check {pid}`")
         try:
             return _read_problem(f["problems"][pid])
         except Exception as exc:  # noqa: BLE001 - damage inside the record, described
@@ -112,12 +127,15 @@ def _crosschecks(g: h5py.Group) -> list[dict]:
 
 
 def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dict:
-    """{"attrs": {...}, "arrays": {key: array}, "array_attrs": {key: {...}}} of one run."""
+    """{"attrs": {...}, "arrays": {key: array}, "array_attrs": {key: {...}}} of one run
+    (NotFoundError, also a KeyError, naming the problem's stored runs if it is absent)."""
     with _opened(path) as f:
         try:
             s = f["problems"][pid]["simulations"][name]
         except KeyError:
-            raise KeyError(f"no simulation {name!r} of {pid} in {path}") from None
+            stored = there(name, _names(f, "problems", pid, "simulations"), "simulation")
+            raise NotFoundError(f"no simulation {name!r} of {pid} in {path} ({stored})") \
+                from None
         try:
             out = {"attrs": {k: _plain(v) for k, v in s.attrs.items()}, "arrays": {},
                    "array_attrs": {}}
@@ -141,6 +159,16 @@ def problems(path: str | Path = DEFAULT_PATH) -> list[str]:
             return sorted(_member(f, "problems").keys())
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, "the list of problems", exc) from None
+
+
+def _names(f: h5py.File, *keys: str) -> list[str]:
+    """The names under f[keys[0]][keys[1]]..., [] where any of them is absent."""
+    group = f
+    for key in keys:
+        if key not in group:
+            return []
+        group = group[key]
+    return sorted(group)
 
 
 def _member(group: h5py.Group, name: str):

@@ -41,7 +41,7 @@ from mechbook.app.sweep_spec import (  # noqa: F401 - re-exported: a sweep's def
     make_spec,
 )
 from mechbook.engine.sweep import UNDEFINED, Grid
-from mechbook.errors import MechbookError
+from mechbook.errors import InputError, MechbookError, NotFoundError
 
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
 DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
@@ -74,7 +74,7 @@ class Sweeper:
         try:
             self.grid = Grid(list(spec.axes), symbols, fixed)
         except ValueError as exc:
-            raise MechbookError(str(exc)) from None
+            raise InputError(str(exc)) from None
         self._check_ranges(symbols)
         self.lin_symbols = [s for s in symbols if s is not self.amplitude]
         self.linear = LinearSweep(self.lin, self.lin_symbols, spec.backend)
@@ -102,8 +102,8 @@ class Sweeper:
         spec = self.spec
         try:
             self.system = self.analysis.system(spec.system)
-        except KeyError as exc:
-            raise MechbookError(str(exc.args[0]) + "; name it with --system") from None
+        except NotFoundError as exc:
+            raise NotFoundError(f"{exc}; name it with --system") from None
         about, steady = self._point(spec.about, "about"), self._point(spec.steady, "steady")
         if steady:
             self.lin = self.analysis.steady_linear(self.system.name, steady, about)
@@ -121,9 +121,9 @@ class Sweeper:
         out = {}
         for name, text in pairs:
             if name not in self.system.coord_names:
-                raise MechbookError(f"--{what} {name}=...: {name!r} is not a coordinate "
-                                    f"of {self.spec.pid} (coordinates: "
-                                    f"{', '.join(self.system.coord_names)})")
+                raise NotFoundError(f"--{what} {name}=...: {name!r} is not a coordinate "
+                                   f"of {self.spec.pid} (coordinates: "
+                                   f"{', '.join(self.system.coord_names)})")
             q = self.system.q[self.system.coord_names.index(name)]
             out[q] = parse(text, names)
         return out
@@ -150,19 +150,19 @@ class Sweeper:
         for a in self.spec.axes:
             sym = symbols[names.index(a.name)] if a.name in names else self.amplitude
             if (sym.is_positive or sym is self.amplitude) and min(a.lo, a.hi) <= 0:
-                raise MechbookError(f"--param {a.text()}: {a.name} is positive; sweep it over "
-                                    "positive values")
+                raise InputError(f"--param {a.text()}: {a.name} is positive; sweep it over "
+                                 "positive values")
             if sym.is_nonzero and min(a.lo, a.hi) <= 0 <= max(a.lo, a.hi):
-                raise MechbookError(f"--param {a.text()}: {a.name} is nonzero; keep 0 out of "
-                                    "its range")
+                raise InputError(f"--param {a.text()}: {a.name} is nonzero; keep 0 out of "
+                                 "its range")
 
     def _part(self, name: str):
         if self.key is None:
-            raise MechbookError(f"--part {name}: {self.spec.pid} has no answer key")
+            raise NotFoundError(f"--part {name}: {self.spec.pid} has no answer key")
         for p in self.key.parts:
             if p.name == name:
                 return p
-        raise MechbookError(f"--part {name}: no such part (parts: "
+        raise NotFoundError(f"--part {name}: no such part (parts: "
                             f"{', '.join(p.name for p in self.key.parts)})")
 
     @property

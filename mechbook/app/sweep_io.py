@@ -21,6 +21,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from mechbook.errors import NotFoundError
 from mechbook.version import __version__
 
 STORE_POINTS = 250_000
@@ -89,15 +90,17 @@ def write_store(result, name: str, path: str | Path) -> Path:
 
 
 def read_store(pid: str, name: str, path: str | Path) -> dict:
-    """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; KeyError if
-    absent, StoreError naming what is damaged."""
-    from mechbook.app.store_read import StoreError, _opened, _reason
+    """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; NotFoundError
+    (also a KeyError) naming the problem's stored sweeps if it is absent, StoreError naming
+    what is damaged."""
+    from mechbook.app.store_read import StoreError, _names, _opened, _reason, there
 
     with _opened(path) as f:
         try:
             g = f["sweeps"][pid][name]
         except KeyError:
-            raise KeyError(f"no sweep {name!r} of {pid} in {path}") from None
+            stored = there(name, _names(f, "sweeps", pid), "sweep")
+            raise NotFoundError(f"no sweep {name!r} of {pid} in {path} ({stored})") from None
         try:
             attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
             coords, vars_ = {}, {}

@@ -31,8 +31,8 @@ def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
         rec = read(check_id(problem_id), path)
     except MechbookError as exc:
         raise click.ClickException(for_terminal(str(exc))) from None
-    except (FileNotFoundError, KeyError) as exc:
-        raise click.ClickException(str(exc).strip("'\"")) from None
+    except FileNotFoundError as exc:  # no store at all; a problem not in it: NotFoundError
+        raise click.ClickException(str(exc)) from None
     _results(problem_id, rec)
     _checks(rec)
     for name in rec.get("simulations", []):
