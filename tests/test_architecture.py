@@ -271,6 +271,70 @@ def test_every_declared_use_of_a_quantity_is_known():
     assert {s for q in table for s in q.sweeps} == set(SWEEPS) - {"drift"}  # drift: no key
 
 
+# ---- statuses: compared as Status members, never as their strings -------------------------
+STATUS_VALUES = {"pass", "fail", "erratum", "unsupported", "error", "n.a."}
+STATUS_COMPARED_IN = ("app", "crosscheck", "verify")
+
+
+def _names_a_status(node: ast.AST) -> bool:
+    """`status`, `x.status`, `x.mode_status`, `r["status"]` or `r.get("status", ...)`."""
+    if isinstance(node, ast.Name):
+        return node.id.lower().endswith("status")
+    if isinstance(node, ast.Attribute):
+        return node.attr.lower().endswith("status")
+    key = None
+    if isinstance(node, ast.Subscript):
+        key = node.slice
+    elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+          and node.func.attr == "get" and node.args):
+        key = node.args[0]
+    return (isinstance(key, ast.Constant) and isinstance(key.value, str)
+            and key.value.lower().endswith("status"))
+
+
+def _status_literals(node: ast.AST) -> list[str]:
+    """A status's string, alone or in a tuple, list or set of them."""
+    if isinstance(node, ast.Constant):
+        return [node.value] if isinstance(node.value, str) and node.value in STATUS_VALUES \
+            else []
+    if isinstance(node, ast.Tuple | ast.List | ast.Set):
+        return [v for e in node.elts for v in _status_literals(e)]
+    return []
+
+
+def status_literals_compared(source: str) -> list[str]:
+    """Each string of a status value compared (==, !=, in, not in, ...) with a status."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            if any(_names_a_status(s) for s in sides):
+                found += [f"line {node.lineno}: {v!r}" for s in sides
+                          for v in _status_literals(s)]
+    return found
+
+
+@pytest.mark.parametrize("module", sorted(m for m in modules()
+                                          if stage(m) in STATUS_COMPARED_IN))
+def test_no_status_is_compared_with_its_string(module):
+    found = status_literals_compared(modules()[module].read_text(encoding="utf-8"))
+    assert not found, (f"{module} compares a status with a string: {found}; use "
+                       "mechbook.records.Status (and its tuples STATUSES, "
+                       "CROSSCHECK_STATUSES, FAILING)")
+
+
+def test_the_status_test_can_fail():
+    for bad in ('ok = o.status == "pass"', 'ok = "fail" != x.status',
+                'ok = o.status in ("fail", "error")', 'ok = r["status"] == "erratum"',
+                'ok = m.get("status", "") not in ["n.a."]', 'ok = status == "unsupported"',
+                'ok = a < self.cross_status == "pass"'):
+        assert status_literals_compared(bad), bad
+    for good in ('ok = o.status == Status.PASS', 'ok = o.status in FAILING',
+                 'ok = kind == "error"', 'ok = o.status == "passed"', 'message = "fail"',
+                 'ok = status.startswith("pass")'):
+        assert not status_literals_compared(good), good
+
+
 # ---- size: modules and functions short enough to read ---------------------------------------
 MAX_MODULE_LINES = 400
 MAX_FUNCTION_LINES = 60  # from `def` to the last line of the body (decorators not counted)
