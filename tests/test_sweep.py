@@ -26,7 +26,7 @@ from mechbook.engine.sweep import (
     LinearSweep,
     parse_axis,
 )
-from mechbook.errors import MechbookError
+from mechbook.errors import InputError, MechbookError, NotFoundError
 from mechbook.model.problem import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -206,18 +206,29 @@ def test_wrong_requests_are_refused():
     with pytest.raises(MechbookError, match="not a parameter"):
         Sweeper(make_spec("lim-2031", ROOT, "frequencies", [parse_axis("zeta=1:2:3")],
                           about={"theta": "pi"}), ROOT)
-    with pytest.raises(MechbookError, match="positive"):
+    with pytest.raises(InputError, match="positive"):
         Sweeper(make_spec("lim-2031", ROOT, "frequencies", [parse_axis("omega=0:2:3")],
                           about={"theta": "pi"}), ROOT)
     with pytest.raises(MechbookError, match="amplitude"):
         Sweeper(make_spec("lim-2031", ROOT, "drift", [parse_axis("omega=1:2:3")],
                           about={"theta": "pi"}), ROOT)
-    with pytest.raises(MechbookError, match="no such part"):
+    with pytest.raises(NotFoundError, match="no such part"):
         Sweeper(make_spec("lim-2031", ROOT, "frequencies", [parse_axis("omega=1:2:3")],
                           part="nope"), ROOT)
-    with pytest.raises(MechbookError, match="not a coordinate"):
+    with pytest.raises(NotFoundError, match="not a coordinate"):
         Sweeper(make_spec("lim-2031", ROOT, "frequencies", [parse_axis("omega=1:2:3")],
                           about={"phi": "0"}), ROOT)
+
+
+def test_a_steady_motion_holds_the_momenta_the_reduced_system_holds():
+    """--part b of Symon 11-18 is about a steady precession: the sweep's held momenta are
+    the reduced system's (the SystemLike contract), and its point says so."""
+    sweeper = Sweeper(make_spec("symon-11-18", ROOT, "frequencies", [parse_axis("m=0.01:0.1:2")],
+                                part="b"), ROOT)
+    system = sweeper.lin.dyn.sys
+    assert system.reduced and sweeper.steady == system.held_momenta
+    assert [str(c) for c in sweeper.steady] == ["phi", "psi"]
+    assert "; steady, momenta p_phi = " in sweeper.point_text()
 
 
 def test_a_part_brings_its_assumptions(tmp_path):
