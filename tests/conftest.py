@@ -6,7 +6,11 @@ name: pyproject.toml puts tests/ on the path (`pythonpath = ["tests"]`), so no t
 inserts into sys.path.
 
 Tiers: tests marked `slow` (whole modules by `pytestmark`) are left out of
-`make test-quick` (`-m 'not slow'`); `make test` runs everything.
+`make test-quick` (`-m 'not slow'`). The two mutation tests of every answer key (the
+checker's structural mutants, tests/test_checker.py, and its 1 % mutants,
+tests/test_power.py) run on a sample of six keys in `make test`; on every other key they
+are marked `mutation` too and run in `make test-mutation` (CI runs both; the sample and
+the marks: tests/mutation_keys.py).
 """
 
 from __future__ import annotations

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 import sympy as sp
+from mutation_keys import per_key
 from ruamel.yaml import YAML
 
 from mechbook.core.timeout import Timeout, time_limit
@@ -702,24 +703,9 @@ def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
 
 
 # ---- (b) the mutation test ------------------------------------------------------------------
-# The quick tier (`-m 'not slow'`) mutates a small fixed sample of answer keys: both books,
-# every chapter, and scalar, tensor, constraint-force, turning-point and stability
-# quantities; `make test` mutates every key.
-QUICK_MUTANT_KEYS = {"lim-2041", "symon-09-12", "symon-10-15", "symon-11-03", "symon-11-22",
-                     "symon-12-21"}
-
-
-def _mutation_param(path: Path):
-    name = f"{path.parent.name}-{path.stem}"
-    marks = () if name in QUICK_MUTANT_KEYS else (pytest.mark.slow,)
-    return pytest.param(path, id=name, marks=marks)
-
-
-assert QUICK_MUTANT_KEYS <= {f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES}, \
-    "a key of the quick mutation sample is gone: pick another"
-
-
-@pytest.mark.parametrize("answer_file", [_mutation_param(p) for p in ANSWER_FILES])
+# A sample of six keys runs in every tier (the quick one too); every other key is `slow` and
+# `mutation` (tests/mutation_keys.py: `make test-mutation`).
+@pytest.mark.parametrize("answer_file", per_key(ANSWER_FILES))
 def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, repo_analysis):
     key = load_answers(answer_file)
     analysis = repo_analysis(key.problem_id)

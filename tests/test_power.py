@@ -13,6 +13,7 @@ from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from mutation_keys import per_key
 from ruamel.yaml import YAML
 
 from mechbook.engine.analysis import Analysis
@@ -220,9 +221,7 @@ def _put(data, path, value):
     _get(data, path[:-1])[path[-1]] = value
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("answer_file", ANSWER_FILES,
-                         ids=[f"{p.parent.name}-{p.stem}" for p in ANSWER_FILES])
+@pytest.mark.parametrize("answer_file", per_key(ANSWER_FILES, pytest.mark.slow))
 def test_every_one_percent_mutant_fails(answer_file: Path):
     """Every number and every parameter occurrence of every passing part's value scaled by
     1.01, the value shifted by 1 % of its size, a count moved by one, a flag or verdict
