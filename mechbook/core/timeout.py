@@ -75,10 +75,9 @@ def _limit(seconds: float, interval: float) -> Iterator[None]:
     if seconds <= 0 or math.isinf(seconds) or not _usable():  # 0 or infinite: no limit
         yield
         return
-    now = cpu_time()
-    deadline = now + seconds
     with _quiet():
-        _drop_spent(now)
+        _drop_spent()
+    deadline = cpu_time() + seconds
     if _ACTIVE and _ACTIVE[-1][0] <= deadline:
         yield  # an outer limit runs out first and governs
         return
@@ -101,10 +100,20 @@ def _limit(seconds: float, interval: float) -> Iterator[None]:
                     signal.signal(_SIGNAL, previous)
 
 
-def _drop_spent(now: float) -> None:
-    """Drop the innermost limits that have run out while no alarm is pending for them."""
-    while _ACTIVE and _ACTIVE[-1][0] < now and signal.getitimer(_TIMER)[0] == 0:
+def _drop_spent() -> None:
+    """Drop the innermost limit if its alarm is spent, and give the timer back to the one
+    outside it (which fires at once if it has run out meanwhile).
+
+    Spent means no alarm pending while the limit is open: every limit arms the timer on
+    entry and leaving an inner limit re-arms the outer one, so a one-shot timer at zero has
+    fired (a repeating one never is). The timer, not the deadline, says so: ITIMER_VIRTUAL
+    and getrusage account CPU time apart, and the alarm can come a little before the
+    deadline as cpu_time() reads it; compared with the deadline, such a limit was kept and
+    a new limit inside it deferred to it, with no timer armed."""
+    if _ACTIVE and signal.getitimer(_TIMER)[0] == 0:
         _ACTIVE.pop()
+        if _ACTIVE:
+            _arm(*_ACTIVE[-1][:2])
 
 
 @contextmanager
