@@ -139,17 +139,42 @@ class Orbit:
             else:
                 raise UnsupportedError("level set: no turning point (the coordinate runs "
                                        "away or goes round)")
-            lo, hi = (inside, c) if direction > 0 else (c, inside)
-            for _ in range(DPS * 4):  # bisection: robust where V_eff is steep or singular
-                mid = (lo + hi) / 2
-                k = self.kinetic(mid)
-                if (mpmath.isfinite(k) and k >= 0) == (direction > 0):
-                    lo = mid
-                else:
-                    hi = mid
-                if hi - lo <= abs(mid) * mpmath.mpf(10) ** (-(DPS - 5)):
-                    break
-            return (lo + hi) / 2
+            return self._refine(inside, c, self.kinetic(inside), k)
+
+    def _refine(self, inside, outside, k_in, k_out):
+        """The turning point between `inside` (E − V ≥ 0) and `outside` (E − V < 0, or no
+        value): the Illinois method (regula falsi that halves a stale end's value, so both
+        ends close in superlinearly) where E − V has a finite value at both ends, bisection
+        where it has none (V_eff singular) or where the bracket did not halve in three
+        steps; ~15 evaluations instead of bisection's ~170 to the same width."""
+        tol = mpmath.mpf(10) ** (-(DPS - 5))
+        width, stale_side, stale = abs(outside - inside), 0, 0
+        for _ in range(DPS * 4):
+            finite = mpmath.isfinite(k_out) and mpmath.isfinite(k_in) and k_in != k_out
+            if finite and stale < 3:
+                mid = inside + (outside - inside) * k_in / (k_in - k_out)
+                if not (min(inside, outside) < mid < max(inside, outside)):
+                    mid = (inside + outside) / 2
+            else:
+                mid = (inside + outside) / 2
+            k = self.kinetic(mid)
+            if mpmath.isfinite(k) and k >= 0:
+                inside, k_in = mid, k
+                if stale_side == +1:
+                    k_out /= 2  # Illinois: the outside end has stayed: halve its value
+                stale_side = +1
+            else:
+                outside, k_out = mid, k
+                if stale_side == -1:
+                    k_in /= 2
+                stale_side = -1
+            now = abs(outside - inside)
+            if now <= abs(mid) * tol:
+                break
+            stale = 0 if now <= width / 2 else stale + 1
+            if stale == 0:
+                width = now
+        return (inside + outside) / 2
 
     @cached_property
     def turning_points(self) -> tuple:
