@@ -22,6 +22,7 @@ from __future__ import annotations
 import ctypes
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 import sympy as sp
@@ -106,9 +107,15 @@ def _tangent_basis(n: np.ndarray) -> np.ndarray:
 
 
 class Phases:
-    """A system with frictional contacts at fixed parameter values, integrated in phases."""
+    """A system with frictional contacts at fixed parameter values, integrated in phases.
 
-    def __init__(self, system, dyn, values: dict):
+    `smooth`, the system's own compiled model (mechbook.numerics.model.build_model: every
+    contact sliding, −μN·v_t/|v_t| in its forces), lets a phase in which every contact
+    slides run in the compiled DOP853 loop (`_sliding`); the other phases, and the step in
+    which an event happens, run in SciPy's DOP853 on this class's right-hand side."""
+
+    def __init__(self, system, dyn, values: dict, smooth=None):
+        self._smooth = smooth
         if not system.contacts:
             raise UnsupportedError("no frictional contact")
         if system.constraints:
@@ -306,9 +313,15 @@ class Phases:
         start_nfev = self.nfev
         for _ in range(max_phases):
             switch = self._switch_events(modes, directions, eps)
-            sol = scipy_solve_ivp(lambda tt, yy, m=modes, d=directions: self.rhs(tt, yy, m, d),
-                                  (t, t_end), y, method=method, rtol=rtol, atol=atol,
-                                  events=user + switch)
+            native = self._native() if method == "DOP853" else None
+            if native is not None and all(m == "slip" for m in modes) \
+                    and all(d is None for d in directions):
+                sol = self._sliding(native, (t, t_end), y, user + switch, modes, directions,
+                                    rtol, atol)
+            else:
+                sol = scipy_solve_ivp(lambda tt, yy, m=modes, d=directions:
+                                      self.rhs(tt, yy, m, d), (t, t_end), y, method=method,
+                                      rtol=rtol, atol=atol, events=user + switch)
             if sol.status < 0:
                 return Result(np.array([t]), y[:, None], t_events, y_events, -1,
                               self.nfev - start_nfev, sol.message, switches)
@@ -339,3 +352,85 @@ class Phases:
             switches += [(t, self.contacts[i][0], "through") for i in stopped
                          if modes[i] == "slip"]  # stopped, and pushed on the other way
         raise UnsupportedError(f"friction: more than {max_phases} stick-slip phases")
+
+    # ---- every contact sliding: the compiled loop ------------------------------------------
+    def _native(self):
+        """The smooth model's compiled loops (native.NativeModel), or None (no model given,
+        no C compiler, another backend): then every phase runs in SciPy."""
+        if self._smooth is None or self._smooth.constraints:
+            return None
+        return self._smooth.native
+
+    def _sliding(self, native, span, y0, events, modes, directions, rtol, atol,
+                 rows: int = 4096) -> SimpleNamespace:
+        """A phase with every contact sliding, answered like solve_ivp (t, y, t_events,
+        y_events, status, message).
+
+        The compiled DOP853 loop (mechbook.numerics.compiled.adaptive: solve_ivp's steps, in
+        C) runs on the smooth model and records every step; the events are evaluated at the
+        steps in turn, with solve_ivp's rule for a sign change (find_active_events). The
+        first step in which one changes sign is integrated again by SciPy on this class's
+        right-hand side, which locates the events there on its dense output as a whole
+        phase in SciPy would; a terminal one ends the phase there, after any other the
+        compiled loop goes on from the end of that step."""
+        from mechbook.numerics.compiled import adaptive
+
+        t, t_end = float(span[0]), float(span[1])
+        y = np.asarray(y0, float)
+        t_events = [[] for _ in events]
+        y_events = [[] for _ in events]
+
+        def fun(tt, yy, m=modes, d=directions):
+            return self.rhs(tt, yy, m, d)
+
+        while True:
+            times, states, code, message, _ = adaptive(native, self._smooth.stats, "DOP853",
+                                                       (t, t_end), y, rtol, atol,
+                                                       max_points=rows)
+            if code in (-1, -2):
+                return SimpleNamespace(t=np.array([t]), y=y[:, None], t_events=t_events,
+                                       y_events=y_events, status=-1, message=message)
+            before = np.array([ev(times[0], states[:, 0]) for ev in events])
+            hit = None
+            for k in range(1, len(times)):
+                after = np.array([ev(times[k], states[:, k]) for ev in events])
+                if _active(before, after, events):
+                    hit = k
+                    break
+                before = after
+            if hit is None:
+                t, y = float(times[-1]), states[:, -1]
+                if code == 0:
+                    return SimpleNamespace(t=np.array([t]), y=y[:, None],
+                                           t_events=[np.array(x) for x in t_events],
+                                           y_events=[np.array(x).reshape(len(x), len(y))
+                                                     for x in y_events],
+                                           status=0, message=message)
+                continue  # the record was full: on from its last step
+            sol = scipy_solve_ivp(fun, (float(times[hit - 1]), float(times[hit])),
+                                  states[:, hit - 1], method="DOP853", rtol=rtol, atol=atol,
+                                  events=events)
+            if sol.status < 0:
+                return sol
+            for k in range(len(events)):
+                t_events[k] += list(sol.t_events[k])
+                y_events[k] += list(sol.y_events[k])
+            t, y = float(sol.t[-1]), sol.y[:, -1]
+            if sol.status == 1 or t >= t_end:
+                return SimpleNamespace(t=np.array([t]), y=y[:, None],
+                                       t_events=[np.array(x) for x in t_events],
+                                       y_events=[np.array(x).reshape(len(x), len(y))
+                                                 for x in y_events],
+                                       status=sol.status, message=sol.message)
+
+
+def _active(g: np.ndarray, g_new: np.ndarray, events) -> bool:
+    """solve_ivp's rule: an event is active in a step if its value goes from ≤ 0 to ≥ 0
+    (direction > 0), from ≥ 0 to ≤ 0 (direction < 0), or either (direction 0)."""
+    for a, b, ev in zip(g, g_new, events, strict=True):
+        direction = getattr(ev, "direction", 0)
+        up, down = a <= 0 <= b, a >= 0 >= b
+        if (up and direction > 0) or (down and direction < 0) or \
+                ((up or down) and direction == 0):
+            return True
+    return False

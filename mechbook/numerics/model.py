@@ -293,7 +293,7 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
 
         from mechbook.numerics.friction import Phases
 
-        model.phases = partial(Phases, system, dyn, values)
+        model.phases = partial(Phases, system, dyn, values, model)
     return model
 
 
