@@ -4,7 +4,7 @@
 checked out into a temporary git worktree; "after" is this tree (or --after REF). Both run
 with this interpreter and its packages, each tree imported on its own; the before tree with
 SymPy's pure-Python integers (SYMPY_GROUND_TYPES=python), as on a machine without gmpy2,
-which the before tree did not install. Both trees are byte-compiled first (a user's machine
+where the before tree did not install it (its constraints.txt lacks gmpy2). Both trees are byte-compiled first (a user's machine
 compiles once). Measured for each tree, the two trees taking turns:
 
     cold -j N     `mechbook check --fresh --no-store -j N`: the wall time, and each
@@ -98,8 +98,9 @@ def launcher(tree: Path) -> list[str]:
 def environment(tree: Path, before: bool) -> dict:
     env = dict(os.environ, MECHBOOK_ROOT=str(tree))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    if before:
-        env["SYMPY_GROUND_TYPES"] = "python"  # the before tree did not install gmpy2
+    constraints = tree / "constraints.txt"
+    if before and constraints.exists() and "gmpy2" not in constraints.read_text():
+        env["SYMPY_GROUND_TYPES"] = "python"  # a tree that did not install gmpy2
     return env
 
 
