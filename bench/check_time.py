@@ -2,10 +2,10 @@
 
 "Before" is an earlier commit of this repository (default: a5b256a, main before issue 24),
 checked out into a temporary git worktree; "after" is this tree (or --after REF). Both run
-with this interpreter and its packages, each tree imported on its own; the before tree with
-SymPy's pure-Python integers (SYMPY_GROUND_TYPES=python), as on a machine without gmpy2,
-where the before tree did not install it (its constraints.txt lacks gmpy2). Both trees are byte-compiled first (a user's machine
-compiles once). Measured for each tree, the two trees taking turns:
+with this interpreter and its packages, each tree imported on its own; a before tree that
+did not install gmpy2 (its constraints.txt lacks it) with SymPy's pure-Python integers
+(SYMPY_GROUND_TYPES=python), as on a machine without gmpy2. Both trees are byte-compiled
+first (a user's machine compiles once). Measured for each tree, the two trees taking turns:
 
     cold -j N     `mechbook check --fresh --no-store -j N`: the wall time, and each
                   problem's wall seconds as the workers report them
