@@ -96,7 +96,9 @@ def bad_constant(expr: sp.Basic, memo: dict | None = None,
     """Why a symbol-free expression is not a finite real number (None if it is, or if it
     has free symbols, or is not a number at all). With `complex_ok` (tensor expressions,
     whose eigenvalues are complex on purpose) only a non-finite value is refused."""
-    if not isinstance(expr, sp.Expr) or expr.free_symbols or expr.is_Rational:
+    # is_number stops at the first symbol it meets; free_symbols walks the whole tree, and
+    # the parser asks this of every node it builds (quadratic in a large tensor formula)
+    if not isinstance(expr, sp.Expr) or expr.is_Rational or not expr.is_number:
         return None
     if expr.has(*_NOT_FINITE):
         return "is not finite"
