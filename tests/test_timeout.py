@@ -108,6 +108,14 @@ def test_an_entry_left_behind_does_not_disable_later_limits():
     assert res.returncode == 0, res.stdout + res.stderr
 
 
+def test_an_entry_left_behind_that_has_not_run_out_does_not_govern():
+    """An entry whose deadline is still ahead but that has no timer (nor our handler: the
+    process's default) must not be deferred to: a new limit arms its own timer."""
+    res = _fresh("timeout._ACTIVE.append((cpu_time() + 0.1, 0.0, object()))\n"
+                 "assert signal.getsignal(signal.SIGVTALRM) in (signal.SIG_DFL, 0)")
+    assert res.returncode == 0, res.stdout + res.stderr
+
+
 def test_a_timer_of_ours_left_running_is_taken_over():
     """Our handler installed and the timer running with no limit open (left behind): the
     next limit takes the timer over instead of running without one."""

@@ -56,6 +56,10 @@ def _usable() -> bool:
 
 
 def _arm(deadline: float, interval: float) -> None:
+    """The timer set for a limit (our handler first: the default action of the signal would
+    end the process)."""
+    if signal.getsignal(_SIGNAL) is not _raise:
+        signal.signal(_SIGNAL, _raise)
     signal.setitimer(_TIMER, max(deadline - cpu_time(), 1e-3), interval)
 
 
@@ -69,35 +73,60 @@ def _limit(seconds: float, interval: float) -> Iterator[None]:
     caught and went on, or an entry a signal at the wrong moment left behind) no longer
     governs: it is dropped, so a new limit inside it has a timer of its own. Without that,
     every later limit of the process deferred to it and none was armed: an integral that
-    SymPy never finishes ran unbounded."""
+    SymPy never finishes ran unbounded. For the same reason a new limit defers to an outer
+    one only while the outer one's alarm is set (the timer running, our handler
+    installed); otherwise it arms its own. The bookkeeping is undone even when an outer
+    alarm held back during it is delivered as it ends."""
     if math.isnan(seconds):  # NaN compares false with everything: it would be no limit
         raise ValueError("a time limit of NaN seconds")
     if seconds <= 0 or math.isinf(seconds) or not _usable():  # 0 or infinite: no limit
         yield
         return
-    with _quiet():
-        _drop_spent()
-    deadline = cpu_time() + seconds
-    if _ACTIVE and _ACTIVE[-1][0] <= deadline:
-        yield  # an outer limit runs out first and governs
-        return
-    entry = (deadline, interval, object())  # told apart by identity when it is left
-    with _quiet():  # the bookkeeping is not interrupted by an outer limit's alarm
-        previous = signal.signal(_SIGNAL, _raise) if not _ACTIVE else None
-        _ACTIVE.append(entry)
-        _arm(deadline, interval)
+    entry, previous = None, None
     try:
-        yield
+        with _quiet():  # the bookkeeping is not interrupted by an outer limit's alarm
+            _drop_spent()
+            deadline = cpu_time() + seconds
+            if not _governed(deadline):
+                entry = (deadline, interval, object())  # told apart by identity when left
+                previous = _install()
+                _ACTIVE.append(entry)
+                _arm(deadline, interval)
+        # (an outer alarm held back above is delivered here: the entry is taken out below)
+        yield  # without an entry: an outer limit runs out first, its alarm set, governs
     finally:
-        with _quiet():
-            if any(e is entry for e in _ACTIVE):
-                _ACTIVE[:] = [e for e in _ACTIVE if e is not entry]
-            if _ACTIVE:
-                _arm(*_ACTIVE[-1][:2])
-            else:
-                signal.setitimer(_TIMER, 0)
-                if previous is not None:
-                    signal.signal(_SIGNAL, previous)
+        if entry is not None:
+            _leave(entry, previous)
+
+
+def _leave(entry: tuple, previous) -> None:
+    """Take a limit out; the timer goes back to the one outside it, or off (and the
+    handler that was there before back) when it was the last."""
+    with _quiet():
+        if any(e is entry for e in _ACTIVE):
+            _ACTIVE[:] = [e for e in _ACTIVE if e is not entry]
+        if _ACTIVE:
+            _arm(*_ACTIVE[-1][:2])
+        else:
+            signal.setitimer(_TIMER, 0)
+            if previous is not None:
+                signal.signal(_SIGNAL, previous)
+
+
+def _governed(deadline: float) -> bool:
+    """An outer limit runs out no later than `deadline` and its alarm is set (the timer
+    running, our handler installed): a new limit need not be armed. Whatever else (an
+    entry left behind without a timer or a handler) does not govern."""
+    return bool(_ACTIVE) and _ACTIVE[-1][0] <= deadline \
+        and signal.getitimer(_TIMER)[0] > 0 and signal.getsignal(_SIGNAL) is _raise
+
+
+def _install():
+    """Our handler installed; what was there before if it was not ours (to put back when
+    the last limit is left), else None."""
+    if signal.getsignal(_SIGNAL) is _raise:
+        return None
+    return signal.signal(_SIGNAL, _raise)
 
 
 def _drop_spent() -> None:
