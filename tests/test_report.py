@@ -220,15 +220,30 @@ def faults(page, trouble: list[str]) -> list[str]:
     return out
 
 
-def test_every_page_loads_cleanly_and_nothing_overflows(report, browser):
+SHOWN = ("lim-2031", "symon-09-01", "symon-12-27", "toy-3.2")  # pages kept as screenshots
+
+
+@pytest.fixture(scope="module")
+def screenshots(report, browser) -> list[Path]:
+    """Screenshots of a few pages, kept for a reader under results/test-artifacts (taken
+    here, not as a side effect of another test: under xdist the tests run in any order)."""
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    shots = []
+    for path in pages(report):
+        if path.stem in SHOWN:
+            page, _ = open_page(browser, path)
+            shots.append(ARTIFACTS / f"{path.stem}.png")
+            page.screenshot(path=str(shots[-1]), full_page=True)
+            page.close()
+    return shots
+
+
+def test_every_page_loads_cleanly_and_nothing_overflows(report, browser):
     for path in pages(report):
         page, trouble = open_page(browser, path)
         assert faults(page, trouble) == [], path.name
         if path.parent.name == "problems":
             assert page.locator("math").count() > 3, f"{path.name}: no equations"
-        if path.stem in ("lim-2031", "symon-09-01", "symon-12-27", "toy-3.2"):
-            page.screenshot(path=str(ARTIFACTS / f"{path.stem}.png"), full_page=True)
         page.close()
 
 
@@ -292,14 +307,13 @@ def test_the_filters_select_by_book_and_outcome(report, browser):
     page.close()
 
 
-def test_screenshots_are_not_blank(report, browser):
+def test_screenshots_are_not_blank(screenshots):
     """The screenshots kept for a reader are images of the right size that are not blank
     (many distinct colours: text, equations, the status badges)."""
     from PIL import Image
 
-    shots = sorted(ARTIFACTS.glob("*.png"))
-    assert len(shots) >= 4
-    for shot in shots:
+    assert len(screenshots) == len(SHOWN)
+    for shot in screenshots:
         image = Image.open(shot).convert("RGB")
         assert image.width == 1280 and image.height > 800
         colours = image.getcolors(maxcolors=1 << 20)
