@@ -29,7 +29,6 @@ counts as a fail).
 
 from __future__ import annotations
 
-from mechbook.crosscheck.guard import fault as _fault  # noqa: F401 - tests read it here
 from mechbook.crosscheck.problem import crosscheck_problem
 
 __all__ = ["crosscheck_problem"]

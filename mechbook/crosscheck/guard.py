@@ -41,8 +41,3 @@ def guarded(out: CrossCheck, *, reason: str = "",
         out.status, out.detail = Status.ERROR, describe(exc)
     finally:
         out.seconds = time.perf_counter() - start
-
-
-def fault(exc: BaseException) -> str:
-    """The detail an unexpected exception leaves (mechbook.errors.describe)."""
-    return describe(exc)

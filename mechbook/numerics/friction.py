@@ -388,8 +388,7 @@ class Phases:
                                                        (t, t_end), y, rtol, atol,
                                                        max_points=rows)
             if code in (-1, -2):
-                return SimpleNamespace(t=np.array([t]), y=y[:, None], t_events=t_events,
-                                       y_events=y_events, status=-1, message=message)
+                return _answer(t, y, t_events, y_events, -1, message)
             before = np.array([ev(times[0], states[:, 0]) for ev in events])
             hit = None
             for k in range(1, len(times)):
@@ -401,11 +400,7 @@ class Phases:
             if hit is None:
                 t, y = float(times[-1]), states[:, -1]
                 if code == 0:
-                    return SimpleNamespace(t=np.array([t]), y=y[:, None],
-                                           t_events=[np.array(x) for x in t_events],
-                                           y_events=[np.array(x).reshape(len(x), len(y))
-                                                     for x in y_events],
-                                           status=0, message=message)
+                    return _answer(t, y, t_events, y_events, 0, message)
                 continue  # the record was full: on from its last step
             sol = scipy_solve_ivp(fun, (float(times[hit - 1]), float(times[hit])),
                                   states[:, hit - 1], method="DOP853", rtol=rtol, atol=atol,
@@ -417,11 +412,16 @@ class Phases:
                 y_events[k] += list(sol.y_events[k])
             t, y = float(sol.t[-1]), sol.y[:, -1]
             if sol.status == 1 or t >= t_end:
-                return SimpleNamespace(t=np.array([t]), y=y[:, None],
-                                       t_events=[np.array(x) for x in t_events],
-                                       y_events=[np.array(x).reshape(len(x), len(y))
-                                                 for x in y_events],
-                                       status=sol.status, message=sol.message)
+                return _answer(t, y, t_events, y_events, sol.status, sol.message)
+
+
+def _answer(t: float, y: np.ndarray, t_events: list, y_events: list, status: int,
+            message: str) -> SimpleNamespace:
+    """A phase's end as solve_ivp answers (the end state, the events found on the way)."""
+    return SimpleNamespace(t=np.array([t]), y=y[:, None],
+                           t_events=[np.array(x) for x in t_events],
+                           y_events=[np.array(x).reshape(len(x), len(y)) for x in y_events],
+                           status=status, message=message)
 
 
 def _active(g: np.ndarray, g_new: np.ndarray, events) -> bool:

@@ -42,6 +42,7 @@ from mechbook.numerics.methods import (  # noqa: F401 - the names, re-exported
     SCIPY_METHODS,
     TAYLOR,
     kind,
+    why_not,
 )
 from mechbook.numerics.model import Model, structure
 
@@ -393,21 +394,6 @@ FIXED: dict[str, type[FixedStep]] = {m: _FIXED_CLASSES[ALIASES.get(m, m)]
                                      for m in FIXED_METHODS}  # names: numerics.methods
 
 
-# why an option another kind of method takes has no effect on this kind
-_NO_EFFECT = {
-    "rtol": "a fixed-step method has no tolerance: give `step`",
-    "atol": "{method}'s tolerance is relative only (`rtol` or `tol`)",
-    "max_step": "a fixed-step method takes `step`",
-    "first_step": "a fixed-step method takes `step`",
-    "dense_output": "only SciPy's methods have a dense output",
-    "step": "an adaptive method chooses its own steps: give `rtol` (and `atol`), or "
-            "`max_step` to bound them",
-    "max_points": "SciPy's methods record the times asked for (`t_eval`)",
-    "tol": "only the implicit midpoint rule (its iteration) and the taylor method take a "
-           "`tol`; SciPy's methods take `rtol` and `atol`",
-    "max_iter": "only the implicit midpoint rule iterates",
-    "compiled": "the taylor method is always compiled (heyoka)",
-}
 
 
 def make_integrator(method: str, **options) -> Integrator:
@@ -428,9 +414,9 @@ def _applicable(method: str, allowed: tuple[str, ...], options: dict) -> dict:
     """The options `method` takes; IntegratorError naming one given that it does not."""
     for name, value in options.items():
         if value is not None and name not in allowed:
-            why = _NO_EFFECT.get(name, "no method takes it").format(method=method)
             raise IntegratorError(f"option {name!r} does not apply to method {method!r} "
-                                  f"({why}); it takes: {', '.join(sorted(allowed))}")
+                                  f"({why_not(name, method)}); it takes: "
+                                  f"{', '.join(sorted(allowed))}")
     return {k: v for k, v in options.items() if k in allowed}
 
 

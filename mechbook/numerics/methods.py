@@ -27,3 +27,25 @@ def kind(method: str) -> str | None:
     if method in FIXED_METHODS:
         return "fixed"
     return "taylor" if method == TAYLOR else None
+
+
+# why an option another kind of method takes has no effect on this kind
+NO_EFFECT = {
+    "rtol": "a fixed-step method has no tolerance: give `step`",
+    "atol": "{method}'s tolerance is relative only (`rtol` or `tol`)",
+    "max_step": "a fixed-step method takes `step`",
+    "first_step": "a fixed-step method takes `step`",
+    "dense_output": "only SciPy's methods have a dense output",
+    "step": "an adaptive method chooses its own steps: give `rtol` (and `atol`), or "
+            "`max_step` to bound them",
+    "max_points": "SciPy's methods record the times asked for (`t_eval`)",
+    "tol": "only the implicit midpoint rule (its iteration) and the taylor method take a "
+           "`tol`; SciPy's methods take `rtol` and `atol`",
+    "max_iter": "only the implicit midpoint rule iterates",
+    "compiled": "the taylor method is always compiled (heyoka)",
+}
+
+
+def why_not(option: str, method: str) -> str:
+    """Why `option` has no effect on `method` (it is not among OPTIONS[kind(method)])."""
+    return NO_EFFECT.get(option, "no method takes it").format(method=method)

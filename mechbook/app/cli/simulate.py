@@ -128,19 +128,20 @@ def _refuse_what_does_not_apply(ctx: click.Context, method: str | None,
     """An option the run would drop silently is refused, saying why: a tolerance or step
     the method does not take (mechbook.numerics.methods.OPTIONS; no --method: DOP853 or
     Radau, SciPy's), --points for a fixed-step method, limits with --serial."""
-    from mechbook.numerics.methods import OPTIONS, kind
+    from mechbook.numerics.methods import OPTIONS, kind, why_not
 
     if method is not None or accuracy is None:  # with --accuracy alone the method is chosen
         family = kind(method or "DOP853")
-        unused = [flag for key, flag in TOLERANCES.items()
-                  if given(ctx, key) and key not in OPTIONS[family]]
+        keys = [key for key in TOLERANCES if given(ctx, key) and key not in OPTIONS[family]]
+        unused = [TOLERANCES[key] for key in keys]
         if family in ("fixed", "midpoint") and given(ctx, "points"):
             unused.append("--points")
         if unused:
             raise click.UsageError(
                 f"{', '.join(unused)} {'does' if len(unused) == 1 else 'do'} not apply to "
                 f"the {family} method {method or 'DOP853 (the default)'}; it takes "
-                f"{', '.join(TOLERANCES.get(k, '') for k in OPTIONS[family] if k in TOLERANCES)}")
+                f"{', '.join(TOLERANCES.get(k, '') for k in OPTIONS[family] if k in TOLERANCES)}"
+                + "".join(f" ({why_not(k, method or 'DOP853')})" for k in keys[:1]))
     dropped = [flag for key, flag in (("timeout", "--timeout"), ("memory_mb", "--memory"))
                if serial and given(ctx, key)]
     if dropped:

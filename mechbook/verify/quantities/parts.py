@@ -58,10 +58,28 @@ def linear_motion(ctx: Context, pt: dict) -> LinearMotion:
     return LinearMotion(lin, pt, dq, dv)
 
 
-def energy_at(ctx: Context, energy: sp.Expr, pt: dict):
-    """A function of the displacement state δy = (δq, δq̇) giving the part's energy: the
-    quadratic energy as g·δy + δy·H·δy/2 (exact: it has no higher terms), its coefficients
-    at the point in 60-digit arithmetic."""
+class QuadraticEnergy:
+    """The part's energy as a function of the displacement state δy = (δq, δq̇):
+    g·δy + δy·H·δy/2 (exact: it has no higher terms), g and H at the point in 60 digits;
+    calling it evaluates in mpmath, `scan` the same in double precision at many states."""
+
+    def __init__(self, g: list, H: list):
+        self.g, self.H = g, H
+        self._gf = np.array([float(x) for x in g])
+        self._Hf = np.array([[float(x) for x in row] for row in H])
+
+    def __call__(self, dy: list):
+        g, H, m = self.g, self.H, len(dy)
+        return sum(g[i] * dy[i] for i in range(m)) + sum(
+            H[i][j] * dy[i] * dy[j] for i in range(m) for j in range(m)) / 2
+
+    def scan(self, dy: np.ndarray) -> np.ndarray:
+        """The energy at each row of dy (states), in double precision."""
+        return dy @ self._gf + np.einsum("ki,ij,kj->k", dy, self._Hf, dy) / 2
+
+
+def energy_at(ctx: Context, energy: sp.Expr, pt: dict) -> QuadraticEnergy:
+    """The part's energy about the linearization point as a QuadraticEnergy of δy."""
     sys, lin = ctx.system, ctx.linear()
     y = list(sys.q) + list(sys.qd)
     at0 = {q: sp.S(lin.point.get(q, 0)) for q in sys.q}
@@ -73,21 +91,7 @@ def energy_at(ctx: Context, energy: sp.Expr, pt: dict):
         grad = [sp.diff(energy, a) for a in y]
         g = [mpmath.re(evaluate_mp(d, env, 60)) for d in grad]
         H = [[mpmath.re(evaluate_mp(sp.diff(d, b), env, 60)) for b in y] for d in grad]
-
-    def at(dy: list):
-        m = len(dy)
-        return sum(g[i] * dy[i] for i in range(m)) + sum(
-            H[i][j] * dy[i] * dy[j] for i in range(m) for j in range(m)) / 2
-
-    gf = np.array([float(x) for x in g])
-    Hf = np.array([[float(x) for x in row] for row in H])
-
-    def scan(dy: np.ndarray) -> np.ndarray:
-        """The same energy in double precision at many states (rows of dy) at once."""
-        return dy @ gf + np.einsum("ki,ij,kj->k", dy, Hf, dy) / 2
-
-    at.scan = scan
-    return at
+    return QuadraticEnergy(g, H)
 
 
 @quantity('part_energy',
