@@ -140,6 +140,32 @@ def test_newton_passes_and_catches_a_wrong_lagrangian(tmp_path):
     assert x.status == "fail" and x.error > 1e-3
 
 
+@pytest.mark.parametrize(("pid", "name"), [("lim-2039", None), ("lim-2042", "spring"),
+                                          ("symon-text-11-5-heavy-top", "euler"),
+                                          ("symon-11-15", "sliding")])
+def test_newton_residual_is_the_same_in_symengine_and_sympy(pid, name):
+    """The Newton side is assembled by SymEngine where it can, by SymPy otherwise (an
+    unknown function): the two algebras give the same residual at random states."""
+    import symengine as se
+
+    from mechbook.crosscheck.newton import _newton_residual
+
+    an, _ = real(pid)
+    sys = an.system(name)
+    fast, slow = _newton_residual(sys), _newton_residual(sys, symengine=False)
+    assert all(isinstance(e, se.Basic) for e in fast)
+    assert all(isinstance(e, sp.Basic) for e in slow)
+    rng = np.random.default_rng(5)
+    symbols = sorted(set().union(*(e.free_symbols for e in slow)), key=str)
+    for _ in range(3):
+        point = {s: float(rng.uniform(0.2, 0.9)) for s in symbols}
+        by_name = {str(s): v for s, v in point.items()}
+        for a, b in zip(fast, slow, strict=True):
+            va = float(a.subs({se.Symbol(k): v for k, v in by_name.items()}))
+            vb = float(b.xreplace(point))
+            assert abs(va - vb) <= 1e-12 * max(1.0, abs(vb)), (pid, a, b)
+
+
 def test_newton_not_applicable_without_positions():
     an, _ = real("lim-2032")
     assert newton_crosscheck(an, "free").status == "n.a."

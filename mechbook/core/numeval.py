@@ -11,6 +11,8 @@ by the safe parser or the engine.
 
 from __future__ import annotations
 
+from collections import OrderedDict
+
 import mpmath
 import sympy as sp
 
@@ -39,20 +41,18 @@ def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, fl
 
     Raises NotNumeric for a free symbol missing from the point or an unknown function, and
     ZeroDivisionError or ValueError where the expression is singular at the point."""
+    prog = program(expr)
     with mpmath.workdps(digits):
-        memo: dict = {}
-        pt = {k: _number(v) for k, v in point.items()}
-        v, m = _walk(expr, pt, memo)
+        v, m = prog.run({k: _number(v) for k, v in point.items()})
         return complex(v), float(m)
 
 
 def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
     """expr at `point` as an mpmath number of `digits` digits (call inside a context of at
     least that precision to keep them); errors as for `evaluate`."""
+    prog = program(expr)
     with mpmath.workdps(digits):
-        pt = {k: _number(v) for k, v in point.items()}
-        v, _ = _walk(expr, pt, {})
-        return v
+        return prog.run({k: _number(v) for k, v in point.items()})[0]
 
 
 def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits: int = 240,
@@ -61,11 +61,11 @@ def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits:
     to `max_digits`) until the value stands `margin` digits clear of what cancelled on the
     way; 0 if it never does (it is zero to max_digits). For a value judged close to a
     boundary, where terms of size 1e24 cancel to 1e-25 and 30 digits leave only noise."""
+    prog = program(expr)
     d = digits
     while True:
         with mpmath.workdps(d):
-            pt = {k: _number(v) for k, v in point.items()}
-            v, m = _walk(expr, pt, {})
+            v, m = prog.run({k: _number(v) for k, v in point.items()})
             if abs(v) > mpmath.mpf(10) ** (margin - d) * m:
                 return v
         if d >= max_digits:
@@ -90,74 +90,158 @@ def _number(v):
     return mpmath.mpmathify(complex(v))
 
 
-def _walk(e: sp.Basic, pt: dict, memo: dict):
-    hit = memo.get(e)
+PROGRAMS = 4096  # expressions whose programs are kept (least recently used dropped first)
+_programs: OrderedDict = OrderedDict()
+
+
+def program(expr: sp.Basic) -> Program:
+    """The evaluation program of `expr`, compiled once and kept: the same expression is
+    evaluated at thousands of points (sampled conditions, scans, zero tests)."""
+    hit = _programs.get(expr)
     if hit is not None:
+        _programs.move_to_end(expr)
         return hit
-    out = _node(e, pt, memo)
-    memo[e] = out
-    return out
+    prog = Program(expr)
+    _programs[expr] = prog
+    if len(_programs) > PROGRAMS:
+        _programs.popitem(last=False)
+    return prog
 
 
-def _node(e: sp.Basic, pt: dict, memo: dict):
-    if e.is_Symbol:
-        if e not in pt:
-            raise NotNumeric(f"no value for {e}")
-        v = pt[e]
-        return v, abs(v)
-    if e in _NOT_FINITE:  # zoo, nan, oo (d/dx 0**x = 0**x*log(0)): singular here
-        raise ValueError(f"{e} in the expression")
-    if e.is_Number or e.is_NumberSymbol or e is sp.I:
-        v = mpmath.mpmathify(complex(e)) if e is sp.I else mpmath.mpf(sp.Float(e, mpmath.mp.dps)
-                                                                      ._mpf_)
-        return v, abs(v)
-    if e.is_Add:
-        v, m = mpmath.mpf(0), mpmath.mpf(0)
-        for a in e.args:
-            va, ma = _walk(a, pt, memo)
-            v += va
-            m += ma
-        return v, m
-    if e.is_Mul:
-        v, m = mpmath.mpf(1), mpmath.mpf(1)
-        for a in e.args:
-            va, ma = _walk(a, pt, memo)
-            v *= va
-            m *= ma
-        return v, m
-    if e.is_Pow:
-        vb, mb = _walk(e.base, pt, memo)
-        ex = e.exp
-        if ex.is_Integer and ex > 0:
-            return vb ** int(ex), mb ** int(ex)
-        ve, me = _walk(ex, pt, memo)
-        if ex.is_Integer:
-            v = vb ** int(ex)
-        elif ex.is_Rational and ex.q == 2 and mpmath.im(vb) == 0 and vb >= 0:
-            v = mpmath.sqrt(vb) ** int(ex.p)
-        else:
-            v = mpmath.power(vb, ve)
-        # first-order propagation: what the base's (and exponent's) cancellation can do
-        m = abs(v) + abs(ve * v / vb) * mb if vb != 0 else abs(v)
-        if not ex.is_Number and vb != 0:
-            m += abs(v * mpmath.log(vb)) * me
-        return v, m
-    f = _FUNCS.get(e.func)
-    if f is not None:
-        walked = [_walk(a, pt, memo) for a in e.args]
-        args = [w[0] for w in walked]
-        v = f(*args)
-        if len(args) == 1 and f not in (abs, mpmath.sign, mpmath.re, mpmath.im, mpmath.conj):
-            slope = abs(mpmath.diff(f, args[0]))
-            return v, abs(v) + slope * walked[0][1]
-        if f is mpmath.atan2:
-            (y, my), (x, mx) = walked
-            r2 = abs(x) ** 2 + abs(y) ** 2
-            return v, abs(v) + ((abs(x) * my + abs(y) * mx) / r2 if r2 else 0)
-        return v, abs(v) + sum(w[1] for w in walked)
-    if isinstance(e, sp.Piecewise) or not e.args:
-        raise NotNumeric(f"cannot evaluate {type(e).__name__}")
-    # Anything else SymPy knows how to evaluate (rare): substitute the numbers and ask it.
+# the instructions of a Program (see its docstring)
+_SYMBOL, _CONST, _RAISE, _ADD, _MUL, _POWI, _POW, _FUNC, _SYMPY = range(9)
+_NO_SLOPE = (abs, mpmath.sign, mpmath.re, mpmath.im, mpmath.conj)
+
+
+class Program:
+    """An expression flattened into a list of instructions in the order a bottom-up walk
+    visits its nodes, each repeated subexpression once; `run` carries (value, magnitude)
+    through them in mpmath arithmetic.
+
+    Why: walking the SymPy tree at each point asks every node what it is (SymPy's
+    properties and equality), which cost more than the arithmetic; the program asks once.
+    Errors (a missing symbol, zoo, an unknown function) are raised when the walk reaches the
+    node, in the order the recursive walk met them."""
+
+    def __init__(self, expr: sp.Basic):
+        self.code: list[tuple] = []
+        self._consts: list[sp.Basic] = []
+        self._const_dps: int | None = None
+        self._const_values: list = []
+        self._index: dict = {}
+        self._emit(expr)
+        del self._index
+
+    def _emit(self, e: sp.Basic) -> int:
+        hit = self._index.get(e)
+        if hit is not None:
+            return hit
+        code = self.code
+        if e.is_Symbol:
+            ins = (_SYMBOL, e)
+        elif e in _NOT_FINITE:  # zoo, nan, oo (d/dx 0**x = 0**x*log(0)): singular here
+            ins = (_RAISE, ValueError, f"{e} in the expression")
+        elif e.is_Number or e.is_NumberSymbol or e is sp.I:
+            self._consts.append(e)
+            ins = (_CONST, len(self._consts) - 1)
+        elif e.is_Add:
+            ins = (_ADD, tuple(self._emit(a) for a in e.args))
+        elif e.is_Mul:
+            ins = (_MUL, tuple(self._emit(a) for a in e.args))
+        elif e.is_Pow:
+            base, ex = self._emit(e.base), e.exp
+            if ex.is_Integer and ex > 0:
+                ins = (_POWI, base, int(ex))
+            else:
+                iex = int(ex) if ex.is_Integer else None
+                half = int(ex.p) if ex.is_Rational and ex.q == 2 else None
+                ins = (_POW, base, self._emit(ex), iex, half, bool(ex.is_Number))
+        elif (f := _FUNCS.get(e.func)) is not None:
+            ins = (_FUNC, f, tuple(self._emit(a) for a in e.args))
+        elif isinstance(e, sp.Piecewise) or not e.args:
+            ins = (_RAISE, NotNumeric, f"cannot evaluate {type(e).__name__}")
+        else:  # anything else SymPy knows how to evaluate (rare): see _sympy_value
+            ins = (_SYMPY, e)
+        code.append(ins)
+        self._index[e] = len(code) - 1
+        return len(code) - 1
+
+    def _constants(self) -> list:
+        dps = mpmath.mp.dps
+        if self._const_dps != dps:
+            self._const_values = [mpmath.mpmathify(complex(c)) if c is sp.I else
+                                  mpmath.mpf(sp.Float(c, dps)._mpf_) for c in self._consts]
+            self._const_dps = dps
+        return self._const_values
+
+    def run(self, pt: dict) -> tuple:
+        """(value, magnitude) at `pt` (symbols to mpmath numbers), at the current precision."""
+        consts = self._constants()
+        vals: list = []
+        mags: list = []
+        for ins in self.code:
+            op = ins[0]
+            if op == _SYMBOL:
+                v = pt.get(ins[1])
+                if v is None:
+                    raise NotNumeric(f"no value for {ins[1]}")
+                m = abs(v)
+            elif op == _CONST:
+                v = consts[ins[1]]
+                m = abs(v)
+            elif op == _ADD:
+                v, m = mpmath.mpf(0), mpmath.mpf(0)
+                for a in ins[1]:
+                    v += vals[a]
+                    m += mags[a]
+            elif op == _MUL:
+                v, m = mpmath.mpf(1), mpmath.mpf(1)
+                for a in ins[1]:
+                    v *= vals[a]
+                    m *= mags[a]
+            elif op == _POWI:
+                v, m = vals[ins[1]] ** ins[2], mags[ins[1]] ** ins[2]
+            elif op == _POW:
+                v, m = _power(vals[ins[1]], mags[ins[1]], vals[ins[2]], mags[ins[2]], *ins[3:])
+            elif op == _FUNC:
+                v, m = _function(ins[1], [vals[a] for a in ins[2]], [mags[a] for a in ins[2]])
+            elif op == _RAISE:
+                raise ins[1](ins[2])
+            else:
+                v, m = _sympy_value(ins[1], pt)
+            vals.append(v)
+            mags.append(m)
+        return vals[-1], mags[-1]
+
+
+def _power(vb, mb, ve, me, iex, half, numeric_exponent):
+    if iex is not None:
+        v = vb ** iex
+    elif half is not None and mpmath.im(vb) == 0 and vb >= 0:
+        v = mpmath.sqrt(vb) ** half
+    else:
+        v = mpmath.power(vb, ve)
+    # first-order propagation: what the base's (and exponent's) cancellation can do
+    m = abs(v) + abs(ve * v / vb) * mb if vb != 0 else abs(v)
+    if not numeric_exponent and vb != 0:
+        m += abs(v * mpmath.log(vb)) * me
+    return v, m
+
+
+def _function(f, args: list, mags: list):
+    v = f(*args)
+    if len(args) == 1 and f not in _NO_SLOPE:
+        slope = abs(mpmath.diff(f, args[0]))
+        return v, abs(v) + slope * mags[0]
+    if f is mpmath.atan2:
+        (y, x), (my, mx) = args, mags
+        r2 = abs(x) ** 2 + abs(y) ** 2
+        return v, abs(v) + ((abs(x) * my + abs(y) * mx) / r2 if r2 else 0)
+    return v, abs(v) + sum(mags)
+
+
+def _sympy_value(e: sp.Basic, pt: dict):
+    """A node the program has no instruction for: the numbers substituted, SymPy asked."""
     subs = {k: sp.Float(str(v), mpmath.mp.dps) if mpmath.im(v) == 0 else
             sp.Float(str(mpmath.re(v))) + sp.I * sp.Float(str(mpmath.im(v)))
             for k, v in pt.items() if k in e.free_symbols}

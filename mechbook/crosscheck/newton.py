@@ -16,10 +16,14 @@ are computed here their own way (mechbook.crosscheck.kinematics), never by the e
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import symengine as se
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
+from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.crosscheck.assembly import composite_inertia
 from mechbook.crosscheck.guard import guarded
 from mechbook.crosscheck.kinematics import (
@@ -45,9 +49,10 @@ def newton_crosscheck(analysis: Analysis, system_name: str | None = None,
     return out
 
 
-def _newton_residual(sys) -> list[sp.Expr]:
+def _newton_residual(sys, symengine: bool = True) -> list:
     """Σ J·(m r̈ − F) + rigid-body Euler terms + the Lagrange expressions of everything the
-    file gives other than particles and bodies − Q."""
+    file gives other than particles and bodies − Q: SymEngine expressions where SymEngine
+    can do the calculus (or `symengine` is False), SymPy's otherwise."""
     spec = sys.spec
     if "approximation" in spec or "average" in spec:
         raise UnsupportedError("Newton cross-check: the Lagrangian is an approximation "
@@ -58,36 +63,98 @@ def _newton_residual(sys) -> list[sp.Expr]:
         raise UnsupportedError("Newton cross-check: no particle or body positions (T and V "
                                "are given directly)")
     parse = sys._parse  # the system's own safe parser, at the file's paths
-    q, qd = sys.q, sys.qd
-    n = len(q)
+    n = len(sys.q)
     positions = {name: sys.positions[name] for name in list(particles) + list(bodies)}
     masses = {name: sys.masses[name] for name in positions}
     forces = _gravity(sys, spec, positions, masses, parse)
     rest = _springs(spec, positions, forces, parse) + _given_terms(spec, parse)
-    res = [sp.S.Zero] * n
-    for name, r in positions.items():
-        acc = sys.dt(sys.dt(r))
-        net = masses[name] * acc - forces[name]
-        for i in range(n):
-            res[i] += sp.diff(r, q[i]).dot(net)
     frames = {name: _body_frame(sys, name, b, masses[name], parse) for name, b in bodies.items()}
-    for tensor, omega, _ in frames.values():
-        if omega.rows == 1:  # planar: (∂ω/∂q̇) I ω̇
-            torque = tensor * sys.dt(omega)
-        else:
-            torque = tensor * sys.dt(omega) + omega.cross(tensor * omega)
-        for i in range(n):
-            res[i] += sp.diff(omega, qd[i]).dot(torque)
     pulls, attractor_q = _attractors(sys, spec, positions, masses, frames, parse)
     torque_q = _torques(sys, spec, frames, parse)
     friction_q = _friction(sys, spec, positions, frames, parse)
-    for name, pull in pulls.items():
-        for i in range(n):
-            res[i] -= sp.diff(positions[name], q[i]).dot(pull)
-    for i in range(n):
-        res[i] += sys.dt(sp.diff(rest, qd[i])) - sp.diff(rest, q[i]) - sys.declared_forces[i]
-        res[i] -= attractor_q[i] + torque_q[i] + friction_q[i]
+    given = [sys.declared_forces[i] + attractor_q[i] + torque_q[i] + friction_q[i]
+             for i in range(n)]
+    terms = _Terms(positions, masses, forces, frames, pulls, rest, given)
+    if symengine:
+        try:
+            return _assemble(sys, terms, se.sympify)  # SymEngine's calculus, ten times sooner
+        except UnsupportedError:
+            raise
+        except Exception:  # noqa: BLE001, S110 - SymEngine's conversion or calculus failed
+            pass
+    return _assemble(sys, terms, lambda e: e)  # SymPy's, where SymEngine cannot
+
+
+@dataclass
+class _Terms:
+    """What Newton's residual is assembled from, as SymPy objects."""
+
+    positions: dict
+    masses: dict
+    forces: dict
+    frames: dict
+    pulls: dict
+    rest: sp.Expr
+    given: list  # generalized forces: declared, attractors' torques, torques, friction
+
+
+def _assemble(sys, terms: _Terms, conv) -> list:
+    """Σ (∂r/∂q_i)·(m r̈ − F) + Σ (∂ω/∂q̇_i)·(I ω̇ + ω × Iω) − pulls + the Lagrange
+    expressions of `rest` − Q, in the algebra `conv` converts to: SymEngine's (`se.sympify`;
+    raises SymEngineCannot where a derivative stays unevaluated) or SymPy's (the identity).
+    The same few lines for both: `diff`, +, * and free_symbols are all either needs."""
+    n = len(sys.q)
+    q, qd = [conv(x) for x in sys.q], [conv(x) for x in sys.qd]
+    t = conv(sys.t)
+    chains = [(conv(a), conv(b)) for x, v, a_ in zip(sys.q, sys.qd, sys.qdd, strict=True)
+              for a, b in ((x, v), (v, a_))]
+    chains += [(conv(a), conv(b)) for y, yd, ydd in sys.free_driven
+               for a, b in ((y, yd), (yd, ydd))]
+    third = {conv(ydd) for _, _, ydd in sys.free_driven}
+
+    def dt(e):
+        if third & e.free_symbols:
+            raise UnsupportedError("third derivative of a free driven coordinate")
+        out = e.diff(t)
+        for x, v in chains:
+            out += e.diff(x) * v
+        return out
+
+    def vec(m) -> list:
+        return [conv(x) for x in m]
+
+    def along(vectors: list, rate, other: list):  # Σ_k ∂v_k/∂rate · other_k
+        return sum((v.diff(rate) * o for v, o in zip(vectors, other, strict=True)), conv(0))
+
+    res = [conv(sp.S.Zero)] * n
+    for name, r in terms.positions.items():
+        rv, m = vec(r), conv(terms.masses[name])
+        net = [m * dt(dt(x)) - f for x, f in zip(rv, vec(terms.forces[name]), strict=True)]
+        res = [res[i] + along(rv, q[i], net) for i in range(n)]
+    for tensor, omega, _ in terms.frames.values():
+        inertia = [vec(tensor.row(a)) for a in range(tensor.rows)]
+        w = vec(omega)
+        torque = _times(inertia, [dt(x) for x in w])
+        if len(w) == 3:  # + ω × Iω (a planar body's ω is one rate)
+            iw = _times(inertia, w)
+            torque = [a + b for a, b in zip(torque, _cross(w, iw), strict=True)]
+        res = [res[i] + along(w, qd[i], torque) for i in range(n)]
+    for name, pull in terms.pulls.items():
+        res = [res[i] - along(vec(terms.positions[name]), q[i], vec(pull)) for i in range(n)]
+    rest = conv(terms.rest)
+    res = [res[i] + dt(rest.diff(qd[i])) - rest.diff(q[i]) - conv(terms.given[i])
+           for i in range(n)]
+    if conv is se.sympify and any(e.atoms(se.Derivative, se.Subs) for e in res):
+        raise SymEngineCannot("a derivative SymEngine leaves unevaluated")
     return res
+
+
+def _times(matrix: list, v: list) -> list:
+    return [sum((a * b for a, b in zip(row, v, strict=True)), 0 * v[0]) for row in matrix]
+
+
+def _cross(a: list, b: list) -> list:
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
 def _gravity(sys, spec: dict, positions: dict, masses: dict, parse) -> dict[str, sp.Matrix]:
@@ -270,10 +337,11 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     free = [s for trio in sys.free_driven for s in trio]
     args = [sys.t, *sys.q, *sys.qd, *sys.qdd, *free, *params]
     exprs = engine + newton
-    stray = set().union(*(e.free_symbols for e in exprs)) - set(args)
+    # by name: the Newton side is SymEngine's where SymEngine could build it
+    stray = {str(s) for e in exprs for s in e.free_symbols} - {str(a) for a in args}
     if stray:
         raise UnsupportedError("Newton cross-check: symbols without values: "
-                               + ", ".join(sorted(map(str, stray))))
+                               + ", ".join(sorted(stray)))
     fn, _ = compile_exprs(args, exprs)
     n = len(sys.q)
     rng = np.random.default_rng(20261123)

@@ -364,14 +364,15 @@ class System(SystemLike):
             amps.append(self.coord_names.index(name))
         modes = [sp.sin((k + 1) * sp.pi * x / length) for k in range(len(amps))]
         kinetic = potential = sp.S.Zero
+        known: dict = {}  # the pairs of modes share most of their terms' integrals
         for a, ia in enumerate(amps):
             for b, ib in enumerate(amps):
                 if b < a:
                     continue
                 mult = 1 if a == b else 2
                 try:
-                    mass = sp.integrate(sp.expand(TR8(density * modes[a] * modes[b])),
-                                        (x, 0, length))
+                    mass = _integral(sp.expand(TR8(density * modes[a] * modes[b])), x,
+                                     length, known)
                 except Exception as exc:  # noqa: BLE001 - SymPy's many failure modes
                     raise self._error(sub + ("density",), f"cannot integrate: {exc}") from None
                 if mass.has(sp.Integral) or mass.has(x):
@@ -477,3 +478,16 @@ def system_of(problem: Problem, name: str | None = None) -> System:
     if name not in problem._cache:
         problem._cache[name] = System(problem, problem.systems[name])
     return problem._cache[name]
+
+
+def _integral(expr: sp.Expr, x: sp.Symbol, length: sp.Expr, known: dict) -> sp.Expr:
+    """∫₀ˡ expr dx term by term, each term's factor free of x taken out and each integral
+    of what remains done once (`known`): the mass integrals of N modes' N(N+1)/2 pairs
+    repeat the same few cos(kπx/l) terms, and SymPy's integrate is the costly part."""
+    total = sp.S.Zero
+    for term in sp.Add.make_args(expr):
+        factor, rest = term.as_independent(x, as_Add=False)
+        if rest not in known:
+            known[rest] = sp.integrate(rest, (x, 0, length))
+        total += factor * known[rest]
+    return total

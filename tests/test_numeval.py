@@ -1,0 +1,91 @@
+"""The numeric evaluator's compiled programs (mechbook.core.numeval.Program)."""
+
+from __future__ import annotations
+
+import mpmath
+import pytest
+import sympy as sp
+
+from mechbook.core import numeval
+from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, evaluate_resolved
+
+x, y = sp.symbols("x y", positive=True)
+z = sp.Symbol("z", real=True)
+
+
+def _reference(expr: sp.Basic, point: dict, digits: int) -> mpmath.mpc:
+    """SymPy's own evaluation at `digits` + 10 digits (an independent route to the value)."""
+    d = digits + 10
+    v = sp.N(expr.xreplace({k: sp.Float(v, d) for k, v in point.items()}), d)
+    re, im = (sp.Float(part, d) for part in v.as_real_imag())
+    with mpmath.workdps(d):
+        return mpmath.mpc(mpmath.mpf(re._mpf_), mpmath.mpf(im._mpf_))
+
+
+@pytest.mark.parametrize("expr", [
+    x**3 * sp.sin(y) + sp.cos(x * y) ** 2 - sp.Rational(7, 3),
+    sp.sqrt(x + y) ** 3 + sp.exp(-x) * sp.log(y) + sp.pi * sp.atan2(y, x),
+    (x + y) ** sp.Rational(-1, 2) + sp.Abs(z - 1) + sp.tanh(z) ** 4,
+    x**y + sp.I * sp.sin(x),
+])
+def test_the_program_agrees_with_sympy_to_the_working_precision(expr):
+    point = {x: 0.7, y: 1.3, z: -0.4}
+    for digits in (15, 30, 60):
+        value, size = evaluate(expr, point, digits)
+        ref = _reference(expr, point, digits)
+        assert abs(value - complex(ref)) <= 1e-13 * max(1.0, abs(complex(ref)))
+        assert size >= abs(value) * (1 - 1e-12)
+        with mpmath.workdps(digits):
+            precise = evaluate_mp(expr, point, digits)
+            assert abs(precise - ref) <= mpmath.mpf(10) ** (3 - digits) * max(1, abs(ref))
+
+
+def test_a_kept_program_follows_the_precision_of_each_call():
+    """The constants of a kept program are converted again when the precision changes: a
+    program first run at 15 digits must not carry 15-digit constants into a 60-digit run."""
+    expr = sp.pi * x - sp.Rational(1, 3)
+    evaluate(expr, {x: 1}, 15)
+    with mpmath.workdps(60):
+        v = evaluate_mp(expr, {x: 1}, 60)
+        assert abs(v - (mpmath.pi - mpmath.mpf(1) / 3)) < mpmath.mpf(10) ** -58
+
+
+def test_the_magnitude_measures_cancellation():
+    expr = (x + 1) ** 2 - x**2 - 2 * x - 1  # zero, by cancelling terms of size ~1e12
+    value, size = evaluate(expr, {x: 1e6}, 30)
+    assert abs(value) <= 1e-15 * size and size > 1e12
+
+
+def test_errors_are_raised_when_the_walk_reaches_them():
+    with pytest.raises(NotNumeric, match="no value for y"):
+        evaluate(x + y, {x: 1})
+    with pytest.raises(ValueError, match="zoo"):
+        evaluate(x + sp.zoo, {x: 1})
+    with pytest.raises(NotNumeric, match="Piecewise"):
+        evaluate(sp.Piecewise((x, x > 1), (0, True)), {x: 2})
+    with pytest.raises(ZeroDivisionError):
+        evaluate(1 / (x - 1), {x: 1})
+    # the same errors again from the kept programs, a fresh exception each time
+    first = second = None
+    for _ in range(2):
+        try:
+            evaluate(x + y, {x: 1})
+        except NotNumeric as exc:
+            first, second = second, exc
+    assert first is not None and first is not second
+
+
+def test_resolved_values_raise_the_precision_until_they_stand_clear():
+    big = sp.Integer(10) ** 24
+    expr = (x + big) - big - x + sp.Rational(1, 10**25)
+    assert abs(evaluate_resolved(expr, {x: sp.Rational(1, 3)}) - mpmath.mpf(10) ** -25) \
+        < mpmath.mpf(10) ** -35
+
+
+def test_the_kept_programs_are_bounded(monkeypatch):
+    monkeypatch.setattr(numeval, "PROGRAMS", 8)
+    numeval._programs.clear()
+    for k in range(20):
+        evaluate(x + k, {x: 1})
+    assert len(numeval._programs) == 8
+    assert evaluate(x + 19, {x: 1})[0] == 20  # the newest are kept, still right
