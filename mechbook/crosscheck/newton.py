@@ -22,6 +22,7 @@ import numpy as np
 import symengine as se
 import sympy as sp
 
+from mechbook.core.backends import FEW_CALLS_BACKEND
 from mechbook.core.compile import compile_exprs
 from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.crosscheck.assembly import composite_inertia
@@ -342,7 +343,7 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     if stray:
         raise UnsupportedError("Newton cross-check: symbols without values: "
                                + ", ".join(sorted(stray)))
-    fn, _ = compile_exprs(args, exprs)
+    fn, _ = compile_exprs(args, exprs, FEW_CALLS_BACKEND)  # 3 to 40 × samples calls
     n = len(sys.q)
     rng = np.random.default_rng(20261123)
     base = np.array([p.value for p in sys.params.values()])

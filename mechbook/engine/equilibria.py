@@ -14,11 +14,13 @@ from functools import cached_property
 
 import numpy as np
 import scipy.optimize
+import symengine as se
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import without_absent
+from mechbook.core.secalc import to_sympy
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
 from mechbook.engine.domains import clip_ranges, inside
 from mechbook.engine.lagrange import Dynamics
@@ -206,14 +208,16 @@ class Equilibria:
         at = dict(point)
         at.update({q: at.get(q, sp.S.Zero) for q in dyn.q})
         rest = {v: sp.S.Zero for v in dyn.qd}
-        # each second derivative from the smallest expression that still holds it:
-        # A from L at the point (a function of q̇), C and the force from L at rest,
-        # B from ∂L/∂q̇ at rest
         held = self.sys.held  # Routh's held momenta: symbols until now
-        L_at, L_rest = dyn.L.xreplace(at), dyn.L.xreplace(rest)
-        b = [sp.diff(dyn.L, v).xreplace(rest) for v in dyn.qd]
-        dq = [sp.diff(L_rest, q) for q in dyn.q]
-        force = [g.xreplace(at).xreplace(held) for g in dq]
+        try:  # SymEngine's calculus, its entries brought back to SymPy once
+            names = set(dyn.L.free_symbols).union(*(sp.S(v).free_symbols for v in
+                                                     (*at.values(), *held.values())))
+            force, A, B, C = (
+                [to_sympy(x, names) for x in part] for part in
+                _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, se.sympify))
+        except Exception:  # noqa: BLE001 - SymEngine cannot (SymEngineCannot): SymPy's way
+            force, A, B, C = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held,
+                                                 lambda e: e)
         bad = [g for g in force if not is_zero(g, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium "
@@ -221,11 +225,8 @@ class Equilibria:
                                       f"{sp.sstr(bad[0])[:120]} "
                                       "is left there")
         simp = (lambda x: try_simplify(x, 5)) if dyn.simplify else (lambda x: x)
-        dv = [sp.diff(L_at, v) for v in dyn.qd]
-        A = sp.Matrix(n, n, lambda i, j: simp(sp.diff(dv[i], dyn.qd[j]).xreplace(rest)
-                                              .xreplace(held)))
-        B = sp.Matrix(n, n, lambda i, j: sp.diff(b[i], dyn.q[j]).xreplace(at).xreplace(held))
-        C = sp.Matrix(n, n, lambda i, j: sp.diff(dq[i], dyn.q[j]).xreplace(at).xreplace(held))
+        A = sp.Matrix(n, n, [simp(x) for x in A])
+        B, C = sp.Matrix(n, n, B), sp.Matrix(n, n, C)
         return LinearSystem(dyn, dict(point), A, (B - B.T).applyfunc(simp),
                             (-C).applyfunc(simp), sp.zeros(n, 1))
 
@@ -322,3 +323,22 @@ class Equilibria:
             raise UnsupportedError("linearization about a uniform motion whose linear "
                                    "equations have time-dependent coefficients")
         return zeroth, M, C, K, F
+
+
+def _second_derivatives(L, q, qd, at: dict, rest: dict, held: dict, conv) -> tuple:
+    """(∂L/∂q at the point, A, B, C row by row) of `_linearize_lagrangian`, in the algebra
+    `conv` converts to (SymEngine's or SymPy's: both have diff and xreplace). Each second
+    derivative from the smallest expression that still holds it: A from L at the point (a
+    function of q̇), C and the force from L at rest, B from ∂L/∂q̇ at rest."""
+    L = conv(L)
+    q, qd = [conv(x) for x in q], [conv(x) for x in qd]
+    at, rest, held = ({conv(k): conv(v) for k, v in d.items()} for d in (at, rest, held))
+    L_at, L_rest = L.xreplace(at), L.xreplace(rest)
+    b = [L.diff(v).xreplace(rest) for v in qd]
+    dq = [L_rest.diff(x) for x in q]
+    force = [g.xreplace(at).xreplace(held) for g in dq]
+    dv = [L_at.diff(v) for v in qd]
+    A = [dv[i].diff(v).xreplace(rest).xreplace(held) for i in range(len(q)) for v in qd]
+    B = [b[i].diff(x).xreplace(at).xreplace(held) for i in range(len(q)) for x in q]
+    C = [dq[i].diff(x).xreplace(at).xreplace(held) for i in range(len(q)) for x in q]
+    return force, A, B, C

@@ -1,0 +1,43 @@
+"""The Lagrangian linearization's second derivatives in SymEngine and in SymPy agree.
+
+`Equilibria._linearize_lagrangian` takes them in SymEngine and falls back to SymPy where
+SymEngine cannot (an unknown function): the two algebras must give the same matrices."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import symengine as se
+import sympy as sp
+
+from mechbook.core.secalc import to_sympy
+from mechbook.engine.analysis import Analysis
+from mechbook.engine.equilibria import _second_derivatives
+from mechbook.model.problem import load_problem
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize(("pid", "name"), [("lim/2043.yaml", "general"),
+                                          ("lim/2057.yaml", "planar"),
+                                          ("symon/11-18.yaml", None)])
+def test_second_derivatives_agree_in_both_algebras(pid, name):
+    an = Analysis(load_problem(ROOT / "problems" / pid))
+    sys = an.system(name)
+    dyn = an.dynamics(sys.name)
+    rng = np.random.default_rng(3)
+    at = {q: sp.Float(rng.uniform(0.1, 0.9)) for q in dyn.q}
+    rest = {v: sp.S.Zero for v in dyn.qd}
+    names = set(dyn.L.free_symbols)
+    fast = [[to_sympy(x, names) for x in part] for part in
+            _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, sys.held, se.sympify)]
+    slow = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, sys.held, lambda e: e)
+    symbols = sorted(set().union(*(e.free_symbols for part in slow for e in part)), key=str)
+    point = {s: sp.Float(rng.uniform(0.5, 1.5)) for s in symbols}
+    for part_fast, part_slow in zip(fast, slow, strict=True):
+        assert len(part_fast) == len(part_slow) and part_slow
+        for a, b in zip(part_fast, part_slow, strict=True):
+            va, vb = complex(a.xreplace(point).evalf()), complex(b.xreplace(point).evalf())
+            assert abs(va - vb) <= 1e-12 * max(1.0, abs(vb)), (a, b)
