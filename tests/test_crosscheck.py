@@ -267,3 +267,19 @@ def test_a_double_exponent_with_one_mode_is_not_measured():
     pair = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.eye(2), np.zeros((2, 2))]])
     lam, V = scipy.linalg.eig(pair)
     assert not any(_defective(lam, V, j, 1.0) for j in range(4))
+
+
+def test_box_integrals_term_by_term_equal_sympys_multiple_integral():
+    """kinematics._box_integral: products of one-variable factors integrated factor by
+    factor; a term mixing the variables, or limits depending on another variable, go to
+    SymPy's multiple integral. The same values either way."""
+    from mechbook.crosscheck.kinematics import _box_integral
+
+    u, v, w, a = sp.symbols("u v w a", positive=True)
+    box = ((u, 0, a), (v, 0, sp.pi), (w, 0, 2 * sp.pi))
+    for e in (u**2 * sp.sin(v) ** 3 * sp.cos(w) ** 2 + a * u * sp.sin(v),  # separable
+              u * sp.sin(v + w) ** 2 + u**3,  # a term mixing v and w
+              (u + v) ** 2 * sp.cos(w) ** 2):
+        assert sp.simplify(_box_integral(e, box, {}) - sp.integrate(sp.expand(e), *box)) == 0
+    tri = ((u, 0, v), (v, 0, a))  # a limit depending on the other variable
+    assert sp.simplify(_box_integral(u * v, tri, {}) - a**4 / 8) == 0
