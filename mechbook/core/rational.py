@@ -58,9 +58,19 @@ def vanishes_identically(expr) -> bool | None:
     return se.expand(numerator) == 0
 
 
-def cancel(expr: sp.Expr) -> sp.Expr:
+class TooLarge(Exception):
+    """The expanded numerator and denominator outgrow the limit `cancel` was given."""
+
+
+def cancel(expr: sp.Expr, max_growth: float | None = None) -> sp.Expr:
     """`sympy.cancel(expr)`: the same steps and canonical result (common factors of the
-    numerator and denominator polynomials removed), with their expansion in SymEngine."""
+    numerator and denominator polynomials removed), with their expansion in SymEngine.
+
+    `max_growth`: raise TooLarge, before the costly part (the polynomials' conversion and
+    their greatest common divisor), when the expanded numerator and denominator are more
+    than this many times the size of `expr` (printed lengths): a caller that cancels to
+    make an expression smaller can stop there (the cancelled form is seldom far smaller
+    than the expansion it comes from)."""
     f = signsimp(expr)
     if f.is_Number or not isinstance(f, sp.Expr) or not f.is_commutative \
             or f.has(sp.Piecewise) or len({s.name for s in f.free_symbols}) \
@@ -69,7 +79,14 @@ def cancel(expr: sp.Expr) -> sp.Expr:
     f = factor_terms(f, radical=True)
     p, q = f.as_numer_denom()
     try:
-        p, q = (to_sympy(se.expand(se.sympify(x)), x.free_symbols) for x in (p, q))
+        expanded = [se.expand(se.sympify(x)) for x in (p, q)]
+    except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's way
+        return sp.cancel(expr)
+    if max_growth is not None and sum(len(str(x)) for x in expanded) > \
+            max_growth * len(str(se.sympify(expr))):
+        raise TooLarge(f"the expansion outgrows {max_growth:g} times the expression")
+    try:
+        p, q = (to_sympy(x, y.free_symbols) for x, y in zip(expanded, (p, q), strict=True))
     except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's way
         return sp.cancel(expr)
     c, P, Q = sp.cancel((p, q), expand=False)
