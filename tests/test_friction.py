@@ -206,9 +206,18 @@ CASES = [(INCLINE.format(mu=0.5), [0.0, 2.0], 1.0), (INCLINE.format(mu=0.2), [0.
 @pytest.mark.parametrize("text, y0, t_end", CASES, ids=["sticks", "slides-back", "disk", "push"])
 def test_sliding_phases_in_the_compiled_loop_agree_with_scipy(tmp_path, text, y0, t_end):
     """Phases where every contact slides run in the compiled DOP853 loop on the smooth
-    model, the step of an event again in SciPy: the same switches, at the same times (to
-    1e-12), the same end state (to 1e-10), and every crossing of a non-terminal event of
-    the caller's found as a whole run in SciPy finds it."""
+    model, the step of an event again in SciPy: the same switches, at the same times, the
+    same end state (to 1e-10), and every crossing of a non-terminal event of the caller's
+    found as a whole run in SciPy finds it; the caller's non-terminal event changes nothing
+    in the motion (as in solve_ivp).
+
+    The times agree to 1e-12 when both runs see |v_t| fall below ε at a step's end. The
+    window is ~2ε/|a| ≈ 1e-9 s wide, and a step may straddle it: the smooth model then
+    slides through v_t = 0 and back, and the stop is found a few ns later (both SciPy and
+    the compiled loop do this). Which run does it depends on rounding here: these motions
+    are polynomials in t, DOP853's error estimate of them is rounding noise, and so are the
+    step sizes of the compiled loop (the smooth model) and the reference (this class's
+    right-hand side). Hence 1e-8 for the switches."""
     a = _analysis(tmp_path, text)
     sys, dyn, values = a.system(), a.dynamics(), a.problem.values()
     model = build_model(sys, dyn, values)
@@ -226,7 +235,10 @@ def test_sliding_phases_in_the_compiled_loop_agree_with_scipy(tmp_path, text, y0
         assert model.native.nfev() > before  # the compiled loop ran
     assert [s[1:] for s in fast.switches] == [s[1:] for s in reference.switches]
     for (tf, *_), (tr, *_) in zip(fast.switches, reference.switches, strict=True):
-        assert abs(tf - tr) <= 1e-12 * max(1.0, abs(tr))
+        assert abs(tf - tr) <= 1e-8 * max(1.0, abs(tr))
+    alone = Phases(sys, dyn, values, model).solve_ivp((0.0, t_end), y0)
+    assert alone.switches == fast.switches
+    assert np.array_equal(alone.y, fast.y)
     assert np.allclose(fast.y[:, -1], reference.y[:, -1], rtol=1e-10, atol=1e-12)
     assert len(fast.t_events[0]) == len(reference.t_events[0]) >= 1
     assert np.allclose(fast.t_events[0], reference.t_events[0], rtol=1e-12)

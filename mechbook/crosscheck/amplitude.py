@@ -14,12 +14,12 @@ still measured; one that never comes back (it left the well) is reported as NaN.
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from mechbook.crosscheck.modal import modal_setup, mode_signal, normal_modes, start_state
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.events import solve_with_events
 
 PERIODS = 4
 MAX_PERIODS = 40
@@ -92,8 +92,9 @@ def _measure(s, mode: dict, amplitude: float, period: float) -> float:
     y0 = start_state(s, mode, amplitude)
     scale = np.maximum(np.abs(y0), 1.0)
     with np.errstate(all="ignore"):
-        sol = solve_ivp(s.model.rhs, (0.0, MAX_PERIODS * period), y0, method="DOP853",
-                        rtol=RTOL, atol=1e-13 * amplitude * scale, events=[g])
+        sol = solve_with_events(s.model.native, s.model.rhs, (0.0, MAX_PERIODS * period),
+                                y0, rtol=RTOL, atol=1e-13 * amplitude * scale, events=[g],
+                                stats=s.model.stats)
     times = np.asarray(sol.t_events[0])
     if not sol.success or len(times) < 3:
         return float("nan")

@@ -6,6 +6,7 @@
                  Taylor method, one interface
     native       loops.c built once per machine, called through ctypes (Model.rhs too)
     compiled     the compiled loops run once per integration (fixed steps, DOP853, RK45)
+    events       DOP853 with solve_ivp's events in the compiled loop (event steps in SciPy)
     taylor       heyoka's Taylor method: integration, events, batch mode, float128
     hyexpr       SymPy -> heyoka expressions by walking the tree; LDLᵀ solve
     monitors     drift of the conserved quantities the engine found

@@ -9,6 +9,7 @@ DOP853 and RK45) step for step, so the numbers agree to rounding (tests/test_nat
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -76,16 +77,43 @@ MESSAGES = {0: "The solver successfully reached the end of the integration inter
             -2: "evaluation budget spent", -3: "more steps than max_points"}
 
 
+class Run(NamedTuple):
+    """A run of `adaptive`: the records, its status (0 finished, negative failed:
+    MESSAGES), the right-hand-side evaluations it cost, and the step size it would try
+    next from its last record (with status -3, the record full, a run from there with
+    first_step=next_step goes on exactly as this one would have)."""
+
+    t: np.ndarray
+    y: np.ndarray  # 2n × N
+    status: int
+    message: str
+    evaluations: int
+    next_step: float
+
+
+def tolerances(atol, size: int) -> np.ndarray:
+    """atol as solve_ivp takes it (a number, or one per component) as a contiguous array of
+    `size` floats, the compiled loop's form."""
+    a = np.asarray(atol, dtype=float)
+    if a.ndim == 0:
+        a = np.full(size, float(a))
+    elif a.shape != (size,):
+        raise ValueError(f"atol has shape {a.shape}: a number or {size} values wanted")
+    if not np.all(a >= 0):
+        raise ValueError("atol must be positive")
+    return np.ascontiguousarray(a)
+
+
 def adaptive(nat: NativeModel, stats, method: str, t_span, y0: np.ndarray, rtol: float,
-             atol: float, max_step: float = math.inf, first_step: float | None = None,
-             t_eval=None, max_points: int = 200_001):
-    """DOP853 or RK45 as solve_ivp runs them: (t, y (2n × N), status, message, evaluations);
-    status 0 finished, negative failed (MESSAGES)."""
+             atol, max_step: float = math.inf, first_step: float | None = None,
+             t_eval=None, max_points: int = 200_001) -> Run:
+    """DOP853 or RK45 as solve_ivp runs them (atol a number or one per component of y0)."""
     kind, *table = _tableau(method)
     A, B, C, E3, E5, D = (np.ascontiguousarray(x, dtype=float) for x in table)
     t0, t1 = map(float, t_span)
     y0 = np.ascontiguousarray(y0, dtype=float)
     n2 = len(y0)
+    tol = tolerances(atol, n2)
     if t_eval is not None:
         te = np.ascontiguousarray(t_eval, dtype=float)
         neval, rows_cap = len(te), len(te)
@@ -94,14 +122,16 @@ def adaptive(nat: NativeModel, stats, method: str, t_span, y0: np.ndarray, rtol:
     rec = np.empty((rows_cap, n2))
     tout = np.empty(rows_cap)
     status = np.zeros(1, dtype=np.int32)
+    h_next = np.zeros(1)
     before = nat.nfev()
     rows = nat.lib.mb_rk_adaptive(
-        nat.ptr, int(kind), t0, t1, address(y0), float(rtol), float(atol),
+        nat.ptr, int(kind), t0, t1, address(y0), float(rtol), address(tol),
         float(max_step), float(first_step or 0.0), address(A), address(B), address(C),
         address(E3), address(E5), address(D), address(te), neval, address(rec),
-        address(tout), address(status), _limit(stats, nat))
+        address(tout), address(status), address(h_next), _limit(stats, nat))
     code = int(status[0])
-    return tout[:rows], rec[:rows].T, code, MESSAGES[code], nat.nfev() - before
+    return Run(tout[:rows], rec[:rows].T, code, MESSAGES[code], nat.nfev() - before,
+               float(h_next[0]))
 
 
-__all__ = ["adaptive", "fixed"]
+__all__ = ["Run", "adaptive", "fixed", "tolerances"]

@@ -30,6 +30,7 @@ from scipy.integrate import solve_ivp as scipy_solve_ivp
 
 from mechbook.core.compile import as_expr, compile_exprs
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.events import ROWS, solve_with_events
 from mechbook.numerics.lapack import solve_small as _gesv
 from mechbook.numerics.native import kernel_pointer
 
@@ -362,75 +363,14 @@ class Phases:
         return self._smooth.native
 
     def _sliding(self, native, span, y0, events, modes, directions, rtol, atol,
-                 rows: int = 4096) -> SimpleNamespace:
+                 rows: int = ROWS) -> SimpleNamespace:
         """A phase with every contact sliding, answered like solve_ivp (t, y, t_events,
-        y_events, status, message).
-
-        The compiled DOP853 loop (mechbook.numerics.compiled.adaptive: solve_ivp's steps, in
-        C) runs on the smooth model and records every step; the events are evaluated at the
-        steps in turn, with solve_ivp's rule for a sign change (find_active_events). The
-        first step in which one changes sign is integrated again by SciPy on this class's
-        right-hand side, which locates the events there on its dense output as a whole
-        phase in SciPy would; a terminal one ends the phase there, after any other the
-        compiled loop goes on from the end of that step."""
-        from mechbook.numerics.compiled import adaptive
-
-        t, t_end = float(span[0]), float(span[1])
-        y = np.asarray(y0, float)
-        t_events = [[] for _ in events]
-        y_events = [[] for _ in events]
+        y_events, status, message): the compiled DOP853 loop on the smooth model, the steps
+        in which an event changes sign taken again by SciPy on this class's right-hand side
+        (mechbook.numerics.events.solve_with_events)."""
 
         def fun(tt, yy, m=modes, d=directions):
             return self.rhs(tt, yy, m, d)
 
-        while True:
-            times, states, code, message, _ = adaptive(native, self._smooth.stats, "DOP853",
-                                                       (t, t_end), y, rtol, atol,
-                                                       max_points=rows)
-            if code in (-1, -2):
-                return _answer(t, y, t_events, y_events, -1, message)
-            before = np.array([ev(times[0], states[:, 0]) for ev in events])
-            hit = None
-            for k in range(1, len(times)):
-                after = np.array([ev(times[k], states[:, k]) for ev in events])
-                if _active(before, after, events):
-                    hit = k
-                    break
-                before = after
-            if hit is None:
-                t, y = float(times[-1]), states[:, -1]
-                if code == 0:
-                    return _answer(t, y, t_events, y_events, 0, message)
-                continue  # the record was full: on from its last step
-            sol = scipy_solve_ivp(fun, (float(times[hit - 1]), float(times[hit])),
-                                  states[:, hit - 1], method="DOP853", rtol=rtol, atol=atol,
-                                  events=events)
-            if sol.status < 0:
-                return sol
-            for k in range(len(events)):
-                t_events[k] += list(sol.t_events[k])
-                y_events[k] += list(sol.y_events[k])
-            t, y = float(sol.t[-1]), sol.y[:, -1]
-            if sol.status == 1 or t >= t_end:
-                return _answer(t, y, t_events, y_events, sol.status, sol.message)
-
-
-def _answer(t: float, y: np.ndarray, t_events: list, y_events: list, status: int,
-            message: str) -> SimpleNamespace:
-    """A phase's end as solve_ivp answers (the end state, the events found on the way)."""
-    return SimpleNamespace(t=np.array([t]), y=y[:, None],
-                           t_events=[np.array(x) for x in t_events],
-                           y_events=[np.array(x).reshape(len(x), len(y)) for x in y_events],
-                           status=status, message=message)
-
-
-def _active(g: np.ndarray, g_new: np.ndarray, events) -> bool:
-    """solve_ivp's rule: an event is active in a step if its value goes from ≤ 0 to ≥ 0
-    (direction > 0), from ≥ 0 to ≤ 0 (direction < 0), or either (direction 0)."""
-    for a, b, ev in zip(g, g_new, events, strict=True):
-        direction = getattr(ev, "direction", 0)
-        up, down = a <= 0 <= b, a >= 0 >= b
-        if (up and direction > 0) or (down and direction < 0) or \
-                ((up or down) and direction == 0):
-            return True
-    return False
+        return solve_with_events(native, fun, span, y0, rtol=rtol, atol=atol, events=events,
+                                 rows=rows, stats=self._smooth.stats)

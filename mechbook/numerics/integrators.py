@@ -125,12 +125,13 @@ class SciPyMethod(Integrator):
                 and not opts.get("vectorized"):
             from mechbook.numerics import compiled as loops
 
-            t, y, code, message, evals = loops.adaptive(
+            run = loops.adaptive(
                 nat, model.stats, self.name, t_span, y0, opts["rtol"], opts["atol"],
                 opts.get("max_step", math.inf), opts.get("first_step"), t_eval)
-            model.stats["rhs_calls"] += evals
-            return Trajectory(t, y[:n], y[n:], self.name, {**settings, "compiled": True},
-                              evals, code == 0, message)
+            model.stats["rhs_calls"] += run.evaluations
+            return Trajectory(run.t, run.y[:n], run.y[n:], self.name,
+                              {**settings, "compiled": True}, run.evaluations,
+                              run.status == 0, run.message)
         sol = solve_ivp(model.rhs, t_span, y0, method=self.name, t_eval=t_eval,
                         events=events, **opts)
         return Trajectory(sol.t, sol.y[:n], sol.y[n:], self.name, settings, int(sol.nfev),

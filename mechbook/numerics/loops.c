@@ -314,9 +314,12 @@ long mb_midpoint(model_t *md, double t0, double h, long steps, const double *z0,
 /* ---- DOP853 and RK45 as scipy.integrate.solve_ivp runs them -------------------------------
  * kind 8: DOP853 (A 16x16, B 12, C 16, E3/E5 13, D 4x16); kind 5: RK45 (A 6x6, B 6, C 6,
  * E 7 in E5, P 7x4 in D). Output at the sorted times t_eval (dense output), or at every
- * step when neval < 0 (rec then holds up to -neval rows, *tout their times).
+ * step when neval < 0 (rec then holds up to -neval rows, *tout their times). atol has one
+ * entry per component (2n), as solve_ivp's vector atol.
  * Returns rows written; *status: 0 finished, -1 step size too small, -2 evaluation budget
- * spent, -3 record buffer full. */
+ * spent, -3 record buffer full: then no step beyond the last row was taken, and *h_next
+ * (always written) is the step size the loop would try next from the last state, so a
+ * call from there with first_step = *h_next goes on exactly as this one would have. */
 static double rms(const double *v, int len) {
     double s = 0.0;
     for (int i = 0; i < len; i++) s += v[i] * v[i];
@@ -324,10 +327,10 @@ static double rms(const double *v, int len) {
 }
 
 long mb_rk_adaptive(model_t *md, int kind, double t0, double t1, const double *y0, double rtol,
-                    double atol, double max_step, double first_step, const double *A,
+                    const double *atol, double max_step, double first_step, const double *A,
                     const double *B, const double *C, const double *E3, const double *E5,
                     const double *D, const double *t_eval, long neval, double *rec,
-                    double *tout, int *status, long max_nfev) {
+                    double *tout, int *status, double *h_next, long max_nfev) {
     int n2 = 2 * md->n;
     int dop = kind == 8, stages = dop ? 12 : 6, ext = dop ? 16 : 7, lda = dop ? 16 : 6;
     double eeo = dop ? 7.0 : 4.0, exponent = -1.0 / (eeo + 1.0);
@@ -346,7 +349,7 @@ long mb_rk_adaptive(model_t *md, int kind, double t0, double t1, const double *y
     if (first_step > 0) h_abs = first_step;
     else if (interval == 0.0) h_abs = 0.0;
     else {
-        for (int i = 0; i < n2; i++) sc[i] = atol + fabs(y[i]) * rtol;
+        for (int i = 0; i < n2; i++) sc[i] = atol[i] + fabs(y[i]) * rtol;
         for (int i = 0; i < n2; i++) tmp[i] = y[i] / sc[i];
         double d0 = rms(tmp, n2);
         for (int i = 0; i < n2; i++) tmp[i] = f[i] / sc[i];
@@ -365,6 +368,7 @@ long mb_rk_adaptive(model_t *md, int kind, double t0, double t1, const double *y
     if (neval < 0) { tout[0] = t0; memcpy(rec, y, n2 * sizeof(double)); w = 1; }
     while (!(t == t1)) {
         if (md->nfev > max_nfev) { *status = -2; break; }
+        if (neval < 0 && w >= cap) { *status = -3; break; }  /* no room for this step */
         double min_step = 10 * fabs(nextafter(t, direction * INFINITY) - t);
         double ha = h_abs > max_step ? max_step : (h_abs < min_step ? min_step : h_abs);
         int accepted = 0, rejected = 0;
@@ -391,7 +395,7 @@ long mb_rk_adaptive(model_t *md, int kind, double t0, double t1, const double *y
                 ynew[i] = y[i] + h * acc;
             }
             mb_rhs(md, t + h, ynew, K + stages * n2);
-            for (int i = 0; i < n2; i++) sc[i] = atol + fmax(fabs(y[i]), fabs(ynew[i])) * rtol;
+            for (int i = 0; i < n2; i++) sc[i] = atol[i] + fmax(fabs(y[i]), fabs(ynew[i])) * rtol;
             double err;
             if (dop) {
                 double s5 = 0, s3 = 0;
@@ -429,7 +433,6 @@ long mb_rk_adaptive(model_t *md, int kind, double t0, double t1, const double *y
         t = tnew;
         h_abs = ha;
         if (neval < 0) {
-            if (w >= cap) { *status = -3; break; }
             tout[w] = t;
             memcpy(rec + w * n2, y, n2 * sizeof(double));
             w++;
@@ -487,6 +490,7 @@ long mb_rk_adaptive(model_t *md, int kind, double t0, double t1, const double *y
         }
         w = ie;
     }
+    *h_next = h_abs;
     free(K);
     return w;
 }

@@ -42,8 +42,8 @@ _SIGNATURES = {
     "mb_leapfrog": (_L, [_P, _D, _D, _L, _P, _I, _P, _P, _P, _L, _P, _P, _L]),
     "mb_midpoint": (_L, [_P, _D, _D, _L, _P, _D, _I, _P, _L, _P, _P, _L]),
     "mb_rhs_repeat": (None, [_P, _D, _P, _P, _L]),
-    "mb_rk_adaptive": (_L, [_P, _I, _D, _D, _P, _D, _D, _D, _D, _P, _P, _P, _P, _P, _P, _P,
-                            _L, _P, _P, _P, _L]),
+    "mb_rk_adaptive": (_L, [_P, _I, _D, _D, _P, _D, _P, _D, _D, _P, _P, _P, _P, _P, _P, _P,
+                            _L, _P, _P, _P, _P, _L]),
 }
 
 _state: dict = {"lib": None, "tried": False, "build_seconds": 0.0, "why": ""}
