@@ -41,3 +41,28 @@ def test_second_derivatives_agree_in_both_algebras(pid, name):
         for a, b in zip(part_fast, part_slow, strict=True):
             va, vb = complex(a.xreplace(point).evalf()), complex(b.xreplace(point).evalf())
             assert abs(va - vb) <= 1e-12 * max(1.0, abs(vb)), (a, b)
+
+
+def test_either_algebra_falls_back_to_sympy_and_lets_a_problem_fault_through():
+    from mechbook.core.secalc import either, same
+    from mechbook.errors import UnsupportedError
+
+    x = sp.Symbol("x", real=True)
+    used = []
+
+    def build(conv):
+        used.append(conv)
+        e = conv(sp.floor(x) * x)  # SymEngine leaves d/dx floor(x) unevaluated
+        d = e.diff(conv(x))
+        if conv is not same and d.atoms(se.Derivative):
+            raise ValueError("unevaluated")
+        return d
+
+    assert either(build) == sp.diff(sp.floor(x) * x, x) and used == [se.sympify, same]
+    assert either(lambda conv: conv(x**2).diff(conv(x))) == 2 * se.Symbol("x")
+
+    def refused(conv):
+        raise UnsupportedError("a capability the engine lacks")
+
+    with pytest.raises(UnsupportedError):
+        either(refused)

@@ -9,10 +9,13 @@ does not know a function, SymPy does the work, so the answer never depends on wh
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from typing import TypeVar
 
 import symengine as se
 import sympy as sp
+
+T = TypeVar("T")
 
 
 class Unsupported(Exception):
@@ -86,3 +89,24 @@ def total_derivative(expr: sp.Basic, t: sp.Symbol,
         raise
     except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
         raise Unsupported(str(exc)) from None
+
+
+def same(e):
+    """The identity: SymPy's algebra for a computation written for either (`either`)."""
+    return e
+
+
+def either(build: Callable[[Callable], T]) -> T:
+    """build(se.sympify): a computation written once for either algebra (SymEngine's and
+    SymPy's objects both have diff, xreplace, +, * and free_symbols) done in SymEngine;
+    where SymEngine cannot (an unknown function, a derivative it leaves unevaluated: then
+    `build` raises), done again in SymPy, build(same). A MechbookError (the problem's
+    own fault, or a capability the engine lacks) is not a reason to try again."""
+    from mechbook.errors import MechbookError
+
+    try:
+        return build(se.sympify)
+    except MechbookError:
+        raise
+    except Exception:  # noqa: BLE001 - SymEngine's conversion or calculus failed
+        return build(same)

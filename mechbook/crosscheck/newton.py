@@ -17,6 +17,7 @@ are computed here their own way (mechbook.crosscheck.kinematics), never by the e
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import symengine as se
@@ -25,6 +26,7 @@ import sympy as sp
 from mechbook.core.backends import FEW_CALLS_BACKEND
 from mechbook.core.compile import compile_exprs
 from mechbook.core.secalc import Unsupported as SymEngineCannot
+from mechbook.core.secalc import either, same
 from mechbook.crosscheck.assembly import composite_inertia
 from mechbook.crosscheck.guard import guarded
 from mechbook.crosscheck.kinematics import (
@@ -76,14 +78,8 @@ def _newton_residual(sys, symengine: bool = True) -> list:
     given = [sys.declared_forces[i] + attractor_q[i] + torque_q[i] + friction_q[i]
              for i in range(n)]
     terms = _Terms(positions, masses, forces, frames, pulls, rest, given)
-    if symengine:
-        try:
-            return _assemble(sys, terms, se.sympify)  # SymEngine's calculus, ten times sooner
-        except UnsupportedError:
-            raise
-        except Exception:  # noqa: BLE001, S110 - SymEngine's conversion or calculus failed
-            pass
-    return _assemble(sys, terms, lambda e: e)  # SymPy's, where SymEngine cannot
+    build = partial(_assemble, sys, terms)
+    return either(build) if symengine else build(same)  # SymEngine's calculus where it can
 
 
 @dataclass

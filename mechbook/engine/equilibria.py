@@ -14,13 +14,12 @@ from functools import cached_property
 
 import numpy as np
 import scipy.optimize
-import symengine as se
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import without_absent
-from mechbook.core.secalc import to_sympy
+from mechbook.core.secalc import either, same, to_sympy
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
 from mechbook.engine.domains import clip_ranges, inside
 from mechbook.engine.lagrange import Dynamics
@@ -209,15 +208,14 @@ class Equilibria:
         at.update({q: at.get(q, sp.S.Zero) for q in dyn.q})
         rest = {v: sp.S.Zero for v in dyn.qd}
         held = self.sys.held  # Routh's held momenta: symbols until now
-        try:  # SymEngine's calculus, its entries brought back to SymPy once
-            names = set(dyn.L.free_symbols).union(*(sp.S(v).free_symbols for v in
-                                                     (*at.values(), *held.values())))
-            force, A, B, C = (
-                [to_sympy(x, names) for x in part] for part in
-                _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, se.sympify))
-        except Exception:  # noqa: BLE001 - SymEngine cannot (SymEngineCannot): SymPy's way
-            force, A, B, C = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held,
-                                                 lambda e: e)
+        names = set(dyn.L.free_symbols).union(*(sp.S(v).free_symbols for v in
+                                                 (*at.values(), *held.values())))
+
+        def build(conv):  # in SymEngine, its entries brought back to SymPy once; or SymPy
+            parts = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, conv)
+            return parts if conv is same else [[to_sympy(x, names) for x in p] for p in parts]
+
+        force, A, B, C = either(build)
         bad = [g for g in force if not is_zero(g, self.sys.numeric_values())]
         if bad:
             raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium "
