@@ -8,6 +8,7 @@ and the equations of motion are E = 0, i.e. M(q,t)·q̈ = f(q,q̇,t) + Aᵀλ wi
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import cached_property
 
 import sympy as sp
@@ -40,6 +41,31 @@ def solve_accelerations(M: sp.Matrix, rhs: sp.Matrix, unknowns: list) -> sp.Matr
                                 f"not determine every acceleration [{exc}]") from None
 
 
+def lagrange_expressions(system: SystemLike, L: sp.Expr,
+                         forces: Sequence[sp.Expr] | None = None) -> list[sp.Expr]:
+    """expand(d/dt(∂L/∂q̇_i) − ∂L/∂q_i − Q_i) for each coordinate of `system` (Q = 0 when
+    `forces` is None), d/dt along the system's motion (its free driven coordinates too);
+    by SymEngine (core.secalc, ten times sooner) where it can, else by SymPy."""
+    forces = list(forces) if forces is not None else [sp.S.Zero] * len(system.q)
+    chains = list(zip(system.q, system.qd, strict=True)) + list(zip(system.qd, system.qdd,
+                                                                    strict=True))
+    stop = []
+    if not system.reduced:  # a System: its free driven coordinates too (a system reduced
+        # by Routh differentiates its own coordinates only)
+        for y, yd, ydd in system.free_driven:
+            chains += [(y, yd), (yd, ydd)]
+            stop.append(ydd)
+    try:
+        return euler_lagrange(L, system.q, system.qd, chains, system.t, forces, stop)
+    except SymEngineCannot:
+        pass
+    out = []
+    for q, qd, force in zip(system.q, system.qd, forces, strict=True):
+        e = system.dt(sp.diff(L, qd)) - sp.diff(L, q) - force
+        out.append(sp.expand(e))
+    return out
+
+
 class Dynamics:
     """Equations of motion, momenta, conserved quantities and the Hamiltonian of a system."""
 
@@ -64,24 +90,7 @@ class Dynamics:
     def residuals(self) -> list[sp.Expr]:
         """E_i without constraint forces (see module docstring), differentiated and expanded
         by SymEngine (core.secalc, ten times sooner) where it can, else by SymPy."""
-        chains = list(zip(self.q, self.qd, strict=True)) + list(zip(self.qd, self.qdd,
-                                                                    strict=True))
-        stop = []
-        if not self.sys.reduced:  # a System: its free driven coordinates too (a
-            # system reduced by Routh differentiates its own coordinates only)
-            for y, yd, ydd in self.sys.free_driven:
-                chains += [(y, yd), (yd, ydd)]
-                stop.append(ydd)
-        try:
-            return euler_lagrange(self.L, self.q, self.qd, chains, self.sys.t,
-                                  self.sys.forces, stop)
-        except SymEngineCannot:
-            pass
-        out = []
-        for q, qd, force in zip(self.q, self.qd, self.sys.forces, strict=True):
-            e = self.sys.dt(sp.diff(self.L, qd)) - sp.diff(self.L, q) - force
-            out.append(sp.expand(e))
-        return out
+        return lagrange_expressions(self.sys, self.L, self.sys.forces)
 
     @cached_property
     def mass_matrix(self) -> sp.Matrix:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechbook.engine.lagrange import lagrange_expressions
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, linear_accelerations, split_named
 from mechbook.verify.registration import quantity
@@ -24,11 +25,7 @@ def check_lagrangian(ctx: Context, val) -> Verdict:
     engine = ctx.system.lagrangian
     if "about" in ctx.part.data:
         engine = ctx.analysis.equilibria(ctx.part.system).quadratic_lagrangian(ctx.point())
-    diff = book - engine
-    sys = ctx.system
-    exprs = [sys.dt(sp.diff(diff, qd)) - sp.diff(diff, q) for q, qd in zip(sys.q, sys.qd,
-                                                                           strict=True)]
-    return all_vanish(exprs, ctx.sampler)
+    return all_vanish(lagrange_expressions(ctx.system, book - engine), ctx.sampler)
 
 
 @quantity('eom',
