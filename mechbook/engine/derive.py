@@ -20,12 +20,20 @@ DEFAULT_COMPUTE = ["lagrangian", "eom", "momenta", "cyclic", "energy", "equilibr
                    "small_oscillations"]
 
 
-def show(expr) -> str:
+def show(expr, order: str | None = None) -> str:
+    """expr (or lists and dicts of them) in the parser's own syntax. `order="none"`: the
+    terms in SymPy's internal order, not sorted for a reader (for the store: sorting a
+    sum's terms for printing is most of the time a long one takes, and the report reads
+    the text back and typesets it in its own order)."""
     if isinstance(expr, (list, tuple)):
-        return "[" + ", ".join(show(e) for e in expr) + "]"
+        return "[" + ", ".join(show(e, order) for e in expr) + "]"
     if isinstance(expr, dict):
-        return "{" + ", ".join(f"{k}: {show(v)}" for k, v in expr.items()) + "}"
-    return sp.sstr(expr)
+        return "{" + ", ".join(f"{k}: {show(v, order)}" for k, v in expr.items()) + "}"
+    return sp.sstr(expr, order=order)
+
+
+def _stored(expr) -> str:
+    return show(expr, "none")
 
 
 def derive(analysis: Analysis, system: str | None = None,
@@ -192,9 +200,9 @@ def computed(analysis: Analysis) -> list[Results]:
         if sys is None:  # no part touched this system
             continue
         res = Results(name)
-        res.text["lagrangian"] = show(sys.lagrangian)
-        res.text["kinetic"] = show(sys.kinetic)  # built with the system: nothing derived
-        res.text["potential"] = show(sys.potential)
+        res.text["lagrangian"] = _stored(sys.lagrangian)
+        res.text["kinetic"] = _stored(sys.kinetic)  # built with the system: nothing derived
+        res.text["potential"] = _stored(sys.potential)
         dyn = analysis._dyn.get(name)
         if dyn is not None:
             for key in _DYNAMICS_TEXT:
@@ -202,18 +210,18 @@ def computed(analysis: Analysis) -> list[Results]:
                     val = dyn.__dict__[key]
                     if key == "momenta":
                         val = dict(zip(sys.q, val, strict=True))
-                    res.text[key] = show(val.tolist() if hasattr(val, "tolist") else val)
+                    res.text[key] = _stored(val.tolist() if hasattr(val, "tolist") else val)
         eq = analysis._eq.get(name)
         if eq is not None and eq._solved is not None:
-            res.text["equilibria"] = show(eq._solved)
+            res.text["equilibria"] = _stored(eq._solved)
         linears = [lin for key, lin in analysis._lin.items() if key[0] == name]
         for i, lin in enumerate(linears):
             tag = f"linear_{i}"
-            res.text[f"{tag}/point"] = show(lin.point)
+            res.text[f"{tag}/point"] = _stored(lin.point)
             if lin.dyn.sys.reduced:
-                res.text[f"{tag}/steady_momenta"] = show(lin.dyn.sys.held_momenta)
+                res.text[f"{tag}/steady_momenta"] = _stored(lin.dyn.sys.held_momenta)
             for m in ("M", "C", "K"):
-                res.text[f"{tag}/{m}"] = show(getattr(lin, m).tolist())
+                res.text[f"{tag}/{m}"] = _stored(getattr(lin, m).tolist())
             try:
                 M, C, K = lin.matrices(values)
                 res.arrays[f"{tag}/M"], res.arrays[f"{tag}/K"] = M, K
