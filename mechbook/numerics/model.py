@@ -26,6 +26,7 @@ from mechbook.core.compile import (
     compile_batch,
     compile_exprs,
 )
+from mechbook.core.secalc import either, same
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.lapack import solve_small as _gesv
 
@@ -236,33 +237,41 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
     t = system.t
     q, qd, qdd = list(dyn.q), list(dyn.qd), list(dyn.qdd)
     n = len(q)
-    residuals = [e.xreplace(sub) for e in dyn.residuals]
     zero_acc = {a: 0 for a in qdd}
-    M = [sp.diff(e, a) for e in residuals for a in qdd]
-    f = [-e.xreplace(zero_acc) for e in residuals]
-    exprs = M + f
-    m = 0
-    if system.constraints:
-        A = dyn.constraint_jacobian.xreplace(sub)
-        cons = [c.xreplace(sub) for _, c in system.constraints]
-        b = [system.dt(system.dt(c)).xreplace(zero_acc) for c in cons]
-        exprs += list(A) + b
-        m = len(cons)
-    exprs = [as_expr(e) for e in exprs]  # a derivative of a plain 0 can be a Python int
-    bad = set().union(*(e.free_symbols for e in exprs)) - set([t] + q + qd)
+    m = len(system.constraints)
+
+    def equations(conv) -> list:  # M, f (and A, b) in either algebra (core.secalc.either)
+        at = {conv(k): conv(v) for k, v in sub.items()}
+        res = [conv(e).xreplace(at) for e in dyn.residuals]
+        rest = {conv(a): conv(0) for a in qdd}
+        exprs = [e.diff(conv(a)) for e in res for a in qdd] + [-e.xreplace(rest) for e in res]
+        if system.constraints:
+            exprs += [conv(x).xreplace(at) for x in dyn.constraint_jacobian]
+            exprs += [conv(system.dt(system.dt(c)).xreplace(zero_acc)).xreplace(at)
+                      for _, c in system.constraints]
+        return [as_expr(e) if conv is same else e for e in exprs]  # d(plain 0) is an int
+
+    exprs = either(equations)  # SymEngine's objects go to the compile layer as they are
+    bad = {str(x) for e in exprs for x in e.free_symbols} - {str(x) for x in [t] + q + qd}
     if bad:
         raise UnsupportedError("simulation: symbols without a value: "
-                               + ", ".join(sorted(map(str, bad))))
+                               + ", ".join(sorted(bad)))
     args = [t] + q + qd
     mf, used = compile_exprs(args, exprs, backend)
 
     def canonical() -> Compiled:
-        L = system.lagrangian.xreplace(sub)
-        ML = [sp.diff(L, a, b) for a in qd for b in qd]
-        bvec = [sp.diff(L, a).xreplace({v: 0 for v in qd}) for a in qd]
-        forces = [F.xreplace(sub) for F in system.forces]
-        dLdq = [sp.diff(L, x) + F for x, F in zip(q, forces, strict=True)]
-        fn, _ = compile_exprs(args, ML + bvec + dLdq, used)
+        def parts(conv) -> list:  # ∂²L/∂q̇∂q̇, ∂L/∂q̇ at q̇ = 0, ∂L/∂q + Q
+            at = {conv(k): conv(v) for k, v in sub.items()}
+            L = conv(system.lagrangian).xreplace(at)
+            v = [conv(x) for x in qd]
+            rest = {x: conv(0) for x in v}
+            ML = [L.diff(a).diff(b) for a in v for b in v]
+            bvec = [L.diff(a).xreplace(rest) for a in v]
+            dLdq = [L.diff(conv(x)) + conv(F).xreplace(at)
+                    for x, F in zip(q, system.forces, strict=True)]
+            return ML + bvec + dLdq
+
+        fn, _ = compile_exprs(args, either(parts), used)
         return fn
 
     monitor_fn = momenta_fn = None
