@@ -195,3 +195,41 @@ def test_a_system_without_equilibria_checks_its_parts(tmp_path):
     assert len(rows) == 2 and all(" pass " in ln for ln in rows), result.output
     store = tmp_path / "results" / "mechbook.h5"
     assert stored(store) == ["lim-2099"]
+
+
+GC_STATE = """\
+import sys
+sys.path.insert(0, {tests!r})
+from pathlib import Path
+from mechbook.app.batch import Batch, BatchOptions
+import json
+import test_batch
+print(json.dumps(Batch(Path("."), BatchOptions(jobs=2, timeout=600, memory_mb=0),
+                       task=test_batch.gc_state).run(["a", "b"])))
+"""
+
+
+def gc_state(item, base, options, stage):
+    """A task that reports its worker's garbage collector: frozen objects, thresholds."""
+    import gc
+
+    return (gc.get_freeze_count(), gc.get_threshold())
+
+
+def test_workers_start_with_the_imported_engine_frozen_out_of_the_collector(tmp_path):
+    """batch.settle: the fork server freezes what it imported (mechbook.app.frozen), so
+    each worker starts with ~10⁵ objects the collector never walks again, and young
+    collections rarer; the process that runs the batch keeps its own collector as it was."""
+    import gc
+
+    from mechbook.app.batch import GC_THRESHOLDS
+
+    before = (gc.get_freeze_count(), gc.get_threshold())
+    out = subprocess.run([sys.executable, "-c", GC_STATE.format(tests=str(ROOT / "tests"))],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert out.returncode == 0, out.stderr
+    states = json.loads(out.stdout)
+    assert len(states) == 2
+    for frozen, thresholds in states:
+        assert frozen > 50_000 and tuple(thresholds) == GC_THRESHOLDS
+    assert (gc.get_freeze_count(), gc.get_threshold()) == before

@@ -277,9 +277,13 @@ def test_box_integrals_term_by_term_equal_sympys_multiple_integral():
 
     u, v, w, a = sp.symbols("u v w a", positive=True)
     box = ((u, 0, a), (v, 0, sp.pi), (w, 0, 2 * sp.pi))
-    for e in (u**2 * sp.sin(v) ** 3 * sp.cos(w) ** 2 + a * u * sp.sin(v),  # separable
-              u * sp.sin(v + w) ** 2 + u**3,  # a term mixing v and w
-              (u + v) ** 2 * sp.cos(w) ** 2):
-        assert sp.simplify(_box_integral(e, box, {}) - sp.integrate(sp.expand(e), *box)) == 0
+    for e, separable in ((u**2 * sp.sin(v) ** 3 * sp.cos(w) ** 2 + a * u * sp.sin(v), True),
+                         (u * sp.sin(v + w) ** 2 + u**3, False),  # a term mixing v and w
+                         ((u + v) ** 2 * sp.cos(w) ** 2, True)):
+        known: dict = {}
+        assert sp.simplify(_box_integral(e, box, known) - sp.integrate(sp.expand(e), *box)) \
+            == 0
+        if separable:  # done factor by factor: each one-variable integral kept
+            assert {key[1] for key in known} == {u, v, w}
     tri = ((u, 0, v), (v, 0, a))  # a limit depending on the other variable
     assert sp.simplify(_box_integral(u * v, tri, {}) - a**4 / 8) == 0

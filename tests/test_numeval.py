@@ -56,6 +56,16 @@ def test_the_magnitude_measures_cancellation():
     assert abs(value) <= 1e-15 * size and size > 1e12
 
 
+@pytest.mark.parametrize(("expr", "point", "size"), [
+    (x * y - z, {x: 2, y: 3, z: 5}, 2 * 3 + 5),  # sums add magnitudes, products multiply
+    (sp.sin(x), {x: 1}, abs(mpmath.sin(1)) + abs(mpmath.cos(1)) * 1),  # |f| + |f'|·|x|
+    (sp.sqrt(x), {x: 4}, 2 + 0.5 * 2 / 4 * 4),  # |v| + |exponent·v/base|·|base|
+    (sp.atan2(y, x), {x: 3, y: 4}, abs(mpmath.atan2(4, 3)) + (3 * 4 + 4 * 3) / 25),
+])
+def test_the_magnitude_of_each_kind_of_node(expr, point, size):
+    assert evaluate(expr, point, 30)[1] == pytest.approx(float(size), rel=1e-14)
+
+
 def test_errors_are_raised_when_the_walk_reaches_them():
     with pytest.raises(NotNumeric, match="no value for y"):
         evaluate(x + y, {x: 1})
@@ -65,16 +75,21 @@ def test_errors_are_raised_when_the_walk_reaches_them():
         evaluate(sp.Piecewise((x, x > 1), (0, True)), {x: 2})
     with pytest.raises(ZeroDivisionError):
         evaluate(1 / (x - 1), {x: 1})
-    # the same errors again from the kept programs, a fresh exception each time
-    first = second = None
-    for _ in range(2):
-        try:
-            evaluate(x + y, {x: 1})
-        except NotNumeric as exc:
-            first, second = second, exc
-    assert first is not None and first is not second
 
 
+@pytest.mark.parametrize("missing_first", [True, False])
+def test_of_two_faults_the_first_in_the_walk_is_raised(missing_first):
+    """A missing symbol (NotNumeric: not known to be zero) and a singularity (ValueError:
+    the zero test draws another point) in one expression: the walk meets the arguments in
+    order, as the recursive walk before the programs did."""
+    missing = sp.sin(y)
+    singular = sp.log(z)  # log(0) = zoo at z = 0
+    expr = sp.Add(missing, singular, evaluate=False) if missing_first else \
+        sp.Add(singular, missing, evaluate=False)
+    first = expr.args[0]
+    expected = NotNumeric if first.has(y) else (ValueError, ZeroDivisionError)
+    with pytest.raises(expected):
+        evaluate(expr, {x: 1, z: 0})
 def test_resolved_values_raise_the_precision_until_they_stand_clear():
     big = sp.Integer(10) ** 24
     expr = (x + big) - big - x + sp.Rational(1, 10**25)
@@ -82,10 +97,13 @@ def test_resolved_values_raise_the_precision_until_they_stand_clear():
         < mpmath.mpf(10) ** -35
 
 
-def test_the_kept_programs_are_bounded(monkeypatch):
+def test_the_kept_programs_are_bounded_and_the_recently_used_stay(monkeypatch):
     monkeypatch.setattr(numeval, "PROGRAMS", 8)
     numeval._programs.clear()
     for k in range(20):
         evaluate(x + k, {x: 1})
+        evaluate(x + 100, {x: 1})  # used all along: never the least recently used
     assert len(numeval._programs) == 8
+    assert x + 100 in numeval._programs and x + 19 in numeval._programs
+    assert x + 0 not in numeval._programs
     assert evaluate(x + 19, {x: 1})[0] == 20  # the newest are kept, still right

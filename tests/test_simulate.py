@@ -168,3 +168,40 @@ def test_interrupted_simulation_write_keeps_previous_file(tmp_path, monkeypatch)
         store.write_simulation("lim-1", "b", {"t": np.arange(4.0)}, {}, path=h5)
     assert h5.read_bytes() == before
     assert not list(tmp_path.glob("*.tmp"))
+
+
+V_WELL = """\
+id: lim-9302
+source: test
+title: a mass in a V-shaped well, V = k|x| (SymEngine leaves d|x|/dx unevaluated)
+parameters:
+  m: {value: 0.5}
+  k: {value: 2.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*abs(x)
+"""
+
+
+def test_a_model_where_symengine_leaves_a_derivative_is_built_by_sympy(tmp_path):
+    """build_model's equations and canonical parts are built by SymEngine where it can and
+    by SymPy where it leaves a derivative unevaluated (d|x|/dx = sign(x)): the V-shaped well
+    compiles, its force is −k·sign(x) both ways, and a symplectic method runs on it."""
+    d = tmp_path / "problems" / "lim"
+    d.mkdir(parents=True)
+    (d / "9302.yaml").write_text(V_WELL)
+    p = load_problem(d / "9302.yaml")
+    an = Analysis(p)
+    sys = system_of(p)
+    model = build_model(sys, an.dynamics(), p.values())
+    for x0 in (0.3, -0.7):
+        assert model.accelerations(0.0, np.array([x0]), np.array([0.1]))[0] == \
+            pytest.approx(-2.0 * np.sign(x0) / 0.5, rel=1e-12)
+        ML, b, dLdq = model.canonical_parts(0.0, np.array([x0]), np.array([0.1]))
+        assert float(np.ravel(ML)[0]) == pytest.approx(0.5) and \
+            float(np.ravel(dLdq)[0]) == pytest.approx(-2.0 * np.sign(x0))
+    sim = simulate(an, init={"x": "0.5", "xdot": "0"}, t_span=(0, 2), method="leapfrog",
+                   step=1e-3)
+    assert sim.trajectory.success and sim.trajectory.q.shape[1] > 100
+    assert np.max(np.abs(sim.trajectory.q[0])) <= 0.5 + 1e-3  # energy kept: never far out

@@ -125,19 +125,32 @@ GC_THRESHOLDS = (10_000, 20, 100)  # young collections ~14 times rarer than Pyth
 
 def _context():
     ctx = mp.get_context("forkserver")
-    ctx.set_forkserver_preload(list(PRELOAD))
+    # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap
+    ctx.set_forkserver_preload([*PRELOAD, "mechbook.app.frozen"])
     return ctx
 
 
-def settle() -> None:
-    """Keep the garbage collector off what was imported: the objects alive now (the
-    engine's modules: SymPy, SciPy, NumPy, mechbook) are frozen out of its reach, and young
+def settle(preload: bool = False) -> None:
+    """Keep the garbage collector off what was imported, once per process: the objects
+    alive now (the engine's modules: SymPy, SciPy, NumPy, mechbook; with `preload`, PRELOAD
+    imported first) are frozen out of its reach after a last collection, and young
     collections come rarer. Why: every full collection walks all live container objects,
     and the imported modules' were most of them: a serial check of the 158 problems spent
-    55.3 s of CPU, 49.1 s with this (bench/check_time.py measures it in the check it times).
-    Only for the batch's own processes: the Python API leaves the caller's collector be."""
-    gc.freeze()
+    55.3 s of CPU, 49.1 s with this. For processes of mechbook's own only (the batch's
+    workers, `mechbook check --serial`): the Python API leaves the caller's collector be."""
+    if _settled:
+        return
+    if preload:
+        for name in PRELOAD:
+            importlib.import_module(name)
+    if not gc.get_freeze_count():  # a worker forked from the settled fork server: done
+        gc.collect()  # garbage now would be frozen with the rest, never to be collected
+        gc.freeze()
     gc.set_threshold(*GC_THRESHOLDS)
+    _settled.append(True)
+
+
+_settled: list = []
 
 
 def _rss_mb(os_pid: int) -> float:
@@ -208,9 +221,6 @@ class Batch:
 
     def _serial(self, ids: list[Hashable]) -> list[Any]:
         """In this process, one after another: no limits, but a debugger can follow."""
-        for name in PRELOAD:
-            importlib.import_module(name)
-        settle()
         out = []
         for pid in ids:
             self.on_start(pid)

@@ -3,10 +3,11 @@
 Checking that an expression vanishes needs its value at a point *and* a scale to judge that
 value against: the sum of the magnitudes of everything that was added on the way (a rounding
 error analysis's condition number). Expanding the expression to read off its terms costs far
-more than the check itself on large equations of motion, so this module walks the expression
-once, bottom-up, sharing repeated subexpressions, in mpmath arithmetic, and carries both the
-value and that magnitude. Nothing here parses text: the input is an expression already built
-by the safe parser or the engine.
+more than the check itself on large equations of motion, so this module compiles an
+expression once into a kept program (its nodes bottom-up, repeated subexpressions once) and
+runs it at each point in mpmath arithmetic, carrying both the value and that magnitude.
+Nothing here parses text: the input is an expression already built by the safe parser or
+the engine.
 """
 
 from __future__ import annotations
@@ -126,7 +127,7 @@ class Program:
     def __init__(self, expr: sp.Basic):
         self.code: list[tuple] = []
         self._consts: list[sp.Basic] = []
-        self._const_dps: int | None = None
+        self._const_prec: int | None = None
         self._const_values: list = []
         self._index: dict = {}
         self._emit(expr)
@@ -167,11 +168,14 @@ class Program:
         return len(code) - 1
 
     def _constants(self) -> list:
-        dps = mpmath.mp.dps
-        if self._const_dps != dps:
+        """The constants as mpmath numbers at the working precision (converted again when
+        it changes: by binary precision, which two workprec calls of one dps can differ in)."""
+        prec = mpmath.mp.prec
+        if self._const_prec != prec:
             self._const_values = [mpmath.mpmathify(complex(c)) if c is sp.I else
-                                  mpmath.mpf(sp.Float(c, dps)._mpf_) for c in self._consts]
-            self._const_dps = dps
+                                  mpmath.mpf(sp.Float(c, precision=prec)._mpf_)
+                                  for c in self._consts]
+            self._const_prec = prec
         return self._const_values
 
     def run(self, pt: dict) -> tuple:

@@ -2,15 +2,18 @@
 
 SymPy's `diff` and `expand` dominate the derivation of a system's equations (seconds for a
 rigid body's Lagrangian); SymEngine does the same calculus in C++ in milliseconds. The
-results come back as SymPy expressions with the original symbols (SymEngine keeps no
-assumptions: its `x` would come back as another symbol than a real `x`). Where SymEngine
-does not know a function, SymPy does the work, so the answer never depends on which did.
+functions here give their results back as SymPy expressions with the original symbols
+(SymEngine keeps no assumptions: its `x` would come back as another symbol than a real
+`x`); `either` runs a computation written for both algebras in SymEngine and leaves its
+result SymEngine's (for the compile layer, which takes it as it is, or for the caller to
+convert once). Where SymEngine does not know a function, SymPy does the work, so the
+answer never depends on which did.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import symengine as se
 import sympy as sp
@@ -91,7 +94,7 @@ def total_derivative(expr: sp.Basic, t: sp.Symbol,
         raise Unsupported(str(exc)) from None
 
 
-def same(e):
+def same(e: Any) -> Any:
     """The identity: SymPy's algebra for a computation written for either (`either`)."""
     return e
 
@@ -99,14 +102,27 @@ def same(e):
 def either(build: Callable[[Callable], T]) -> T:
     """build(se.sympify): a computation written once for either algebra (SymEngine's and
     SymPy's objects both have diff, xreplace, +, * and free_symbols) done in SymEngine;
-    where SymEngine cannot (an unknown function, a derivative it leaves unevaluated: then
-    `build` raises), done again in SymPy, build(same). A MechbookError (the problem's
-    own fault, or a capability the engine lacks) is not a reason to try again."""
+    where SymEngine cannot (an unknown function, a conversion that fails, or a derivative
+    it leaves unevaluated in what `build` returns: d|x|/dx, d floor(x)/dx), done again in
+    SymPy, build(same). A MechbookError (the problem's own fault, or a capability the
+    engine lacks), running out of memory or of recursion depth are not reasons to try
+    again."""
     from mechbook.errors import MechbookError
 
     try:
-        return build(se.sympify)
-    except MechbookError:
+        out = build(se.sympify)
+    except (MechbookError, MemoryError, RecursionError):
         raise
     except Exception:  # noqa: BLE001 - SymEngine's conversion or calculus failed
         return build(same)
+    if _unevaluated(out):
+        return build(same)
+    return out
+
+
+def _unevaluated(out: Any) -> bool:
+    """Does a result (SymEngine objects, or lists and tuples of them) hold a derivative or
+    substitution SymEngine left unevaluated?"""
+    if isinstance(out, (list, tuple)):
+        return any(_unevaluated(x) for x in out)
+    return isinstance(out, se.Basic) and bool(out.atoms(se.Derivative, se.Subs))

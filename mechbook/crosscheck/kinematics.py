@@ -77,7 +77,8 @@ def _box_integral(e: sp.Expr, ranges: tuple, known: dict) -> sp.Expr:
     The same value, four to eight times sooner for the shapes here (`integrate` works
     through the expanded entries one term at a time, and again for every entry)."""
     names = {v for v, _, _ in ranges}
-    if any((sp.S(lo).free_symbols | sp.S(hi).free_symbols) & names for _, lo, hi in ranges):
+    if any(set().union(*(getattr(x, "free_symbols", set()) for x in (lo, hi))) & names
+           for _, lo, hi in ranges):
         return sp.integrate(sp.expand(e), *ranges)
     total = sp.S.Zero
     for term in sp.Add.make_args(sp.expand(e)):

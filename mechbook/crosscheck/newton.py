@@ -20,12 +20,10 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-import symengine as se
 import sympy as sp
 
 from mechbook.core.backends import FEW_CALLS_BACKEND
 from mechbook.core.compile import compile_exprs
-from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.core.secalc import either, same
 from mechbook.crosscheck.assembly import composite_inertia
 from mechbook.crosscheck.guard import guarded
@@ -55,7 +53,7 @@ def newton_crosscheck(analysis: Analysis, system_name: str | None = None,
 def _newton_residual(sys, symengine: bool = True) -> list:
     """Σ J·(m r̈ − F) + rigid-body Euler terms + the Lagrange expressions of everything the
     file gives other than particles and bodies − Q: SymEngine expressions where SymEngine
-    can do the calculus (or `symengine` is False), SymPy's otherwise."""
+    can do the calculus, SymPy's where it cannot or `symengine` is False."""
     spec = sys.spec
     if "approximation" in spec or "average" in spec:
         raise UnsupportedError("Newton cross-check: the Lagrangian is an approximation "
@@ -98,7 +96,7 @@ class _Terms:
 def _assemble(sys, terms: _Terms, conv) -> list:
     """Σ (∂r/∂q_i)·(m r̈ − F) + Σ (∂ω/∂q̇_i)·(I ω̇ + ω × Iω) − pulls + the Lagrange
     expressions of `rest` − Q, in the algebra `conv` converts to: SymEngine's (`se.sympify`;
-    raises SymEngineCannot where a derivative stays unevaluated) or SymPy's (the identity).
+    `either` refuses its result where a derivative stays unevaluated) or SymPy's (the identity).
     The same few lines for both: `diff`, +, * and free_symbols are all either needs."""
     n = len(sys.q)
     q, qd = [conv(x) for x in sys.q], [conv(x) for x in sys.qd]
@@ -141,9 +139,7 @@ def _assemble(sys, terms: _Terms, conv) -> list:
     rest = conv(terms.rest)
     res = [res[i] + dt(rest.diff(qd[i])) - rest.diff(q[i]) - conv(terms.given[i])
            for i in range(n)]
-    if conv is se.sympify and any(e.atoms(se.Derivative, se.Subs) for e in res):
-        raise SymEngineCannot("a derivative SymEngine leaves unevaluated")
-    return res
+    return res  # `either` refuses SymEngine's where it left a derivative unevaluated
 
 
 def _times(matrix: list, v: list) -> list:

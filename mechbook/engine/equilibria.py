@@ -208,7 +208,7 @@ class Equilibria:
         at.update({q: at.get(q, sp.S.Zero) for q in dyn.q})
         rest = {v: sp.S.Zero for v in dyn.qd}
         held = self.sys.held  # Routh's held momenta: symbols until now
-        names = set(dyn.L.free_symbols).union(*(sp.S(v).free_symbols for v in
+        names = set(dyn.L.free_symbols).union(*(getattr(v, "free_symbols", set()) for v in
                                                  (*at.values(), *held.values())))
 
         def build(conv):  # in SymEngine, its entries brought back to SymPy once; or SymPy

@@ -71,12 +71,14 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     frequency part's linear system is confirmed by simulating the nonlinear equations along
     every mode, and each system's Lagrange equations against Newton's law
     (docs/numerics.md); a cross-check fail also exits 1."""
-    from mechbook.app.batch import BatchOptions
+    from mechbook.app.batch import BatchOptions, settle
     from mechbook.app.run import RunOptions
     from mechbook.app.service import CheckOptions, CheckService
     from mechbook.records import ProofPolicy
 
     _refuse_serial_limits(ctx, serial)
+    if serial:  # this process checks: the engine imported, the collector kept off it
+        settle(preload=True)
     base = resolve_root(ctx)
     batch = BatchOptions(jobs, timeout, memory_mb, serial=serial, run=RunOptions(
         crosscheck=not no_crosscheck, policy=ProofPolicy(prove, prove_seconds)))
