@@ -55,6 +55,11 @@ import json, time
 from pathlib import Path
 tree = Path(sys.argv[1]); sys.path.insert(0, str(tree))
 from mechbook.app.run import RunOptions, run_problem
+try:  # as the tree's own check processes run (a tree that has it: its collector settled)
+    from mechbook.app.batch import settle
+    settle(preload=True)
+except ImportError:
+    pass
 for pid in sys.argv[2:]:
     stages, cur = {}, ["loading", time.process_time()]
     def stage(text):
