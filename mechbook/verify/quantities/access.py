@@ -22,6 +22,7 @@ from __future__ import annotations
 import mpmath
 import sympy as sp
 
+from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.access import Access
 from mechbook.verify import boundary
 from mechbook.verify.compare import Sampler, Verdict, equal
@@ -110,10 +111,13 @@ def check_accessible(ctx: Context, val) -> Verdict:
         with mpmath.workdps(dps):
             cfg = {}
             for q, e in config.items():
-                v = sp.N(e.subs(pt), dps)
-                re, im = v.as_real_imag()
-                if not re.is_number or abs(im) > 1e-25 * max(1, abs(re)):
+                try:  # numeval: SymPy's subs and N at every sample cost far more
+                    v = mpmath.mpmathify(evaluate_mp(e, pt, dps))
+                except (NotNumeric, ValueError, ZeroDivisionError, TypeError, OverflowError):
                     return None  # the configuration does not exist here
+                re, im = mpmath.re(v), mpmath.im(v)
+                if not mpmath.isfinite(re) or abs(im) > 1e-25 * max(1, abs(re)):
+                    return None
                 cfg[q] = sp.Float(re, dps)
             if access.on_constraints(cfg, pt, dps) > 1e-20:
                 raise ctx.part.error(("at",), "the configuration is not on the constraints")
