@@ -39,7 +39,7 @@ system is the one at ε = 0, or at `unperturbed:` values (a splitting that scale
 
 from __future__ import annotations
 
-from functools import partial
+from functools import lru_cache, partial
 
 import mpmath
 import sympy as sp
@@ -93,6 +93,16 @@ def _names(ctx: Context) -> tuple[dict, list[sp.Symbol]]:
     return names, idx
 
 
+@lru_cache(maxsize=32)
+def _potential_derivatives(V: sp.Expr, q: tuple) -> tuple[list, list, list]:
+    """∂V/∂q_k, ∂²V/∂q_k∂q_m and the third derivatives, symbolic: once per potential, not
+    at every sample point (each point substitutes its numbers into them)."""
+    d1 = [sp.diff(V, x) for x in q]
+    d2 = [[sp.diff(d, x) for x in q] for d in d1]
+    d3 = [[[sp.diff(e, x) for x in q] for e in row] for row in d2]
+    return d1, d2, d3
+
+
 class _Tables:
     """The numbers behind W0(j), Wp(j, r), ... at one parameter point."""
 
@@ -121,16 +131,17 @@ class _Tables:
             point = self.ctx.point()
             at = {x: sp.S(point.get(x, 0)).subs(self.pt) for x in q}
             V = sys.potential
-            Vp = V.subs(self.pt) - V.subs(self.unperturbed)
-            V0 = V.subs(self.unperturbed)
+            d1, d2, d3 = _potential_derivatives(V, tuple(q))  # symbolic, once per potential
+            pt, un = self.pt, self.unperturbed  # numbers: xreplace is subs here
             n = range(len(q))
             self._v = {
-                "dV": {(k,): sp.diff(Vp, q[k]) for k in n},
-                "d2V": {(k, m): sp.diff(Vp, q[k], q[m]) for k in n for m in n},
-                "K0": {(k, m): sp.diff(V0, q[k], q[m]) for k in n for m in n},
-                "d3V0": {(k, m, i): sp.diff(V0, q[k], q[m], q[i]) for k in n for m in n
+                "dV": {(k,): d1[k].xreplace(pt) - d1[k].xreplace(un) for k in n},
+                "d2V": {(k, m): d2[k][m].xreplace(pt) - d2[k][m].xreplace(un) for k in n
+                        for m in n},
+                "K0": {(k, m): d2[k][m].xreplace(un) for k in n for m in n},
+                "d3V0": {(k, m, i): d3[k][m][i].xreplace(un) for k in n for m in n
                          for i in n},
-                "at": at, "V": V.subs(self.pt), "q": q}
+                "at": at, "V": V, "hessian": d2, "q": q}
         return self._v
 
     def number(self, name: str, args: tuple[int, ...]):
@@ -340,7 +351,7 @@ def _error(ctx, kind, book, T: _Tables, names, f, mode):
         return worst
     if kind in ("equilibrium", "stiffness"):
         v = T.potential_derivatives()
-        x0 = pert.perturbed_equilibrium(v["V"], v["q"], T.pt, v["at"])
+        x0 = pert.perturbed_equilibrium(v["V"], v["q"], T.pt, v["at"])  # V at T.pt there
         comps = _indices(ctx, ctx.part.data.get("component"), names,
                          1 if kind == "equilibrium" else 2)
         worst = mpmath.mpf(0)
@@ -353,7 +364,7 @@ def _error(ctx, kind, book, T: _Tables, names, f, mode):
             else:
                 at = {q: sp.Float(mpmath.nstr(x, pert.DPS), pert.DPS)
                       for q, x in zip(v["q"], x0, strict=True)}
-                hess = sp.diff(v["V"], v["q"][ks[0]], v["q"][ks[1]])
+                hess = v["hessian"][ks[0]][ks[1]].xreplace(T.pt)
                 exact = (_mp(hess.subs(at))
                          - T.number("K0", tuple(k + 1 for k in ks)))
                 scale = max(1, max(abs(T.number("K0", (i + 1, i + 1))) for i in range(f)))
