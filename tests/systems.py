@@ -35,3 +35,38 @@ def load_analysis(tmp_path: Path, text: str, num: str) -> Analysis:
     d.mkdir(parents=True, exist_ok=True)
     (d / f"{num}.yaml").write_text(text)
     return Analysis(load_problem(d / f"{num}.yaml"))
+
+
+# a double pendulum, and a bead on a hoop turning at a given rate (explicitly time-dependent);
+# their `id:` lines are rewritten by load_analysis
+DOUBLE = """\
+id: lim-9302
+source: test
+title: double pendulum
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  g: {value: 1.0}
+coordinates:
+  a: {}
+  b: {}
+particles:
+  p1: {mass: m, position: [l*sin(a), -l*cos(a)]}
+  p2: {mass: m, position: [l*sin(a) + l*sin(b), -l*cos(a) - l*cos(b)]}
+gravity: {}
+"""
+DRIVEN = """\
+id: lim-9303
+source: test
+title: bead on a rotating hoop (explicitly time-dependent)
+parameters:
+  m: {value: 0.1}
+  omega: {value: 6.0}
+  b: {value: 0.5}
+  g: {}
+coordinates:
+  theta: {}
+particles:
+  bead: {mass: m, position: [b*sin(theta)*cos(omega*t), b*sin(theta)*sin(omega*t), b*cos(theta)]}
+gravity: {}
+"""

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from systems import load_analysis, pendulum
+from systems import DOUBLE, DRIVEN, load_analysis, pendulum
 
 from mechbook.numerics import compiled, events, native
 from mechbook.numerics.events import solve_with_events
@@ -30,37 +30,6 @@ potential: k*x**2/2
 """
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9312\nsource: test\ntitle: simple pendulum\n")
-DOUBLE = """\
-id: lim-9313
-source: test
-title: double pendulum
-parameters:
-  m: {value: 1.0}
-  l: {value: 1.0}
-  g: {value: 1.0}
-coordinates:
-  a: {}
-  b: {}
-particles:
-  p1: {mass: m, position: [l*sin(a), -l*cos(a)]}
-  p2: {mass: m, position: [l*sin(a) + l*sin(b), -l*cos(a) - l*cos(b)]}
-gravity: {}
-"""
-DRIVEN = """\
-id: lim-9314
-source: test
-title: bead on a rotating hoop (explicitly time-dependent)
-parameters:
-  m: {value: 0.1}
-  omega: {value: 6.0}
-  b: {value: 0.5}
-  g: {}
-coordinates:
-  theta: {}
-particles:
-  bead: {mass: m, position: [b*sin(theta)*cos(omega*t), b*sin(theta)*sin(omega*t), b*cos(theta)]}
-gravity: {}
-"""
 RUNAWAY = """\
 id: lim-9315
 source: test
