@@ -37,8 +37,8 @@ def load_analysis(tmp_path: Path, text: str, num: str) -> Analysis:
     return Analysis(load_problem(d / f"{num}.yaml"))
 
 
-# a double pendulum, and a bead on a hoop turning at a given rate (explicitly time-dependent);
-# their `id:` lines are rewritten by load_analysis
+# a harmonic oscillator, a double pendulum, and a bead on a hoop turning at a given rate
+# (explicitly time-dependent); their `id:` lines are rewritten by load_analysis
 DOUBLE = """\
 id: lim-9302
 source: test
@@ -69,4 +69,16 @@ coordinates:
 particles:
   bead: {mass: m, position: [b*sin(theta)*cos(omega*t), b*sin(theta)*sin(omega*t), b*cos(theta)]}
 gravity: {}
+"""
+OSCILLATOR = """\
+id: lim-9103
+source: test
+title: oscillator
+parameters:
+  m: {value: 1.5}
+  k: {value: 6.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*x**2/2
 """

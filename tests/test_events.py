@@ -10,24 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from systems import DOUBLE, DRIVEN, load_analysis, pendulum
+from systems import DOUBLE, DRIVEN, OSCILLATOR, load_analysis, pendulum
 
 from mechbook.numerics import compiled, events, native
 from mechbook.numerics.events import solve_with_events
 from mechbook.numerics.model import build_model
 
-OSCILLATOR = """\
-id: lim-9311
-source: test
-title: oscillator
-parameters:
-  m: {value: 1.5}
-  k: {value: 6.0}
-coordinates:
-  x: {}
-kinetic: m*xdot**2/2
-potential: k*x**2/2
-"""
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9312\nsource: test\ntitle: simple pendulum\n")
 RUNAWAY = """\

@@ -7,11 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from systems import pendulum
+from systems import DOUBLE, OSCILLATOR, load_analysis, pendulum
 
-from mechbook.engine.analysis import Analysis
-from mechbook.model.problem import load_problem
-from mechbook.model.system import system_of
 from mechbook.numerics.integrators import IntegratorError, integrate
 from mechbook.numerics.model import build_model, structure
 from mechbook.numerics.monitors import conserved_quantities, drifts
@@ -19,45 +16,13 @@ from mechbook.numerics.monitors import conserved_quantities, drifts
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9101\nsource: test\ntitle: simple pendulum\n")
 
-DOUBLE = """\
-id: lim-9102
-source: test
-title: double pendulum (non-separable)
-parameters:
-  m: {value: 1.0}
-  l: {value: 1.0}
-  g: {value: 1.0}
-coordinates:
-  a: {}
-  b: {}
-particles:
-  p1: {mass: m, position: [l*sin(a), -l*cos(a)]}
-  p2: {mass: m, position: [l*sin(a) + l*sin(b), -l*cos(a) - l*cos(b)]}
-gravity: {}
-"""
 
-OSCILLATOR = """\
-id: lim-9103
-source: test
-title: harmonic oscillator
-parameters:
-  m: {value: 1.5}
-  k: {value: 6.0}
-coordinates:
-  x: {}
-kinetic: m*xdot**2/2
-potential: k*x**2/2
-"""
 
 
 def model_of(tmp_path: Path, text: str, num: str):
-    d = tmp_path / "problems" / "lim"
-    d.mkdir(parents=True, exist_ok=True)
-    (d / f"{num}.yaml").write_text(text)
-    problem = load_problem(d / f"{num}.yaml")
-    an = Analysis(problem)
-    sys, dyn = system_of(problem), an.dynamics()
-    return build_model(sys, dyn, problem.values(), conserved_quantities(sys, dyn))
+    an = load_analysis(tmp_path, text, num)
+    sys, dyn = an.system(), an.dynamics()
+    return build_model(sys, dyn, an.problem.values(), conserved_quantities(sys, dyn))
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from systems import DOUBLE, DRIVEN, load_analysis, pendulum
+from systems import DOUBLE, DRIVEN, OSCILLATOR, load_analysis, pendulum
 
 from mechbook.numerics import native
 from mechbook.numerics.integrators import integrate
@@ -32,18 +32,6 @@ particles:
 gravity: {}
 constraints:
   - {name: rod, expr: x**2 + y**2 - l**2}
-"""
-OSCILLATOR = """\
-id: lim-9305
-source: test
-title: oscillator
-parameters:
-  m: {value: 1.5}
-  k: {value: 6.0}
-coordinates:
-  x: {}
-kinetic: m*xdot**2/2
-potential: k*x**2/2
 """
 
 pytestmark = pytest.mark.skipif(native.library() is None,
