@@ -270,10 +270,11 @@ def test_a_double_exponent_with_one_mode_is_not_measured():
 
 
 def test_box_integrals_term_by_term_equal_sympys_multiple_integral():
-    """kinematics._box_integral: products of one-variable factors integrated factor by
-    factor; a term mixing the variables, or limits depending on another variable, go to
-    SymPy's multiple integral. The same values either way."""
-    from mechbook.crosscheck.kinematics import _box_integral
+    """core.integrals.box_integral (the inertia shapes', a string's mass integrals):
+    products of one-variable factors integrated factor by factor; a term mixing the
+    variables, or limits depending on another variable, go to SymPy's multiple integral.
+    The same values either way."""
+    from mechbook.core.integrals import box_integral as _box_integral
 
     u, v, w, a = sp.symbols("u v w a", positive=True)
     box = ((u, 0, a), (v, 0, sp.pi), (w, 0, 2 * sp.pi))

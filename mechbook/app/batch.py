@@ -131,15 +131,15 @@ def _context():
 
 
 def settle(preload: bool = False) -> None:
-    """Keep the garbage collector off what was imported, once per process: the objects
-    alive now (the engine's modules: SymPy, SciPy, NumPy, mechbook; with `preload`, PRELOAD
-    imported first) are frozen out of its reach after a last collection, and young
-    collections come rarer. Why: every full collection walks all live container objects,
-    and the imported modules' were most of them: a serial check of the 158 problems spent
-    55.3 s of CPU, 49.1 s with this. For processes of mechbook's own only (the batch's
-    workers, `mechbook check --serial`): the Python API leaves the caller's collector be."""
-    if _settled:
-        return
+    """Keep the garbage collector off what was imported: the objects alive now (the
+    engine's modules: SymPy, SciPy, NumPy, mechbook; with `preload`, PRELOAD imported
+    first) are frozen out of its reach after a last collection, once per process (a
+    process that already froze, or was forked from the settled fork server, only sets the
+    thresholds), and young collections come rarer. Why: every full collection walks all
+    live container objects, and the imported modules' were most of them: a serial check
+    of the 158 problems spent 55.3 s of CPU, 49.1 s with this. For processes of
+    mechbook's own only (the batch's workers, `mechbook check --serial`): the Python API
+    leaves the caller's collector be."""
     if preload:
         for name in PRELOAD:
             importlib.import_module(name)
@@ -147,10 +147,6 @@ def settle(preload: bool = False) -> None:
         gc.collect()  # garbage now would be frozen with the rest, never to be collected
         gc.freeze()
     gc.set_threshold(*GC_THRESHOLDS)
-    _settled.append(True)
-
-
-_settled: list = []
 
 
 def _rss_mb(os_pid: int) -> float:

@@ -94,6 +94,14 @@ def total_derivative(expr: sp.Basic, t: sp.Symbol,
         raise Unsupported(str(exc)) from None
 
 
+def expand(expr: sp.Basic) -> sp.Basic:
+    """`sympy.expand(expr)`, the expansion done by SymEngine (SymPy's where it cannot)."""
+    try:
+        return to_sympy(se.expand(se.sympify(expr)), expr.free_symbols)
+    except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's expand
+        return sp.expand(expr)
+
+
 def same(e: Any) -> Any:
     """The identity: SymPy's algebra for a computation written for either (`either`)."""
     return e

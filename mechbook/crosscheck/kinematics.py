@@ -18,6 +18,8 @@ from functools import cache
 
 import sympy as sp
 
+from mechbook.core.integrals import box_integral
+
 # generic dimensions, substituted by the body's own after integration
 _M, _R, _L = sp.symbols("M_ R_ L_", positive=True)
 _A, _B, _C = sp.symbols("A_ B_ C_", positive=True)
@@ -67,32 +69,8 @@ def _tensor(r: sp.Matrix) -> sp.Matrix:
 
 def _integrate(density: sp.Expr, r: sp.Matrix, *ranges) -> sp.Matrix:
     known: dict = {}  # the entries share most of their one-variable integrals
-    return (density * _tensor(r)).applyfunc(lambda e: _box_integral(e, ranges, known))
+    return (density * _tensor(r)).applyfunc(lambda e: box_integral(e, ranges, known))
 
-
-def _box_integral(e: sp.Expr, ranges: tuple, known: dict) -> sp.Expr:
-    """∫ e over `ranges` [(variable, low, high), ...]: where the limits are constants and
-    each term of e is a product of one-variable factors, term by term as products of
-    one-variable integrals, each done once (`known`); SymPy's multiple integral otherwise.
-    The same value, four to eight times sooner for the shapes here (`integrate` works
-    through the expanded entries one term at a time, and again for every entry)."""
-    names = {v for v, _, _ in ranges}
-    if any(set().union(*(getattr(x, "free_symbols", set()) for x in (lo, hi))) & names
-           for _, lo, hi in ranges):
-        return sp.integrate(sp.expand(e), *ranges)
-    total = sp.S.Zero
-    for term in sp.Add.make_args(sp.expand(e)):
-        value, rest = sp.S.One, term
-        for var, lo, hi in ranges:
-            rest, part = rest.as_independent(var, as_Add=False)
-            if part.free_symbols & (names - {var}):  # not a product of one-variable factors
-                return sp.integrate(sp.expand(e), *ranges)
-            key = (part, var, lo, hi)
-            if key not in known:
-                known[key] = sp.integrate(part, (var, lo, hi))
-            value *= known[key]
-        total += rest * value
-    return total
 
 
 def _moments(density: sp.Expr, r: sp.Matrix, *ranges) -> tuple[sp.Expr, sp.Matrix, sp.Matrix]:

@@ -35,6 +35,7 @@ from mechbook.crosscheck.kinematics import (
 )
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.model.system import motion_chains
 from mechbook.records import CrossCheck, Status
 
 NEWTON_TOL = 1e-9
@@ -101,11 +102,9 @@ def _assemble(sys, terms: _Terms, conv) -> list:
     n = len(sys.q)
     q, qd = [conv(x) for x in sys.q], [conv(x) for x in sys.qd]
     t = conv(sys.t)
-    chains = [(conv(a), conv(b)) for x, v, a_ in zip(sys.q, sys.qd, sys.qdd, strict=True)
-              for a, b in ((x, v), (v, a_))]
-    chains += [(conv(a), conv(b)) for y, yd, ydd in sys.free_driven
-               for a, b in ((y, yd), (yd, ydd))]
-    third = {conv(ydd) for _, _, ydd in sys.free_driven}
+    pairs, stop = motion_chains(sys)
+    chains = [(conv(a), conv(b)) for a, b in pairs]
+    third = {conv(ydd) for ydd in stop}
 
     def dt(e):
         if third & e.free_symbols:

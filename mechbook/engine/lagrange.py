@@ -19,6 +19,7 @@ from mechbook.core.secalc import euler_lagrange
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.protocol import SystemLike
+from mechbook.model.system import motion_chains
 
 
 class SingularMassError(MechbookError):
@@ -47,14 +48,7 @@ def lagrange_expressions(system: SystemLike, L: sp.Expr,
     `forces` is None), d/dt along the system's motion (its free driven coordinates too);
     by SymEngine (core.secalc, ten times sooner) where it can, else by SymPy."""
     forces = list(forces) if forces is not None else [sp.S.Zero] * len(system.q)
-    chains = list(zip(system.q, system.qd, strict=True)) + list(zip(system.qd, system.qdd,
-                                                                    strict=True))
-    stop = []
-    if not system.reduced:  # a System: its free driven coordinates too (a system reduced
-        # by Routh differentiates its own coordinates only)
-        for y, yd, ydd in system.free_driven:
-            chains += [(y, yd), (yd, ydd)]
-            stop.append(ydd)
+    chains, stop = motion_chains(system)
     try:
         return euler_lagrange(L, system.q, system.qd, chains, system.t, forces, stop)
     except SymEngineCannot:

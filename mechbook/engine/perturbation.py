@@ -163,7 +163,7 @@ def perturbed_equilibrium(V: sp.Expr, q: list, values: dict, start: dict) -> lis
     digits (SymPy evaluates the gradient: the systems are small)."""
     x = [sp.Float(sp.N(sp.S(start.get(v, 0)).subs(values), DPS), DPS) for v in q]
     try:
-        return _newton_mp(*_derivatives(V, tuple(q)), q, x, values)
+        return _newton_mp(*potential_derivatives(V, tuple(q)), q, x, values)
     except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
         pass  # a function numeval does not know: SymPy evaluates
     grad = [sp.diff(V, x).subs(values) for x in q]
@@ -182,11 +182,20 @@ def perturbed_equilibrium(V: sp.Expr, q: list, values: dict, start: dict) -> lis
 
 
 @lru_cache(maxsize=32)
-def _derivatives(V: sp.Expr, q: tuple) -> tuple[list, sp.Matrix]:
+def potential_derivatives(V: sp.Expr, q: tuple) -> tuple[list, sp.Matrix]:
     """∇V and its Hessian, symbolic (once per potential: a walk along a parameter evaluates
     them at many parameter values)."""
     grad = [sp.diff(V, x) for x in q]
     return grad, sp.Matrix(grad).jacobian(list(q))
+
+
+@lru_cache(maxsize=32)
+def third_derivatives(V: sp.Expr, q: tuple) -> list:
+    """∂³V/∂q_k∂q_m∂q_i as nested lists [k][m][i], from the kept Hessian (once per
+    potential, as `potential_derivatives`)."""
+    hess = potential_derivatives(V, q)[1]
+    n = len(q)
+    return [[[sp.diff(hess[k, m], x) for x in q] for m in range(n)] for k in range(n)]
 
 
 def _newton_mp(grad: list, hess: sp.Matrix, q: list, x: list, values: dict) -> list:

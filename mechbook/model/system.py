@@ -13,6 +13,7 @@ from __future__ import annotations
 import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
+from mechbook.core.integrals import box_integral
 from mechbook.core.numeval import is_zero, without_absent
 from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.core.secalc import total_derivative
@@ -25,6 +26,21 @@ from mechbook.model.loads import attractor_potential, average_over, torque_force
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
 from mechbook.model.protocol import SystemLike
 
+
+def motion_chains(system) -> tuple[list[tuple[sp.Symbol, sp.Symbol]], list[sp.Symbol]]:
+    """d/dt along the motion of `system` (a System, or one reduced by Routh): the pairs
+    (x, ẋ) with d/dt = ∂/∂t + Σ ẋ ∂/∂x — each coordinate and its rate, each rate and its
+    acceleration, and a System's free driven coordinates likewise — and the symbols that
+    have no time derivative (a free driven coordinate's second derivative). A system
+    reduced by Routh differentiates its own coordinates only."""
+    chains = [pair for q, qd, qdd in zip(system.q, system.qd, system.qdd, strict=True)
+              for pair in ((q, qd), (qd, qdd))]
+    stop = []
+    if not system.reduced:
+        for y, yd, ydd in system.free_driven:
+            chains += [(y, yd), (yd, ydd)]
+            stop.append(ydd)
+    return chains, stop
 
 class System(SystemLike):
     """Symbols and the Lagrangian of one system of a problem (the full system: nothing
@@ -371,8 +387,8 @@ class System(SystemLike):
                     continue
                 mult = 1 if a == b else 2
                 try:
-                    mass = _integral(sp.expand(TR8(density * modes[a] * modes[b])), x,
-                                     length, known)
+                    mass = box_integral(sp.expand(TR8(density * modes[a] * modes[b])),
+                                        ((x, 0, length),), known)
                 except Exception as exc:  # noqa: BLE001 - SymPy's many failure modes
                     raise self._error(sub + ("density",), f"cannot integrate: {exc}") from None
                 if mass.has(sp.Integral) or mass.has(x):
@@ -411,12 +427,9 @@ class System(SystemLike):
         """Total time derivative along the motion: d/dt = ∂t + Σ qdot ∂q + Σ qddot ∂qdot."""
         if isinstance(expr, sp.MatrixBase):
             return expr.applyfunc(self.dt)
-        drivers = [ydd for _, _, ydd in self.free_driven]
-        if isinstance(expr, sp.Basic) and not any(expr.has(ydd) for ydd in drivers):
+        chains, stop = motion_chains(self)
+        if isinstance(expr, sp.Basic) and not any(expr.has(ydd) for ydd in stop):
             # SymEngine's calculus (core.secalc: the same derivative, ten times sooner)
-            chains = [pair for q, qd, qdd in zip(self.q, self.qd, self.qdd, strict=True)
-                      for pair in ((q, qd), (qd, qdd))]
-            chains += [pair for y, yd, ydd in self.free_driven for pair in ((y, yd), (yd, ydd))]
             try:
                 return total_derivative(expr, T, chains)
             except SymEngineCannot:
@@ -479,15 +492,3 @@ def system_of(problem: Problem, name: str | None = None) -> System:
         problem._cache[name] = System(problem, problem.systems[name])
     return problem._cache[name]
 
-
-def _integral(expr: sp.Expr, x: sp.Symbol, length: sp.Expr, known: dict) -> sp.Expr:
-    """∫₀ˡ expr dx term by term, each term's factor free of x taken out and each integral
-    of what remains done once (`known`): the mass integrals of N modes' N(N+1)/2 pairs
-    repeat the same few cos(kπx/l) terms, and SymPy's integrate is the costly part."""
-    total = sp.S.Zero
-    for term in sp.Add.make_args(expr):
-        factor, rest = term.as_independent(x, as_Add=False)
-        if rest not in known:
-            known[rest] = sp.integrate(rest, (x, 0, length))
-        total += factor * known[rest]
-    return total

@@ -39,7 +39,7 @@ system is the one at ε = 0, or at `unperturbed:` values (a splitting that scale
 
 from __future__ import annotations
 
-from functools import lru_cache, partial
+from functools import partial
 
 import mpmath
 import sympy as sp
@@ -93,16 +93,6 @@ def _names(ctx: Context) -> tuple[dict, list[sp.Symbol]]:
     return names, idx
 
 
-@lru_cache(maxsize=32)
-def _potential_derivatives(V: sp.Expr, q: tuple) -> tuple[list, list, list]:
-    """∂V/∂q_k, ∂²V/∂q_k∂q_m and the third derivatives, symbolic: once per potential, not
-    at every sample point (each point substitutes its numbers into them)."""
-    d1 = [sp.diff(V, x) for x in q]
-    d2 = [[sp.diff(d, x) for x in q] for d in d1]
-    d3 = [[[sp.diff(e, x) for x in q] for e in row] for row in d2]
-    return d1, d2, d3
-
-
 class _Tables:
     """The numbers behind W0(j), Wp(j, r), ... at one parameter point."""
 
@@ -131,7 +121,9 @@ class _Tables:
             point = self.ctx.point()
             at = {x: sp.S(point.get(x, 0)).subs(self.pt) for x in q}
             V = sys.potential
-            d1, d2, d3 = _potential_derivatives(V, tuple(q))  # symbolic, once per potential
+            d1, hess = pert.potential_derivatives(V, tuple(q))  # symbolic, once per potential
+            d3 = pert.third_derivatives(V, tuple(q))
+            d2 = hess.tolist()
             pt, un = self.pt, self.unperturbed  # numbers: xreplace is subs here
             n = range(len(q))
             self._v = {

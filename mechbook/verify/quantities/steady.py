@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import mpmath
 import numpy as np
-import symengine as se
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_resolved
-from mechbook.core.secalc import to_sympy
+from mechbook.core.secalc import expand
 from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
 from mechbook.errors import UnsupportedError
@@ -253,11 +252,7 @@ def _poly(e: sp.Expr, x: sp.Symbol) -> sp.Poly:
     terms collected by powers of x over SymPy's expression domain. Why: building the
     polynomial ring of the coefficients' many symbols, as Poly does by default, was most of
     the time (symon-12-22: 0.82 -> 0.13 s, the same coefficients)."""
-    try:
-        expanded = to_sympy(se.expand(se.sympify(e)), e.free_symbols)
-    except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's expand
-        expanded = sp.expand(e)
-    return sp.Poly(expanded, x, domain=sp.EX)
+    return sp.Poly(expand(e), x, domain=sp.EX)
 
 
 def _common_real_root(coefficients: list[list], pt: dict, precise: bool = False) -> bool:
