@@ -21,6 +21,7 @@ from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.screen import screen
 from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.model.manifold import manifold_of
 from mechbook.numerics.integrators import integrate
 from mechbook.numerics.model import build_model
 from mechbook.numerics.simulate import FALLBACK_OFFSET, initial_state
@@ -101,6 +102,13 @@ def conserved_crosscheck(analysis: Analysis, ctx: PartView, exprs: list[sp.Expr]
     rng = np.random.default_rng(20261123)
     q0, qd0 = _start(analysis, sys, params, rng)
     qd0 = qd0 + rng.uniform(-0.3, 0.3, len(qd0))  # moving, so the integral is exercised
+    manifold = manifold_of(sys)
+    if manifold is not None:  # a constrained system moves on its constraint manifold
+        settled = manifold.settle(params, q0, qd0)
+        if settled is None:
+            raise UnsupportedError("no start on the constraint manifold found near the "
+                                   "chosen state")
+        q0, qd0 = np.array(settled[0]), np.array(settled[1])
     ts = np.linspace(0.0, T_END, SAMPLES)
     traj = integrate(model, (0.0, T_END), q0, qd0, method="DOP853", t_eval=ts,
                      rtol=1e-12, atol=1e-12)

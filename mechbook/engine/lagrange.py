@@ -99,29 +99,62 @@ class Dynamics:
 
     @cached_property
     def constraint_jacobian(self) -> sp.Matrix:
+        """∂g/∂q of the holonomic constraints g(q, t) = 0 (m_h × n)."""
         cons = [f for _, f in self.sys.constraints]
         return sp.Matrix([[sp.diff(f, q) for q in self.q] for f in cons]) if cons else sp.zeros(0,
                                                                                               len(self.q))
 
+    @property
+    def constrained(self) -> bool:
+        """Whether any constraint, holonomic or on the velocities, is held by multipliers."""
+        return bool(self.sys.constraints or self.sys.velocity_constraints)
+
+    @cached_property
+    def velocity_jacobian(self) -> sp.Matrix:
+        """A of every constraint at the velocity level, A(q, t)·q̇ + b(q, t) = 0: the
+        holonomic constraints' ∂g/∂q (their ġ), then the velocity constraints' ∂c/∂q̇.
+        The multipliers (`multipliers`, in the same order) exert the generalized force Aᵀλ."""
+        rows = [sp.Matrix([[sp.diff(c, v) for v in self.qd]])
+                for _, c in self.sys.velocity_constraints]
+        return sp.Matrix.vstack(self.constraint_jacobian, *rows) if rows else \
+            self.constraint_jacobian
+
+    @cached_property
+    def velocity_rows(self) -> list[sp.Expr]:
+        """Every constraint at the velocity level, c(q, q̇, t) = A·q̇ + b (each must vanish
+        along the motion): ġ of the holonomic ones, then the velocity constraints."""
+        return ([self.sys.dt(g) for _, g in self.sys.constraints]
+                + [c for _, c in self.sys.velocity_constraints])
+
+    @cached_property
+    def constraint_bias(self) -> sp.Matrix:
+        """The rest of dc/dt once A·q̈ is taken out: A·q̈ + bias = 0 along the motion (g̈ of
+        the holonomic constraints, ċ of the velocity constraints, at q̈ = 0)."""
+        zero = {a: 0 for a in self.qdd}
+        return sp.Matrix([self.sys.dt(self.sys.dt(fc)).subs(zero) for _, fc in self.sys.constraints]
+                         + [self.sys.dt(c).subs(zero) for _, c in self.sys.velocity_constraints])
+
     @cached_property
     def multipliers(self) -> list[sp.Symbol]:
-        return [sp.Symbol(f"lambda_{name}", real=True) for name, _ in self.sys.constraints]
+        """λ of each constraint (the holonomic ones, then those on the velocities)."""
+        return [sp.Symbol(f"lambda_{name}", real=True)
+                for name, _ in list(self.sys.constraints) + list(self.sys.velocity_constraints)]
 
     @cached_property
     def solved(self) -> dict:
-        """Accelerations (and multipliers) solved as functions of q, q̇, t."""
+        """Accelerations (and multipliers) solved as functions of q, q̇, t: with constraints,
+        M·q̈ − Aᵀλ = f and A·q̈ = −bias together (valid on the constraint manifold)."""
         n = len(self.q)
         M, f = self.mass_matrix, self.forcing
-        if not self.sys.constraints:
+        if not self.constrained:
             try:
                 with time_limit(60):
                     sol = solve_accelerations(M, f, list(self.qdd))
             except Timeout:
                 raise UnsupportedError("solving the mass matrix symbolically (too large)") from None
             return {a: self._simp(s) for a, s in zip(self.qdd, sol, strict=True)}
-        A = self.constraint_jacobian
-        zero = {a: 0 for a in self.qdd}
-        b = sp.Matrix([self.sys.dt(self.sys.dt(fc)).subs(zero) for _, fc in self.sys.constraints])
+        A = self.velocity_jacobian
+        b = self.constraint_bias
         m = A.rows
         big = sp.zeros(n + m, n + m)
         big[:n, :n] = M
@@ -145,9 +178,11 @@ class Dynamics:
     def cyclic(self) -> dict[sp.Symbol, sp.Expr]:
         """Ignorable coordinates (absent from L, no force, no constraint) and their momenta."""
         cons = [f for _, f in self.sys.constraints]
+        held = [c for _, c in self.sys.velocity_constraints]  # no force along q: c free of q̇
         out = {}
-        for q, p, force in zip(self.q, self.momenta, self.sys.forces, strict=True):
+        for q, v, p, force in zip(self.q, self.qd, self.momenta, self.sys.forces, strict=True):
             if (force == 0 and all(sp.diff(c, q) == 0 for c in cons)
+                    and all(sp.diff(c, v) == 0 for c in held)
                     and is_zero(sp.diff(self.L, q))):
                 out[q] = p
         return out
@@ -165,6 +200,10 @@ class Dynamics:
         power += sum((f * v for f, v in zip(self.sys.forces, self.qd, strict=True)), sp.S.Zero)
         if any(sp.diff(f, self.sys.t) != 0 for _, f in self.sys.constraints):
             return sp.nan  # moving constraints do work; not decided here
+        rest = {v: 0 for v in self.qd}
+        if any(c.has(self.sys.t) or not is_zero(c.xreplace(rest))
+               for _, c in self.sys.velocity_constraints):
+            return sp.nan  # A·q̇ + b = 0 with b ≠ 0 (a turntable): its force does work
         return self._simp(power)
 
     @property

@@ -40,6 +40,7 @@ class ReducedSystem(SystemLike):
         self.small_params = base.small_params
         self.free_driven = base.free_driven
         self.constraints = []
+        self.velocity_constraints = []
         self.spec = base.spec
         # the remaining coordinates' declared domains are not checked in a reduced system
         # (its equilibria are searched everywhere, as they always were)
@@ -49,8 +50,10 @@ class ReducedSystem(SystemLike):
         for i, c in zip(idx, cyc, strict=True):
             if not is_zero(sp.diff(base.lagrangian, c)) or base.forces[i] != 0:
                 raise UnsupportedError(f"steady motion: {c} is not a cyclic coordinate")
-        if base.constraints:
-            raise UnsupportedError("steady motion of a system with multiplier constraints")
+        if base.constraints or base.velocity_constraints:
+            raise UnsupportedError("Routh's reduction of a system with multiplier constraints "
+                                   "(a steady motion is then linearized in full: "
+                                   "`reduce: false`)")
         keep = [i for i in range(len(base.q)) if i not in idx]
         self.q = [base.q[i] for i in keep]
         self.qd = [base.qd[i] for i in keep]

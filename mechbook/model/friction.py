@@ -42,7 +42,7 @@ class Contact:
     force: list  # the sliding law's generalized forces Q_k
 
 
-def _velocity(sys, body: str, point: sp.Matrix, sub: tuple) -> sp.Matrix:
+def point_velocity(sys, body: str, point: sp.Matrix, sub: tuple) -> sp.Matrix:
     """The velocity of the body's material point now at `point`."""
     if body not in sys.positions:
         raise sys._error(sub + ("body",), f"no particle or rigid body {body!r}")
@@ -77,7 +77,7 @@ def contacts(sys, specs: list) -> list[Contact]:
         sub = ("friction", i)
         point = sp.Matrix([sys._parse(x, sub + ("point", j)) for j, x in
                            enumerate(spec["point"])])
-        v = _velocity(sys, spec["body"], point, sub)
+        v = point_velocity(sys, spec["body"], point, sub)
         if "normal" in spec:
             n = sp.Matrix([sys._parse(x, sub + ("normal", j))
                            for j, x in enumerate(spec["normal"])])

@@ -36,6 +36,8 @@ class SystemLike(Protocol):
     lagrangian: sp.Expr
     forces: list[sp.Expr]  # generalized forces not derived from a potential, per coordinate
     constraints: list[tuple[str, sp.Expr]]  # (name, g(q)) held by multipliers
+    # (name, c(q, q̇, t)) linear in q̇, held by multipliers: velocity constraints, rolling
+    velocity_constraints: list[tuple[str, sp.Expr]]
     small_params: list[sp.Symbol]  # parameters switched off at an equilibrium
     free_driven: list[tuple[sp.Symbol, sp.Symbol, sp.Symbol]]  # (y, ẏ, ÿ) driven freely
     domains: dict[sp.Symbol, Domain]  # coordinates' declared domains, where they are checked

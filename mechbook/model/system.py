@@ -193,6 +193,12 @@ class System(SystemLike):
                                   f"constraint {cname!r} has the multiplier lambda_{cname}, "
                                   f"which is already a name here: rename the constraint or "
                                   f"lambda_{cname}")
+        # velocity constraints A(q, t)·q̇ + b(q, t) = 0 and rolling contacts (model.rolling)
+        self.velocity_constraints: list[tuple[str, sp.Expr]] = []
+        if s.get("velocity_constraints") or s.get("rolling"):
+            from mechbook.model.rolling import velocity_constraints
+
+            self.velocity_constraints = velocity_constraints(self)
 
     def _rigid_body(self, name: str, b: dict) -> sp.Expr:
         sub = ("rigid_bodies", name)

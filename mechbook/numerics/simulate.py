@@ -27,6 +27,7 @@ import sympy as sp
 from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.model.manifold import manifold_of
 from mechbook.numerics.accuracy import choose
 from mechbook.numerics.domain import check_start, within_domains
 from mechbook.numerics.integrators import SCIPY_METHODS, Trajectory, integrate
@@ -130,7 +131,44 @@ def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[s
             target[i] = float(sp.N(expr.subs(values)))
         except (TypeError, ValueError) as exc:
             raise MechbookError(f"initial value for {key!r} does not evaluate: {exc}") from None
+    manifold = manifold_of(sys)
+    if manifold is not None:
+        q0, qd0, solved = _on_manifold(analysis, sys, manifold, values, q0, qd0, given,
+                                       overrides)
+        if solved:
+            source += f" ({', '.join(solved)} solved from the constraints)"
     return q0, qd0, source
+
+
+def _on_manifold(analysis: Analysis, sys, manifold, values: dict, q0: np.ndarray,
+                 qd0: np.ndarray, given: dict, overrides: dict) -> tuple:
+    """The stated start, its unstated coordinates and velocities solved from the
+    constraints (least change from 0); an error naming the constraint where the stated
+    ones alone break it."""
+    stated = {q for q, c in zip(sys.q, sys.coord_names, strict=True) if c in given}
+    stated |= {v for v, c in zip(sys.qd, sys.coord_names, strict=True) if c + "dot" in given}
+    free = manifold.state - stated
+    settled = manifold.settle(values, q0, qd0, 0.0, free)
+    if settled is not None:
+        q1, qd1 = np.array(settled[0]), np.array(settled[1])
+        moved = [c for c, a, b in zip(sys.coord_names, q0, q1, strict=True)
+                 if abs(a - b) > 1e-12 * max(1.0, abs(a))]
+        moved += [c + "dot" for c, a, b in zip(sys.coord_names, qd0, qd1, strict=True)
+                  if abs(a - b) > 1e-12 * max(1.0, abs(a))]
+        return q1, qd1, moved
+    point = dict(values)
+    point.update({q: float(x) for q, x in zip(sys.q, q0, strict=True)})
+    point.update({v: float(x) for v, x in zip(sys.qd, qd0, strict=True)})
+    point[sys.t] = 0.0
+    worst = max(manifold.residuals(point), key=lambda r: r[1])
+    message = (f"the initial state is not on the constraint manifold: constraint "
+               f"{worst[0]!r} is off by {worst[1]:.3g} (relative) there, and the "
+               "coordinates and velocities left unstated cannot make it hold: state a start "
+               "that satisfies the constraints (or leave the dependent ones out, to be "
+               "solved for)")
+    if given and not overrides:
+        raise analysis.problem.doc.error(sys.path + ("initial",), message)
+    raise MechbookError(message)
 
 
 def _fallback(analysis: Analysis, system_name: str | None, values: dict,
@@ -152,7 +190,16 @@ def _fallback(analysis: Analysis, system_name: str | None, values: dict,
                             "start near")
     point = stable[0]
     q0 = np.array([float(sp.N(point.get(q, 0).subs(values))) for q in sys.q]) + FALLBACK_OFFSET
-    return q0, np.zeros(len(sys.q))
+    qd0 = np.zeros(len(sys.q))
+    manifold = manifold_of(sys)
+    if manifold is not None:  # the offset moved the start off the constraints: back onto them
+        settled = manifold.settle(values, q0, qd0)
+        if settled is None:
+            raise MechbookError(f"{analysis.problem.id}: no initial conditions (`initial:` in "
+                                "the problem file, or --init q=value), and no start on the "
+                                "constraint manifold found near the stable equilibrium")
+        q0, qd0 = np.array(settled[0]), np.array(settled[1])
+    return q0, qd0
 
 
 def parameter_values(analysis: Analysis, overrides: dict[str, str] | None) -> dict:

@@ -43,7 +43,7 @@ class Sampler:
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
                  seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
                  rtol: float = RTOL, fixed: Sequence[sp.Symbol] = (),
-                 derived: dict[sp.Symbol, sp.Expr] | None = None):
+                 derived: dict[sp.Symbol, sp.Expr] | None = None, manifold=None):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
@@ -54,6 +54,10 @@ class Sampler:
         # symbols fixed by the others (a part's `restrict:`, a surface in parameter space):
         # computed after each draw, in order, so a later one may use an earlier one
         self.derived = dict(derived or {})
+        # a constrained system's states (mechbook.model.manifold.StateManifold): a draw that
+        # gives a coordinate or a velocity a value is moved onto the constraint manifold,
+        # where the system's motion is (its solved accelerations hold nowhere else)
+        self.manifold = manifold
 
     def _complete(self, point: dict) -> dict | None:
         """The point with its derived symbols computed (None where one is not real)."""
@@ -97,8 +101,15 @@ class Sampler:
                     point[v] = self.rng.uniform(0.1, 1.0) if v.is_nonnegative \
                         else self.rng.uniform(-1.0, 1.0)  # a radius declared positive
             point = self._complete({k: sp.Float(v, DIGITS) for k, v in point.items()})
+            if point is not None and self.manifold is not None and \
+                    self.manifold.state & set(variables):
+                point = self.manifold.project(point)
             if point is not None and all(holds(c, point) for c in self.conditions):
                 return point
+        if self.manifold is not None:
+            raise ValueError("no state on the constraint manifold found from random starts "
+                             "(the constraints hold nowhere near them, or are dependent "
+                             "there), or none that satisfies the stated conditions")
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
     def complete(self, point: dict) -> dict | None:
@@ -109,7 +120,8 @@ class Sampler:
     def widened(self, spread: float) -> Sampler:
         """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
         return Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
-                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived)
+                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived,
+                       manifold=self.manifold)
 
     def default(self) -> dict[sp.Symbol, sp.Float]:
         """The default values (when they satisfy the conditions on the parameters alone;

@@ -19,6 +19,7 @@ from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
 from mechbook.model.declared import declared
+from mechbook.model.manifold import manifold_of
 from mechbook.records import NUMERIC, ProofPolicy
 from mechbook.verify.compare import Sampler, value, vanishes
 from mechbook.verify.part import Part
@@ -80,6 +81,9 @@ class Context:
                 raise self.part.error(("restrict", k), "a restricted symbol is given by the "
                                       "others, not by itself or another restricted one")
             derived[sym] = expr
+        # a constrained system's states are drawn on its constraint manifold
+        manifold = (manifold_of(self.system) if self.system is not None and
+                    not self.tensor_mode else None)
         if "estimate" in self.part.data:  # a number the book computed: one point, its rtol
             est = self.part.data["estimate"]
             for k, v in (est.get("values") or {}).items():
@@ -92,9 +96,10 @@ class Context:
                     raise self.part.error(("estimate", "values", k), "a number is expected")
                 base[sym] = float(val)
             self.sampler = Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
-                                   fixed=list(base), derived=derived)
+                                   fixed=list(base), derived=derived, manifold=manifold)
         else:
-            self.sampler = Sampler(base, conds, policy=self.policy, derived=derived)
+            self.sampler = Sampler(base, conds, policy=self.policy, derived=derived,
+                                   manifold=manifold)
 
     @property
     def dyn(self):

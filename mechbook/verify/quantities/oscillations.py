@@ -10,7 +10,8 @@ import sympy as sp
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine import perturbation
 from mechbook.engine.linear import LinearSystem
-from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError, WrongAnswerError
+from mechbook.model.manifold import Freedoms
 from mechbook.verify.compare import Verdict, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import EXPR, LIMIT, quantity
@@ -414,12 +415,70 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
 
 
 @quantity('mode_count',
-          book='integer',
-          how='the number of degrees of freedom')
+          book='integer, or `{configuration: k, velocity: d}`',
+          how=('the degrees of freedom: the coordinates less the rank of the constraints\' '
+               'Jacobian, at the part\'s point (`about:`) or at 6 random states on the '
+               'constraint manifold (40 digits). An integer is the number of independent '
+               'velocities (virtual displacements: velocity constraints such as rolling count); '
+               '`configuration:` and `velocity:` state the freedoms of the configuration '
+               '(holonomic constraints only) and of the velocity apart'))
 def check_mode_count(ctx: Context, val) -> Verdict:
+    """Coordinates less the rank of the constraint Jacobian (holonomic, and with the
+    velocity constraints), where the system moves (mechbook.model.manifold)."""
+    want = _freedom_claim(ctx, val)
+    found = _freedoms(ctx)
+    got = {"configuration": found.configuration, "velocity": found.velocity}
+    wrong = [k for k, v in want.items() if got[k] != v]
+    bare = isinstance(val, int)  # the one count: the independent velocities
+    said = str(val) if bare else ", ".join(f"{k} {v}" for k, v in want.items())
+    engine = str(got["velocity"]) if bare else ", ".join(f"{k} {got[k]}" for k in want)
+    if wrong:
+        return Verdict(False, "exact", f"book {said}, engine {engine} degrees of freedom "
+                       f"({len(ctx.system.q)} coordinates)")
+    return Verdict(True, "exact", f"{engine} degrees of freedom ({len(ctx.system.q)} "
+                   "coordinates)", power="exact: an integer")
+
+
+def _freedom_claim(ctx: Context, val) -> dict[str, int]:
+    if isinstance(val, bool):
+        raise ctx.part.error(("book",), "expected an integer (or {configuration, velocity})")
+    if isinstance(val, int):
+        return {"velocity": val}
+    val = ctx.as_map(val, ("book",))
+    out = {}
+    for k, v in val.items():
+        if k not in ("configuration", "velocity"):
+            raise ctx.part.error(("book", k), "the freedoms are `configuration` and `velocity`")
+        if not isinstance(v, int) or isinstance(v, bool):
+            raise ctx.part.error(("book", k), "expected an integer")
+        out[k] = v
+    if not out:
+        raise ctx.part.error(("book",), "give `configuration`, `velocity` or both")
+    return out
+
+
+def _freedoms(ctx: Context) -> Freedoms:
+    """The freedoms at the part's point, or the most frequent over random states (a rank
+    drops only on a thin set: where the constraints are singular)."""
+    manifold = ctx.sampler.manifold
     n = len(ctx.system.q)
-    ok = isinstance(val, int) and val == n
-    return Verdict(ok, "exact", f"book {val}, engine {n} degrees of freedom")
+    if manifold is None:
+        return Freedoms(n, n)
+    state = list(ctx.system.q) + list(ctx.system.qd)
+    if "about" in ctx.part.data:
+        pt = ctx.sampler.draw()
+        at = {q: v.subs(pt) for q, v in ctx.point().items()}
+        at.update({v: sp.S.Zero for v in ctx.system.qd})
+        projected = manifold.project({**pt, **at, ctx.system.t: sp.S.Zero})
+        if projected is None or any(abs(float(projected[q] - sp.N(at[q], 30))) > 1e-12
+                                    for q in at if q in ctx.system.q):
+            raise WrongAnswerError("the part's point does not satisfy the constraints")
+        return manifold.freedoms(projected)
+    seen: dict[Freedoms, int] = {}
+    for _ in range(6):
+        f = manifold.freedoms(ctx.sampler.draw(state))
+        seen[f] = seen.get(f, 0) + 1
+    return max(seen, key=lambda f: seen[f])
 
 
 @quantity('mode_node',

@@ -1,0 +1,258 @@
+"""The states a constrained system can be in, and how many freedoms it has there.
+
+A system with holonomic constraints g(q, t) = 0 and velocity constraints (differentiated
+holonomic ones ġ, rolling, a skate's blade: c = A(q, t)·q̇ + b(q, t) = 0) moves on the set
+of states where all of them hold. A claim about its motion — a first integral, an equation
+of motion, a constraint force — is a claim about those states only: the solved
+accelerations hold there and nowhere else, so a state drawn at random off it (f ≠ 0,
+ḟ ≠ 0) contradicts a true answer. `StateManifold.project` moves a state onto the manifold
+to the working precision: the coordinates by Gauss–Newton steps of least norm
+(q ← q − Gᵀ(GGᵀ)⁻¹g, quadratically convergent from a nearby start), then the velocities by
+the orthogonal projection onto A·q̇ + b = 0 (linear: one exact step). Both at 40 digits,
+kept to 30: the residuals of a projected state are below 1e-28 of their scale.
+
+Degrees of freedom (`freedoms`): n coordinates less the rank of the holonomic constraints'
+Jacobian G are the configuration's freedoms; less, further, the rank the velocity
+constraints add ([G; A_v]) are the velocity's freedoms — the independent virtual
+displacements, what "degrees of freedom" means for a rolling body (Goldstein §1.3). Ranks
+are taken at states on the manifold, in 40-digit arithmetic.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import mpmath
+import sympy as sp
+
+from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, program
+
+DIGITS = 30  # the checks' working precision: a projected state is kept to it
+WORK = 40  # digits of the iteration
+ITERATIONS = 40
+RANK_TOL = 30  # a singular value below 10^-RANK_TOL of the largest is zero at WORK digits
+
+_FAULTS = (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError)
+
+
+@dataclass(frozen=True)
+class Freedoms:
+    """The freedoms of a constrained system at a state: of its configuration (coordinates
+    less independent holonomic constraints) and of its velocity (less, further, independent
+    velocity constraints)."""
+
+    configuration: int
+    velocity: int
+
+
+class StateManifold:
+    """Where the states of `system` may be: its constraints, their Jacobians, projection."""
+
+    def __init__(self, system):
+        self.system = system
+        self.q, self.qd, self.t = list(system.q), list(system.qd), system.t
+        self.position = [g for _, g in system.constraints]
+        self.position_names = [name for name, _ in system.constraints]
+        self.velocity = [c for _, c in system.velocity_constraints]
+        self.velocity_names = [name for name, _ in system.velocity_constraints]
+
+    @property
+    def empty(self) -> bool:
+        return not (self.position or self.velocity)
+
+    @cached_property
+    def state(self) -> frozenset:
+        """The symbols a state gives values to: coordinates and velocities."""
+        return frozenset(self.q + self.qd)
+
+    @cached_property
+    def _jacobian(self) -> list[list[sp.Expr]]:
+        return [[sp.diff(g, q) for q in self.q] for g in self.position]
+
+    @cached_property
+    def _rows(self) -> tuple[list[list[sp.Expr]], list[sp.Expr]]:
+        """(A, b) of every velocity-level constraint c = A·q̇ + b: ġ, then the velocity
+        constraints."""
+        rows = [self.system.dt(g) for g in self.position] + list(self.velocity)
+        rest = {v: sp.S.Zero for v in self.qd}
+        return ([[sp.diff(c, v) for v in self.qd] for c in rows],
+                [c.xreplace(rest) for c in rows])
+
+    # ---- projection --------------------------------------------------------------------
+    def project(self, point: dict, free: set | None = None) -> dict | None:
+        """`point` (parameters, t if it has one, and a drawn state) with its coordinates
+        and velocities moved onto the manifold (30-digit Floats; those it lacks start at
+        0.5), or None where the iteration does not converge or leaves a coordinate's
+        domain (the caller draws again). `free` (default: all) names the coordinates and
+        velocities that may move: the others are a state someone stated."""
+        env = {k: _mpf(v) for k, v in point.items()}
+        env.setdefault(self.t, mpmath.mpf(0))
+        free = self.state if free is None else frozenset(free)
+        with mpmath.workdps(WORK):
+            for x in self.q + self.qd:
+                if x not in env:
+                    env[x] = mpmath.mpf(0.5)
+            try:
+                if self.position and not self._settle_coordinates(env, free):
+                    return None
+                if not self._inside(env):
+                    return None
+                if not self._settle_velocities(env, free):
+                    return None
+            except _FAULTS:
+                return None
+        out = dict(point)
+        for x in self.q + self.qd:
+            out[x] = sp.Float(mpmath.nstr(env[x], DIGITS + 5), DIGITS)
+        return out
+
+    def settle(self, values: dict, q0, qd0, t0: float = 0.0,
+               free: set | None = None) -> tuple[list[float], list[float]] | None:
+        """(q0, q̇0) as floats, moved onto the manifold (only the `free` entries), for a
+        simulation's start; None where that fails."""
+        point = dict(values)
+        point[self.t] = t0
+        point.update({q: float(x) for q, x in zip(self.q, q0, strict=True)})
+        point.update({v: float(x) for v, x in zip(self.qd, qd0, strict=True)})
+        out = self.project(point, free)
+        if out is None:
+            return None
+        return [float(out[q]) for q in self.q], [float(out[v]) for v in self.qd]
+
+    def _settle_coordinates(self, env: dict, free: frozenset) -> bool:
+        cols = [j for j, q in enumerate(self.q) if q in free]
+        for _ in range(ITERATIONS):
+            g, scale = self._values(self.position, env)
+            if max(abs(x) / s for x, s in zip(g, scale, strict=True)) < mpmath.mpf(10) ** (
+                    -DIGITS - 2):
+                return True
+            if not cols:
+                return False
+            G = _columns(self._matrix(self._jacobian, env), cols)
+            step = G.T * mpmath.lu_solve(G * G.T, mpmath.matrix(g))
+            if not all(mpmath.isfinite(x) for x in step):
+                return False
+            for k, j in enumerate(cols):
+                env[self.q[j]] -= step[k]
+        return False
+
+    def _settle_velocities(self, env: dict, free: frozenset) -> bool:
+        """The velocities moved (the free ones, least norm) to A·q̇ + b = 0: one exact step;
+        False where the free ones cannot make it hold."""
+        A_expr, b_expr = self._rows
+        if not A_expr:
+            return True
+        cols = [j for j, v in enumerate(self.qd) if v in free]
+        A = self._matrix(A_expr, env)
+        b = mpmath.matrix([evaluate_mp(x, env, WORK) for x in b_expr])
+        v = mpmath.matrix([env[x] for x in self.qd])
+        r = A * v + b
+        if cols:
+            Af = _columns(A, cols)
+            step = Af.T * mpmath.lu_solve(Af * Af.T, r)
+            for k, j in enumerate(cols):
+                env[self.qd[j]] = mpmath.re(v[j] - step[k])
+        v = mpmath.matrix([env[x] for x in self.qd])
+        left = A * v + b
+        size = max([abs(x) for x in A] + [abs(x) for x in b] + [mpmath.mpf(1)])
+        return all(abs(x) <= mpmath.mpf(10) ** (-DIGITS - 2) * size * max(
+            [abs(y) for y in v] + [mpmath.mpf(1)]) for x in left)
+
+    def _inside(self, env: dict) -> bool:
+        """Every coordinate within its declared domain (a radius stays positive)."""
+        domains = getattr(self.system, "domains", {})
+        values = {k: float(v) for k, v in env.items()
+                  if isinstance(k, sp.Symbol) and k not in self.state}
+        for q in self.q:
+            if q in domains and not domains[q].contains(float(env[q]), values):
+                return False
+            if q.is_positive and env[q] <= 0 or q.is_nonnegative and env[q] < 0:
+                return False
+        return True
+
+    def _values(self, exprs: list, env: dict) -> tuple[list, list]:
+        """Values and the magnitudes of what cancelled in them (the scale a residual is
+        judged against), at the working precision."""
+        vals, scales = [], []
+        for e in exprs:
+            v, m = program(e).run(env)
+            if not (mpmath.isfinite(v) and mpmath.isfinite(m)):
+                raise ValueError("not finite")
+            vals.append(mpmath.re(v))
+            scales.append(max(m, mpmath.mpf(10) ** -300))
+        return vals, scales
+
+    def _matrix(self, rows: list[list[sp.Expr]], env: dict):
+        out = mpmath.matrix(len(rows), len(rows[0]) if rows else 0)
+        for i, row in enumerate(rows):
+            for j, x in enumerate(row):
+                v = evaluate_mp(x, env, WORK) if x != 0 else mpmath.mpf(0)
+                if not mpmath.isfinite(v):
+                    raise ValueError("not finite")
+                out[i, j] = mpmath.re(v)
+        return out
+
+    # ---- residuals and freedoms --------------------------------------------------------
+    def residuals(self, point: dict) -> list[tuple[str, float]]:
+        """(name, |value| relative to its scale) of each constraint at `point`: the
+        holonomic ones, then the velocity-level ones (ġ named `<name>'`)."""
+        env = {k: _mpf(v) for k, v in point.items()}
+        env.setdefault(self.t, mpmath.mpf(0))
+        _, b_expr = self._rows
+        A_expr, _ = self._rows
+        rows = ([g for g in self.position]
+                + [sum((a * v for a, v in zip(row, self.qd, strict=True)), sp.S.Zero) + b
+                   for row, b in zip(A_expr, b_expr, strict=True)])
+        names = (self.position_names + [n + "'" for n in self.position_names]
+                 + self.velocity_names)
+        out = []
+        for name, e in zip(names, rows, strict=True):
+            v, m = evaluate(e, env, DIGITS)
+            out.append((name, abs(v) / max(m, 1e-300) if m > 0 else abs(v)))
+        return out
+
+    def freedoms(self, point: dict) -> Freedoms:
+        """The freedoms at `point` (a state on the manifold and the parameters)."""
+        env = {k: _mpf(v) for k, v in point.items()}
+        env.setdefault(self.t, mpmath.mpf(0))
+        n = len(self.q)
+        with mpmath.workdps(WORK):
+            A_expr, _ = self._rows
+            holonomic = _rank(self._matrix(self._jacobian, env)) if self.position else 0
+            both = _rank(self._matrix(A_expr, env)) if A_expr else 0
+        return Freedoms(n - holonomic, n - both)
+
+
+def _columns(A, cols: list[int]):
+    out = mpmath.matrix(A.rows, len(cols))
+    for i in range(A.rows):
+        for k, j in enumerate(cols):
+            out[i, k] = A[i, j]
+    return out
+
+
+def _rank(A) -> int:
+    if A.rows == 0:
+        return 0
+    s = mpmath.svd_r(A, compute_uv=False)
+    top = max([abs(x) for x in s] + [mpmath.mpf(0)])
+    if top == 0:
+        return 0
+    return sum(1 for x in s if abs(x) > mpmath.mpf(10) ** -RANK_TOL * top)
+
+
+def _mpf(v):
+    if isinstance(v, (mpmath.mpf, mpmath.mpc)):
+        return v
+    if isinstance(v, sp.Float):
+        return mpmath.mpf(v._mpf_)
+    if isinstance(v, sp.Basic):
+        return mpmath.mpf(sp.Float(v, WORK)._mpf_)
+    return mpmath.mpf(v)
+
+
+def manifold_of(system) -> StateManifold | None:
+    """The state manifold of a constrained system (None without constraints)."""
+    m = StateManifold(system)
+    return None if m.empty else m
