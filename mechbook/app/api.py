@@ -78,12 +78,13 @@ class SystemView:
 
     @property
     def eom(self) -> list[sp.Eq]:
-        """Lagrange's equations M·q̈ = f (+ Aᵀλ with constraint multipliers λ)."""
+        """Lagrange's equations M·q̈ = f (+ Aᵀλ with constraint multipliers λ: A the
+        constraints at the velocity level, holonomic ones as ġ, then velocity constraints)."""
         dyn = self._dyn
         lhs = dyn.mass_matrix * sp.Matrix(dyn.qdd)
         rhs = dyn.forcing
-        if self._sys.constraints:
-            rhs = rhs + dyn.constraint_jacobian.T * sp.Matrix(dyn.multipliers)
+        if dyn.constrained:
+            rhs = rhs + dyn.velocity_jacobian.T * sp.Matrix(dyn.multipliers)
         return MathList(sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True))
 
     @property

@@ -51,6 +51,8 @@ class Access:
             p = dyn.momenta[dyn.q.index(q)]
             P.append(([sp.diff(p, a) for a in qd], p.subs(zero)))
         J = [([sp.diff(f, q) for q in dyn.q], sp.diff(f, sys.t)) for _, f in sys.constraints]
+        J += [([sp.diff(k, v) for v in qd], k.subs(zero))  # A(q, t)·q̇ + b = 0 likewise
+              for _, k in sys.velocity_constraints]
         for expr in [c, *b, *(x for row in A for x in row)]:
             if expr.has(*qd):
                 raise UnsupportedError("accessibility: the energy function is not quadratic "

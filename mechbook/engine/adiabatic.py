@@ -60,7 +60,7 @@ def frozen(dyn: Dynamics, coordinate: sp.Symbol, slow: sp.Symbol, point: dict) -
     if len(dyn.q) != 1:
         raise UnsupportedError("an adiabatic invariant of a system with more than one "
                                "coordinate (one oscillation at a time is supported)")
-    if sys.constraints:
+    if sys.constraints or sys.velocity_constraints:
         raise UnsupportedError("an adiabatic invariant with multiplier constraints")
     q, qd, qdd = dyn.q[0], dyn.qd[0], dyn.qdd[0]
     e = dyn.residuals[0].subs({trio[1]: 0, trio[2]: 0})

@@ -20,7 +20,28 @@ constraint force λ*·A(q) turns with the manifold, and its curvature is a stiff
 pendulum written in x, y with x² + y² = l² gets g/l from it alone). This is the Hessian of
 the Lagrange function V − λ*·g restricted to the tangent space, the textbook second-order
 condition, and what sympy.physics.mechanics' Linearizer gives with dependent coordinates.
-Moving (time-dependent) constraints and steady motions with constraints are refused.
+Moving (time-dependent) holonomic constraints are refused.
+
+*Velocity constraints* (rolling without slipping: A_v(q, t)·q̇ + b(q, t) = 0) leave fewer
+independent velocities than coordinates, so the linearization about a point or a uniform
+motion q*(t) = q0 + v·t (`linearize_first_order`; v stated, zero where `about:` names the
+coordinate, else solved from the constraints) is first order. With every constraint at the
+velocity level, A(q)·q̇ + b = 0 (holonomic rows ġ), the multipliers μ* of the reference
+motion from E* = A*ᵀμ*, and H = ∂(A(q)ᵀμ*)/∂q, D = ∂(A·q̇ + b)/∂q there:
+
+    M·δq̈ + C·δq̇ + (K − H)·δq = F + A*ᵀδμ,   G·δq = 0,   A_v·δq̇ + D_v·δq = 0.
+
+δq = N_h·δs (N_h the null space of the holonomic G, as above); the velocity constraints
+then fix some of the rates δṡ by the others: δṡ = T·δu + R·δs, δu the independent speeds
+(columns of A_v·N_h invertible, taken from the end). Projecting on the admissible
+displacements P = N_h·T removes δμ, and δs̈ = T·δu̇ + R·δṡ gives
+
+    δṡ = R·δs + T·δu,
+    M_r·δu̇ = −Pᵀ(M·N_h·R² + C·N_h·R + (K − H)·N_h)·δs − Pᵀ(M·N_h·R·T + C·N_h·T)·δu + Pᵀ·F,
+
+M_r = PᵀMP: a StateSpaceSystem (mechbook.engine.state_space) in z = (δs, δu). Without
+velocity constraints T = 1, R = 0 and this is the second-order system above. The
+coefficients must be free of t (the motion is a symmetry orbit), as for every steady motion.
 """
 
 from __future__ import annotations
@@ -30,9 +51,10 @@ from itertools import combinations
 import numpy as np
 import sympy as sp
 
-from mechbook.core.numeval import NotNumeric, evaluate
+from mechbook.core.numeval import NotNumeric, evaluate, without_absent
 from mechbook.engine.linear import LinearSystem
 from mechbook.engine.residual import is_zero, show_point
+from mechbook.engine.state_space import StateSpaceSystem
 from mechbook.errors import NotEquilibriumError, UnsupportedError
 
 
@@ -54,25 +76,32 @@ def multipliers_at(E: list[sp.Expr], A: sp.Matrix) -> tuple[sp.Matrix, list[sp.E
     return lam, list(E - A.T * lam)
 
 
+def _at_rest_jacobian(dyn) -> sp.Matrix:
+    """Every constraint's A at the velocity level (holonomic ∂g/∂q, velocity ∂c/∂q̇): the
+    directions its force may take, at rest as in motion."""
+    return dyn.velocity_jacobian
+
+
 def equilibrium_conditions(eq) -> tuple[list[sp.Expr], list[sp.Symbol]]:
     """Conditions in (q, λ) whose common roots are the constrained equilibria: E(q, 0, 0) −
-    A(q)ᵀλ = 0 and g(q) = 0 (n + m equations in n + m unknowns)."""
+    A(q)ᵀλ = 0 and g(q) = 0 (n + m_h equations; a velocity constraint adds a multiplier and
+    no equation, so its rest points come in families)."""
     dyn, sys = eq.dyn, eq.sys
     cons = constraint_functions(sys)
     lam = dyn.multipliers
-    A = dyn.constraint_jacobian
+    A = _at_rest_jacobian(dyn)
     rest = eq.rest_residuals()
-    conds = [rest[i] - sum((A[j, i] * lam[j] for j in range(len(cons))), sp.S.Zero)
+    conds = [rest[i] - sum((A[j, i] * lam[j] for j in range(A.rows)), sp.S.Zero)
              for i in range(len(dyn.q))] + list(cons)
     return conds, list(dyn.q) + list(lam)
 
 
 def residual_at(eq, point: dict) -> list[sp.Expr]:
     """What must vanish at a constrained equilibrium `point`: each constraint, and the force
-    left at rest minus its normal (constraint) part."""
+    left at rest minus its part along the constraints' normals (their forces)."""
     dyn, sys = eq.dyn, eq.sys
     cons = constraint_functions(sys)
-    A = dyn.constraint_jacobian.xreplace(point)
+    A = _at_rest_jacobian(dyn).xreplace(point)
     E = [r.xreplace(point) for r in eq.rest_residuals()]
     _, tangential = multipliers_at(E, A)
     return [c.xreplace(point) for c in cons] + tangential
@@ -108,13 +137,13 @@ def _independent(A: sp.Matrix, q: list, values: dict) -> list[int]:
 
 
 def linearize_on_manifold(eq, point: dict, velocity: dict | None = None,
-                          given: dict | None = None) -> LinearSystem:
+                          given: dict | None = None) -> LinearSystem | StateSpaceSystem:
     """The linear system about the constrained equilibrium `point`, over the independent
-    coordinates (see the module docstring)."""
+    coordinates (see the module docstring); first order where velocity constraints leave
+    fewer independent velocities than coordinates, or about a steady motion."""
     dyn, sys = eq.dyn, eq.sys
-    if velocity:
-        raise UnsupportedError("linearization about a steady motion of a system with "
-                               "multiplier constraints")
+    if sys.velocity_constraints or velocity:
+        return linearize_first_order(eq, point, velocity, given)
     cons = constraint_functions(sys)
     at = {q: sp.S(point.get(q, 0)) for q in dyn.q}
     values = sys.numeric_values()
@@ -134,16 +163,8 @@ def linearize_on_manifold(eq, point: dict, velocity: dict | None = None,
         raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium: a force "
                                   f"along the constraint manifold {sp.sstr(bad[0])[:120]} is "
                                   "left there")
-    n, m = len(dyn.q), len(cons)
-    dep = _independent(A, dyn.q, values)
-    ind = [i for i in range(n) if i not in dep]
-    N = sp.zeros(n, n - m)
-    for j, i in enumerate(ind):
-        N[i, j] = 1
-    solved = -A[:, dep].LUsolve(A[:, ind])  # δq_dep = −A_dep⁻¹ A_ind δq_ind
-    for r, i in enumerate(dep):
-        for j in range(n - m):
-            N[i, j] = sp.cancel(solved[r, j])
+    n = len(dyn.q)
+    N, ind = _null_basis(A, _independent(A, dyn.q, values))  # δq_dep = −A_dep⁻¹ A_ind δq_ind
     curvature = sp.zeros(n, n)
     for j, g in enumerate(cons):
         curvature += lam[j] * sp.hessian(g, dyn.q).subs(at)
@@ -156,3 +177,155 @@ def linearize_on_manifold(eq, point: dict, velocity: dict | None = None,
     return LinearSystem(dyn, dict(point), tidy(Nt * M * N), tidy(Nt * C * N),
                         tidy(Nt * Kc * N), tidy(Nt * F), {},
                         coords=[dyn.q[i] for i in ind], embedding=N)
+
+
+def reference_rates(eq, point: dict, velocity: dict, given: dict | None = None) -> dict:
+    """Every coordinate's rate along the reference motion: stated (`velocity`), zero for a
+    coordinate the point names, else solved from the constraints at the velocity level
+    (the stated rates and the point fix them: a rolling disk's centre follows its spin)."""
+    dyn = eq.dyn
+    values = eq.sys.numeric_values()
+    rates = {q: sp.S(velocity[q]) for q in dyn.q if q in velocity}
+    rates.update({q: sp.S.Zero for q in dyn.q if q not in velocity and q in point})
+    open_ = [i for i, q in enumerate(dyn.q) if q not in rates]
+    if not open_:
+        return rates
+    at = {q: sp.S(point.get(q, 0)) for q in dyn.q}
+    A = dyn.velocity_jacobian.xreplace(at)
+    rest = {v: sp.S.Zero for v in dyn.qd}
+    b = sp.Matrix([c.xreplace(rest).xreplace(at) for c in dyn.velocity_rows])
+    known = [i for i in range(len(dyn.q)) if i not in open_]
+    rhs = -b - A[:, known] * sp.Matrix([rates[dyn.q[i]] for i in known]) if known else -b
+    Ao = A[:, open_]
+    if A.rows == 0 or sp.Matrix(Ao).rank(iszerofunc=lambda x: is_zero(x, values)) < len(open_):
+        names = ", ".join(str(dyn.q[i]) for i in open_)
+        raise UnsupportedError(f"the reference motion leaves the rates of {names} open: give "
+                               "them (`steady:`) or the coordinates' values (`about:`)")
+    solved = (Ao.T * Ao).LUsolve(Ao.T * rhs).applyfunc(sp.cancel)
+    left = [r for r in Ao * solved - rhs if not is_zero(sp.S(r).subs(given or {}), values)]
+    if left:
+        raise NotEquilibriumError("the stated rates break the velocity constraints: "
+                                  f"{sp.sstr(left[0])[:120]} is left")
+    rates.update({dyn.q[i]: solved[k] for k, i in enumerate(open_)})
+    return rates
+
+
+def linearize_first_order(eq, point: dict, velocity: dict | None = None,
+                          given: dict | None = None) -> LinearSystem | StateSpaceSystem:
+    """The linearization about the point (at rest) or the uniform motion point + v·t on
+    the constraint manifold, velocity constraints and all (the module docstring): a
+    StateSpaceSystem in (δs, δu); a LinearSystem over δs where no velocity constraint
+    leaves fewer speeds than coordinates."""
+    dyn, sys = eq.dyn, eq.sys
+    t = sys.t
+    values = sys.numeric_values()
+    cons = constraint_functions(sys)
+    rates = reference_rates(eq, point, dict(velocity or {}), given)
+    moving = {q: r for q, r in rates.items() if not (r == 0)}
+    where = {q: sp.S(point.get(q, 0)) + moving.get(q, 0) * t for q in dyn.q}
+    where.update({v: rates[q] for q, v in zip(dyn.q, dyn.qd, strict=True)})
+
+    def restricted(x: sp.Expr) -> sp.Expr:
+        return x.subs(given) if given else x
+
+    def along(x: sp.Expr, what: str) -> sp.Expr:
+        """x on the reference motion, which must not depend on t there."""
+        x = without_absent(x.xreplace(where), [t])
+        if x.has(t):
+            raise UnsupportedError(f"linearization about a motion along which {what} "
+                                   "changes with time (not a symmetry orbit)")
+        return x
+
+    off = [c for c in cons if not is_zero(restricted(along(c, "a constraint")), values)]
+    if off:
+        raise NotEquilibriumError(f"the point {show_point(point)} violates the constraint "
+                                  f"{sp.sstr(off[0])} = 0")
+    n, mh = len(dyn.q), len(cons)
+    A = dyn.velocity_jacobian.applyfunc(lambda x: along(x, "a constraint's direction"))
+    rows = [along(c, "a constraint") for c in dyn.velocity_rows]
+    broken = [c for c in rows if not is_zero(restricted(c), values)]
+    if broken:
+        raise NotEquilibriumError(f"the motion {show_point(point)} with rates "
+                                  f"{show_point(moving)} breaks a velocity constraint "
+                                  f"({sp.sstr(broken[0])[:120]} is left)")
+    zeroth, M, C, K, F = eq.expand(point, moving, given)
+    lam, tangential = multipliers_at(zeroth[:n], A)
+    bad = [r for r in tangential if not is_zero(restricted(r), values)]
+    if bad:
+        raise NotEquilibriumError(f"the point {show_point(point)} is not an equilibrium (or "
+                                  f"steady motion): a force the constraints cannot take, "
+                                  f"{sp.sstr(bad[0])[:120]}, is left there")
+    lam = lam.applyfunc(sp.cancel)
+    # the constraint forces Aᵀμ* turn with the state: a stiffness H; the constraints'
+    # rows' dependence on q at the motion's rates: D
+    force = dyn.velocity_jacobian.T * lam
+    H = sp.Matrix(n, n, lambda i, k: along(sp.diff(force[i], dyn.q[k]), "a constraint force"))
+    D = sp.Matrix(len(rows), n, lambda j, k: along(sp.diff(dyn.velocity_rows[j], dyn.q[k]),
+                                                     "a constraint"))
+    Kc = K - H
+    if mh:
+        Nh, ind = _null_basis(A[:mh, :], _independent(A[:mh, :], dyn.q, values))
+        drift = (D[:mh, :] * Nh).applyfunc(sp.cancel)
+        if any(not is_zero(x, values) for x in drift):
+            raise UnsupportedError("linearization about a motion along which the holonomic "
+                                   "constraints' normals turn")
+    else:
+        Nh, ind = sp.eye(n), list(range(n))
+    coords = [dyn.q[i] for i in ind]
+    k = Nh.cols
+    Av, Dv = (A[mh:, :] * Nh), (D[mh:, :] * Nh)
+    mv = Av.rows
+    if mv:
+        dep_s = _independent(Av, coords, values)
+        ind_s = [i for i in range(k) if i not in dep_s]
+        T = sp.zeros(k, k - mv)
+        R = sp.zeros(k, k)
+        for j, i in enumerate(ind_s):
+            T[i, j] = 1
+        inv_d = Av[:, dep_s]
+        Td = -inv_d.LUsolve(Av[:, ind_s])
+        Rd = -inv_d.LUsolve(Dv)
+        for r, i in enumerate(dep_s):
+            for j in range(k - mv):
+                T[i, j] = sp.cancel(Td[r, j])
+            for j in range(k):
+                R[i, j] = sp.cancel(Rd[r, j])
+    else:
+        ind_s = list(range(k))
+        T, R = sp.eye(k), sp.zeros(k, k)
+    P = Nh * T
+    Pt = P.T
+
+    def tidy(X: sp.Matrix) -> sp.Matrix:
+        return X.applyfunc(sp.cancel)
+
+    Mr = tidy(Pt * M * P)
+    if not mv:  # second order over δs: a LinearSystem, as at rest
+        return LinearSystem(dyn, dict(point), Mr, tidy(Pt * C * Nh), tidy(Pt * Kc * Nh),
+                            tidy(Pt * F), dict(moving), coords=coords, embedding=Nh)
+    MN, CN = M * Nh, C * Nh
+    low_s = tidy(-Pt * (MN * R * R + CN * R + Kc * Nh))
+    low_u = tidy(-Pt * (MN * R * T + CN * T))
+    d = k - mv
+    E = sp.diag(sp.eye(k), Mr)
+    Ahat = sp.Matrix.vstack(sp.Matrix.hstack(R, T), sp.Matrix.hstack(low_s, low_u))
+    f = sp.Matrix.vstack(sp.zeros(k, 1), tidy(Pt * F))
+    speeds = [dyn.qd[dyn.q.index(coords[i])] for i in ind_s]
+    assert len(speeds) == d
+    return StateSpaceSystem(dyn, dict(point), E, Ahat, f, coords, speeds, Nh, (T, R),
+                            dict(moving))
+
+
+def _null_basis(G: sp.Matrix, dep: list[int]) -> tuple[sp.Matrix, list[int]]:
+    """(N, independent columns): N = [I; −G_dep⁻¹G_ind] in the system's order, so that
+    δq = N·δs over the independent coordinates and G·N = 0."""
+    m, n = G.shape
+    ind = [i for i in range(n) if i not in dep]
+    N = sp.zeros(n, n - m)
+    for j, i in enumerate(ind):
+        N[i, j] = 1
+    solved = -G[:, dep].LUsolve(G[:, ind])
+    for r, i in enumerate(dep):
+        for j in range(n - m):
+            N[i, j] = sp.cancel(solved[r, j])
+    return N, ind

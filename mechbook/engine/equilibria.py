@@ -42,7 +42,7 @@ class Equilibria:
         """What vanishes at an equilibrium, in the `unknowns`: E_i(q, 0, 0) with small
         parameters switched off; with multiplier constraints, E(q, 0, 0) − A(q)ᵀλ and the
         constraints g(q) (mechbook.engine.constrained)."""
-        if self.sys.constraints:
+        if self.dyn.constrained:
             from mechbook.engine.constrained import equilibrium_conditions
 
             return equilibrium_conditions(self)[0]
@@ -51,7 +51,7 @@ class Equilibria:
     @cached_property
     def unknowns(self) -> list[sp.Symbol]:
         """The coordinates, and the constraints' multipliers where there are constraints."""
-        return list(self.dyn.q) + (list(self.dyn.multipliers) if self.sys.constraints else [])
+        return list(self.dyn.q) + (list(self.dyn.multipliers) if self.dyn.constrained else [])
 
     def rest_residuals(self) -> list[sp.Expr]:
         """E_i(q, 0, 0) with small parameters switched off (no constraint forces)."""
@@ -159,8 +159,11 @@ class Equilibria:
     def _multiplier_start(self, values: dict):
         """x0 ↦ starting multipliers (least squares of Aᵀλ = E at x0); none without
         constraints."""
-        if not self.sys.constraints:
+        if not self.dyn.constrained:
             return lambda x0: np.zeros(0)
+        if self.sys.velocity_constraints:
+            raise UnsupportedError("numeric equilibria with velocity constraints (their rest "
+                                   "points come in families: give the point)")
         q = self.dyn.q
         A = self.dyn.constraint_jacobian.subs(values)
         E = [r.subs(values) for r in self.rest_residuals()]
@@ -184,7 +187,7 @@ class Equilibria:
     def residual(self, point: dict) -> list[sp.Expr]:
         """What must vanish if `point` is an equilibrium (with constraints: each constraint
         and the force along the constraint manifold)."""
-        if self.sys.constraints:
+        if self.dyn.constrained:
             from mechbook.engine.constrained import residual_at
 
             return residual_at(self, point)
@@ -193,7 +196,7 @@ class Equilibria:
     def _conservative(self) -> bool:
         """L alone decides the motion: no forces, constraints, small parameters or time."""
         sys = self.sys
-        return (not sys.constraints and not sys.small_params and not sys.free_driven
+        return (not self.dyn.constrained and not sys.small_params and not sys.free_driven
                 and all(f == 0 for f in sys.forces) and not self.dyn.L.has(sys.t))
 
     def _linearize_lagrangian(self, point: dict) -> LinearSystem:
@@ -239,7 +242,7 @@ class Equilibria:
         the point is an equilibrium (an answer's `restrict:`): the zeroth order must vanish
         there; M, C, K and F stay in the original parameters. A system with multiplier
         constraints is linearized on its constraint manifold (mechbook.engine.constrained)."""
-        if self.sys.constraints:
+        if self.dyn.constrained:
             from mechbook.engine.constrained import linearize_on_manifold
 
             return linearize_on_manifold(self, point, velocity, given)

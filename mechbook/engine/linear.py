@@ -47,6 +47,7 @@ class LinearSystem:
     coords: list | None = None
     embedding: sp.Matrix | None = None
     _compiled: tuple | None = field(default=None, repr=False, compare=False)
+    first_order = False  # second order: M, C, K (mechbook.engine.state_space: first order)
 
     @property
     def q(self) -> list:

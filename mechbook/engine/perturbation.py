@@ -64,6 +64,8 @@ def precise_squared_frequencies(lin: LinearSystem, values: dict) -> list:
 
 def precise_exponents(lin: LinearSystem, values: dict) -> list:
     """The 2n exponents p of e^{pt} (state-space eigenvalues) at DPS digits."""
+    if lin.first_order:
+        return lin.precise_exponents(values, DPS)
     with mpmath.workdps(DPS):
         A = state_matrix(*(_mp(X, values) for X in (lin.M, lin.C, lin.K)))
         return list(mpmath.eig(A, left=False, right=False))
@@ -77,6 +79,8 @@ def precise_frequencies(lin: LinearSystem, values: dict) -> list:
     terms the imaginary parts of the exponents with Im p ≥ 0. A zero mode (a free
     translation, a cyclic coordinate kept), split by rounding to about 1e-50 of the
     largest ω², is exactly 0."""
+    if lin.first_order:  # velocity constraints: the state matrix's own (engine.state_space)
+        return lin.precise_frequencies(values, DPS)
     with mpmath.workdps(DPS):
         if not lin.gyroscopic:
             w2 = precise_squared_frequencies(lin, values)

@@ -34,7 +34,7 @@ class PhaseFlow:
     """The flow of one system in (q, p), compiled once; parameters are given per call."""
 
     def __init__(self, system, dyn, rtol: float = RTOL):
-        if system.constraints:
+        if system.constraints or system.velocity_constraints:
             raise UnsupportedError("phase-space flow of a system with multiplier constraints "
                                    "(its (q, p) are not canonical coordinates)")
         if system.free_driven:

@@ -61,7 +61,9 @@ def eigenpairs(lin: LinearSystem, values: dict, precise: bool = False,
 
 
 def exponents(lin: LinearSystem, values: dict, precise: bool = False) -> np.ndarray:
-    """The 2n exponents p of e^{pt} solutions."""
+    """The 2n exponents p of e^{pt} solutions (a first-order system's: one per state)."""
+    if lin.first_order:
+        return lin.exponents(values, precise)
     return eigenpairs(lin, values, precise)[0]
 
 

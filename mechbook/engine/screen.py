@@ -74,7 +74,7 @@ def screen(eq: Equilibria, values: dict, ranges: dict | None = None) -> Screen:
     parameter without a value left in the conditions, or more distinct equilibria than
     MAX_FOUND (a continuum)."""
     dyn, sys = eq.dyn, eq.sys
-    if sys.constraints:
+    if sys.constraints or sys.velocity_constraints:
         raise UnsupportedError("numeric equilibria with multiplier constraints")
     n = len(dyn.q)
     # the algebra in SymEngine: differentiating and substituting large residuals takes

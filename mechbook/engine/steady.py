@@ -86,8 +86,9 @@ def steady_conditions(sys, rates: dict | None = None, momenta: dict | None = Non
 def cyclic_check(dyn: Dynamics, coords: list[sp.Symbol]) -> None:
     """Refuse a coordinate that is not cyclic (present in L, or acted on by a force)."""
     sys = dyn.sys
-    if sys.constraints:
-        raise UnsupportedError("steady motions of a system with multiplier constraints")
+    if sys.constraints or sys.velocity_constraints:
+        raise UnsupportedError("steady motions at fixed cyclic momenta of a system with "
+                               "multiplier constraints (give the motion's `steady:` rates)")
     for c in coords:
         i = sys.q.index(c)
         if not is_zero(sp.diff(dyn.L, c)) or sys.forces[i] != 0:

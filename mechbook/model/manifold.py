@@ -30,7 +30,7 @@ from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, program
 
 DIGITS = 30  # the checks' working precision: a projected state is kept to it
 WORK = 40  # digits of the iteration
-ITERATIONS = 40
+ITERATIONS = 30
 RANK_TOL = 30  # a singular value below 10^-RANK_TOL of the largest is zero at WORK digits
 
 _FAULTS = (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError)
@@ -60,6 +60,11 @@ class StateManifold:
     @property
     def empty(self) -> bool:
         return not (self.position or self.velocity)
+
+    @cached_property
+    def moving(self) -> bool:
+        """Whether a constraint depends on t: a state is then a state at a time."""
+        return any(c.has(self.t) for c in self.position + self.velocity)
 
     @cached_property
     def state(self) -> frozenset:
@@ -122,13 +127,15 @@ class StateManifold:
 
     def _settle_coordinates(self, env: dict, free: frozenset) -> bool:
         cols = [j for j, q in enumerate(self.q) if q in free]
+        first = None
         for _ in range(ITERATIONS):
             g, scale = self._values(self.position, env)
-            if max(abs(x) / s for x, s in zip(g, scale, strict=True)) < mpmath.mpf(10) ** (
-                    -DIGITS - 2):
+            worst = max(abs(x) / s for x, s in zip(g, scale, strict=True))
+            if worst < mpmath.mpf(10) ** (-DIGITS - 2):
                 return True
-            if not cols:
-                return False
+            first = worst if first is None else first
+            if not cols or worst > 1e6 * first:
+                return False  # diverging: no configuration near this start
             G = _columns(self._matrix(self._jacobian, env), cols)
             step = G.T * mpmath.lu_solve(G * G.T, mpmath.matrix(g))
             if not all(mpmath.isfinite(x) for x in step):

@@ -26,6 +26,7 @@ T = sp.Symbol("t", real=True)
 RESERVED = {"t"} | set(CONSTANTS) | set(FUNCTIONS)
 SYSTEM_KEYS = ("coordinates", "driven", "particles", "rigid_bodies", "gravity", "springs",
                "kinetic", "potential", "lagrangian", "velocity_potential", "constraints",
+               "velocity_constraints", "rolling",
                "forces", "torques", "friction", "attractors", "dissipation", "string", "average",
                "approximation", "equilibria", "initial", "compute", "doc")
 DEFAULT_VALUES = {"g": 9.81}  # documented default for the gravitational acceleration

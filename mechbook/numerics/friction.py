@@ -119,7 +119,7 @@ class Phases:
         self._smooth = smooth
         if not system.contacts:
             raise UnsupportedError("no frictional contact")
-        if system.constraints:
+        if system.constraints or system.velocity_constraints:
             raise UnsupportedError("stick and slip with multiplier constraints")
         sub = {k: sp.Float(float(v), 17) for k, v in values.items()}
         q, qd, qdd = list(dyn.q), list(dyn.qd), list(dyn.qdd)

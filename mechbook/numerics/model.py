@@ -1,8 +1,8 @@
 """Numeric right-hand sides generated once from the engine's symbolic equations of motion.
 
 The equations are taken as the engine states them, M(q, t)·q̈ = f(q, q̇, t) (plus Aᵀλ with
-holonomic constraints), from `Dynamics.residuals` — never re-derived — with the parameter
-values substituted. M and f are compiled together (common subexpressions eliminated, by the
+constraints, holonomic ones kept as g̈ = 0, velocity ones as ċ = 0), from
+`Dynamics.residuals` — never re-derived — with the parameter values substituted. M and f are compiled together (common subexpressions eliminated, by the
 compile layer `mechbook.core.compile`) and the accelerations come from a numeric linear
 solve at each call, which is cheaper to generate and more robust than SymPy's symbolic
 inverse of M. The backend that compiled them is recorded on the model.
@@ -238,17 +238,16 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
     q, qd, qdd = list(dyn.q), list(dyn.qd), list(dyn.qdd)
     n = len(q)
     zero_acc = {a: 0 for a in qdd}
-    m = len(system.constraints)
+    m = dyn.velocity_jacobian.rows  # holonomic constraints (as g̈) and velocity ones
 
     def equations(conv) -> list:  # M, f (and A, b) in either algebra (core.secalc.either)
         at = {conv(k): conv(v) for k, v in sub.items()}
         res = [conv(e).xreplace(at) for e in dyn.residuals]
         rest = {conv(a): conv(0) for a in qdd}
         exprs = [e.diff(conv(a)) for e in res for a in qdd] + [-e.xreplace(rest) for e in res]
-        if system.constraints:
-            exprs += [conv(x).xreplace(at) for x in dyn.constraint_jacobian]
-            exprs += [conv(system.dt(system.dt(c)).xreplace(zero_acc)).xreplace(at)
-                      for _, c in system.constraints]
+        if m:  # A q̈ + bias = 0: the constraints differentiated to the accelerations
+            exprs += [conv(x).xreplace(at) for x in dyn.velocity_jacobian]
+            exprs += [conv(x).xreplace(at) for x in dyn.constraint_bias]
         return [as_expr(e) if conv is same else e for e in exprs]  # d(plain 0) is an int
 
     exprs = either(equations)  # SymEngine's objects go to the compile layer as they are
@@ -285,10 +284,9 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
         Ms = [as_expr(sp.diff(e, a)) for e in res for a in qdd]
         fs = [as_expr(-e.xreplace(zero_acc)) for e in res]
         As, bs = [], []
-        if system.constraints:
-            As = [as_expr(x) for x in dyn.constraint_jacobian]
-            bs = [as_expr(system.dt(system.dt(c)).xreplace(zero_acc))
-                  for _, c in system.constraints]
+        if m:
+            As = [as_expr(x) for x in dyn.velocity_jacobian]
+            bs = [as_expr(x) for x in dyn.constraint_bias]
         return EquationSource(t, q, qd, Ms, fs, As, bs,
                               {k: float(v) for k, v in values.items()})
 

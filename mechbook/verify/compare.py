@@ -24,6 +24,7 @@ RTOL = 1e-10  # relative tolerance of a numeric comparison
 # error through where 1e10-sized terms cancel (Symon 11-5: a wrong solution passed so)
 EXACT_RTOL = 1e-20
 POINTS = 6  # random points per numeric comparison
+MANIFOLD_TRIES = 200  # starts that found no state on the constraint manifold, then give up
 DIGITS = 30
 
 
@@ -85,6 +86,10 @@ class Sampler:
         # a condition may bound a state variable (an `assume:` such as r > 0): draw it too
         extra = set().union(*(c.free_symbols for c in self.conditions)) - set(self.base)
         variables = list(variables) + sorted(extra - set(variables), key=str)
+        onto = self.manifold is not None and bool(self.manifold.state & set(variables))
+        if onto and self.manifold.moving and self.manifold.t not in variables:
+            variables.append(self.manifold.t)  # moving constraints: a state at a time
+        missed = 0  # starts the projection onto the manifold could not bring onto it
         for attempt in range(tries):
             if attempt and attempt % (tries // 5) == 0:
                 spread *= 4
@@ -101,9 +106,13 @@ class Sampler:
                     point[v] = self.rng.uniform(0.1, 1.0) if v.is_nonnegative \
                         else self.rng.uniform(-1.0, 1.0)  # a radius declared positive
             point = self._complete({k: sp.Float(v, DIGITS) for k, v in point.items()})
-            if point is not None and self.manifold is not None and \
-                    self.manifold.state & set(variables):
+            if point is not None and onto:
                 point = self.manifold.project(point)
+                if point is None:
+                    missed += 1
+                    if missed >= MANIFOLD_TRIES:
+                        break
+                    continue
             if point is not None and all(holds(c, point) for c in self.conditions):
                 return point
         if self.manifold is not None:

@@ -142,8 +142,11 @@ class Context:
             if "about" not in self.part.data:
                 raise self.part.error(("steady",), "a steady motion needs `about:` for the "
                                       "coordinates that stay put")
+            # Routh's reduction holds the cyclic momenta; with multiplier constraints the
+            # motion is linearized in full, constraints and all (engine.constrained)
+            constrained = bool(self.system.constraints or self.system.velocity_constraints)
             return self.analysis.steady_linear(self.part.system, self.rates(), self.point(),
-                                               self.part.data.get("reduce", True),
+                                               self.part.data.get("reduce", not constrained),
                                                self.sampler.derived)
         if "reduce" in self.part.data:
             raise self.part.error(("reduce",), "`reduce:` applies to a steady motion")

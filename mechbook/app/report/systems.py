@@ -74,8 +74,8 @@ def _eom(view: StoredSystem, dyn, sys_) -> list:
     f = sp.Matrix(f).reshape(M.rows, 1)
     lhs = M * sp.Matrix(dyn.qdd)
     rhs = f
-    if sys_.constraints:
-        rhs = rhs + dyn.constraint_jacobian.T * sp.Matrix(dyn.multipliers)
+    if dyn.constrained:
+        rhs = rhs + dyn.velocity_jacobian.T * sp.Matrix(dyn.multipliers)
     return [sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True)]
 
 

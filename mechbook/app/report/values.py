@@ -131,8 +131,8 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         dyn = ctx.dyn
         lhs = sp.Matrix(M) * sp.Matrix(dyn.qdd)
         rhs = sp.Matrix(f).reshape(lhs.rows, 1)
-        if ctx.system.constraints:
-            rhs = rhs + dyn.constraint_jacobian.T * sp.Matrix(dyn.multipliers)
+        if dyn.constrained:
+            rhs = rhs + dyn.velocity_jacobian.T * sp.Matrix(dyn.multipliers)
         return [sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True)]
     if shown in ("frequency_list", "period_list"):
         lin = part_linear(ctx, view, values)

@@ -66,8 +66,9 @@ def _precise_frequencies(ctx: Context, book, lin: LinearSystem, partial: bool):
     the eigensolver's rounding still fails. None where 50 digits mean nothing: numbers of
     double precision in the equations (a numeric equilibrium) or in the book, or an
     estimate."""
-    if ctx.sampler.rtol > 1e-10 or any(_has_doubles(x) for x in list(book) + list(lin.M)
-                                       + list(lin.K) + list(lin.C)):
+    entries = (list(lin.E) + list(lin.Ahat) if lin.first_order else
+               list(lin.M) + list(lin.K) + list(lin.C))
+    if ctx.sampler.rtol > 1e-10 or any(_has_doubles(x) for x in list(book) + entries):
         return None
     pt = ctx.sampler.draw()
     try:

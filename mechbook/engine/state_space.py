@@ -1,0 +1,254 @@
+"""A linearization that is first order: E·ż = Â·z + f(t), z = (δs, δu).
+
+A system with velocity constraints (rolling without slipping, a skate's blade) has more
+coordinates than independent velocities, so its linearization is not M·δq̈ + C·δq̇ + K·δq
+over one set of coordinates: it is first order in the independent coordinates δs and the
+independent speeds δu (mechbook.engine.constrained builds it, as sympy.physics.mechanics'
+Linearizer does with dependent speeds). The state matrix A = E⁻¹Â is what its exponents,
+frequencies and stability come from; E = diag(1, M_r) with M_r the mass matrix on the
+admissible velocities, kept apart so the symbolic matrices stay small (E⁻¹ is taken
+numerically; `state_matrix()` gives the symbolic A on request).
+
+Exact zero exponents are taken out before the eigenvalues are computed: a state that no
+derivative depends on (a cyclic coordinate: a zero column of A) or whose derivative is zero
+(a conserved speed: a zero row) adds an exponent 0 exactly; removing its row and column
+leaves the rest of the spectrum unchanged (the matrix is block triangular). Left in, such
+zeros form Jordan blocks that rounding splits into exponents of size ε^(1/k), which no
+fixed threshold tells from a slow instability (a rolling disk keeps six of them). The rest
+(`core`) is decided as the gyroscopic systems' state matrices are (mechbook.engine.linear):
+an exponent with a positive real part beyond rounding is an instability; a zero cluster of
+a symmetry left in the core is neutral.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from mechbook.core.numeval import is_zero
+from mechbook.engine.linear import ZERO_CLUSTER, mp_matrix
+from mechbook.errors import MechbookError, UnsupportedError
+
+FIRST_ORDER = ("has a first-order linearization (velocity constraints: more coordinates than "
+               "independent velocities): {what} of M·δq̈ + C·δq̇ + K·δq do not exist; its "
+               "exponents, frequencies and stability come from the state matrix")
+
+
+@dataclass
+class StateSpaceSystem:
+    """E·ż = Â·z + f(t) about `point` (and the uniform motion `velocity`): z = (δs, δu),
+    δs the independent coordinates `coords`, δu the independent speeds `speeds` (rates of
+    some of them); `embedding` maps δs to every coordinate (δq = embedding·δs) and
+    `speed_map` (T, R) gives δṡ = T·δu + R·δs."""
+
+    dyn: object
+    point: dict
+    E: sp.Matrix
+    Ahat: sp.Matrix
+    f: sp.Matrix
+    coords: list
+    speeds: list
+    embedding: sp.Matrix
+    speed_map: tuple[sp.Matrix, sp.Matrix]
+    velocity: dict = field(default_factory=dict)
+    first_order = True
+
+    # ---- what a second-order system has and this one does not -------------------------
+    @property
+    def M(self):
+        raise UnsupportedError(FIRST_ORDER.format(what="M, C and K"))
+
+    C = K = F = M
+
+    def matrices(self, values: dict):
+        raise UnsupportedError(FIRST_ORDER.format(what="M, C and K"))
+
+    def numeric_modes(self, values: dict):
+        raise UnsupportedError(FIRST_ORDER.format(what="real normal modes"))
+
+    @property
+    def frequencies(self):
+        raise UnsupportedError(FIRST_ORDER.format(what="closed-form frequencies"))
+
+    @property
+    def stability_condition(self):
+        raise UnsupportedError(FIRST_ORDER.format(what="Sylvester's conditions on K"))
+
+    # ---- the linear system's coordinates ------------------------------------------------
+    @property
+    def q(self) -> list:
+        return list(self.coords)
+
+    @property
+    def qd(self) -> list:
+        return [self.dyn.qd[self.dyn.q.index(c)] for c in self.coords]
+
+    @property
+    def coord_names(self) -> list[str]:
+        return [str(q) for q in self.coords]
+
+    @property
+    def states(self) -> list[str]:
+        """The state's names: the independent coordinates, then the independent speeds."""
+        return [f"delta_{c}" for c in self.coords] + [f"delta_{s}" for s in self.speeds]
+
+    @property
+    def dependent(self) -> dict:
+        ds = sp.Matrix([q - self.point.get(q, 0) for q in self.coords])
+        out = {}
+        for i, q in enumerate(self.dyn.q):
+            if q not in self.coords:
+                out[q] = sum((self.embedding[i, j] * ds[j] for j in range(len(self.coords))),
+                             sp.S.Zero)
+        return out
+
+    @cached_property
+    def gyroscopic(self) -> bool:
+        return True  # velocity terms: decided from the state matrix, as with C ≠ 0
+
+    @cached_property
+    def driven(self) -> bool:
+        return not all(is_zero(x) for x in self.f)
+
+    def state_matrix(self) -> sp.Matrix:
+        """A = E⁻¹Â, symbolic (the lower block solved by LU; entries cancelled)."""
+        n = len(self.coords)
+        low = self.E[n:, n:].LUsolve(self.Ahat[n:, :])
+        return sp.Matrix.vstack(self.Ahat[:n, :], low).applyfunc(sp.cancel)
+
+    # ---- numbers -----------------------------------------------------------------------
+    @cached_property
+    def core(self) -> list[int]:
+        """The states left once those that add an exact zero exponent are taken out: a
+        zero column of A (nothing depends on the state) or a zero row (the state is
+        constant), repeatedly. An entry is zero where it vanishes to 1e-30 of the matrix
+        at two random parameter points (40 digits): an entry that is not identically zero
+        vanishes at a random point with probability zero."""
+        rng = np.random.default_rng(20261129)
+        base = dict(self.dyn.sys.numeric_values())
+        free = set().union(*(x.free_symbols for x in list(self.E) + list(self.Ahat)))
+        base.update({x: 0.3 + rng.uniform(0, 1) for x in free if x not in base})
+        zero = None
+        for _ in range(2):
+            values = {k: sp.Float(v * float(np.exp(rng.uniform(-0.3, 0.3))) if k.is_positive
+                                  else v + rng.uniform(-0.3, 0.3), 40) for k, v in base.items()}
+            A = self._mp_state(values, 40, core=False)
+            scale = max([abs(x) for x in A] + [mpmath.mpf(10) ** -300])
+            here = [[abs(A[i, j]) <= mpmath.mpf(10) ** -30 * scale for j in range(A.cols)]
+                    for i in range(A.rows)]
+            zero = here if zero is None else [[a and b for a, b in zip(r1, r2, strict=True)]
+                                              for r1, r2 in zip(zero, here, strict=True)]
+        keep = list(range(self.Ahat.rows))
+        changed = True
+        while changed:
+            changed = False
+            for j in list(keep):
+                if all(zero[i][j] for i in keep) or all(zero[j][i] for i in keep):
+                    keep.remove(j)
+                    changed = True
+        return keep
+
+    @property
+    def neutral(self) -> int:
+        """How many exact zero exponents the structure gives (taken out of `core`)."""
+        return self.Ahat.rows - len(self.core)
+
+    def _mp_state(self, values: dict, dps: int, core: bool = True):
+        with mpmath.workdps(dps):
+            E = mp_matrix(self.E, values, dps)
+            Ahat = mp_matrix(self.Ahat, values, dps)
+            A = mpmath.inverse(E) * Ahat if E.rows else Ahat
+            if not core:
+                return A
+            idx = self.core
+            out = mpmath.matrix(len(idx), len(idx))
+            for a, i in enumerate(idx):
+                for b, j in enumerate(idx):
+                    out[a, b] = A[i, j]
+            return out
+
+    def mp_state_matrix(self, values: dict, dps: int = 50):
+        """The whole state matrix at `values`, in mpmath at `dps` digits."""
+        return self._mp_state(values, dps, core=False)
+
+    def numeric_state_matrix(self, values: dict, core: bool = False) -> np.ndarray:
+        """The state matrix (or its `core`) at `values`, from 30-digit entries."""
+        A = self._mp_state(values, 30, core)
+        return np.array([[float(mpmath.re(A[i, j])) for j in range(A.cols)]
+                         for i in range(A.rows)], dtype=float).reshape(A.rows, A.cols)
+
+    def exponents(self, values: dict, precise: bool = False) -> np.ndarray:
+        """Every exponent p of e^{pt}: the core's eigenvalues and the structural zeros."""
+        if precise:
+            return np.array([complex(x) for x in self.precise_exponents(values)])
+        core = self.numeric_state_matrix(values, core=True)
+        lam = np.linalg.eigvals(core) if core.size else np.zeros(0, complex)
+        return np.concatenate([lam, np.zeros(self.neutral, complex)])
+
+    def precise_exponents(self, values: dict, dps: int = 50) -> list:
+        """The exponents at `dps` digits (mpmath), structural zeros exact."""
+        with mpmath.workdps(dps):
+            A = self._mp_state(values, dps)
+            lam = list(mpmath.eig(A, left=False, right=False)) if A.rows else []
+            return lam + [mpmath.mpf(0)] * self.neutral
+
+    def numeric_frequencies(self, values: dict) -> np.ndarray:
+        """The oscillation frequencies: |Im p| of each exponent pair ±iω (one per pair);
+        NaN for each exponent that grows without oscillating. Zero exponents (the steady
+        family, cyclic coordinates, conserved speeds) are not frequencies."""
+        core = self.numeric_state_matrix(values, core=True)
+        lam = np.linalg.eigvals(core) if core.size else np.zeros(0, complex)
+        mags = np.abs(lam[np.abs(lam) > 0])
+        if len(mags) and mags.max() > 1e6 * mags.min():
+            lam = np.array([complex(x) for x in self.precise_exponents(values)[: core.shape[0]]])
+        return _frequencies(lam)
+
+    def precise_frequencies(self, values: dict, dps: int = 50) -> list:
+        """`numeric_frequencies` at `dps` digits."""
+        with mpmath.workdps(dps):
+            lam = self.precise_exponents(values, dps)[: len(self.core)]
+            scale = max([abs(x) for x in lam] + [mpmath.mpf(1)])
+            tiny = mpmath.mpf(10) ** (20 - dps) * scale
+            out = [abs(mpmath.im(x)) for x in lam if mpmath.im(x) > tiny]
+            out += [mpmath.nan for x in lam if abs(mpmath.im(x)) <= tiny and
+                    mpmath.re(x) > tiny]
+            return sorted(out, key=lambda x: (mpmath.isnan(x), x))
+
+    def numeric_stability(self, values: dict) -> str:
+        """'stable' or 'unstable' from the core's exponents (double precision)."""
+        core = self.numeric_state_matrix(values, core=True)
+        if not core.size:
+            return "stable"
+        if not np.all(np.isfinite(core)):
+            raise MechbookError("the linearized system has no finite value at this point")
+        lam = np.linalg.eigvals(core)
+        scale = max(1.0, float(np.max(np.abs(lam))))
+        live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
+        return "unstable" if np.any(live.real > 1e-8 * scale) else "stable"
+
+    def precise_stability(self, values: dict, dps: int = 40) -> str:
+        """`numeric_stability` with the core and its eigenvalues at `dps` digits."""
+        with mpmath.workdps(dps):
+            A = self._mp_state(values, dps)
+            if not A.rows:
+                return "stable"
+            lam = mpmath.eig(A, left=False, right=False)
+            scale = max([abs(x) for x in lam] + [mpmath.mpf(1)])
+            tiny = mpmath.mpf(10) ** (12 - dps)
+            live = [x for x in lam if abs(x) > mpmath.mpf(10) ** (-dps / 4) * scale]
+            return "unstable" if any(mpmath.re(x) > tiny * scale for x in live) else "stable"
+
+    def fast_matrices(self, values: dict):
+        raise UnsupportedError(FIRST_ORDER.format(what="M, C and K"))
+
+
+def _frequencies(lam: np.ndarray) -> np.ndarray:
+    scale = max(1e-300, float(np.max(np.abs(lam)))) if len(lam) else 1.0
+    tol = 1e-9 * scale
+    out = [abs(x.imag) for x in lam if x.imag > tol]
+    out += [float("nan") for x in lam if abs(x.imag) <= tol and x.real > max(tol, 1e-8 * scale)]
+    return np.array(sorted(out, key=lambda w: (w != w, w)))
