@@ -2,10 +2,11 @@
 
 The equations are taken as the engine states them, M(q, t)·q̈ = f(q, q̇, t) (plus Aᵀλ with
 constraints, holonomic ones kept as g̈ = 0, velocity ones as ċ = 0), from
-`Dynamics.residuals` — never re-derived — with the parameter values substituted. M and f are compiled together (common subexpressions eliminated, by the
-compile layer `mechbook.core.compile`) and the accelerations come from a numeric linear
-solve at each call, which is cheaper to generate and more robust than SymPy's symbolic
-inverse of M. The backend that compiled them is recorded on the model.
+`Dynamics.residuals` — never re-derived — with the parameter values substituted. M and f
+are compiled together (common subexpressions eliminated, by the compile layer
+`mechbook.core.compile`) and the accelerations come from a numeric linear solve at each
+call, which is cheaper to generate and more robust than SymPy's symbolic inverse of M. The
+backend that compiled them is recorded on the model.
 """
 
 from __future__ import annotations
