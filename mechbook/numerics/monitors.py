@@ -28,6 +28,23 @@ def conserved_quantities(system, dyn) -> dict[str, sp.Expr]:
     for q in dyn.cyclic:
         i = dyn.q.index(q)
         out[f"p_{system.coord_names[i]}"] = sp.diff(L, dyn.qd[i])
+    out.update(constraint_monitors(system))
+    return out
+
+
+CONSTRAINT = "constraint "  # a monitor of a constraint's residual: "constraint <name>"
+SCALE = "scale of "  # its companion: the sum of its terms' magnitudes (what it is judged by)
+
+
+def constraint_monitors(system) -> dict[str, sp.Expr]:
+    """Each constraint's residual (holonomic g, velocity A·q̇ + b), which the integrator keeps
+    at zero only to its tolerance, and beside it the sum of its terms' magnitudes: a run
+    reports how far it drifted off the constraint manifold, relative to that."""
+    out: dict[str, sp.Expr] = {}
+    for name, c in list(system.constraints) + list(getattr(system, "velocity_constraints", [])):
+        out[CONSTRAINT + name] = c
+        terms = sp.Add.make_args(sp.expand(c))
+        out[SCALE + CONSTRAINT + name] = sp.Add(*(sp.Abs(x) for x in terms))
     return out
 
 
@@ -68,11 +85,17 @@ def drifts(model: Model, traj: Trajectory) -> list[Drift]:
         return []
     values = model.monitors(traj.t, traj.q, traj.qd)
     momenta = model.momenta_along(traj.t, traj.q, traj.qd)
+    series = dict(zip(model.monitor_names, values, strict=True))
     out = []
-    for name, vals in zip(model.monitor_names, values, strict=True):
+    for name, vals in series.items():
+        if name.startswith(SCALE):
+            continue
         q0 = float(vals[0])
         dev = vals - q0
-        if name == "energy_function":
+        if name.startswith(CONSTRAINT):  # judged against what it is made of, from zero
+            dev = vals
+            extra = float(np.max(np.abs(series[SCALE + name])))
+        elif name == "energy_function":
             extra = float(np.max(np.sum(np.abs(traj.qd * momenta), axis=0)))
         else:
             extra = float(np.max(np.abs(momenta)))
