@@ -107,10 +107,11 @@ def residual_at(eq, point: dict) -> list[sp.Expr]:
     return [c.xreplace(point) for c in cons] + tangential
 
 
-def _independent(A: sp.Matrix, q: list, values: dict) -> list[int]:
+def _independent(A: sp.Matrix, q: list, values: dict,
+                 prefer: list[int] | None = None) -> list[int]:
     """Indices of the dependent coordinates: m columns of A invertible at the default
     parameters (and at two nearby points), taken from the end so the first coordinates stay
-    the independent ones."""
+    the independent ones; those of `prefer` first, where they will do."""
     m, n = A.shape
     rng = np.random.default_rng(11)
     points = [values] + [{k: v * float(np.exp(rng.uniform(-0.2, 0.2))) for k, v in
@@ -127,7 +128,10 @@ def _independent(A: sp.Matrix, q: list, values: dict) -> list[int]:
     if any(np.linalg.matrix_rank(a) < m for a in num):
         raise UnsupportedError("constrained linearization where the constraints are "
                                "dependent (their Jacobian loses rank at the point)")
-    for dep in combinations(range(n - 1, -1, -1), m):
+    order = list(range(n - 1, -1, -1))
+    if prefer:
+        order = [i for i in order if i in prefer] + [i for i in order if i not in prefer]
+    for dep in combinations(order, m):
         cols = sorted(dep)
         if all(abs(np.linalg.det(a[:, cols])) > 1e-9 * max(1.0, np.abs(a).max()) ** m
                for a in num):
@@ -276,7 +280,10 @@ def linearize_first_order(eq, point: dict, velocity: dict | None = None,
     Av, Dv = (A[mh:, :] * Nh), (D[mh:, :] * Nh)
     mv = Av.rows
     if mv:
-        dep_s = _independent(Av, coords, values)
+        # the dependent speeds: those of ignorable coordinates first (a rolling body's
+        # centre follows its turning): then the ignorable states drop out of the
+        # linearization whole, with their zero exponents (engine.state_space)
+        dep_s = _independent(Av, coords, values, _ignorable(dyn, A, coords))
         ind_s = [i for i in range(k) if i not in dep_s]
         T = sp.zeros(k, k - mv)
         R = sp.zeros(k, k)
@@ -314,6 +321,16 @@ def linearize_first_order(eq, point: dict, velocity: dict | None = None,
     assert len(speeds) == d
     return StateSpaceSystem(dyn, dict(point), E, Ahat, f, coords, speeds, Nh, (T, R),
                             dict(moving))
+
+
+def _ignorable(dyn, A: sp.Matrix, coords: list) -> list[int]:
+    """Indices (in `coords`) of the coordinates absent from L, the forces and the
+    constraints' directions: their positions enter no equation."""
+    absent = set(dyn.q) - dyn.L.free_symbols
+    absent -= set().union(*(f.free_symbols for f in dyn.sys.forces))
+    absent -= set().union(*(x.free_symbols for x in dyn.velocity_jacobian))
+    absent -= set().union(*(c.free_symbols for c in dyn.velocity_rows))
+    return [i for i, q in enumerate(coords) if q in absent]
 
 
 def _null_basis(G: sp.Matrix, dep: list[int]) -> tuple[sp.Matrix, list[int]]:

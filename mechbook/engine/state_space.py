@@ -193,8 +193,7 @@ class StateSpaceSystem:
         """The exponents at `dps` digits (mpmath), structural zeros exact."""
         with mpmath.workdps(dps):
             A = self._mp_state(values, dps)
-            lam = list(mpmath.eig(A, left=False, right=False)) if A.rows else []
-            return lam + [mpmath.mpf(0)] * self.neutral
+            return _eigenvalues(A) + [mpmath.mpf(0)] * self.neutral
 
     def numeric_frequencies(self, values: dict) -> np.ndarray:
         """The oscillation frequencies: |Im p| of each exponent pair ±iω (one per pair);
@@ -202,8 +201,7 @@ class StateSpaceSystem:
         family, cyclic coordinates, conserved speeds) are not frequencies."""
         core = self.numeric_state_matrix(values, core=True)
         lam = np.linalg.eigvals(core) if core.size else np.zeros(0, complex)
-        mags = np.abs(lam[np.abs(lam) > 0])
-        if len(mags) and mags.max() > 1e6 * mags.min():
+        if _ambiguous(lam):
             lam = np.array([complex(x) for x in self.precise_exponents(values)[: core.shape[0]]])
         return _frequencies(lam)
 
@@ -226,6 +224,8 @@ class StateSpaceSystem:
         if not np.all(np.isfinite(core)):
             raise MechbookError("the linearized system has no finite value at this point")
         lam = np.linalg.eigvals(core)
+        if _ambiguous(lam):
+            return self.precise_stability(values)
         scale = max(1.0, float(np.max(np.abs(lam))))
         live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
         return "unstable" if np.any(live.real > 1e-8 * scale) else "stable"
@@ -236,7 +236,7 @@ class StateSpaceSystem:
             A = self._mp_state(values, dps)
             if not A.rows:
                 return "stable"
-            lam = mpmath.eig(A, left=False, right=False)
+            lam = _eigenvalues(A)
             scale = max([abs(x) for x in lam] + [mpmath.mpf(1)])
             tiny = mpmath.mpf(10) ** (12 - dps)
             live = [x for x in lam if abs(x) > mpmath.mpf(10) ** (-dps / 4) * scale]
@@ -244,6 +244,25 @@ class StateSpaceSystem:
 
     def fast_matrices(self, values: dict):
         raise UnsupportedError(FIRST_ORDER.format(what="M, C and K"))
+
+
+def _eigenvalues(A) -> list:
+    """The eigenvalues of an mpmath matrix (mpmath's eig answers a 1×1 matrix otherwise)."""
+    if A.rows == 0:
+        return []
+    if A.rows == 1:
+        return [A[0, 0]]
+    return list(mpmath.eig(A, left=False, right=False))
+
+
+def _ambiguous(lam: np.ndarray) -> bool:
+    """Exponents double precision cannot place: a small one (below 1e-4 of the largest:
+    a zero of a Jordan block, which rounding splits into ±ε^(1/k), or a slow mode beside
+    it) or a spread beyond 1e6. Then the exponents are taken at 40-50 digits."""
+    mags = np.abs(lam)
+    top = float(np.max(mags)) if len(mags) else 0.0
+    small = mags[(mags > 0) & (mags < 1e-4 * top)]
+    return bool(len(small))
 
 
 def _frequencies(lam: np.ndarray) -> np.ndarray:

@@ -134,7 +134,9 @@ def _at(ctx: Context, expr: sp.Basic, state: dict | None) -> sp.Basic:
 @quantity('constraint_force',
           book='expression',
           how=('the generalized force λ·∂f/∂q of constraint `constraint:` on coordinate '
-               "`coordinate:`, as a function of the state, equals the book's (`at:` pins"
+               "`coordinate:` (λ·∂c/∂q̇ of a velocity constraint; a rolling contact's "
+               "`<name>_1`, `<name>_2` are the friction along its tangents), as a function of "
+               "the state on the constraint manifold, equals the book's (`at:` pins"
                ' the constrained coordinates, e.g. `{r: l, rdot: 0}`). `released: {q: '
                'q0, …}` names the state the motion started from (velocities zero unless '
                'given): the one velocity `at:` leaves open is then fixed by the energy '
@@ -149,16 +151,17 @@ def check_constraint_force(ctx: Context, val) -> Verdict:
     a function of the state; `at:` fixes coordinates and velocities the constraint pins
     (e.g. {r: l, rdot: 0} for a string of length l)."""
     dyn = ctx.dyn
-    names = [n for n, _ in ctx.system.constraints]
+    names = [n for n, _ in list(ctx.system.constraints) + list(ctx.system.velocity_constraints)]
     cname = ctx.part.data.get("constraint")
     if cname not in names:
         raise ctx.part.error(("constraint",), f"no constraint {cname!r} (have {names})")
     coord = ctx.part.data.get("coordinate")
     if coord not in ctx.system.coord_names:
         raise ctx.part.error(("coordinate",), f"{coord!r} is not a coordinate")
-    f = ctx.system.constraints[names.index(cname)][1]
-    q = ctx.system.q[ctx.system.coord_names.index(coord)]
-    engine = dyn.solved[dyn.multipliers[names.index(cname)]] * sp.diff(f, q)
+    j = names.index(cname)
+    i = ctx.system.coord_names.index(coord)
+    # its row of A (∂g/∂q of a holonomic constraint, ∂c/∂q̇ of a velocity constraint)
+    engine = dyn.solved[dyn.multipliers[j]] * dyn.velocity_jacobian[j, i]
     book = ctx.parse(val, ("book",))
     at = {}
     for k, v in (ctx.part.data.get("at") or {}).items():
