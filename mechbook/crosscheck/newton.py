@@ -26,6 +26,7 @@ from mechbook.core.backends import FEW_CALLS_BACKEND
 from mechbook.core.compile import compile_exprs
 from mechbook.core.secalc import either, same
 from mechbook.crosscheck.assembly import composite_inertia
+from mechbook.crosscheck.contact import on_manifold
 from mechbook.crosscheck.guard import guarded
 from mechbook.crosscheck.kinematics import (
     body_angular_velocity,
@@ -321,169 +322,6 @@ def _attractors(sys, spec, positions, masses, frames, parse) -> tuple[dict, list
     return pulls, torque_q
 
 
-def _tangents(n: sp.Matrix) -> list[sp.Matrix]:
-    """The tangent basis of a contact's plane, by the convention docs/schema.md states (in
-    space: t1 the first coordinate axis not along n made orthogonal to it, t2 = n × t1; in
-    a plane: n turned by −90°), built here from that statement."""
-    if n.rows == 2:
-        return [sp.Matrix([n[1], -n[0]])]
-    for k in range(3):
-        e = sp.Matrix([1 if i == k else 0 for i in range(3)])
-        w = e - e.dot(n) * n
-        if sp.N(w.dot(w)) > 1e-6:
-            t1 = w / sp.sqrt(w.dot(w))
-            return [t1, n.cross(t1)]
-    raise UnsupportedError("Newton cross-check: a contact's normal is zero")
-
-
-def _contact_point(spec: dict, c: dict, sub: tuple, r: sp.Matrix, frame, n: sp.Matrix,
-                   parse) -> sp.Matrix:
-    """Where a rolling body touches the plane: its `point`, or from its shape with this
-    module's own attitude R (a sphere at r − ρn; a disk, ring or cylinder at r − ρu, u the
-    unit part of n normal to its own z axis Rẑ; a planar body at r − ρn)."""
-    if "point" in c:
-        return sp.Matrix([parse(x, sub + ("point", j)) for j, x in enumerate(c["point"])])
-    body = c["body"]
-    inertia = spec["rigid_bodies"][body]["inertia"]
-    rho = parse(inertia["radius"], ("rigid_bodies", body, "inertia", "radius"))
-    R = frame[2] if frame is not None else None
-    if inertia["shape"] in ("solid_sphere", "spherical_shell") or R is None:
-        return r - rho * n
-    e = R * sp.Matrix([0, 0, 1])
-    w = n - n.dot(e) * e
-    return r - rho * w / sp.sqrt(w.dot(w))
-
-
-def _constraint_forces(sys, spec: dict, positions: dict, frames: dict, parse,
-                       multipliers: list) -> tuple[list[sp.Expr], list[sp.Expr]]:
-    """(generalized forces of the constraints, rolling rows) given their multipliers, from
-    the file here: λ·∂g/∂q of a holonomic constraint, λ·∂c/∂q̇ of a velocity constraint, and
-    for a rolling contact the friction Σ λ_k t_k acting at the contact point, Q = F·∂v/∂q̇
-    with this module's own contact velocity v = v_G + ω × (P − r_G) (less the surface's),
-    whose tangential components are returned too (the rows rolling adds)."""
-    n = len(sys.q)
-    out = [sp.S.Zero] * n
-    lam = iter(multipliers)
-    for i, c in enumerate(spec.get("constraints") or []):
-        g = parse(c["expr"], ("constraints", i, "expr"))
-        mu = next(lam)
-        out = [o + mu * sp.diff(g, q) for o, q in zip(out, sys.q, strict=True)]
-    for i, c in enumerate(spec.get("velocity_constraints") or []):
-        k = parse(c["expr"], ("velocity_constraints", i, "expr"))
-        mu = next(lam)
-        out = [o + mu * sp.diff(k, v) for o, v in zip(out, sys.qd, strict=True)]
-    rows = []
-    for i, c in enumerate(spec.get("rolling") or []):
-        sub = ("rolling", i)
-        body = c["body"]
-        r = positions[body]
-        surface = c.get("surface") or {}
-        nv = (sp.Matrix([parse(x, sub + ("surface", "normal", j))
-                         for j, x in enumerate(surface["normal"])]) if "normal" in surface
-              else sp.Matrix([0] * (r.rows - 1) + [1]))
-        nv = nv / sp.sqrt(nv.dot(nv))
-        frame = frames.get(body)
-        p = _contact_point(spec, c, sub, r, frame, nv, parse)
-        v = sys.dt(r)
-        _, omega, R = frame
-        d = p - r
-        if R is None and omega.rows == 1:  # planar
-            v = v + sp.Matrix([-omega[0] * d[1], omega[0] * d[0]])
-        else:
-            v = v + (R * omega if R is not None else omega).cross(d)
-        if "velocity" in surface:
-            v = v - sp.Matrix([parse(x, sub + ("surface", "velocity", j))
-                               for j, x in enumerate(surface["velocity"])])
-        force = sp.zeros(r.rows, 1)
-        for t in _tangents(nv):
-            force += next(lam) * t
-            rows.append(v.dot(t))
-        out = [o + force.dot(sp.diff(v, qd)) for o, qd in zip(out, sys.qd, strict=True)]
-    return out, rows
-
-
-def _on_shell(analysis: Analysis, sys, newton: list, samples: int
-              ) -> tuple[float, float, int]:
-    """(worst relative difference of the rolling rows, worst relative force imbalance,
-    states) on the constraint manifold: each rolling contact's own tangential velocity
-    against the engine's constraint rows, and Newton–Euler with the contact forces: at
-    the engine's accelerations and multipliers (its equations solved numerically there),
-    Σ J·(m r̈ − F) + Euler terms equals the constraints' forces built here from the
-    multipliers."""
-    from mechbook.model.manifold import manifold_of
-
-    dyn = analysis.dynamics(sys.name)
-    spec = sys.spec
-    particles = dict(spec.get("particles") or {})
-    bodies = dict(spec.get("rigid_bodies") or {})
-    parse = sys._parse
-    positions = {name: sys.positions[name] for name in list(particles) + list(bodies)}
-    masses = {name: sys.masses[name] for name in positions}
-    frames = {name: _body_frame(sys, name, b, masses[name], parse) for name, b in bodies.items()}
-    lam = list(dyn.multipliers)
-    forces, rows = _constraint_forces(sys, spec, positions, frames, parse, lam)
-    engine_rows = [c for name, c in sys.velocity_constraints][
-        len(spec.get("velocity_constraints") or []):]
-    params = [p.symbol for p in sys.params.values()]
-    args = [sys.t, *sys.q, *sys.qd, *sys.qdd, *lam, *params]
-    n, m = len(sys.q), len(lam)
-    exprs = (list(dyn.residuals) + newton + forces + list(dyn.velocity_jacobian)
-             + list(dyn.constraint_bias) + rows + engine_rows)
-    fn, _ = compile_exprs(args, exprs, FEW_CALLS_BACKEND)
-    manifold = manifold_of(sys)
-    rng = np.random.default_rng(20261129)
-    base = np.array([p.value for p in sys.params.values()])
-    positive = np.array([p.positive for p in sys.params.values()])
-    worst_rows = worst_force = 0.0
-    used = 0
-    for _ in range(10 * samples):
-        if used >= samples:
-            break
-        pv = np.where(positive, base * np.exp(rng.uniform(-0.3, 0.3, len(base))),
-                      base + rng.uniform(-0.3, 0.3, len(base)))
-        values = dict(zip(params, pv, strict=True))
-        t0 = float(rng.uniform(0, 1))
-        settled = manifold.settle(values, rng.uniform(0.05, 0.6, n), rng.uniform(-1, 1, n), t0)
-        if settled is None:
-            continue
-        q, qd = np.array(settled[0]), np.array(settled[1])
-        state = np.concatenate(([t0], q, qd))
-        at = partial(_evaluate, fn, state, pv)
-        zero = at(np.zeros(n), np.zeros(m))
-        e0 = zero[:n]
-        M = np.column_stack([at(np.eye(n)[k], np.zeros(m))[:n] - e0 for k in range(n)])
-        k = 3 * n
-        A = zero[k: k + m * n].reshape(m, n)
-        bias = zero[k + m * n: k + m * n + m]
-        kkt = np.block([[M, -A.T], [A, np.zeros((m, m))]])
-        if not (np.all(np.isfinite(kkt)) and np.all(np.isfinite(zero))):
-            continue
-        sol = np.linalg.solve(kkt, np.concatenate((-e0, -bias)))
-        val = at(sol[:n], sol[n:])
-        nw, fc = val[n: 2 * n], val[2 * n: 3 * n]
-        scale = max(float(np.max(np.abs(nw))), float(np.max(np.abs(fc))),
-                    float(np.max(np.abs(M @ sol[:n]))), 1e-300)
-        worst_force = max(worst_force, float(np.max(np.abs(nw - fc))) / scale)
-        r = len(rows)
-        if r:
-            own = val[k + m * n + m: k + m * n + m + r]
-            eng = val[k + m * n + m + r:]
-            size = max(float(np.max(np.abs(own))), float(np.max(np.abs(eng))),
-                       float(np.max(np.abs(qd))), 1e-300)
-            worst_rows = max(worst_rows, float(np.max(np.abs(own - eng))) / size)
-        used += 1
-    if used < 3:
-        raise MechbookError("Newton cross-check: no states on the constraint manifold "
-                            "evaluate")
-    return worst_rows, worst_force, used
-
-
-def _evaluate(fn, state: np.ndarray, params: np.ndarray, qdd: np.ndarray,
-              multipliers: np.ndarray) -> np.ndarray:
-    with np.errstate(all="ignore"):
-        return fn(np.concatenate((state, qdd, multipliers, params)))
-
-
 def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     dyn = analysis.dynamics(sys.name)
     newton = _newton_residual(sys)
@@ -525,7 +363,9 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     out.status = Status.PASS if worst < NEWTON_TOL else Status.FAIL
     out.detail = _what_was_compared(sys.spec, used, worst)
     if sys.constraints or sys.velocity_constraints:
-        rows, force, states = _on_shell(analysis, sys, newton, samples)
+        frames = {k: _body_frame(sys, k, b, sys.masses[k], sys._parse)
+                  for k, b in (sys.spec.get("rigid_bodies") or {}).items()}
+        rows, force, states = on_manifold(analysis, sys, newton, frames, samples)
         out.error = max(worst, rows, force)
         if max(rows, force) >= NEWTON_TOL:
             out.status = Status.FAIL
