@@ -40,7 +40,7 @@ PROBLEM_COUNTS = {
 }
 SYSTEM_COUNTS = {
     "coordinates": 16, "driven": 16, "particles": 32, "rigid_bodies": 32, "springs": 64,
-    "constraints": 16, "forces": 16, "initial": 64,
+    "constraints": 16, "velocity_constraints": 16, "rolling": 8, "forces": 16, "initial": 64,
 }
 ANSWER_COUNTS = {"parts": 64, "abbreviations": 64, "symbols": 64}
 PART_COUNTS = {"assume": 32, "define": 32}
