@@ -17,6 +17,7 @@ from constrained_systems import (
     write_tree,
 )
 
+from mechbook.app.validate import build_systems
 from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError
@@ -250,3 +251,48 @@ def test_initial_state_off_the_manifold(tmp_path):
         simulate(an, None, t_span=(0.0, 1.0))
     assert "not on the constraint manifold" in str(exc.value)
     assert "blade" in str(exc.value) and "9512.yaml:" in str(exc.value)
+
+
+def test_rolling_contact_that_leaves_the_surface_is_refused(tmp_path):
+    """The coin's centre held at height R whatever its tilt: tilted, its rim's lowest point
+    leaves the plane, so rolling there is not a velocity constraint alone."""
+    problem = COIN.replace("SHAPE", "disk").replace("[x, y, R*sin(theta)]", "[x, y, R]")
+    ppath, _ = write_tree(tmp_path, "9513", problem, key(""))
+    with pytest.raises(MechbookError) as exc:
+        build_systems(load_problem(ppath))
+    assert "leaves the surface" in str(exc.value) and "9513.yaml:" in str(exc.value)
+
+
+def test_dependent_constraints_are_refused(tmp_path):
+    from constrained_systems import CIRCLE
+
+    problem = CIRCLE.replace('  - {name: rod, expr: "x**2 + y**2 - l**2"}\n',
+                             '  - {name: rod, expr: "x**2 + y**2 - l**2"}\n'
+                             '  - {name: again, expr: "2*x**2 + 2*y**2 - 2*l**2"}\n')
+    ppath, _ = write_tree(tmp_path, "9514", problem, key(""))
+    with pytest.raises(MechbookError) as exc:
+        build_systems(load_problem(ppath))
+    assert "constraints are dependent" in str(exc.value) and "9514.yaml:" in str(exc.value)
+
+
+def test_dependent_velocity_constraints_are_refused(tmp_path):
+    problem = SLEIGH.replace(
+        '  - {name: blade, expr: "-xdot*sin(theta) + ydot*cos(theta)"}\n',
+        '  - {name: blade, expr: "-xdot*sin(theta) + ydot*cos(theta)"}\n'
+        '  - {name: twice, expr: "-2*xdot*sin(theta) + 2*ydot*cos(theta)"}\n')
+    ppath, _ = write_tree(tmp_path, "9515", problem, key(""))
+    with pytest.raises(MechbookError) as exc:
+        build_systems(load_problem(ppath))
+    assert "velocity constraints are dependent" in str(exc.value)
+
+
+@pytest.mark.parametrize("book, status", [
+    # Newton along the slope and about the centre, with the friction λ along +x
+    ('["m*xddot = m*g*sin(alpha) + lambda_contact", '
+     '"m*R**2*phiddot = -R*lambda_contact"]', "pass"),
+    ('["m*xddot = m*g*sin(alpha) - lambda_contact"]', "fail"),
+])
+def test_hoop_equations_with_the_multiplier(tmp_path, book, status):
+    out = check(tmp_path, "9516", HOOP, key(
+        f"  - part: a\n    cite: hoop\n    quantity: eom\n    book: {book}\n"))["a"]
+    assert out.status == status, out.detail

@@ -137,7 +137,7 @@ class StateManifold:
             if not cols or worst > 1e6 * first:
                 return False  # diverging: no configuration near this start
             G = _columns(self._matrix(self._jacobian, env), cols)
-            step = G.T * mpmath.lu_solve(G * G.T, mpmath.matrix(g))
+            step = _least_norm(G, mpmath.matrix(g))
             if not all(mpmath.isfinite(x) for x in step):
                 return False
             for k, j in enumerate(cols):
@@ -156,8 +156,7 @@ class StateManifold:
         v = mpmath.matrix([env[x] for x in self.qd])
         r = A * v + b
         if cols:
-            Af = _columns(A, cols)
-            step = Af.T * mpmath.lu_solve(Af * Af.T, r)
+            step = _least_norm(_columns(A, cols), r)
             for k, j in enumerate(cols):
                 env[self.qd[j]] = mpmath.re(v[j] - step[k])
         v = mpmath.matrix([env[x] for x in self.qd])
@@ -231,6 +230,17 @@ class StateManifold:
         return Freedoms(n - holonomic, n - both)
 
 
+def _least_norm(G, r):
+    """Gᵀ(GGᵀ + δ)⁻¹r: the least-norm step, δ = 10^(5 − WORK)·max|G|² keeping it defined
+    where rows repeat (a redundant constraint, refused by `check_constraint_set` with its
+    line) at no cost to a full-rank G's 30 digits."""
+    size = max([abs(x) for x in G] + [mpmath.mpf(10) ** -300])
+    GG = G * G.T
+    for i in range(GG.rows):
+        GG[i, i] += mpmath.mpf(10) ** (5 - WORK) * size**2
+    return G.T * mpmath.lu_solve(GG, r)
+
+
 def _columns(A, cols: list[int]):
     out = mpmath.matrix(A.rows, len(cols))
     for i in range(A.rows):
@@ -263,3 +273,68 @@ def manifold_of(system) -> StateManifold | None:
     """The state manifold of a constrained system (None without constraints)."""
     m = StateManifold(system)
     return None if m.empty else m
+
+
+def check_constraint_set(system, starts: int = 8) -> None:
+    """SpecError (file:line, what is wrong) for constraints that are dependent at every
+    state tried on the manifold (one repeats what the others say: its multiplier is not
+    determined), and for a rolling contact whose point leaves the surface (its velocity
+    along the normal does not vanish: the coordinates do not keep the body on it). Judged
+    at states projected from random starts; where none projects, the engine judges later."""
+    manifold = manifold_of(system)
+    if manifold is None:
+        return
+    import random
+
+    rng = random.Random(20261129)
+    values = {k: sp.Float(v, DIGITS) for k, v in system.numeric_values().items()}
+    states = []
+    for _ in range(starts):
+        start = {q: sp.Float(rng.uniform(-1, 1)) for q in manifold.q}
+        start.update({v: sp.Float(rng.uniform(-1, 1)) for v in manifold.qd})
+        point = manifold.project({**values, **start, manifold.t: sp.Float(rng.uniform(0, 1))})
+        if point is not None:
+            states.append(point)
+    if not states:
+        return
+    n = len(manifold.q)
+    holonomic = len(manifold.position)
+    ranks = [manifold.freedoms(pt) for pt in states]
+    if holonomic and all(n - f.configuration < holonomic for f in ranks):
+        r = max(n - f.configuration for f in ranks)
+        raise system._error(("constraints",), f"the constraints are dependent: their Jacobian "
+                            f"has rank {r} for {holonomic} constraints at every state tried "
+                            "(one repeats what the others say, and its multiplier is not "
+                            "determined): remove the redundant one")
+    rows = holonomic + len(manifold.velocity)
+    if len(manifold.velocity) and all(n - f.velocity < rows for f in ranks):
+        r = max(n - f.velocity for f in ranks)
+        key = "rolling" if system.spec.get("rolling") else "velocity_constraints"
+        raise system._error((key,), f"the velocity constraints are dependent: with the "
+                            f"holonomic ones their rows have rank {r} for {rows} constraints "
+                            "at every state tried (one repeats what the others say): remove "
+                            "the redundant one")
+    _contacts_stay_on(system, states)
+
+
+def _contacts_stay_on(system, states: list[dict]) -> None:
+    from mechbook.model.rolling import relative_velocity
+
+    for i, spec in enumerate(system.spec.get("rolling") or []):
+        v, n = relative_velocity(system, spec, ("rolling", i))
+        normal = v.dot(n)
+        worst = 0.0
+        for pt in states:
+            try:
+                value, scale = evaluate(normal, pt, DIGITS)
+            except _FAULTS:
+                continue
+            speed = max(float(abs(pt[x])) for x in system.qd) if system.qd else 1.0
+            worst = max(worst, abs(value) / max(scale, speed, 1e-300))
+        if worst > 1e-12:
+            raise system._error(("rolling", i), f"rolling contact {spec['name']!r}: the "
+                                f"contact point leaves the surface (its velocity along the "
+                                f"normal, {sp.sstr(normal)[:100]}, is not zero): choose "
+                                "coordinates that keep the body on the surface (its height a "
+                                "function of the others), or add the holonomic constraint "
+                                "that does")

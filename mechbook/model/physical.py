@@ -18,6 +18,8 @@ import random
 import numpy as np
 import sympy as sp
 
+from mechbook.model.manifold import check_constraint_set
+
 POINTS = 5  # random points; refused only if the mass matrix is not positive definite at all
 SEED = 20260521
 
@@ -27,6 +29,7 @@ def check_physical(system) -> None:
     values = system.numeric_values()
     _masses(system, values)
     _mass_matrix(system, values)
+    check_constraint_set(system)  # dependent constraints; a rolling body off its surface
 
 
 def _masses(system, values: dict) -> None:
@@ -108,6 +111,8 @@ def _derivatives(system) -> tuple[list, list, list[str]]:
     hess = [[grad[i].diff(vel[j]) for j in range(len(vel))] for i in range(len(vel))]
     coords = [se.sympify(q) for q in system.q]
     jac = [[se.sympify(f).diff(q) for q in coords] for _, f in system.constraints]
+    jac += [[se.sympify(c).diff(v) for v in vel]  # A of A·q̇ + b = 0: a function of q
+            for _, c in getattr(system, "velocity_constraints", [])]
     args = set()
     for e in [x for row in hess + jac for x in row]:
         args |= {str(a) for a in e.free_symbols}

@@ -55,6 +55,9 @@ class Context:
             self.names = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
             for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
                 self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
+            for c, _ in list(self.system.constraints) + list(self.system.velocity_constraints):
+                name = "lambda_" + c  # a constraint's multiplier, as the engine names it
+                self.names.setdefault(name, sp.Symbol(name, real=True))
         if self.system is not None and not self.tensor_mode:
             for k, v in (self.part.data.get("define") or {}).items():  # e.g. alpha = theta - pi
                 if k in self.names:

@@ -31,8 +31,9 @@ def check_lagrangian(ctx: Context, val) -> Verdict:
 @quantity('eom',
           book='list of equations',
           how=("each holds once the engine's solved accelerations are substituted "
-               '(linearized ones with `about`); so any nonzero multiple of an equation '
-               'is accepted, and each must contain an acceleration'),
+               '(linearized ones with `about`; with constraints the multipliers '
+               '`lambda_<name>` too, on the constraint manifold); so any nonzero multiple of '
+               'an equation is accepted, and each must contain an acceleration'),
           crosschecks=("newton",), display="equations_of_motion")
 def check_eom(ctx: Context, val) -> Verdict:
     """Each book equation holds once the engine's accelerations are substituted
@@ -41,6 +42,8 @@ def check_eom(ctx: Context, val) -> Verdict:
            for i, v in enumerate(ctx.as_list(val, ("book",)))]
     if "about" in ctx.part.data:
         acc = linear_accelerations(ctx.linear())
+    elif ctx.dyn.constrained:  # the multipliers solved with the accelerations
+        acc = dict(ctx.dyn.solved)
     else:
         acc = dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True))
     out = []
