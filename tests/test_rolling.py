@@ -296,3 +296,33 @@ def test_hoop_equations_with_the_multiplier(tmp_path, book, status):
     out = check(tmp_path, "9516", HOOP, key(
         f"  - part: a\n    cite: hoop\n    quantity: eom\n    book: {book}\n"))["a"]
     assert out.status == status, out.detail
+
+
+def test_api_linearization_of_a_rolling_coin(tmp_path):
+    """The Python API's Linearizer-like view: states, A, freedoms, exponents."""
+    import mechbook
+
+    write_tree(tmp_path, "9517", COIN.replace("SHAPE", "disk"), key(""))
+    coin = mechbook.load("lim-9517", tmp_path, simplify=False)
+    lin = coin.linearize(about={"phi": 0, "theta": "pi/2", "psi": 0}, steady={"psi": "Omega"})
+    assert lin.M is None and lin.A.shape == (8, 8) and lin.B.shape == (8, 0)
+    assert (lin.freedoms.configuration, lin.freedoms.velocity) == (5, 3)
+    values = {"m": 0.4, "R": 0.3, "g": 9.81, "Omega": 5.0}
+    wobble = np.sqrt((12 * 25.0 - 4 * 9.81 / 0.3) / 5)
+    assert abs(lin.frequencies(values)[0] - wobble) < 1e-10 * wobble
+    assert lin.stability(values) == "stable"
+    assert lin.stability({**values, "Omega": 0.9 * np.sqrt(9.81 / 0.9)}) == "unstable"
+    lam = lin.exponents(values)
+    assert np.sort(np.abs(lam.imag))[-1] == pytest.approx(wobble, rel=1e-10)
+
+
+def test_api_linearization_second_order(tmp_path):
+    import mechbook
+    from constrained_systems import CIRCLE
+
+    write_tree(tmp_path, "9518", CIRCLE, key(""))
+    p = mechbook.load("lim-9518", tmp_path, simplify=False)
+    lin = p.linearize(about={"x": 0, "y": "-l"})
+    g, l = (sp.Symbol("g", positive=True), sp.Symbol("l", positive=True))  # noqa: E741
+    assert lin.A == sp.Matrix([[0, 1], [-g / l, 0]])
+    assert lin.M is not None and lin.freedoms.velocity == 1

@@ -26,6 +26,7 @@ from typing import Any
 import sympy as sp
 
 from mechbook.app.display import MathDict, MathList
+from mechbook.app.linearization import Linearization, linearization
 from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
 from mechbook.engine.analysis import Analysis
@@ -144,6 +145,49 @@ class SystemView:
         """The linearized system M·δq̈ + C·δq̇ + K·δq = F about an equilibrium."""
         return self._an.linear(self.name, self.point(about))
 
+    def linearize(self, about: dict | None = None, steady: dict | None = None,
+                  reduce: bool | None = None) -> Linearization:
+        """The linearization about an equilibrium, or about a steady motion, as
+        sympy.physics.mechanics' Linearizer gives it: ż = A·z + B·r, with M, C, K where it
+        is second order, and the degrees of freedom there.
+
+        Parameters
+        ----------
+        about : dict, optional
+            {coordinate name: value (text or number)}: the point (the coordinates at rest in
+            a steady motion). Default: the system's one stable equilibrium.
+        steady : dict, optional
+            {coordinate name: rate} of a steady motion; the rates a constraint fixes (a
+            rolling body's centre) are solved for.
+        reduce : bool, optional
+            Routh's reduction of a steady motion (default: yes, unless the system has
+            constraints: then it is linearized in full).
+
+        Returns
+        -------
+        Linearization
+            `A`, `B`, `states`, `inputs`, `M`, `C`, `K`, `freedoms`; `exponents()`,
+            `frequencies()`, `stability()` at the default or given parameter values.
+
+        Examples
+        --------
+        >>> coin = mechbook.load("mybook-3.1")                      # doctest: +SKIP
+        >>> lin = coin.linearize(about={"phi": 0, "theta": "pi/2", "psi": 0},
+        ...                      steady={"psi": "Omega"})           # doctest: +SKIP
+        >>> lin.A.shape, lin.freedoms                                # doctest: +SKIP
+        """
+        point = self.point(about) if (about is not None or not steady) else {}
+        model = self.problem.model
+        if steady:
+            rates = self.point(steady)
+            sys = self._sys
+            if reduce is None:
+                reduce = not (sys.constraints or sys.velocity_constraints)
+            lin = self._an.steady_linear(self.name, rates, point, reduce)
+        else:
+            lin = self._an.linear(self.name, point)
+        return linearization(lin, model.values())
+
     def frequencies(self, about: dict | None = None, numeric: bool = False) -> list:
         """Normal angular frequencies about an equilibrium: SymPy expressions, or floats at
         the default parameter values with `numeric=True`."""
@@ -247,6 +291,11 @@ class Problem:
 
     def frequencies(self, about: dict | None = None, numeric: bool = False) -> list:
         return self.system().frequencies(about, numeric)
+
+    def linearize(self, about: dict | None = None, steady: dict | None = None,
+                  reduce: bool | None = None) -> Linearization:
+        """The only system's linearization (SystemView.linearize)."""
+        return self.system().linearize(about, steady, reduce)
 
     def modes(self, about: dict | None = None):
         return self.system().modes(about)

@@ -51,6 +51,7 @@ from itertools import combinations
 import numpy as np
 import sympy as sp
 
+from mechbook.core.expansion import trig_canonical
 from mechbook.core.numeval import NotNumeric, evaluate, without_absent
 from mechbook.engine.linear import LinearSystem
 from mechbook.engine.residual import is_zero, show_point
@@ -303,8 +304,8 @@ def linearize_first_order(eq, point: dict, velocity: dict | None = None,
     P = Nh * T
     Pt = P.T
 
-    def tidy(X: sp.Matrix) -> sp.Matrix:
-        return X.applyfunc(sp.cancel)
+    def tidy(X: sp.Matrix) -> sp.Matrix:  # cos² + sin² collapsed, then one fraction
+        return X.applyfunc(lambda x: sp.cancel(trig_canonical(x)))
 
     Mr = tidy(Pt * M * P)
     if not mv:  # second order over δs: a LinearSystem, as at rest

@@ -105,7 +105,7 @@ def derive(analysis: Analysis, system: str | None = None,
                 res.text[f"{tag}/point"] = show(point)
                 try:
                     res.text[f"{tag}/stability"] = lin.numeric_stability(values)
-                    if not lin.gyroscopic:
+                    if not lin.gyroscopic and not lin.first_order:
                         res.text[f"{tag}/stable_if"] = show(lin.stability_condition)
                 except (TypeError, ValueError):
                     res.notes[f"{tag}/stability"] = "does not evaluate at the default values"
@@ -131,6 +131,9 @@ def _ranges(sys, search: dict | None) -> dict | None:
 
 
 def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
+    if lin.first_order:
+        _first_order(res, lin, tag, values, show)
+        return
     res.text[f"{tag}/M"] = show(lin.M.tolist())
     res.text[f"{tag}/K"] = show(lin.K.tolist())
     if lin.gyroscopic:
@@ -147,6 +150,23 @@ def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
     if not lin.gyroscopic:
         w2, modes = lin.numeric_modes(values)
         res.arrays[f"{tag}/modes"] = modes
+
+
+def _first_order(res: Results, lin, tag: str, values: dict, text) -> None:
+    """A first-order linearization (velocity constraints): its states, E and Â of
+    E·ż = Â·z as text, and at the default values the state matrix A = E⁻¹Â, the exponents
+    and the frequencies."""
+    res.text[f"{tag}/states"] = text(lin.states)
+    res.text[f"{tag}/E"] = text(lin.E.tolist())
+    res.text[f"{tag}/Ahat"] = text(lin.Ahat.tolist())
+    try:
+        res.arrays[f"{tag}/A"] = lin.numeric_state_matrix(values)
+        lam = lin.exponents(values)
+        res.arrays[f"{tag}/exponents_real"] = lam.real
+        res.arrays[f"{tag}/exponents_imag"] = lam.imag
+        res.arrays[f"{tag}/frequencies"] = lin.numeric_frequencies(values)
+    except (TypeError, ValueError, MechbookError, ZeroDivisionError) as exc:
+        res.notes[f"{tag}/numeric"] = f"not evaluated at the default values: {exc}"
 
 
 _DYNAMICS_TEXT = ("mass_matrix", "forcing", "momenta", "cyclic", "energy_function",
@@ -220,6 +240,9 @@ def computed(analysis: Analysis) -> list[Results]:
             res.text[f"{tag}/point"] = _stored(lin.point)
             if lin.dyn.sys.reduced:
                 res.text[f"{tag}/steady_momenta"] = _stored(lin.dyn.sys.held_momenta)
+            if lin.first_order:
+                _first_order(res, lin, tag, values, _stored)
+                continue
             for m in ("M", "C", "K"):
                 res.text[f"{tag}/{m}"] = _stored(getattr(lin, m).tolist())
             try:
