@@ -264,8 +264,8 @@ def _mpf(v):
         return v
     if isinstance(v, sp.Float):
         return mpmath.mpf(v._mpf_)
-    if isinstance(v, sp.Basic):
-        return mpmath.mpf(sp.Float(v, WORK)._mpf_)
+    if isinstance(v, sp.Basic):  # an exact number (pi/2): its value at the working precision
+        return mpmath.mpf(sp.N(v, WORK)._mpf_)
     return mpmath.mpf(v)
 
 
