@@ -265,7 +265,7 @@ def _mpf(v):
     if isinstance(v, sp.Float):
         return mpmath.mpf(v._mpf_)
     if isinstance(v, sp.Basic):  # an exact number (pi/2): its value at the working precision
-        return mpmath.mpf(sp.N(v, WORK)._mpf_)
+        return mpmath.mpf(sp.Float(sp.N(v, WORK), WORK)._mpf_)
     return mpmath.mpf(v)
 
 
