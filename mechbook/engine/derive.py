@@ -157,6 +157,8 @@ def _first_order(res: Results, lin, tag: str, values: dict, text) -> None:
     E·ż = Â·z as text, and at the default values the state matrix A = E⁻¹Â, the exponents
     and the frequencies."""
     res.text[f"{tag}/states"] = text(lin.states)
+    if lin.velocity:
+        res.text[f"{tag}/rates"] = text(dict(lin.velocity))
     res.text[f"{tag}/E"] = text(lin.E.tolist())
     res.text[f"{tag}/Ahat"] = text(lin.Ahat.tolist())
     try:

@@ -226,9 +226,7 @@ class StateSpaceSystem:
         lam = np.linalg.eigvals(core)
         if _ambiguous(lam):
             return self.precise_stability(values)
-        scale = max(1.0, float(np.max(np.abs(lam))))
-        live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
-        return "unstable" if np.any(live.real > 1e-8 * scale) else "stable"
+        return classify_exponents(lam)
 
     def precise_stability(self, values: dict, dps: int = 40) -> str:
         """`numeric_stability` with the core and its eigenvalues at `dps` digits."""
@@ -244,6 +242,16 @@ class StateSpaceSystem:
 
     def fast_matrices(self, values: dict):
         raise UnsupportedError(FIRST_ORDER.format(what="M, C and K"))
+
+
+def classify_exponents(lam: np.ndarray) -> str:
+    """'stable' or 'unstable' from exponents in double precision: a real part beyond 1e-8 of
+    the largest is a growth; a zero cluster (ZERO_CLUSTER of the largest) is neutral."""
+    if not len(lam):
+        return "stable"
+    scale = max(1.0, float(np.max(np.abs(lam))))
+    live = lam[np.abs(lam) > ZERO_CLUSTER * scale]
+    return "unstable" if np.any(live.real > 1e-8 * scale) else "stable"
 
 
 def _eigenvalues(A) -> list:

@@ -26,18 +26,24 @@ _LINEAR = re.compile(r"linear_(\d+)/point")
 
 @dataclass
 class Linear:
-    """A linear system the check built: M·δq̈ + C·δq̇ + K·δq = F about `point`."""
+    """A linear system the check built: M·δq̈ + C·δq̇ + K·δq = F about `point`, or (with
+    velocity constraints) first order, E·ż = Â·z (M, C, K None; engine.state_space)."""
 
     point: dict  # {coordinate symbol: value}
-    M: sp.Matrix
-    C: sp.Matrix
-    K: sp.Matrix
+    M: sp.Matrix | None
+    C: sp.Matrix | None
+    K: sp.Matrix | None
     steady: dict | None  # held momenta of a steady motion (Routh), None for an equilibrium
     numeric: dict  # the arrays stored for it (M, K, frequencies, growth_rates)
+    first_order: bool = False  # E, Â stored instead; `rates` the steady motion's, if one
+    rates: dict | None = None
 
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, C, K at `values` (30 digits, core.numeval); MechbookError where a symbol has
         no value there (a point in an answer's own symbols)."""
+        if self.first_order:
+            raise MechbookError("a first-order linearization (velocity constraints) has no "
+                                "M, C, K")
         out = []
         for A in (self.M, self.C, self.K):
             left = A.free_symbols - set(values)
@@ -82,14 +88,19 @@ class StoredSystem:
             if not m:
                 continue
             tag = f"linear_{m.group(1)}"
+            numeric = {k.split("/", 1)[1]: v for k, v in self.arrays.items()
+                       if k.startswith(tag + "/")}
             try:
                 point = self._point(self.get(key))
+                if f"{tag}/Ahat" in self.text:  # first order: its numbers are stored
+                    rates = self.get(f"{tag}/rates")
+                    out.append(Linear(point, None, None, None, None, numeric, True,
+                                      rates if isinstance(rates, dict) else None))
+                    continue
                 M, C, K = (matrix(self.get(f"{tag}/{x}")) for x in ("M", "C", "K"))
                 steady = self.get(f"{tag}/steady_momenta")
             except MechbookError:
                 continue
-            numeric = {k.split("/", 1)[1]: v for k, v in self.arrays.items()
-                       if k.startswith(tag + "/")}
             out.append(Linear(point, M, C, K, steady if isinstance(steady, dict) else None,
                               numeric))
         return out
@@ -98,7 +109,7 @@ class StoredSystem:
         """The stored linear system about `point` (the same expressions, or the same
         numbers at `values`)."""
         for lin in self.linears:
-            if (lin.steady is not None) != steady:
+            if (lin.steady is not None or bool(lin.rates)) != steady:
                 continue
             if same_point(lin.point, point, values):
                 return lin

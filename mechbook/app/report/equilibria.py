@@ -21,6 +21,7 @@ from mechbook.core.numeval import NotNumeric, evaluate
 from mechbook.engine.domains import existing
 from mechbook.engine.growth import growth_rates
 from mechbook.engine.linear import classify_matrices
+from mechbook.engine.state_space import classify_exponents
 from mechbook.errors import MechbookError
 
 MAX_ROWS = 8
@@ -59,8 +60,10 @@ def _row(page, sys_, point: dict, lin, values: dict) -> dict:
     if lin is None:
         row["stability"] = "not linearized by the check"
         return row
-    if lin.steady is not None:
+    if lin.steady is not None or lin.rates:
         row["kind"] = "steady motion"
+    if lin.first_order:
+        return _first_order_row(row, lin)
     try:
         M, C, K = lin.matrices(values)
     except MechbookError:
@@ -81,6 +84,20 @@ def _row(page, sys_, point: dict, lin, values: dict) -> dict:
         if exact is not None and row["stability"] == "stable":
             row["exact"] = page.show(sp.Eq(sp.Symbol("omega_1"), exact, evaluate=False),
                                      simplify=False)
+    return row
+
+
+def _first_order_row(row: dict, lin) -> dict:
+    """A first-order linearization's row, from the numbers the check stored at the default
+    values: its exponents decide the stability, its oscillating pairs give frequencies."""
+    real, imag = lin.numeric.get("exponents_real"), lin.numeric.get("exponents_imag")
+    if real is None or imag is None:
+        row["stability"] = "in the answer's own symbols: no numbers at the default values"
+        return row
+    row["stability"] = classify_exponents(np.asarray(real) + 1j * np.asarray(imag))
+    freqs = lin.numeric.get("frequencies")
+    row["frequencies"] = [f"ω = {float(w):.6g}" if np.isfinite(w) else "unstable"
+                          for w in (freqs if freqs is not None else [])]
     return row
 
 

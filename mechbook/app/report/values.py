@@ -106,7 +106,7 @@ def part_linear(ctx: Context, view: StoredSystem | None, values: dict):
     steady = "steady" in data
     if "about" in data:
         return view.linear_at(ctx.point(), values, steady=steady)
-    plain = [lin for lin in view.linears if lin.steady is None]
+    plain = [lin for lin in view.linears if lin.steady is None and not lin.rates]
     return plain[0] if len(plain) == 1 and not steady else None
 
 
@@ -122,7 +122,7 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
     if shown == "equations_of_motion":
         if "about" in data or "steady" in data:
             lin = part_linear(ctx, view, values)
-            if lin is None:
+            if lin is None or lin.first_order:
                 return None
             return {sp.Symbol("M"): lin.M, sp.Symbol("C"): lin.C, sp.Symbol("K"): lin.K}
         M, f = view.get("mass_matrix"), view.get("forcing")
@@ -136,7 +136,7 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         return [sp.Eq(a, b, evaluate=False) for a, b in zip(lhs, rhs, strict=True)]
     if shown in ("frequency_list", "period_list"):
         lin = part_linear(ctx, view, values)
-        if lin is None or lin.M.rows != 1 or not lin.C.is_zero_matrix:
+        if lin is None or lin.first_order or lin.M.rows != 1 or not lin.C.is_zero_matrix:
             return None  # several modes: their numbers at one point are shown below
         w = sp.sqrt(lin.K[0, 0] / lin.M[0, 0])
         return [w] if shown == "frequency_list" else [2 * sp.pi / w]
@@ -144,7 +144,7 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         return view.equilibria or None
     if shown == "sylvester_criterion":
         lin = part_linear(ctx, view, values)
-        if lin is None or lin.C.is_zero_matrix is False:
+        if lin is None or lin.first_order or lin.C.is_zero_matrix is False:
             return None
         K = lin.K
         if K.rows > 3:
@@ -177,6 +177,16 @@ def numeric_pair(ctx: Context, view: StoredSystem | None,
     items = book if isinstance(book, list) else [book]
     pt = ctx.sampler.default()
     exprs = [ctx.parse(v, ("book", i)) for i, v in enumerate(items)]
+    if lin.first_order:  # its frequencies are stored at the default values only
+        stored = lin.numeric.get("frequencies")
+        defaults = ctx.analysis.problem.values()
+        if stored is None or any(abs(float(pt[k]) - float(v)) > 1e-12 * max(1.0, abs(v))
+                                 for k, v in defaults.items() if k in pt):
+            return None
+        eng = [float(w) for w in stored if np.isfinite(w)]
+        if shown == "period_list":
+            eng = [2 * np.pi / w for w in eng if w > 1e-12]
+        return numbers(exprs, pt), sorted(eng)
     M, C, K = lin.matrices(pt)
     with np.errstate(all="ignore"):
         if np.any(C):
