@@ -326,3 +326,24 @@ def test_api_linearization_second_order(tmp_path):
     g, l = (sp.Symbol("g", positive=True), sp.Symbol("l", positive=True))  # noqa: E741
     assert lin.A == sp.Matrix([[0, 1], [-g / l, 0]])
     assert lin.M is not None and lin.freedoms.velocity == 1
+
+
+def test_simulated_wobble_confirms_the_first_order_linearization(tmp_path, monkeypatch):
+    """The modes cross-check integrates the rolling coin itself, displaced along the
+    wobble, and reads the frequency off the motion; a state matrix 1 % off fails it."""
+    from mechbook.crosscheck.problem import _modes_check
+    from mechbook.engine.state_space import StateSpaceSystem
+
+    an = _analysis(tmp_path, "9519", COIN.replace("SHAPE", "disk"))
+    x, y, phi, theta, psi = an.system().q
+    names = {str(k): k for k in an.problem.values()}
+    lin = an.steady_linear(None, {psi: names["Omega"]}, {phi: 0, theta: sp.pi / 2, psi: 0},
+                           reduce=False)
+    values = dict(an.problem.values())
+    good = _modes_check(an, lin, values, "modes", {})
+    assert good.status == "pass" and good.error < 1e-6, good.detail
+    right = StateSpaceSystem.numeric_state_matrix
+    monkeypatch.setattr(StateSpaceSystem, "numeric_state_matrix",
+                        lambda self, v, core=False: 1.01 * right(self, v, core))
+    bad = _modes_check(an, lin, values, "modes", {})
+    assert bad.status == "fail", bad.detail

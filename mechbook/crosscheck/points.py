@@ -29,7 +29,13 @@ def numeric_key(lin: LinearSystem, values: dict, params: set) -> tuple:
         except (TypeError, ValueError):
             point.append(str(lin.point.get(q, 0)))
     pv = tuple(sorted((str(k), round(float(v), 12)) for k, v in values.items() if k in params))
-    return (steady, tuple(point), pv)
+    rates = []  # a steady motion kept in full: its rates tell two such motions apart
+    for q, r in sorted((getattr(lin, "velocity", None) or {}).items(), key=lambda kv: str(kv[0])):
+        try:
+            rates.append((str(q), round(float(sp.N(sp.S(r).subs(values))), 9)))
+        except (TypeError, ValueError):
+            rates.append((str(q), str(r)))
+    return (steady, tuple(point), pv) + ((tuple(rates),) if rates else ())
 
 
 def point_label(lin: LinearSystem) -> str:

@@ -21,10 +21,22 @@ from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.crosscheck.partview import PartView
 from mechbook.crosscheck.points import engine_linear_systems, numeric_key, point_label
 from mechbook.crosscheck.response import response_part
+from mechbook.crosscheck.state_modes import state_frequency_crosscheck
 from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis
 from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import AnswerKey, Part
+
+
+def _modes_check(analysis: Analysis, lin, values: dict, name: str, models: dict) -> CrossCheck:
+    """The simulated-modes cross-check of a linear system: second order
+    (mechbook.crosscheck.frequencies) or first order (mechbook.crosscheck.state_modes)."""
+    if not lin.first_order:
+        return frequency_crosscheck(analysis, lin, values, name, models)
+    out = CrossCheck(name, "frequencies", lin.dyn.sys.full.name)
+    with guarded(out):
+        state_frequency_crosscheck(analysis, lin, values, out, models)
+    return out
 
 
 def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
@@ -119,7 +131,7 @@ class _ProblemChecks:
         tag = (sname, *numeric_key(lin, values, self.params))
         if tag not in self.freq:
             self.stage(f"cross-check modes:{sname}@{label}")
-            self.freq[tag] = frequency_crosscheck(self.analysis, lin, values,
+            self.freq[tag] = _modes_check(self.analysis, lin, values,
                                                   f"modes:{sname}@{label}", self.models)
         self.freq[tag].parts.append(part.name)
 
@@ -140,5 +152,5 @@ class _ProblemChecks:
                 tag = (name, *numeric_key(lin, values, self.params))
                 if tag not in self.freq:
                     self.stage(f"cross-check modes:{name}@{label}")
-                    self.freq[tag] = frequency_crosscheck(self.analysis, lin, values,
+                    self.freq[tag] = _modes_check(self.analysis, lin, values,
                                                           f"modes:{name}@{label}", self.models)
