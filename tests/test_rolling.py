@@ -347,3 +347,30 @@ def test_simulated_wobble_confirms_the_first_order_linearization(tmp_path, monke
                         lambda self, v, core=False: 1.01 * right(self, v, core))
     bad = _modes_check(an, lin, values, "modes", {})
     assert bad.status == "fail", bad.detail
+
+
+def test_stability_map_of_the_rolling_disc(tmp_path):
+    """`mechbook sweep` of a first-order linearization: the stacked state matrices' verdict
+    against Ω² > g/(3r) over a grid (points within 1e-9 of the boundary left out)."""
+    from mechbook.engine.state_sweep import StateSweep
+    from mechbook.engine.sweep import STABLE, UNSTABLE
+
+    an = _analysis(tmp_path, "9520", SYMPY_DISC)
+    q1, q2, q3, q4, q5 = an.system().q
+    names = {str(k): k for k in an.problem.values()}
+    lin = an.steady_linear(None, {q3: names["Omega"]}, {q1: names["phi0"], q2: 0, q3: 0},
+                           reduce=False)
+    symbols = list(an.problem.values())
+    sweep = StateSweep(lin, symbols)
+    rng = np.random.default_rng(3)
+    X = np.array([[{"m": 1.0, "r": r, "g": 9.81, "Omega": w, "phi0": 0.3}[str(s)]
+                   for s in symbols] for w, r in rng.uniform([0.3, 0.1], [5.0, 3.0], (400, 2))])
+    block = sweep.evaluate(X)
+    w, r = X[:, symbols.index(names["Omega"])], X[:, symbols.index(names["r"])]
+    margin = w**2 - 9.81 / (3 * r)
+    clear = np.abs(margin) > 1e-9 * w**2
+    want = np.where(margin > 0, STABLE, UNSTABLE)
+    assert np.all(block.stability[clear] == want[clear])
+    stable = clear & (margin > 0)
+    wobble = np.sqrt(np.maximum(12 * w**2 - 4 * 9.81 / r, 0) / 5)
+    assert np.allclose(block.frequencies[stable, 0], wobble[stable], rtol=1e-10)

@@ -52,6 +52,7 @@ class Sweeper:
 
     def __init__(self, spec: SweepSpec, base: Path):
         from mechbook.engine.analysis import Analysis
+        from mechbook.engine.state_sweep import StateSweep
         from mechbook.engine.sweep import LinearSweep
         from mechbook.model.catalog import answer_path, problem_path
         from mechbook.model.problem import load_problem
@@ -77,7 +78,8 @@ class Sweeper:
             raise InputError(str(exc)) from None
         self._check_ranges(symbols)
         self.lin_symbols = [s for s in symbols if s is not self.amplitude]
-        self.linear = LinearSweep(self.lin, self.lin_symbols, spec.backend)
+        sweep = StateSweep if self.lin.first_order else LinearSweep  # velocity constraints
+        self.linear = sweep(self.lin, self.lin_symbols, spec.backend)
         # the problem's conditions, and a part's `assume:`: points outside are undefined
         self.conditions = list(self.context.sampler.conditions if self.context
                                else self.problem.conditions)

@@ -264,13 +264,14 @@ def _eigenvalues(A) -> list:
 
 
 def _ambiguous(lam: np.ndarray) -> bool:
-    """Exponents double precision cannot place: a small one (below 1e-4 of the largest:
-    a zero of a Jordan block, which rounding splits into ±ε^(1/k), or a slow mode beside
-    it) or a spread beyond 1e6. Then the exponents are taken at 40-50 digits."""
+    """Exponents double precision cannot place: small ones (below 1e-4 of the largest)
+    that are several (a Jordan block's zero, which rounding splits into ±ε^(1/k)) or one
+    above rounding (a slow mode, or a split zero). A single exponent at rounding level is a
+    plain zero. Then the exponents are taken at 40-50 digits."""
     mags = np.abs(lam)
     top = float(np.max(mags)) if len(mags) else 0.0
-    small = mags[(mags > 0) & (mags < 1e-4 * top)]
-    return bool(len(small))
+    small = mags[mags < 1e-4 * top]
+    return len(small) >= 2 or bool(np.any(small > 1e-10 * top))
 
 
 def _frequencies(lam: np.ndarray) -> np.ndarray:
