@@ -317,8 +317,9 @@ def test_api_linearization_of_a_rolling_coin(tmp_path):
 
 
 def test_api_linearization_second_order(tmp_path):
-    import mechbook
     from constrained_systems import CIRCLE
+
+    import mechbook
 
     write_tree(tmp_path, "9518", CIRCLE, key(""))
     p = mechbook.load("lim-9518", tmp_path, simplify=False)

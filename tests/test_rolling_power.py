@@ -12,8 +12,8 @@ import copy
 from fractions import Fraction
 
 import pytest
-
 from constrained_systems import CIRCLE, COIN, HOOP, SLEIGH, SPHERICAL, key, write_tree
+
 from mechbook.engine.analysis import Analysis
 from mechbook.model.problem import load_problem
 from mechbook.verify.answers import Part, load_answers
