@@ -248,3 +248,24 @@ gravity: {up: [-sin(alpha), cos(alpha)]}
 rolling:
   - {name: contact, body: hoop}
 """
+
+# sympy.physics.mechanics' rolling disc by Lagrange's method (test_linearize.py): the disc's
+# centre moves as if it turned about the contact point C held fixed, v = ω × (r L.z), so T
+# is not a function of a position alone; sympy's own kinetic energy of that model (BodyD,
+# printed by sympy.physics.mechanics and copied here), and its potential −m g r cos q2.
+SYMPY_LAGRANGE_DISC = """\
+id: lim-NUM
+source: sympy.physics.mechanics, test_linearize.py, rolling disc (Lagrange)
+title: sympy's rolling disc by Lagrange's method
+parameters:
+  m: {}
+  r: {}
+  g: {}
+  Omega: {doc: spin rate, value: 2.0}
+coordinates:
+  q1: {}
+  q2: {}
+  q3: {}
+kinetic: "m*r**2*(5*q1dot**2*sin(q2)**2 + q1dot**2 + 12*q1dot*q3dot*sin(q2) + 5*q2dot**2 + 6*q3dot**2)/8"
+potential: "-m*g*r*cos(q2)"
+"""

@@ -375,3 +375,22 @@ def test_stability_map_of_the_rolling_disc(tmp_path):
     stable = clear & (margin > 0)
     wobble = np.sqrt(np.maximum(12 * w**2 - 4 * 9.81 / r, 0) / 5)
     assert np.allclose(block.frequencies[stable, 0], wobble[stable], rtol=1e-10)
+
+
+def test_sympy_rolling_disc_by_lagrange(tmp_path):
+    """sympy's test_linearize_rolling_disc_lagrange: linearized about upright rolling (q1d =
+    q2d = 0, q3d free), its asserted A in the states (q1, q2, q3, q1', q2', q3')."""
+    import mechbook
+    from constrained_systems import SYMPY_LAGRANGE_DISC
+
+    write_tree(tmp_path, "9521", SYMPY_LAGRANGE_DISC, key(""))
+    p = mechbook.load("lim-9521", tmp_path, simplify=False)
+    lin = p.linearize(about={"q1": 0, "q2": 0, "q3": 0}, steady={"q3": "Omega"}, reduce=False)
+    g, r, w = (sp.Symbol(s, positive=True) for s in ("g", "r", "Omega"))
+    sol = sp.Matrix([[0, 0, 0, 1, 0, 0],
+                     [0, 0, 0, 0, 1, 0],
+                     [0, 0, 0, 0, 0, 1],
+                     [0, 0, 0, 0, -6 * w, 0],
+                     [0, -4 * g / (5 * r), 0, 6 * w / 5, 0, 0],
+                     [0, 0, 0, 0, 0, 0]])
+    assert (lin.A - sol).applyfunc(sp.simplify) == sp.zeros(6, 6)
