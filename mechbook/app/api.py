@@ -147,34 +147,14 @@ class SystemView:
 
     def linearize(self, about: dict | None = None, steady: dict | None = None,
                   reduce: bool | None = None) -> Linearization:
-        """The linearization about an equilibrium, or about a steady motion, as
-        sympy.physics.mechanics' Linearizer gives it: ż = A·z + B·r, with M, C, K where it
-        is second order, and the degrees of freedom there.
+        """The linearization (ż = A·z + B·r as sympy's Linearizer gives it; M, C, K where
+        second order; the degrees of freedom) about `about` ({coordinate: value}; default
+        the one stable equilibrium), or about the steady motion with `steady` rates (those a
+        constraint fixes are solved for; `reduce`: Routh's reduction, default unless the
+        system has constraints). mechbook.app.linearization.Linearization says more.
 
-        Parameters
-        ----------
-        about : dict, optional
-            {coordinate name: value (text or number)}: the point (the coordinates at rest in
-            a steady motion). Default: the system's one stable equilibrium.
-        steady : dict, optional
-            {coordinate name: rate} of a steady motion; the rates a constraint fixes (a
-            rolling body's centre) are solved for.
-        reduce : bool, optional
-            Routh's reduction of a steady motion (default: yes, unless the system has
-            constraints: then it is linearized in full).
-
-        Returns
-        -------
-        Linearization
-            `A`, `B`, `states`, `inputs`, `M`, `C`, `K`, `freedoms`; `exponents()`,
-            `frequencies()`, `stability()` at the default or given parameter values.
-
-        Examples
-        --------
-        >>> coin = mechbook.load("mybook-3.1")                      # doctest: +SKIP
-        >>> lin = coin.linearize(about={"phi": 0, "theta": "pi/2", "psi": 0},
-        ...                      steady={"psi": "Omega"})           # doctest: +SKIP
-        >>> lin.A.shape, lin.freedoms                                # doctest: +SKIP
+        >>> lin = p.linearize(about={"theta": "pi/2"}, steady={"psi": "W"})  # doctest: +SKIP
+        >>> lin.A, lin.freedoms, lin.exponents({"W": 3})                     # doctest: +SKIP
         """
         point = self.point(about) if (about is not None or not steady) else {}
         model = self.problem.model
