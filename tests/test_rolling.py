@@ -380,8 +380,9 @@ def test_stability_map_of_the_rolling_disc(tmp_path):
 def test_sympy_rolling_disc_by_lagrange(tmp_path):
     """sympy's test_linearize_rolling_disc_lagrange: linearized about upright rolling (q1d =
     q2d = 0, q3d free), its asserted A in the states (q1, q2, q3, q1', q2', q3')."""
-    import mechbook
     from constrained_systems import SYMPY_LAGRANGE_DISC
+
+    import mechbook
 
     write_tree(tmp_path, "9521", SYMPY_LAGRANGE_DISC, key(""))
     p = mechbook.load("lim-9521", tmp_path, simplify=False)
