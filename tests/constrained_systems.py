@@ -266,6 +266,7 @@ coordinates:
   q1: {}
   q2: {}
   q3: {}
-kinetic: "m*r**2*(5*q1dot**2*sin(q2)**2 + q1dot**2 + 12*q1dot*q3dot*sin(q2) + 5*q2dot**2 + 6*q3dot**2)/8"
+kinetic: "m*r**2*(5*q1dot**2*sin(q2)**2 + q1dot**2 + 12*q1dot*q3dot*sin(q2)
+  + 5*q2dot**2 + 6*q3dot**2)/8"
 potential: "-m*g*r*cos(q2)"
 """
