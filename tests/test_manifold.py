@@ -115,3 +115,30 @@ def test_freedoms_of_redundant_rows_count_once(tmp_path):
     point = manifold.project({**values, x: sp.Float(0.3), y: sp.Float(0.9)})
     f = manifold.freedoms(point)
     assert (f.configuration, f.velocity) == (1, 1)
+
+
+def _event(initial: str, book: str) -> str:
+    return key("  - part: a\n    cite: quarter swing\n    quantity: event_time\n"
+               f"    initial: {initial}\n    event: x\n    estimate: {{rtol: 1e-6}}\n"
+               f"    book: {book}\n")
+
+
+QUARTER = "0.580881729115339815263"  # sqrt(l/g)·K(sin²(θ0/2)), l = 1.3, g = 9.81, θ0 = 0.5
+
+
+@pytest.mark.parametrize("initial, book, status", [
+    # released from rest at 0.5 rad on the circle: a quarter of the finite-amplitude
+    # period, T/4 = sqrt(l/g)·K(k²), k = sin(θ0/2) (mpmath's ellipk, computed here)
+    ("{x: l*sin(1/2), y: -l*cos(1/2)}", QUARTER, "pass"),
+    ("{x: l*sin(1/2), y: -l*cos(1/2)}", "0.5814", "fail"),
+    # the velocities left unstated are solved from ẋx + ẏy = 0: here zero
+    ("{x: l*sin(1/2), y: -l*cos(1/2), xdot: 0}", QUARTER, "pass"),
+])
+def test_a_trajectory_starts_on_the_manifold(tmp_path, initial, book, status):
+    out = check(tmp_path, "9406", CIRCLE, _event(initial, book))["a"]
+    assert out.status == status, out.detail
+
+
+def test_a_start_off_the_manifold_is_refused(tmp_path):
+    out = check(tmp_path, "9407", CIRCLE, _event("{x: l, y: l}", QUARTER))["a"]
+    assert out.status == "error" and "breaks the constraints" in out.detail, out.detail

@@ -85,12 +85,15 @@ class StateManifold:
                 [c.xreplace(rest) for c in rows])
 
     # ---- projection --------------------------------------------------------------------
-    def project(self, point: dict, free: set | None = None) -> dict | None:
+    def project(self, point: dict, free: set | None = None,
+                stated: float = 0.0) -> dict | None:
         """`point` (parameters, t if it has one, and a drawn state) with its coordinates
         and velocities moved onto the manifold (30-digit Floats; those it lacks start at
         0.5), or None where the iteration does not converge or leaves a coordinate's
         domain (the caller draws again). `free` (default: all) names the coordinates and
-        velocities that may move: the others are a state someone stated."""
+        velocities that may move: the others are a state someone stated, to the relative
+        precision `stated` (a double's rounding leaves 1e-16: what cannot move is on the
+        manifold when its residual is within that)."""
         env = {k: _mpf(v) for k, v in point.items()}
         env.setdefault(self.t, mpmath.mpf(0))
         free = self.state if free is None else frozenset(free)
@@ -99,11 +102,11 @@ class StateManifold:
                 if x not in env:
                     env[x] = mpmath.mpf(0.5)
             try:
-                if self.position and not self._settle_coordinates(env, free):
+                if self.position and not self._settle_coordinates(env, free, stated):
                     return None
                 if not self._inside(env):
                     return None
-                if not self._settle_velocities(env, free):
+                if not self._settle_velocities(env, free, stated):
                     return None
             except _FAULTS:
                 return None
@@ -120,12 +123,12 @@ class StateManifold:
         point[self.t] = t0
         point.update({q: float(x) for q, x in zip(self.q, q0, strict=True)})
         point.update({v: float(x) for v, x in zip(self.qd, qd0, strict=True)})
-        out = self.project(point, free)
+        out = self.project(point, free, stated=1e-12)  # floats: stated to double precision
         if out is None:
             return None
         return [float(out[q]) for q in self.q], [float(out[v]) for v in self.qd]
 
-    def _settle_coordinates(self, env: dict, free: frozenset) -> bool:
+    def _settle_coordinates(self, env: dict, free: frozenset, stated: float) -> bool:
         cols = [j for j, q in enumerate(self.q) if q in free]
         first = None
         for _ in range(ITERATIONS):
@@ -133,8 +136,10 @@ class StateManifold:
             worst = max(abs(x) / s for x, s in zip(g, scale, strict=True))
             if worst < mpmath.mpf(10) ** (-DIGITS - 2):
                 return True
+            if not cols:  # nothing may move: on the manifold to the stated precision?
+                return worst <= stated
             first = worst if first is None else first
-            if not cols or worst > 1e6 * first:
+            if worst > 1e6 * first:
                 return False  # diverging: no configuration near this start
             G = _columns(self._matrix(self._jacobian, env), cols)
             step = _least_norm(G, mpmath.matrix(g))
@@ -144,7 +149,7 @@ class StateManifold:
                 env[self.q[j]] -= step[k]
         return False
 
-    def _settle_velocities(self, env: dict, free: frozenset) -> bool:
+    def _settle_velocities(self, env: dict, free: frozenset, stated: float = 0.0) -> bool:
         """The velocities moved (the free ones, least norm) to A·q̇ + b = 0: one exact step;
         False where the free ones cannot make it hold."""
         A_expr, b_expr = self._rows
@@ -162,8 +167,9 @@ class StateManifold:
         v = mpmath.matrix([env[x] for x in self.qd])
         left = A * v + b
         size = max([abs(x) for x in A] + [abs(x) for x in b] + [mpmath.mpf(1)])
-        return all(abs(x) <= mpmath.mpf(10) ** (-DIGITS - 2) * size * max(
-            [abs(y) for y in v] + [mpmath.mpf(1)]) for x in left)
+        tol = max(mpmath.mpf(10) ** (-DIGITS - 2), mpmath.mpf(stated))
+        return all(abs(x) <= tol * size * max([abs(y) for y in v] + [mpmath.mpf(1)])
+                   for x in left)
 
     def _inside(self, env: dict) -> bool:
         """Every coordinate within its declared domain (a radius stays positive)."""

@@ -182,6 +182,29 @@ class Context:
                                       "coordinates (x) and their velocities (xdot)")
         return q0, v0
 
+    def settled(self, q0, qd0, pt: dict) -> tuple:
+        """A start (arrays of the coordinates and velocities) on the constraint manifold:
+        what `initial:` does not state is solved from the constraints (least change from
+        zero); a start whose stated values break a constraint is an error at `initial:`."""
+        manifold = self.sampler.manifold
+        if manifold is None:
+            return q0, qd0
+        import numpy as np
+
+        given = self.as_map(self.part.data.get("initial") or {}, ("initial",))
+        names = self.system.coord_names
+        stated = {self.system.q[names.index(k)] for k in given if k in names}
+        stated |= {self.system.qd[names.index(k[:-3])] for k in given
+                   if k.endswith("dot") and k[:-3] in names}
+        params = {k: v for k, v in pt.items() if k in self.analysis.problem.values()}
+        out = manifold.settle(params, q0, qd0, 0.0, manifold.state - stated)
+        if out is None:
+            raise self.part.error(("initial",), "the start breaks the constraints, and what "
+                                  "it leaves unstated cannot make them hold: state a start "
+                                  "on the constraint manifold (or leave the dependent "
+                                  "coordinates and velocities out, to be solved for)")
+        return np.array(out[0]), np.array(out[1])
+
     def mode_shape(self, shape, sub) -> sp.Matrix:
         """A mode shape over the linear system's coordinates (a steady motion reduced by
         Routh has lost its cyclic ones); a coordinate left out is 0. On a constraint

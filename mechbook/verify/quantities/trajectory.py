@@ -78,6 +78,7 @@ class Motion:
         st = self.state(pt)
         q0 = np.array([float(st[q]) for q in sys.q])
         qd0 = np.array([float(st[v]) for v in sys.qd])
+        q0, qd0 = ctx.settled(q0, qd0, pt)  # a constrained system starts on its manifold
         scale = 1.0 / (1.0 + float(np.max(np.abs(qd0))))
         return measure(model, fn, q0, qd0, scale)
 
@@ -268,6 +269,7 @@ def check_event_time(ctx: Context, val) -> Verdict:
         st = {k: v.subs(pt) for k, v in start.items()}
         q0 = np.array([float(st[q]) for q in sys.q])
         qd0 = np.array([float(st[v]) for v in sys.qd])
+        q0, qd0 = ctx.settled(q0, qd0, pt)  # a constrained system starts on its manifold
         signal = event.subs(pt)
 
         def run(pt=pt, signal=signal, q0=q0, qd0=qd0):
