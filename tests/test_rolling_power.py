@@ -49,7 +49,9 @@ KEYS = {
         "  - part: b\n    cite: f\n    quantity: frequencies\n    about: {x: 0, y: -l}\n"
         "    book: [\"sqrt(g/l)\"]\n")),
     "spherical": (SPHERICAL, key(
-        "  - part: a\n    cite: f\n    quantity: mode_count\n    book: 2\n")),
+        "  - part: a\n    cite: f\n    quantity: mode_count\n    book: 2\n"
+        "  - part: b\n    cite: w\n    quantity: frequencies\n    about: {x: 0, y: 0, z: -l}\n"
+        "    book: [\"sqrt(g/l)\", \"sqrt(g/l)\"]\n")),
 }
 
 
