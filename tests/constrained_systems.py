@@ -270,3 +270,40 @@ kinetic: "m*r**2*(5*q1dot**2*sin(q2)**2 + q1dot**2 + 12*q1dot*q3dot*sin(q2)
   + 5*q2dot**2 + 6*q3dot**2)/8"
 potential: "-m*g*r*cos(q2)"
 """
+
+# A uniform ball (radius r, I = 2 m r²/5) rolling inside a spherical bowl of radius Rb: its
+# centre (x, y, z) on the sphere of radius Rb − r about the bowl's centre (the origin),
+# z = −sqrt((Rb − r)² − x² − y²); the contact point on the same ray, at distance Rb. A
+# curved surface: the contact point is stated, and the fixed normal (the bowl's axis) is
+# nowhere perpendicular to the true one over the bowl's lower half, so the two tangential
+# rows and the kept contact make the contact point's velocity vanish. Small oscillations
+# about the bottom: the centre moves on a sphere of radius Rb − r with rolling,
+# (m + I/r²)(Rb − r) θ̈ = −m g θ, ω² = (5/7) g/(Rb − r), twice (both directions).
+BOWL = """\
+id: lim-NUM
+source: a ball rolling in a spherical bowl
+title: ball in a bowl
+parameters:
+  m: {value: 0.2}
+  r: {value: 0.1}
+  Rb: {value: 1.0}
+  g: {}
+conditions: ["Rb > r"]
+coordinates:
+  x: {}
+  y: {}
+  a: {}
+  b: {}
+  c: {}
+rigid_bodies:
+  ball:
+    mass: m
+    position: [x, y, "-sqrt((Rb - r)**2 - x**2 - y**2)"]
+    inertia: {shape: solid_sphere, radius: r}
+    rotation: [[x, a], [y, b], [z, c]]
+gravity: {}
+rolling:
+  - name: contact
+    body: ball
+    point: ["x*Rb/(Rb - r)", "y*Rb/(Rb - r)", "-sqrt((Rb - r)**2 - x**2 - y**2)*Rb/(Rb - r)"]
+"""

@@ -395,3 +395,20 @@ def test_sympy_rolling_disc_by_lagrange(tmp_path):
                      [0, -4 * g / (5 * r), 0, 6 * w / 5, 0, 0],
                      [0, 0, 0, 0, 0, 0]])
     assert (lin.A - sol).applyfunc(sp.simplify) == sp.zeros(6, 6)
+
+
+@pytest.mark.parametrize("book, status", [
+    ('["sqrt(5*g/(7*(Rb - r)))", "sqrt(5*g/(7*(Rb - r)))"]', "pass"),
+    ('["sqrt(g/(Rb - r))", "sqrt(g/(Rb - r))"]', "fail"),  # sliding, not rolling
+    ('["sqrt(5*g/(7*(Rb - r)))", "1.01*sqrt(5*g/(7*(Rb - r)))"]', "fail"),
+])
+def test_ball_in_a_bowl(tmp_path, book, status):
+    from constrained_systems import BOWL
+
+    out = check(tmp_path, "9522", BOWL, key(
+        "  - part: a\n    cite: bottom\n    quantity: frequencies\n"
+        f"    about: {{x: 0, y: 0, a: 0, b: 0, c: 0}}\n    partial: true\n    book: {book}\n"
+        "  - part: b\n    cite: freedoms\n    quantity: mode_count\n"
+        "    book: {configuration: 5, velocity: 3}\n"))
+    assert out["a"].status == status, out["a"].detail
+    assert out["b"].status == "pass", out["b"].detail
