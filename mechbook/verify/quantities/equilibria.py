@@ -85,8 +85,8 @@ def check_stability_condition(ctx: Context, val) -> Verdict:
             got = lin.numeric_stability(pt)
             if near or got == "marginal":
                 got = lin.precise_stability(pt)
-        except (MechbookError, ZeroDivisionError, ValueError):
-            return None  # no linear system at this point (a singular matrix)
+        except (ZeroDivisionError, ValueError) as exc:  # a singular matrix: no verdict here
+            raise MechbookError(f"no linear system at this point ({exc})") from None
         return None if got == "marginal" else got == "stable"
 
     return boundary.verdict(boundary.compare(cond, stable, ctx.sampler,
