@@ -298,7 +298,7 @@ def _asymptotically_equal(ctx: Context, a: sp.Expr, b: sp.Expr, path: tuple) -> 
     as fast as the book's error must)? Then both are equally right. A leaf of a vector (a
     mode shape) is measured against the whole vector, as the check measures its angle; a
     formula in the text's notation (`perturbation`) with its tables filled in."""
-    from mechbook.verify.quantities.oscillations import asymptotic
+    from mechbook.verify.asymptotic import asymptotic
 
     if ctx.part.quantity == "perturbation":
         from mechbook.verify.quantities.perturbation import formula_difference

@@ -20,9 +20,9 @@ from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
 from mechbook.errors import UndecidedError, UnsupportedError
 from mechbook.verify import boundary
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}

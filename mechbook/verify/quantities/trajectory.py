@@ -23,9 +23,9 @@ from mechbook.engine.levelset import LevelSet
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
 from mechbook.numerics.model import build_model
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, quantity
 
 LEVEL_RTOL = 1e-10
