@@ -436,3 +436,5 @@ def test_a_declared_period_is_verified(mathieu_fixed, tmp_path):
                   period="2*pi").status == "pass"  # a multiple of the period is one too
     out = _check(mathieu_fixed, tmp_path, "lim-9402", **part, period="pi/2")
     assert out.status == "unsupported" and "not a period" in out.detail, out.detail
+    out = _check(mathieu_fixed, tmp_path, "lim-9402", **part, period="2*pi/omegaa")
+    assert out.status == "error" and "unknown name 'omegaa'" in out.detail, out.detail

@@ -64,18 +64,24 @@ def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier) -> Verdic
     along = probes(ctx, cond)
     atoms = boundary._atoms(cond)
 
+    last: dict = {}  # the probe along which the last step's error was largest
+
     def error(pt: dict) -> float:
         worst, found = 0.0, 0
         for p in along:
             ray = _Ray(ctx.sampler, pt, np.array([1.0]), [p])
             for t_star, below, above, reach in _book_crossings(cond, atoms, ray):
                 found += 1
-                worst = max(worst, _engine_offset(classify, ray, t_star, below, above, reach))
+                e = _engine_offset(classify, ray, t_star, below, above, reach)
+                if e >= worst:
+                    worst, last["probe"] = e, p.name
         return worst if found else math.inf
 
     got = asymptotic(ctx, error, floor=FLOOR)
     names = ", ".join(s.name for s in along)
-    detail = f"boundary located along {names}; {got.detail}"
+    where = f" (largest along {last['probe']} at the last step)" if len(along) > 1 and \
+        "probe" in last else ""
+    detail = f"boundary located along {names}{where}; {got.detail}"
     if not got.ok:
         return Verdict(False, got.method, detail)
     return Verdict(True, got.method, detail,
