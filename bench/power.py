@@ -3,9 +3,13 @@
 Every answer part of every book that passes (or is an erratum) is perturbed one place at a
 time (mechbook.verify.mutate): each number and each parameter occurrence of its value scaled
 by 1 + δ, the value shifted by δ times its size, a count moved by one, a flag or verdict
-word changed. A part with `estimate:` is perturbed at twice its stated precision instead of
-the fixed δ. Each mutant goes through the real checker; it is *killed* when the part no
-longer passes (an erratum part: no longer an erratum).
+word changed. A part with `estimate:` is perturbed at twice its stated precision instead
+of the fixed δ. A part whose pass claims more than 1e-6 (its power line says what it
+rejects: "to 1e-08", "≤ 1e-20 of its scale", "wrong by more than ~2e-11", "exact ... below
+1e-39") is perturbed once more at ten times that (class "10×claim"): a claim the
+arithmetic cannot back lets those mutants survive. Each mutant goes through the real
+checker; it is *killed* when the part no longer passes (an erratum part: no longer an
+erratum).
 
 A surviving mutant is *equivalent* (excluded from the rate) only when it provably means the
 same: the same value at 30 digits, an equation multiplied by a constant, a relation with
@@ -30,6 +34,7 @@ import copy
 import importlib.util
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -70,6 +75,28 @@ def _put(data, path, value):
     _get(data, path[:-1])[path[-1]] = value
 
 
+CLAIMED = re.compile(r"(?:\bto|≤)\s*(\d(?:\.\d+)?e-\d+)")
+NUMBER = r"(\d(?:\.\d+)?e-\d+)"
+
+
+def finer_delta(power: str) -> Fraction | None:
+    """Ten times what a pass's power line says it rejects, where that is finer than 1e-6
+    (the coarsest class already measured); None where it says nothing finer. An
+    asymptotic pass states it as a term "wrong by more than ~X", an exact one as "below X"
+    (its error's last values say nothing about what it rejects); any other as "to X" or
+    "≤ X", the finest counting."""
+    if "would show" in power:
+        found = re.findall("wrong by more than ~" + NUMBER, power)
+    elif power.startswith("exact toward the limit"):
+        found = re.findall("below " + NUMBER, power)
+    else:
+        found = CLAIMED.findall(power)
+    finest = min((float(x) for x in found if float(x) > 0), default=None)
+    if finest is None or 10 * finest >= 1e-6:
+        return None
+    return Fraction(f"{10 * finest:.0e}")
+
+
 # ---- measuring one tree (run in a subprocess with that tree first on sys.path) ----------
 def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> None:
     from mechbook.core.timeout import Timeout, time_limit
@@ -108,6 +135,9 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                 est = part.data.get("estimate")
                 classes = ([Fraction(2 * est["rtol"]).limit_denominator(10**9)] if est
                            else list(deltas))
+                finer = None if est else finer_delta(original.power or "")
+                if finer is not None:
+                    classes.append(finer)
                 seen_discrete = False
                 for delta in classes:
                     for m in mutate.part_mutants(value, root, names, delta, sizes,
@@ -133,6 +163,7 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                             "token": getattr(m, "token", ""),
                             "status": status, "killed": killed and status != "timeout",
                             "detail": detail, "estimate": bool(est),
+                            "claim": delta == finer,
                             "seconds": time.process_time() - start}, default=str) + "\n")
                         sink.flush()
                     seen_discrete = True
@@ -250,6 +281,8 @@ def _class(r: dict) -> str:
         return "discrete"
     if r.get("estimate"):
         return "2×estimate"
+    if r.get("claim"):
+        return "10×claim"
     return f"δ = {float(Fraction(r['delta'])):g}"
 
 

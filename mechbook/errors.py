@@ -55,6 +55,12 @@ class UnsupportedError(MechbookError):
         super().__init__(f"unsupported: {capability}")
 
 
+class UndecidedError(MechbookError):
+    """The check ran, but nothing it evaluated could decide the claim (the sampled points
+    never straddle the book's boundary, or no steady motion exists anywhere sampled): an
+    error that says how to widen the check, never a fail, which would blame the book."""
+
+
 class WrongAnswerError(MechbookError):
     """A value an answer gives contradicts the system (a point that is no equilibrium, a
     mode shape off the constraint manifold): the answer is wrong, a fail."""

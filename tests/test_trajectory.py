@@ -155,3 +155,75 @@ def test_heavy_top_level_set_matches_its_measurement():
     assert abs(m.low - lo) < 1e-9 and abs(m.high - hi) < 1e-9
     assert abs(m.period() / float(orbit.period) - 1) < 1e-8
     assert abs(m.advance(1) / float(orbit.advance(ph)) - 1) < 1e-8
+
+
+# ---- asymptotic formulas at the precision they claim (issue 32) ---------------------------
+# The pendulum's ω = ω0(1 − θ0²/16 + 11θ0⁴/3072 + …) (from 4K(sin²(θ0/2)) expanded); the
+# Duffing oscillator m ẍ + k x + β x³ = 0 from rest at A: ω = ω0 + 3βA²/(8mω0) + O(A⁴),
+# ω0 = √(k/m) (Lindstedt–Poincaré, Landau §28). Both sides are taken at 70 digits and the
+# engine's value at 50 as well: their difference is the resolution the walk stops at.
+SERIES = dict(quantity="motion_frequency", **START)
+
+
+@pytest.mark.parametrize("book, order, status", [
+    ("sqrt(g/l)*(1 - theta0**2/16)", 3, "pass"),
+    ("sqrt(g/l)*(1 - theta0**2/16 + theta0**3/10**6)", 3, "fail"),  # a cubic term 1e-6
+    ("sqrt(g/l)*(1 - theta0**2/16*(1 + 1/10**6))", 3, "fail"),      # θ0² off by 1e-6
+    ("sqrt(g/l)*(1 + theta0**2/16)", 2, "fail"),                    # the sign of θ0²
+])
+def test_the_pendulum_series_at_its_order(pend, tmp_path, book, order, status):
+    got, _, detail = check(pend, tmp_path, "symon-text-test-pendulum", **SERIES,
+                           limit={"parameter": "theta0", "to": 0, "order": order}, book=book)
+    assert got == status, detail
+    assert "0, 0" not in detail  # no error read as zero: 70 digits resolve it
+
+
+DUFFING = """\
+id: symon-text-test-duffing
+source: test
+title: Duffing oscillator
+parameters:
+  m: {value: 1.0}
+  k: {value: 1.0}
+  beta: {value: 0.5}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*x**2/2 + beta*x**4/4
+"""
+
+
+@pytest.fixture(scope="module")
+def duffing(tmp_path_factory) -> Analysis:
+    path = tmp_path_factory.mktemp("duffing") / "text-test-duffing.yaml"
+    path.write_text(DUFFING)
+    return Analysis(load_problem(path))
+
+
+@pytest.mark.parametrize("coefficient, status", [
+    ("3", "pass"), ("3.00000003", "fail"), ("3.03", "fail"), ("5", "fail")])
+def test_duffing_frequency_rejects_a_coefficient_moved_by_1e8(duffing, tmp_path,
+                                                               coefficient, status):
+    doc = {"problem": "symon-text-test-duffing", "source": "test",
+           "symbols": {"A": {"value": 0.3}}, "parts": [{
+               "part": "x", "cite": "test", "quantity": "motion_frequency",
+               "coordinate": "x", "initial": {"x": "A"},
+               "limit": {"parameter": "A", "to": 0, "order": 2},
+               "book": f"sqrt(k/m) + {coefficient}*beta*A**2/(8*m*sqrt(k/m))"}]}
+    YAML().dump(doc, (tmp_path / "key.yaml").open("w"))
+    out = check_problem(duffing, load_answers(tmp_path / "key.yaml"))[0]
+    assert out.status == status, out.detail
+    if status == "pass":
+        assert "ε^4.0" in out.power and "resolution" in out.power, out.power
+        shows = float(out.power.split("wrong by more than ~")[1].split(" ")[0])
+        assert shows < 3e-8 * 3 * 0.5 * 0.3**2 / 8  # the 1e-8 mutant's size is above it
+
+
+def test_an_exact_formula_is_exact_to_its_resolution(pend, tmp_path):
+    """2θ0 is the pendulum's excursion at every amplitude: the error sits at the
+    arithmetic's resolution, and the power line says that resolution (not 'exact')."""
+    got, _, detail = check(pend, tmp_path, "symon-text-test-pendulum", quantity="excursion",
+                           **START, limit={"parameter": "theta0", "to": 0, "order": 1},
+                           book="2*theta0")
+    assert got == "pass", detail
+    assert "resolution of its arithmetic" in detail

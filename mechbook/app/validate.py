@@ -120,7 +120,7 @@ def check_part_expressions(part, analysis: Analysis) -> None:
     q = quantities()[part.quantity]
     names = q.names(ctx) if q.names else ctx.names  # a book value's extra names
     for field in ("book", "about", "initial", "released", "region", "time", "hold", "signal",
-                  "event"):
+                  "event", "period"):
         if field == "book" and part.data.get("book") in q.literals:
             continue  # a word such as "stable", not an expression
         if field in part.data:

@@ -11,8 +11,8 @@ over a period by 2∫ u(c) √(m/(2(E − V_eff))) dc, u the part of its rate fr
 part proportional to ċ integrates to zero over the back-and-forth). Quadratures are done
 by the midpoint rule after c = mid − (half-width)·cos s, which removes the square-root
 singularities at the turning points and leaves a smooth periodic integrand (exponential
-convergence), in 50-digit arithmetic: a fast top's nutation of
-1e-12 rad is resolved as well as a slow one's.
+convergence), in 50-digit arithmetic (or more: `orbit(..., dps=)`): a fast top's nutation
+of 1e-12 rad is resolved as well as a slow one's.
 
 The independent measurement of the same quantities by integrating the full equations is
 mechbook.numerics.measure.
@@ -84,21 +84,22 @@ class LevelSet:
                 sp.lambdify(args, V, modules="mpmath"),
                 [sp.lambdify(args, x, modules="mpmath") for x in u])
 
-    def orbit(self, state: dict, values: dict) -> Orbit:
-        """The orbit through `state` ({q: value, q̇: value}) at parameter `values`."""
+    def orbit(self, state: dict, values: dict, dps: int = DPS) -> Orbit:
+        """The orbit through `state` ({q: value, q̇: value}) at parameter `values`, computed
+        in `dps`-digit arithmetic (a second, higher precision measures the first's error)."""
         dyn = self.dyn
-        with mpmath.workdps(DPS):
-            pt = {k: mpmath.mpf(str(sp.N(v, DPS))) for k, v in values.items()}
-            full = {**{k: sp.Float(str(v), DPS) for k, v in pt.items()},
-                    **{k: sp.Float(str(sp.N(v, DPS)), DPS) for k, v in state.items()}}
-            P = [sp.N(sp.diff(dyn.L, v).subs(full), DPS) for v in self.rates]
-            E = sp.N(dyn.energy_function.subs(full), DPS)
+        with mpmath.workdps(dps):
+            pt = {k: mpmath.mpf(str(sp.N(v, dps))) for k, v in values.items()}
+            full = {**{k: sp.Float(str(v), dps) for k, v in pt.items()},
+                    **{k: sp.Float(str(sp.N(v, dps)), dps) for k, v in state.items()}}
+            P = [sp.N(sp.diff(dyn.L, v).subs(full), dps) for v in self.rates]
+            E = sp.N(dyn.energy_function.subs(full), dps)
             if any(not x.is_number for x in [*P, E]):
                 raise UnsupportedError("level set: the initial state leaves something unknown")
             params = [pt[p] for p in self.params]
             return Orbit(self, [mpmath.mpf(str(x)) for x in P], mpmath.mpf(str(E)),
-                         mpmath.mpf(str(sp.N(full[self.c], DPS))),
-                         mpmath.mpf(str(sp.N(full.get(self.cdot, 0), DPS))), params)
+                         mpmath.mpf(str(sp.N(full[self.c], dps))),
+                         mpmath.mpf(str(sp.N(full.get(self.cdot, 0), dps))), params, dps)
 
 
 @dataclass
@@ -109,6 +110,8 @@ class Orbit:
     c0: object
     cdot0: object
     params: list
+    dps: int = DPS  # the working precision: turning points to 10^(5 - dps), quadratures
+    # until two agree to 10^(30 - dps)
 
     def _args(self, c):
         return [c, *self.P, *self.params]
@@ -125,8 +128,8 @@ class Orbit:
         """The turning point reached moving from c0 in `direction`: steps that double
         from 1e-35 (a fast top's orbit is 1e-12 wide) up to MAX_STEP*(1 + |c0|), then
         steps of that size (so a forbidden region is not stepped over), then bisection."""
-        with mpmath.workdps(DPS):
-            h = mpmath.mpf(10) ** (-(DPS - 15))
+        with mpmath.workdps(self.dps):
+            h = mpmath.mpf(10) ** (-(self.dps - 15))
             cap = MAX_STEP * (1 + abs(self.c0))
             inside, step = self.c0, h
             for _ in range(MAX_STEPS):
@@ -147,9 +150,9 @@ class Orbit:
         ends close in superlinearly) where E − V has a finite value at both ends, bisection
         where it has none (V_eff singular) or where the bracket did not halve in three
         steps; ~15 evaluations instead of bisection's ~170 to the same width."""
-        tol = mpmath.mpf(10) ** (-(DPS - 5))
+        tol = mpmath.mpf(10) ** (-(self.dps - 5))
         width, stale_side, stale = abs(outside - inside), 0, 0
-        for _ in range(DPS * 4):
+        for _ in range(self.dps * 4):
             finite = mpmath.isfinite(k_out) and mpmath.isfinite(k_in) and k_in != k_out
             if finite and stale < 3:
                 mid = inside + (outside - inside) * k_in / (k_in - k_out)
@@ -179,9 +182,9 @@ class Orbit:
     @cached_property
     def turning_points(self) -> tuple:
         """(c_min, c_max): with ċ0 = 0 one of them is c0 itself."""
-        with mpmath.workdps(DPS):
+        with mpmath.workdps(self.dps):
             if self.cdot0 == 0:
-                k_plus = self.kinetic(self.c0 + mpmath.mpf(10) ** (-(DPS - 15)))
+                k_plus = self.kinetic(self.c0 + mpmath.mpf(10) ** (-(self.dps - 15)))
                 if mpmath.isfinite(k_plus) and k_plus > 0:
                     return self.c0, self._edge(+1)
                 return self._edge(-1), self.c0
@@ -192,12 +195,14 @@ class Orbit:
 
         With c = mid − half·cos s the integrand becomes weight·√(m/(2r(c))), r = (E − V)/
         ((c − lo)(hi − c)): smooth, even and 2π-periodic in s, so the midpoint rule on
-        [0, π] converges exponentially; N is doubled until two results agree to 1e-20
-        (E − V loses digits near the turning points of a very small orbit: 50 digits leave
-        at least 20 there)."""
+        [0, π] converges exponentially; N is doubled until two results agree to
+        10^(30 − dps), 1e-20 at 50 digits (E − V loses digits near the turning points of a
+        very small orbit: 50 digits leave at least 20 there). What is left of the working
+        precision is measured, where it matters, by computing the orbit at a second, higher
+        one (mechbook.verify.quantities.trajectory)."""
         mass, _, _ = self.level._functions
         lo, hi = self.turning_points
-        with mpmath.workdps(DPS):  # mid and half at full precision: c - lo is tiny near s = 0
+        with mpmath.workdps(self.dps):  # mid, half at full precision: c − lo tiny near s = 0
             mid, half = (lo + hi) / 2, (hi - lo) / 2
 
             def f(s):
@@ -214,7 +219,7 @@ class Orbit:
             while True:
                 total = mpmath.fsum(nodes) * mpmath.pi / n
                 if previous is not None and abs(total - previous) <= \
-                        mpmath.mpf(10) ** -20 * abs(total):
+                        mpmath.mpf(10) ** (30 - self.dps) * abs(total):
                     return 2 * total
                 if n >= 4096:
                     raise UnsupportedError("level set: the period quadrature did not converge")

@@ -166,6 +166,9 @@ class LinearSystem:
         steady rate given as a root — costs milliseconds, not minutes of evalf)."""
         def num(A):
             left = sorted(map(str, A.free_symbols - set(values)))
+            if self.dyn.sys.t.name in left:  # a driven coordinate: not one matrix but M(t)...
+                raise UnsupportedError("the linearized equations have time-dependent "
+                                       "coefficients (M, C, K depend on t)")
             if left:  # e.g. a point that names a symbol the system gives no value
                 raise MechbookError(f"the linearized system keeps {', '.join(left)} without a "
                                     "numeric value")

@@ -12,7 +12,13 @@ side. Tangencies (an atom touching zero without changing sign: a double root of 
 boundary) are found as minima of |atom| along the ray and judged on both sides too.
 
 The engine's verdict is a function `classify(point, near) -> bool | None` (None: no
-verdict there, e.g. marginal); `near` asks for its precise path (a boundary is close).
+verdict there, e.g. marginal; a MechbookError it raises is no verdict either, and its
+message is kept as the reason); `near` asks for its precise path (a boundary is close).
+
+An outcome says only what was evaluated: `fail` where a point contradicted the book; where
+the engine gave no verdict at any point (time-dependent coefficients, say) the check is
+unsupported with the engine's reason, and where the points never straddled the book's
+boundary it is undecided (an error saying how to widen it), never a fail.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, holds
+from mechbook.errors import MechbookError, UndecidedError, UnsupportedError, WrongAnswerError
 from mechbook.verify.compare import DIGITS, Sampler, Verdict
 
 RAYS = 8  # random rays through parameter space
@@ -52,7 +59,10 @@ class BoundaryResult:
     eps: float = EPS
     detail: str = ""
     sides: tuple = (0, 0)  # sides of the relation crossed, of those that can be
-
+    # why ok is False: "fail" (a point contradicted the book), "unsupported" (the engine
+    # gave no verdict anywhere: `detail` says why), "undecided" (nothing straddled the
+    # boundary, or no crossing could be judged)
+    outcome: str = "fail"
 
 
 class Ray:
@@ -105,11 +115,50 @@ def _value(f: sp.Expr, pt: dict) -> tuple[float, float] | None:
     return v.real, m
 
 
+class _Silence:
+    """Why the engine gave no verdict, counted over a whole comparison: the reasons an
+    UnsupportedError or another MechbookError gave, and the points it called marginal."""
+
+    def __init__(self):
+        self.unsupported: dict[str, int] = {}
+        self.errors: dict[str, int] = {}
+        self.marginal = 0
+
+    def ask(self, classify: Classifier, pt: dict, near: bool) -> bool | None:
+        try:
+            got = classify(pt, near)
+        except WrongAnswerError:
+            raise  # the answer named something wrong: a fail, decided elsewhere
+        except UnsupportedError as exc:
+            self.unsupported[exc.capability] = self.unsupported.get(exc.capability, 0) + 1
+            return None
+        except MechbookError as exc:
+            self.errors[str(exc)] = self.errors.get(str(exc), 0) + 1
+            return None
+        if got is None:
+            self.marginal += 1
+        return got
+
+    def reason(self) -> tuple[str, str]:
+        """(outcome, why) where the engine decided nothing: unsupported where it said it
+        cannot (or found every point marginal), undecided where it failed otherwise."""
+        def most(d: dict) -> str:
+            return max(d, key=d.get)
+        if self.unsupported:
+            return "unsupported", most(self.unsupported)
+        if self.errors:
+            return "undecided", most(self.errors)
+        return "unsupported", "the engine finds every point marginal (no verdict)"
+
+
 class _Judge:
     """Both verdicts at points of one ray."""
 
-    def __init__(self, cond: sp.Basic, classify: Classifier, ray: Ray):
-        self.cond, self.classify, self.ray = cond, classify, ray
+    def __init__(self, cond: sp.Basic, classify: Classifier, ray: Ray, silence: _Silence):
+        self.cond, self.classify, self.ray, self.silence = cond, classify, ray, silence
+
+    def engine(self, pt: dict | None, near: bool) -> bool | None:
+        return None if pt is None else self.silence.ask(self.classify, pt, near)
 
     def book(self, t) -> bool | None:
         pt = self.ray.point(t)
@@ -119,7 +168,8 @@ class _Judge:
         pt = self.ray.point(t)
         if pt is None:
             return None, None, None
-        return holds(self.cond, pt), self.classify(pt, near), pt
+        book = holds(self.cond, pt)
+        return book, (None if book is None else self.engine(pt, near)), pt
 
 
 def _bisect(fn: Callable, a: float, b: float, fa) -> tuple[float, float] | None:
@@ -232,12 +282,11 @@ def _show(pt: dict) -> str:
 
 def _engine_crossing(judge: _Judge, a: float, b: float) -> str:
     """Where the engine's verdict changes between a and b, for the message."""
-    ea = judge.classify(judge.ray.point(a), True) if judge.ray.point(a) else None
-    eb = judge.classify(judge.ray.point(b), True) if judge.ray.point(b) else None
+    ea = judge.engine(judge.ray.point(a), True)
+    eb = judge.engine(judge.ray.point(b), True)
     if ea is None or eb is None or ea == eb:
         return ""
-    got = _bisect(lambda t: judge.classify(judge.ray.point(t), True)
-                  if judge.ray.point(t) else None, a, b, ea)
+    got = _bisect(lambda t: judge.engine(judge.ray.point(t), True), a, b, ea)
     if got is None:
         return ""
     return f"; the engine's boundary on this ray is at {_show(judge.ray.point(got[0]))}"
@@ -266,6 +315,8 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
     rays = 0
     sides = {i for i, f in enumerate(atoms) if f.free_symbols & set(symbols)}
     crossed: set[int] = set()
+    silence = _Silence()
+    book_points = 0  # grid points where the book's relation has a truth value
     while rays < n_rays + MORE_RAYS:
         if rays >= n_rays and res.crossings + res.tangencies > 0 and sides <= crossed:
             break  # every side of the relation crossed at least once
@@ -274,9 +325,10 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
         d = rng.normal(size=len(symbols))
         d /= np.linalg.norm(d)
         ray = Ray(sampler, origin, d, symbols, scales)
-        judge = _Judge(cond, classify, ray)
+        judge = _Judge(cond, classify, ray, silence)
         grid = [judge.both(t, False) for t in ts]
         for b, e, pt in grid:
+            book_points += b is not None
             if b is None or e is None:
                 continue
             res.points += 1
@@ -311,14 +363,25 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
                 res.detail = bad
                 return res
             res.tangencies += 1
-    if res.crossings + res.tangencies == 0 or min(seen.values()) == 0:
+    if res.points == 0:  # not one point judged by both sides: nothing was evaluated
         res.ok = False
+        if book_points == 0:
+            res.outcome = "undecided"
+            res.detail = (f"the book's relation has no truth value at any of the points of "
+                          f"{rays} rays (it does not evaluate there)")
+        else:
+            res.outcome, why = silence.reason()
+            res.detail = (f"{why} (no verdict of the engine at any of {book_points} points "
+                          f"on {rays} rays: nothing was compared)")
+        return res
+    if res.crossings + res.tangencies == 0 or min(seen.values()) == 0:
+        res.ok, res.outcome = False, "undecided"
         res.detail = (f"no ray crossed the book's boundary ({rays} rays, {res.points} points: "
-                      f"{seen[True]} {words[0]}, {seen[False]} {words[1]}): the check cannot "
-                      "discriminate (widen the parameters or `assume:` a region)")
+                      f"{seen[True]} {words[0]}, {seen[False]} {words[1]}, all agreeing): the "
+                      "check cannot discriminate (widen the parameters or `assume:` a region)")
         return res
     if res.unjudged and res.unjudged == res.crossings:
-        res.ok = False
+        res.ok, res.outcome = False, "unsupported"
         res.detail = (f"the engine gives no verdict near any of the {res.crossings} crossings "
                       "(marginal there): the boundary cannot be compared")
         return res
@@ -359,8 +422,14 @@ def _judge_crossing(judge: _Judge, t_star, res: BoundaryResult, words: tuple[str
 
 
 def verdict(result: BoundaryResult, crossings_word: str = "crossings") -> Verdict:
-    """A Verdict stating the boundary's resolution (its power)."""
+    """A Verdict stating the boundary's resolution (its power). Where nothing contradicted
+    the book (the engine gave no verdict, or nothing straddled the boundary) there is no
+    verdict: UnsupportedError or UndecidedError with the reason."""
     if not result.ok:
+        if result.outcome == "unsupported":
+            raise UnsupportedError(result.detail)
+        if result.outcome == "undecided":
+            raise UndecidedError(result.detail)
         return Verdict(False, "boundary", result.detail)
     judged = result.crossings - result.unjudged
     tang = f" and {result.tangencies} tangencies" if result.tangencies else ""

@@ -25,6 +25,7 @@ import sympy as sp
 from mechbook.app.mathml import math
 from mechbook.app.report.derivation import StoredSystem
 from mechbook.app.report.syntax import syntax_math
+from mechbook.engine.periodic import time_dependent
 from mechbook.errors import MechbookError
 from mechbook.verify.context import Context, numbers, strip_const
 from mechbook.verify.registry import quantities
@@ -144,8 +145,9 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         return view.equilibria or None
     if shown == "sylvester_criterion":
         lin = part_linear(ctx, view, values)
-        if lin is None or lin.first_order or lin.C.is_zero_matrix is False:
-            return None
+        if lin is None or lin.first_order or lin.C.is_zero_matrix is False \
+                or time_dependent(lin):
+            return None  # velocity terms, first order, or K(t): not K's minors
         K = lin.K
         if K.rows > 3:
             return None

@@ -4,10 +4,11 @@
 from __future__ import annotations
 
 from mechbook.errors import MechbookError
-from mechbook.verify import boundary
+from mechbook.verify import boundary, boundary_limit
 from mechbook.verify.compare import Verdict, all_vanish, combine, vanishes
 from mechbook.verify.context import Context
-from mechbook.verify.registration import quantity
+from mechbook.verify.periodic import FloquetVerdicts, time_dependent
+from mechbook.verify.registration import EXPR, LIMIT, quantity
 
 
 def _engine_points(ctx: Context) -> list[dict]:
@@ -72,22 +73,42 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
                'every place where the relation changes truth (found to 30 digits) the '
                'engine\'s verdict, in 40-digit arithmetic, agrees a relative 1e-8 inside and '
                'outside; tangencies are judged on both sides. A boundary moved by more than '
-               '1e-8 fails'),
+               '1e-8 fails. Coefficients periodic in t (a driven coordinate): the verdict is '
+               'Floquet\'s, from the monodromy over one period (detected, or `period:`) '
+               'integrated in 113-bit arithmetic. With `limit:` the relation holds only in '
+               'that limit: the distance from its boundary to the engine\'s, along each other '
+               'parameter, must fall at the order claimed'),
+          keys={"limit": LIMIT, "period": EXPR},
           crosschecks=("modes",), display="sylvester_criterion", sweeps=("stability",))
 def check_stability_condition(ctx: Context, val) -> Verdict:
     """The book's condition holds exactly where the engine finds the point stable, compared
-    at the condition's boundary (mechbook.verify.boundary) and widely along rays."""
+    at the condition's boundary (mechbook.verify.boundary) and widely along rays; with
+    `limit:`, its boundary approaches the engine's (mechbook.verify.boundary_limit)."""
     cond = ctx.parse(val, ("book",), relation=True)
     lin = ctx.linear()
+    floquet = None
+    if time_dependent(lin):
+        floquet = FloquetVerdicts(ctx, lin)
+        stable = floquet.classify
+    else:
+        if "period" in ctx.part.data:
+            raise ctx.part.error(("period",), "`period:` is for a linearization whose "
+                                 "coefficients depend on t; these do not")
 
-    def stable(pt: dict, near: bool) -> bool | None:
-        try:
-            got = lin.numeric_stability(pt)
-            if near or got == "marginal":
-                got = lin.precise_stability(pt)
-        except (MechbookError, ZeroDivisionError, ValueError):
-            return None  # no linear system at this point (a singular matrix)
-        return None if got == "marginal" else got == "stable"
+        def stable(pt: dict, near: bool) -> bool | None:
+            try:
+                got = lin.numeric_stability(pt)
+                if near or got == "marginal":
+                    got = lin.precise_stability(pt)
+            except (ZeroDivisionError, ValueError) as exc:  # a singular matrix: no verdict
+                raise MechbookError(f"no linear system at this point ({exc})") from None
+            return None if got == "marginal" else got == "stable"
 
-    return boundary.verdict(boundary.compare(cond, stable, ctx.sampler,
-                                             ("stable", "unstable")))
+    if "limit" in ctx.part.data:
+        got = boundary_limit.check(ctx, cond, stable)
+    else:
+        got = boundary.verdict(boundary.compare(cond, stable, ctx.sampler,
+                                                ("stable", "unstable")))
+    if got.ok and floquet is not None:
+        got.power = f"{got.power}; {floquet.power()}"
+    return got

@@ -34,9 +34,9 @@ from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.extremum import Extremum, NoValue, locate, torus_maximum
 from mechbook.engine.linear import mp_matrix, state_matrix
 from mechbook.errors import UnsupportedError
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
-from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.quantities.parts import energy_at, linear_motion, part_energy_expr
 from mechbook.verify.registration import EXPR, LIMIT, POINT, quantity
 

@@ -33,7 +33,7 @@ and index names (`indices:`, default j, r, s). `approximates:` is one of
                         book's matrix (entries in indices `component: [j, r]`)
 
 The error is |book − exact| (relative to the unperturbed value when that exceeds 1) and must
-fall like ε^(order + 1) (mechbook.verify.quantities.oscillations.asymptotic). The unperturbed
+fall like ε^(order + 1) (mechbook.verify.asymptotic). The unperturbed
 system is the one at ε = 0, or at `unperturbed:` values (a splitting that scales with ε).
 """
 
@@ -48,8 +48,8 @@ from sympy.core.function import AppliedUndef
 from mechbook.engine import perturbation as pert
 from mechbook.errors import UnsupportedError
 from mechbook.model.expr import Operator
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.context import Context
-from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registration import EXPR, LIMIT, POINT, quantity
 
 KINDS = ("squared_frequency", "component", "exponent", "damped_component", "equilibrium",

@@ -7,7 +7,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
-from mechbook.errors import UnsupportedError
+from mechbook.errors import UndecidedError, UnsupportedError
 from mechbook.verify.compare import Sampler, Verdict, value
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import EXPR, REGION, quantity
@@ -201,8 +201,8 @@ def check_phase_region(ctx: Context, val) -> Verdict:
         inside += int(np.sum(judge & truth))
         judged += int(np.sum(judge))
     if inside == 0 or inside == judged:
-        return Verdict(False, "numeric", "the sampled points never straddle the region's "
-                       "boundary; the check cannot discriminate")
+        raise UndecidedError(f"the {judged} sampled points never straddle the region's "
+                             "boundary (all agreeing): the check cannot discriminate")
     edge = _region_boundary(ctx, conds, variables, bounds, time, flow)
     if not edge.ok:
         return Verdict(False, "boundary", edge.detail)

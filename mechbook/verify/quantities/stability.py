@@ -12,9 +12,10 @@ from mechbook.engine.certified_count import certified_count
 from mechbook.engine.steady_search import classify, classify_at, roots_in
 from mechbook.verify.compare import Verdict, value
 from mechbook.verify.context import Context
+from mechbook.verify.periodic import FloquetVerdicts, time_dependent
 from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.quantities.steady import coordinate_map
-from mechbook.verify.registration import EXPR, POINT, REGION, quantity
+from mechbook.verify.registration import EXPR, LIMIT, POINT, REGION, quantity
 
 
 @quantity('stability',
@@ -24,9 +25,11 @@ from mechbook.verify.registration import EXPR, POINT, REGION, quantity
                'drawn widely (factors up to e² about the defaults; `assume:` bounds the '
                'region): "always stable / always unstable" claims, no boundary crossing '
                'needed. A marginal point (a zero frequency without gyroscopic terms) counts '
-               'against `stable` and `unstable`; zero exponents of a symmetry are neutral. A '
+               'against `stable` and `unstable`; zero exponents of a symmetry are neutral. '
+               'Coefficients periodic in t: Floquet multipliers (as `stability_condition`). A '
                'relation is checked as `stability_condition`'),
           literals=("stable", "unstable", "marginal"),
+          keys={"limit": LIMIT, "period": EXPR},
           crosschecks=("modes",))
 def check_stability(ctx: Context, val) -> Verdict:
     if isinstance(val, str) and ("<" in val or ">" in val):  # a condition after all
@@ -34,21 +37,29 @@ def check_stability(ctx: Context, val) -> Verdict:
     if val not in ("stable", "unstable", "marginal"):
         raise ctx.part.error(("book",), "expected stable, unstable or marginal (or a "
                              "relation: where it is stable)")
+    if "limit" in ctx.part.data:
+        raise ctx.part.error(("limit",), "`limit:` applies to a relation (where it is stable "
+                             "in the limit), not to a verdict")
     lin = ctx.linear()
+    floquet = FloquetVerdicts(ctx, lin) if time_dependent(lin) else None
+    if floquet is None and "period" in ctx.part.data:
+        raise ctx.part.error(("period",), "`period:` is for a linearization whose "
+                             "coefficients depend on t; these do not")
     wide = ctx.sampler.widened(2.0)
     seen: dict[str, int] = {}
     for n in range(60):
         pt = wide.draw()
-        got = classify(lin, pt)
+        got = classify(lin, pt) if floquet is None else floquet.stability(pt)
         seen[got] = seen.get(got, 0) + 1
         if got != val:
             shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
                 pt.items(), key=lambda kv: kv[0].name)[:8])
             return Verdict(False, f"numeric({n + 1} points)",
                            f"engine finds it {got} at {{{shown}}}")
+    power = (f"60 points drawn widely (factors to e²), all {val}: a claim of no boundary, "
+             "checked away from one")
     return Verdict(True, f"numeric(60 points, all {val})",
-                   power=f"60 points drawn widely (factors to e²), all {val}: a claim of no "
-                         "boundary, checked away from one")
+                   power=power if floquet is None else f"{power}; {floquet.power()}")
 
 
 def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:

@@ -18,11 +18,11 @@ from mechbook.core.numeval import NotNumeric, evaluate_resolved
 from mechbook.core.secalc import expand
 from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
-from mechbook.errors import UnsupportedError
+from mechbook.errors import UndecidedError, UnsupportedError
 from mechbook.verify import boundary
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}
@@ -166,8 +166,8 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
                            f"book's roots {[f'{b:.10g}' for b in book]}, engine's steady rates "
                            f"{[f'{e:.10g}' for e in engine]}")
     if not seen:  # two equations without real roots agree without saying anything
-        return Verdict(False, f"numeric({n} points)", "no steady motion exists at any sampled "
-                       "point: the check cannot discriminate (`assume:` a region where one does)")
+        raise UndecidedError(f"no steady motion exists at any of {n} sampled points: the "
+                             "check cannot discriminate (`assume:` a region where one does)")
     return Verdict(True, f"numeric({n} points, polynomial roots)",
                    power=f"{n} points: the real roots, all of them, to {ROOT_RTOL:g}")
 
@@ -190,8 +190,8 @@ def _vanishes_at_rates(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
                                f"the book's equation does not vanish at the engine's steady "
                                f"rate {r:.10g} (residual {abs(v):.3g} of {scale:.3g})")
     if not seen:
-        return Verdict(False, f"numeric({n} points)", "no steady motion exists at any sampled "
-                       "point: the check cannot discriminate (`assume:` a region where one does)")
+        raise UndecidedError(f"no steady motion exists at any of {n} sampled points: the "
+                             "check cannot discriminate (`assume:` a region where one does)")
     return Verdict(True, f"numeric({n} points, at the engine's rates)",
                    "the equation is not polynomial in the rate: it holds at every steady rate, "
                    "but its other roots are not counted",

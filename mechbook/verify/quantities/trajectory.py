@@ -16,19 +16,23 @@ from __future__ import annotations
 
 import math
 
+import mpmath
 import numpy as np
 import sympy as sp
 
+from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.levelset import LevelSet
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
 from mechbook.numerics.model import build_model
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.quantities.oscillations import asymptotic
 from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, quantity
 
 LEVEL_RTOL = 1e-10
+LEVEL_DPS = 50  # the level set's working precision
+CHECK_DPS = 70  # a second precision for `limit:`: the difference is the first's error
 LEVEL_POINTS = 6
 MEASURED_POINTS = 3
 START = {"initial": POINT, "coordinate": {"type": "string"}}
@@ -63,8 +67,8 @@ class Motion:
     def state(self, pt: dict) -> dict:
         return {k: v.subs(pt) for k, v in self.start.items()}
 
-    def orbit(self, pt: dict):
-        return self.level.orbit(self.state(pt), pt)
+    def orbit(self, pt: dict, dps: int = LEVEL_DPS):
+        return self.level.orbit(self.state(pt), pt, dps)
 
     def measured(self, pt: dict):
         ctx, sys = self.ctx, self.ctx.system
@@ -122,20 +126,29 @@ def _book_values(ctx: Context, val) -> list:
 
 
 def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
-             partial: bool = False) -> Verdict:
+             partial: bool = False, precise=None) -> Verdict:
     """Book values against engine values (a function of the parameter point), at random
-    points; with `limit:` the relative error must fall by decades."""
+    points; with `limit:` the relative error must fall by decades, both sides taken at
+    CHECK_DPS digits (`precise(point, dps)`: the engine's values as mpmath numbers) and
+    the engine's resolution measured as the difference from LEVEL_DPS digits."""
     if "limit" in ctx.part.data:
-        if motion.level is None:
+        if motion.level is None or precise is None:
             raise UnsupportedError("an asymptotic trajectory formula needs the level-set "
                                    "reduction (every other coordinate cyclic)")
 
-        def error(pt) -> float:
-            eng = engine_of(pt)
-            worst = 0.0
-            for b in _at_start(motion.start, book, pt):
-                worst = max(worst, min(abs(e - b) for e in eng) / max(abs(b), 1e-300))
-            return worst
+        def error(pt) -> tuple[float, float]:
+            with mpmath.workdps(CHECK_DPS):
+                eng = precise(pt, CHECK_DPS)
+                coarse = precise(pt, LEVEL_DPS)
+                tiny = mpmath.mpf(10) ** -300
+                resolution = max(abs(a - b) / max(abs(b), tiny)
+                                 for a, b in zip(coarse, eng, strict=True))
+                worst = mpmath.mpf(0)
+                for b in _at_start_mp(motion.start, book, pt):
+                    if b is None:
+                        return float("inf"), float(resolution)
+                    worst = max(worst, min(abs(e - b) for e in eng) / max(abs(b), tiny))
+                return float(worst), max(float(resolution), 1e-60)
 
         return asymptotic(ctx, error)
     how = "level set" if motion.level else "measured"
@@ -149,6 +162,24 @@ def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
                    power=(f"within the stated {motion.rtol:g}" if "estimate" in ctx.part.data
                           else f"{motion.points()} points, each value to {motion.rtol:g} "
                                f"({how})"))
+
+
+def _at_start_mp(start: dict, book: list, pt: dict) -> list:
+    """Book values at the parameter point at CHECK_DPS digits (None where one is not a
+    finite real number), functions of the state evaluated at the start."""
+    state = {k: v.subs(pt) for k, v in start.items()}
+    out = []
+    for b in book:
+        try:
+            v = evaluate_mp(sp.S(b).subs(state), pt, CHECK_DPS)
+        except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
+            out.append(None)
+            continue
+        if not mpmath.isfinite(v) or abs(mpmath.im(v)) > mpmath.mpf(10) ** -40 * max(1, abs(v)):
+            out.append(None)
+        else:
+            out.append(mpmath.re(v))
+    return out
 
 
 def _at_start(start: dict, book: list, pt: dict) -> list[float]:
@@ -166,6 +197,19 @@ def _extremes(motion: Motion, pt: dict) -> list[float]:
     return [m.low, m.high]
 
 
+def _precise(motion: Motion, of):
+    """(point, dps) ↦ the engine's values on the level set at dps digits (mpmath numbers);
+    None where the signal is not the coordinate itself (no level set for it)."""
+    if motion.level is None or motion.of is not None:
+        return None
+
+    def values(pt: dict, dps: int) -> list:
+        with mpmath.workdps(dps):
+            return of(motion.orbit(pt, dps))
+
+    return values
+
+
 KEYS = {**START, "partial": {"type": "boolean"}, "limit": LIMIT, "estimate": ESTIMATE}
 
 
@@ -181,7 +225,8 @@ KEYS = {**START, "partial": {"type": "boolean"}, "limit": LIMIT, "estimate": EST
 def check_turning_points(ctx: Context, val) -> Verdict:
     motion = Motion(ctx)
     return _compare(ctx, motion, _book_values(ctx, val), lambda pt: _extremes(motion, pt),
-                    "turning points", bool(ctx.part.data.get("partial")))
+                    "turning points", bool(ctx.part.data.get("partial")),
+                    _precise(motion, lambda o: list(o.turning_points)))
 
 
 @quantity('excursion',
@@ -199,7 +244,9 @@ def check_excursion(ctx: Context, val) -> Verdict:
         lo, hi = _extremes(motion, pt)
         return [hi - lo]
 
-    return _compare(ctx, motion, _book_values(ctx, val), engine, "excursion")
+    return _compare(ctx, motion, _book_values(ctx, val), engine, "excursion",
+                    precise=_precise(motion, lambda o: [o.turning_points[1]
+                                                        - o.turning_points[0]]))
 
 
 @quantity('motion_frequency',
@@ -216,7 +263,8 @@ def check_motion_frequency(ctx: Context, val) -> Verdict:
             return [float(2 * math.pi / motion.orbit(pt).period)]
         return [2 * math.pi / motion.measured(pt).period()]
 
-    return _compare(ctx, motion, _book_values(ctx, val), engine, "frequency")
+    return _compare(ctx, motion, _book_values(ctx, val), engine, "frequency",
+                    precise=_precise(motion, lambda o: [2 * mpmath.pi / o.period]))
 
 
 @quantity('mean_rate',
@@ -240,7 +288,8 @@ def check_mean_rate(ctx: Context, val) -> Verdict:
         m = motion.measured(pt)
         return [m.advance(ctx.system.q.index(q)) / m.period()]
 
-    return _compare(ctx, motion, _book_values(ctx, val), engine, "mean rate")
+    return _compare(ctx, motion, _book_values(ctx, val), engine, "mean rate",
+                    precise=_precise(motion, lambda o: [o.advance(q) / o.period]))
 
 
 

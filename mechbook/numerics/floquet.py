@@ -1,0 +1,269 @@
+"""Floquet theory of a linearization with periodic coefficients: the monodromy matrix over
+one period, its multipliers and exponents, and the stability verdict they give.
+
+For M(t)·δq̈ + C(t)·δq̇ + K(t)·δq = 0 with period T (mechbook.engine.periodic) the state
+x = (δq, δq̇) obeys ẋ = A(t)·x, A = [[0, 1], [−M⁻¹K, −M⁻¹C]]. The fundamental matrix X(t),
+X(0) = 1, is integrated over one period by heyoka's Taylor method in 113-bit (quadruple)
+arithmetic at its machine tolerance (~1e-34): Φ = X(T), the monodromy matrix. Its
+eigenvalues μ (the multipliers; exponents log μ / T) decide stability: every |μ| ≤ 1.
+
+Deciding "on the unit circle" honestly:
+- Liouville's formula det Φ = exp(−∫₀ᵀ tr(M⁻¹C) dt) is integrated alongside (one more
+  variable) and compared with det Φ: their relative difference is the measured resolution of
+  Φ. A verdict needs it below RESOLVED; where it is not (and no multiplier is clearly off the
+  circle) the point has no verdict (UnsupportedError with the numbers).
+- A multiplier within MARGINAL of ±1 is marginal (a tongue's edge, or a zero exponent of a
+  symmetry): rounding splits a double root there by the square root of the arithmetic's
+  precision (~1e-17), so nearer than 1e-13 nothing can be told.
+- Otherwise unstable iff some |μ| > 1 + ON_CIRCLE(resolution). Off the edges the multipliers
+  of a stable conservative system sit on the circle to the arithmetic's precision, and an
+  unstable one's leave it like the square root of the distance to the boundary: 1e-8 from
+  a tongue's edge they are ~1e-5 off it, far above the resolution.
+
+heyoka is optional (`pip install 'mechbook[taylor]'`); without it Floquet multipliers are
+unsupported, with that reason.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from mechbook.core.numeval import NotNumeric, evaluate_mp
+from mechbook.engine import periodic
+from mechbook.engine.linear import LinearSystem
+from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.numerics.hyexpr import Translator, solve_spd
+
+DPS = 40  # mpmath digits for the period, the parameters and the eigenvalues of Φ
+RESOLVED = 1e-20  # the largest Liouville mismatch at which a verdict is given
+MARGINAL = 1e-13  # a multiplier this close to ±1 is marginal (no verdict)
+CLEARLY = 1e-6  # |μ| beyond 1 + this is unstable whatever the resolution
+ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
+
+
+def on_circle(resolution: float) -> float:
+    """How far |μ| may exceed 1 and still count as on the circle."""
+    return max(1e-24, 1e3 * resolution)
+
+
+@dataclass
+class Multipliers:
+    """The monodromy's eigenvalues at one parameter point, and how well Φ is known."""
+
+    values: list  # mpmath complex numbers
+    period: object  # mpf
+    resolution: float  # |det Φ / exp(−∫tr M⁻¹C) − 1|
+    seconds: float = 0.0
+
+    def exponents(self) -> list:
+        """Characteristic exponents log(μ)/T (real parts: growth rates)."""
+        with mpmath.workdps(DPS):
+            return [mpmath.log(m) / self.period for m in self.values]
+
+    def largest(self) -> float:
+        return float(max(abs(m) for m in self.values))
+
+    def verdict(self) -> str:
+        """'stable', 'unstable' or 'marginal' (see the module's docstring)."""
+        with mpmath.workdps(DPS):
+            edge = [m for m in self.values if min(abs(m - 1), abs(m + 1)) < MARGINAL]
+            off = [m for m in self.values if m not in edge]
+            if any(abs(m) > 1 + CLEARLY for m in off):
+                return "unstable"
+            if self.resolution > RESOLVED:
+                raise UnsupportedError(
+                    f"Floquet multipliers not resolved: det Φ differs from Liouville's "
+                    f"exp(−∫tr M⁻¹C dt) by {self.resolution:.2g} (needs {RESOLVED:g}), and "
+                    f"the largest |μ| = {self.largest():.17g} is too near 1 to decide")
+            if any(abs(m) - 1 > on_circle(self.resolution) for m in off):
+                return "unstable"
+            return "marginal" if edge else "stable"
+
+
+@dataclass
+class Floquet:
+    """The monodromy of one time-periodic linear system, compiled once (heyoka, 113 bits)
+    and evaluated at any parameter point."""
+
+    lin: LinearSystem
+    period: sp.Expr
+    symbols: list = field(default_factory=list)  # the parameters, in heyoka's par[] order
+    _ta: object = field(default=None, repr=False)
+    compile_seconds: float = 0.0
+
+    @classmethod
+    def of(cls, lin: LinearSystem, period: sp.Expr | None = None) -> Floquet:
+        """Floquet's form of `lin`; the period detected from the coefficients unless given
+        (a given one is verified at each point)."""
+        if not periodic.time_dependent(lin):
+            raise UnsupportedError("Floquet multipliers of a linearization whose "
+                                   "coefficients do not depend on t (use its exponents)")
+        return cls(lin, period if period is not None else periodic.period(lin))
+
+    def __post_init__(self):
+        t = self.lin.dyn.sys.t
+        used = set().union(*(A.free_symbols for A in (self.lin.M, self.lin.C, self.lin.K)),
+                           self.period.free_symbols)
+        self.symbols = sorted(used - {t}, key=lambda s: s.name)
+        self.declared = False
+
+    # ---- building the integrator --------------------------------------------------------
+    def _integrator(self):
+        if self._ta is not None:
+            return self._ta
+        try:
+            import heyoka as hy
+        except ImportError:
+            raise UnsupportedError("Floquet multipliers need heyoka's Taylor integrator "
+                                   "(pip install 'mechbook[taylor]')") from None
+        start = time.perf_counter()
+        lin = self.lin
+        n = lin.M.rows
+        if any(not sp.simplify(lin.M[i, j] - lin.M[j, i]) == 0
+               for i in range(n) for j in range(i + 1, n)):
+            raise UnsupportedError("Floquet multipliers with a mass matrix that is not "
+                                   "symmetric")
+        symbols = {lin.dyn.sys.t: hy.time}
+        symbols.update({s: hy.par[i] for i, s in enumerate(self.symbols)})
+        tr = _QuadTranslator(symbols)
+
+        def entry(e):
+            return None if e == 0 else tr(e)
+
+        M = [[entry(lin.M[i, j]) for j in range(n)] for i in range(n)]
+        C = [[entry(lin.C[i, j]) for j in range(n)] for i in range(n)]
+        K = [[entry(lin.K[i, j]) for j in range(n)] for i in range(n)]
+        names = [f"x{i}_{j}" for j in range(2 * n) for i in range(2 * n)]
+        X = list(hy.make_vars(*names, "liouville"))
+        s = X.pop()
+        zero = hy.expression(hy.real128(0))
+        ode = []
+        for j in range(2 * n):  # column j of X: positions Q, velocities V
+            Q, V = X[2 * n * j: 2 * n * j + n], X[2 * n * j + n: 2 * n * (j + 1)]
+            rhs = [_dot([(K[i][k], Q[k]) for k in range(n)] + [(C[i][k], V[k])
+                                                                 for k in range(n)])
+                   for i in range(n)]
+            acc = solve_spd(M, [None if r is None else -r for r in rhs], _is_none)
+            ode += [(Q[i], V[i]) for i in range(n)]
+            ode += [(V[i], zero if acc[i] is None else acc[i]) for i in range(n)]
+        # Liouville: d/dt log det X = tr A = −tr(M⁻¹C); s carries ∫ tr(M⁻¹C) dt
+        cols = [solve_spd(M, [C[i][j] for i in range(n)], _is_none) for j in range(n)]
+        diag = [cols[j][j] for j in range(n) if cols[j][j] is not None]
+        ode.append((s, hy.sum(diag) if diag else zero))
+        state = np.zeros(len(ode), dtype=hy.real128)
+        pars = np.zeros(len(self.symbols), dtype=hy.real128)
+        try:
+            self._ta = hy.taylor_adaptive(ode, state, pars=pars, fp_type=hy.real128)
+        except (ValueError, RuntimeError, TypeError) as exc:
+            raise UnsupportedError(f"Floquet multipliers: heyoka refused the system ({exc})"
+                                   ) from None
+        self.compile_seconds = time.perf_counter() - start
+        return self._ta
+
+    # ---- one parameter point ------------------------------------------------------------
+    def period_at(self, values: dict):
+        with mpmath.workdps(DPS):
+            try:
+                T = evaluate_mp(self.period, values, DPS)
+            except (NotNumeric, ZeroDivisionError, ValueError, TypeError) as exc:
+                raise MechbookError(f"the period {self.period} has no value here ({exc})"
+                                    ) from None
+            if mpmath.im(T) != 0 and abs(mpmath.im(T)) > 1e-30 * abs(T):
+                raise MechbookError(f"the period {self.period} is not real here")
+            T = abs(mpmath.re(T))
+            if not mpmath.isfinite(T) or T == 0:
+                raise MechbookError(f"the period {self.period} is not a finite positive "
+                                    "number here")
+            return T
+
+    def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, float]:
+        """(Φ at DPS digits, T, the Liouville mismatch |det Φ·exp(∫tr M⁻¹C) − 1|)."""
+        import heyoka as hy
+
+        ta = self._integrator()
+        n2 = 2 * self.lin.M.rows
+        T = self.period_at(values)
+        if self.declared and not periodic.declared_period_holds(self.lin, self.period, values):
+            raise UnsupportedError(f"the declared period {self.period} is not a period of "
+                                   "the coefficients here")
+        with mpmath.workdps(DPS):
+            pars = []
+            for s in self.symbols:
+                if s not in values:
+                    raise MechbookError(f"the linearized system keeps {s} without a value")
+                pars.append(hy.real128(mpmath.nstr(_mp(values[s]), 36)))
+            ta.pars[:] = np.array(pars, dtype=hy.real128)
+            state = np.zeros(n2 * n2 + 1, dtype=hy.real128)
+            for j in range(n2):
+                state[n2 * j + j] = hy.real128(1)
+            ta.time = hy.real128(0)
+            ta.state[:] = state
+            out = ta.propagate_until(hy.real128(mpmath.nstr(T, 36)))
+            if out[0] != hy.taylor_outcome.time_limit:
+                raise MechbookError(f"Floquet: the integration over one period stopped "
+                                    f"({out[0]})")
+            y = [mpmath.mpf(str(v)) for v in ta.state]
+            phi = mpmath.matrix(n2, n2)
+            for j in range(n2):
+                for i in range(n2):
+                    phi[i, j] = y[n2 * j + i]
+            det = mpmath.det(phi)
+            liouville = mpmath.exp(-y[-1])
+            mismatch = abs(det / liouville - 1) if liouville != 0 else mpmath.inf
+            return phi, T, float(mismatch)
+
+    def multipliers(self, values: dict) -> Multipliers:
+        start = time.perf_counter()
+        phi, T, mismatch = self.monodromy(values)
+        with mpmath.workdps(DPS):
+            mu = mpmath.eig(phi, left=False, right=False)
+        return Multipliers(list(mu), T, mismatch, time.perf_counter() - start)
+
+    def stability(self, values: dict) -> str:
+        """'stable', 'unstable' or 'marginal' at `values` (see Multipliers.verdict)."""
+        return self.multipliers(values).verdict()
+
+
+def _mp(x):
+    if isinstance(x, sp.Basic):
+        return mpmath.mpf(sp.Float(x, DPS)._mpf_) if x.is_real is not False else \
+            mpmath.mpf(sp.Float(sp.re(x), DPS)._mpf_)
+    return mpmath.mpf(x)
+
+
+def _is_none(e) -> bool:
+    return e is None
+
+
+def _dot(pairs: list) -> object | None:
+    terms = [a * b for a, b in pairs if a is not None]
+    if not terms:
+        return None
+    out = terms[0]
+    for x in terms[1:]:
+        out = out + x
+    return out
+
+
+class _QuadTranslator(Translator):
+    """SymPy → heyoka with every constant in 113-bit precision (the base translator's are
+    doubles: a coefficient 1/3 would be wrong by 1e-17)."""
+
+    def number(self, x) -> object:
+        if isinstance(x, sp.Basic) and x.is_Rational:
+            return self.hy.expression(self.hy.real128(int(x.p))) / \
+                self.hy.expression(self.hy.real128(int(x.q))) if x.q != 1 else \
+                self.hy.expression(self.hy.real128(int(x.p)))
+        return self.hy.expression(self.hy.real128(str(sp.Float(x, 36))))
+
+    def _walk(self, e: sp.Basic):
+        if e is sp.pi:
+            return self.number(sp.pi.evalf(40))
+        if e is sp.E:
+            return self.number(sp.E.evalf(40))
+        return super()._walk(e)

@@ -1,0 +1,56 @@
+"""Stability of a linearization with periodic coefficients, as the verdicts a part needs.
+
+About a rest point of a driven system (a pivot moved up and down, a modulated stiffness)
+M, C and K depend on t; the verdict is Floquet's (mechbook.numerics.floquet): the
+multipliers of the monodromy over one period T, detected from the coefficients or given
+by the part's `period:` (then verified at every point). One compiled integrator per linear
+system serves every parameter point of a part and of the parts after it.
+"""
+
+from __future__ import annotations
+
+from mechbook.engine.linear import LinearSystem
+from mechbook.engine.periodic import time_dependent
+from mechbook.numerics.floquet import ARITHMETIC, RESOLVED, Floquet
+from mechbook.verify.context import Context
+
+__all__ = ["FloquetVerdicts", "time_dependent"]
+
+
+class FloquetVerdicts:
+    """The Floquet verdict at parameter points, and the worst resolution met (for the
+    pass's power)."""
+
+    def __init__(self, ctx: Context, lin: LinearSystem):
+        declared = ctx.part.data.get("period")
+        text = None if declared is None else str(declared)
+
+        def build() -> Floquet:
+            if text is None:
+                return Floquet.of(lin)
+            flo = Floquet.of(lin, ctx.parse(text, ("period",)))
+            flo.declared = True
+            return flo
+
+        self.floquet = ctx.analysis.reuse(("floquet", id(lin), text), build)
+        self.worst = 0.0
+        self.points = 0
+
+    def stability(self, pt: dict) -> str:
+        """'stable', 'unstable' or 'marginal' at `pt`."""
+        got = self.floquet.multipliers(pt)
+        self.points += 1
+        self.worst = max(self.worst, got.resolution)
+        return got.verdict()
+
+    def classify(self, pt: dict, near: bool) -> bool | None:
+        """The boundary comparison's classifier: True stable, False unstable, None marginal
+        (every point is taken at the one, precise, arithmetic: `near` changes nothing)."""
+        got = self.stability(pt)
+        return None if got == "marginal" else got == "stable"
+
+    def power(self) -> str:
+        return (f"the engine's verdicts from Floquet multipliers (the monodromy over one "
+                f"period T = {self.floquet.period}, {ARITHMETIC}; Liouville's determinant "
+                f"agreed to {max(self.worst, 1e-36):.0e} at {self.points} points, "
+                f"{RESOLVED:g} needed)")

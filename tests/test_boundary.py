@@ -1,0 +1,76 @@
+"""Relations decided at their boundary say only what was evaluated (issue 32): `fail` where
+a point contradicted the book; where the engine gave no verdict anywhere, `unsupported`
+with its reason; where nothing straddled the boundary, an error saying so. Never a fail
+that blames the book for what was not compared."""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+from mechbook.errors import MechbookError, UndecidedError, UnsupportedError
+from mechbook.verify import boundary
+from mechbook.verify.compare import Sampler
+
+k = sp.Symbol("k", positive=True)
+c = sp.Symbol("c", positive=True)
+
+
+def _sampler() -> Sampler:
+    return Sampler({k: sp.Float(2.0, 30), c: sp.Float(1.0, 30)})
+
+
+def _stable_above(pt: dict, near: bool) -> bool:
+    return bool(pt[k] > pt[c])  # the engine's boundary: k = c
+
+
+def test_the_right_boundary_passes_and_a_moved_one_fails():
+    right = boundary.verdict(boundary.compare(k > c, _stable_above, _sampler()))
+    assert right.ok and "boundary at" in right.power
+    moved = boundary.compare(k > c * (1 + sp.Rational(1, 10**6)), _stable_above, _sampler())
+    assert not moved.ok and moved.outcome == "fail"
+    assert not boundary.verdict(moved).ok  # a fail: a point contradicted the book
+
+
+def test_no_verdict_anywhere_is_unsupported_with_the_engines_reason():
+    def never(pt, near):
+        raise UnsupportedError("time-dependent coefficients")
+
+    got = boundary.compare(k > c, never, _sampler())
+    assert not got.ok and got.outcome == "unsupported"
+    with pytest.raises(UnsupportedError) as exc:
+        boundary.verdict(got)
+    assert "time-dependent coefficients" in exc.value.capability
+    assert "nothing was compared" in exc.value.capability
+
+
+def test_marginal_everywhere_is_unsupported():
+    got = boundary.compare(k > c, lambda pt, near: None, _sampler())
+    with pytest.raises(UnsupportedError) as exc:
+        boundary.verdict(got)
+    assert "marginal" in exc.value.capability
+
+
+def test_an_engine_error_everywhere_is_an_error_not_a_fail():
+    def broken(pt, near):
+        raise MechbookError("the matrix is singular here")
+
+    got = boundary.compare(k > c, broken, _sampler())
+    with pytest.raises(UndecidedError) as exc:
+        boundary.verdict(got)
+    assert "singular" in str(exc.value)
+
+
+def test_nothing_straddling_the_boundary_is_undecided():
+    """The engine and the book agree everywhere and the book's relation holds at every
+    point drawn: nothing contradicts it, and nothing tests its boundary either."""
+    got = boundary.compare(k > -c, lambda pt, near: True, _sampler())
+    assert not got.ok and got.outcome == "undecided"
+    with pytest.raises(UndecidedError) as exc:
+        boundary.verdict(got)
+    assert "cannot discriminate" in str(exc.value) and "all agreeing" in str(exc.value)
+
+
+def test_a_disagreement_on_the_grid_is_still_a_fail():
+    got = boundary.compare(k > -c, lambda pt, near: False, _sampler())
+    assert not got.ok and got.outcome == "fail" and "the engine finds false" in got.detail
