@@ -47,13 +47,20 @@ def _measure(s: ModalSetup, mode: dict, amplitude: float, period: float) -> tupl
     """Frequency from upward zero crossings of the mode's signal over PERIODS periods
     (DOP853 in the compiled loop where there is one, the crossings located as solve_ivp
     locates them: mechbook.numerics.events)."""
-    g = mode_signal(s, mode)
-    g.direction = 1.0
-    y0 = start_state(s, mode, amplitude)
+    return crossing_frequency(s.model, mode_signal(s, mode), start_state(s, mode, amplitude),
+                              amplitude, period)
+
+
+def crossing_frequency(model, signal, y0: np.ndarray, amplitude: float,
+                       period: float) -> tuple[float, int]:
+    """(frequency, crossings) of `signal(t, y)` along the nonlinear motion from y0: its
+    upward zero crossings over PERIODS + 1 periods, located as solve_ivp locates events,
+    fitted by least squares (DOP853 at rtol 1e-12, atol scaled to the amplitude)."""
+    signal.direction = 1.0
     scale = np.maximum(np.abs(y0), 1.0)
-    sol = solve_with_events(s.model.native, s.model.rhs, (0.0, (PERIODS + 1) * period), y0,
-                            rtol=1e-12, atol=1e-13 * amplitude * scale, events=[g],
-                            stats=s.model.stats)
+    sol = solve_with_events(model.native, model.rhs, (0.0, (PERIODS + 1) * period), y0,
+                            rtol=1e-12, atol=1e-13 * amplitude * scale, events=[signal],
+                            stats=model.stats)
     if not sol.success:
         raise MechbookError(f"integration failed: {sol.message}")
     times = np.asarray(sol.t_events[0])

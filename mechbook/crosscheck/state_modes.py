@@ -19,16 +19,18 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
-from mechbook.crosscheck.frequencies import REL_TOL, SHIFT_TOL, START_AMPLITUDE
+from mechbook.crosscheck.frequencies import (
+    REL_TOL,
+    SHIFT_TOL,
+    START_AMPLITUDE,
+    crossing_frequency,
+)
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.state_space import StateSpaceSystem
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.manifold import manifold_of
-from mechbook.numerics.events import solve_with_events
 from mechbook.numerics.model import build_model
 from mechbook.records import CrossCheck, Status
-
-PERIODS = 4
 
 
 class _Setup:
@@ -146,15 +148,4 @@ def _run(s: _Setup, start: np.ndarray, weights: np.ndarray, amplitude: float,
     def signal(t, y):
         return float(np.real(np.dot(weights, s.deviation(t, y))))
 
-    signal.direction = 1.0
-    scale = np.maximum(np.abs(y0), 1.0)
-    sol = solve_with_events(s.model.native, s.model.rhs, (0.0, (PERIODS + 1) * period), y0,
-                            rtol=1e-12, atol=1e-13 * amplitude * scale, events=[signal],
-                            stats=s.model.stats)
-    if not sol.success:
-        raise MechbookError(f"integration failed: {sol.message}")
-    times = np.asarray(sol.t_events[0])
-    if len(times) < 3:
-        raise MechbookError(f"only {len(times)} zero crossings in {PERIODS + 1} periods")
-    slope = np.polyfit(np.arange(len(times)), times, 1)[0]
-    return float(2 * np.pi / slope)
+    return crossing_frequency(s.model, signal, y0, amplitude, period)[0]

@@ -79,13 +79,8 @@ class LinearSystem:
         without constraints."""
         if self.embedding is None:
             return {}
-        ds = self.displacement()
-        out = {}
-        for i, q in enumerate(self.dyn.q):
-            if q not in self.coords:
-                out[q] = sum((self.embedding[i, j] * ds[j] for j in range(len(self.coords))),
-                             sp.S.Zero)
-        return out
+        return dependent_displacements(self.dyn.q, self.coords, self.embedding,
+                                       self.displacement())
 
     def gradient(self, form: sp.Expr) -> list[sp.Expr]:
         """The gradient at the point of a function of the coordinates, over the linear
@@ -300,6 +295,14 @@ class LinearSystem:
         K = self.K
         minors = [try_simplify(K[:k, :k].det(), 5) for k in range(1, K.rows + 1)]
         return sp.And(*[mi > 0 for mi in minors])
+
+
+def dependent_displacements(q: list, coords: list, embedding: sp.Matrix,
+                            ds: sp.Matrix) -> dict:
+    """{dependent coordinate: its displacement δq_i = Σ_j N_ij δs_j} on a constraint
+    manifold, δs the independent coordinates' displacements."""
+    return {x: sum((embedding[i, j] * ds[j] for j in range(len(coords))), sp.S.Zero)
+            for i, x in enumerate(q) if x not in coords}
 
 
 def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:

@@ -30,7 +30,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import is_zero
-from mechbook.engine.linear import ZERO_CLUSTER, mp_matrix
+from mechbook.engine.linear import ZERO_CLUSTER, dependent_displacements, mp_matrix
 from mechbook.errors import MechbookError, UnsupportedError
 
 FIRST_ORDER = ("has a first-order linearization (velocity constraints: more coordinates than "
@@ -99,12 +99,7 @@ class StateSpaceSystem:
     @property
     def dependent(self) -> dict:
         ds = sp.Matrix([q - self.point.get(q, 0) for q in self.coords])
-        out = {}
-        for i, q in enumerate(self.dyn.q):
-            if q not in self.coords:
-                out[q] = sum((self.embedding[i, j] * ds[j] for j in range(len(self.coords))),
-                             sp.S.Zero)
-        return out
+        return dependent_displacements(self.dyn.q, self.coords, self.embedding, ds)
 
     @cached_property
     def gyroscopic(self) -> bool:

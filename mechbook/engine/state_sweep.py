@@ -98,11 +98,7 @@ class StateSweep:
         elif block.ill:
             block.notes.append(f"{block.ill} points with exponents double precision cannot "
                                f"place kept at float64 (more than {PRECISE_LIMIT} in a block)")
-        if "frequencies" in want:
-            block.frequencies = freq
-        if "stability" in want:
-            block.stability, block.growth = stab, growth
-        return block
+        return block.keep(want, freq, stab, growth)
 
     def _one(self, lam: np.ndarray, i: int, freq, stab, growth) -> None:
         """One point's frequencies, stability code and growth rate from its exponents."""

@@ -142,6 +142,15 @@ class Block:
     precise: int = 0  # of those, recomputed with 50 digits
     notes: list[str] = field(default_factory=list)
 
+    def keep(self, want: Sequence[str], freq: np.ndarray, stab: np.ndarray,
+             growth: np.ndarray) -> Block:
+        """The block with the results `want` asks for."""
+        if "frequencies" in want:
+            self.frequencies = freq
+        if "stability" in want:
+            self.stability, self.growth = stab, growth
+        return self
+
 
 def relations(cond) -> list:
     """The relations (a < b, …) a condition is built of with And / Or / Not."""
@@ -271,11 +280,7 @@ class LinearSweep:
         elif block.ill:
             block.notes.append(f"{block.ill} ill-conditioned points kept at float64 (more "
                                f"than {PRECISE_LIMIT} in a block to recompute)")
-        if "frequencies" in want:
-            block.frequencies = freq
-        if "stability" in want:
-            block.stability, block.growth = stab, growth
-        return block
+        return block.keep(want, freq, stab, growth)
 
     def _symmetric(self, M, K, ok, freq, stab, growth) -> np.ndarray:
         """ω² by the scaled Cholesky reduction; returns the ill-conditioned mask."""
