@@ -28,6 +28,7 @@ from mechbook.engine.sweep import (
     UNDEFINED,
     UNSTABLE,
     Block,
+    sweepable,
 )
 from mechbook.errors import UnsupportedError
 
@@ -45,13 +46,7 @@ class StateSweep:
         self.core = list(lin.core)
         self.n = max(1, len(self.core) // 2)  # frequency slots: one per exponent pair
         free = set().union(*(x.free_symbols for x in list(lin.E) + list(lin.Ahat)))
-        if lin.dyn.sys.t in free:
-            raise UnsupportedError("a sweep of a linear system with time-dependent "
-                                   "coefficients (not autonomous)")
-        unknown = sorted(str(s) for s in free - set(self.symbols))
-        if unknown:
-            raise UnsupportedError(f"sweeping: the linear system depends on {', '.join(unknown)}"
-                                   ", which is not a parameter")
+        sweepable(free, self.symbols, lin.dyn.sys.t)
         self._fn = compile_batch(self.symbols, list(lin.E) + list(lin.Ahat), backend)
 
     def state_matrices(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -206,6 +206,18 @@ def condition_mask(conditions: Sequence, symbols: Sequence[sp.Symbol], X: np.nda
     return np.logical_and.reduce([truth(c, margins, size) for c in conditions])
 
 
+def sweepable(free: set, symbols: Sequence[sp.Symbol], t: sp.Symbol) -> None:
+    """UnsupportedError unless a linear system's entries depend on the swept symbols only
+    (no t: an autonomous system; no symbol without a value)."""
+    if t in free:
+        raise UnsupportedError("a sweep of a linear system with time-dependent "
+                               "coefficients (not autonomous)")
+    unknown = sorted(str(s) for s in free - set(symbols))
+    if unknown:
+        raise UnsupportedError(f"sweeping: the linear system depends on {', '.join(unknown)}"
+                               ", which is not a parameter")
+
+
 class LinearSweep:
     """M(p), C(p), K(p) of one linear system compiled once for stacked evaluation."""
 
@@ -216,13 +228,7 @@ class LinearSweep:
         self.n = len(lin.q)
         mats = (lin.M, lin.C, lin.K)
         free = set().union(*(m.free_symbols for m in mats))
-        if lin.dyn.sys.t in free:
-            raise UnsupportedError("a sweep of a linear system with time-dependent "
-                                   "coefficients (not autonomous)")
-        unknown = sorted(str(s) for s in free - set(self.symbols))
-        if unknown:
-            raise UnsupportedError(f"sweeping: the linear system depends on {', '.join(unknown)}"
-                                   ", which is not a parameter")
+        sweepable(free, self.symbols, lin.dyn.sys.t)
         self.gyroscopic = lin.gyroscopic
         # the point itself (and a steady motion's momenta): where they are not real, the
         # equilibrium does not exist, whatever finite values M, C, K take there
