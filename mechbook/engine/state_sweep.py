@@ -30,7 +30,6 @@ from mechbook.engine.sweep import (
     Block,
     sweepable,
 )
-from mechbook.errors import UnsupportedError
 
 
 class StateSweep:
