@@ -136,27 +136,44 @@ class LinearSystem:
 
     @cached_property
     def frequencies(self) -> list[sp.Expr]:
-        """Symbolic normal angular frequencies ω ≥ 0 (with multiplicity)."""
+        """Symbolic normal angular frequencies ω ≥ 0 (with multiplicity); with gyroscopic
+        terms, the roots real and non-negative at the system's own values
+        (`frequencies_at` for a point that also names an answer key's symbols)."""
+        return self.frequencies_at(self.dyn.sys.numeric_values())
+
+    def frequencies_at(self, values: dict) -> list[sp.Expr]:
+        """The symbolic frequencies; a gyroscopic system's secular equation has 2n roots in
+        ω, and the n kept are those real and non-negative at `values`, which must give
+        every symbol of the roots a number (a steady motion's rate or tilt named by an
+        answer key is not among the system's parameters): UnsupportedError otherwise."""
         if not self.gyroscopic:
             return [try_simplify(sp.sqrt(r), 5) for r in self.squared_frequencies]
-        om = sp.Symbol("omega_root", positive=True)
-        det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
-        n = len(self.q)
-        try:
-            with time_limit(30):
-                roots = sp.roots(sp.Poly(det, om), om)
-        except Timeout:
-            roots = {}
-        # keep the n roots that are real and non-negative at the default parameters
-        values = self.dyn.sys.numeric_values()
         keep = []
-        for r, mult in roots.items():
-            v = complex(r.evalf(subs=values))
+        for r, mult in self._gyroscopic_roots.items():
+            left = sorted(map(str, r.free_symbols - set(values)))
+            if left:
+                raise UnsupportedError("choosing the real roots of a gyroscopic system's "
+                                       f"secular equation needs values of {', '.join(left)}")
+            if r == 0:  # ω = 0 is its own pair (±0): a zero exponent of multiplicity m
+                keep += [sp.S.Zero] * ((mult + 1) // 2)  # is m/2 zero frequencies
+                continue
+            v = _entry(r, values, 30)
             if abs(v.imag) < 1e-9 * (1 + abs(v)) and v.real >= -1e-12:
                 keep += [try_simplify(r, 5)] * mult
-        if len(keep) != n:
+        if len(keep) != len(self.q):
             raise UnsupportedError("closed-form frequencies of a gyroscopic system")
         return keep
+
+    @cached_property
+    def _gyroscopic_roots(self) -> dict:
+        """{root ω: multiplicity} of det(K − ω²M + iωC) = 0 ({} past the time limit)."""
+        om = sp.Symbol("omega_root", positive=True)
+        det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
+        try:
+            with time_limit(30):
+                return sp.roots(sp.Poly(det, om), om)
+        except Timeout:
+            return {}
 
     # ---- numeric -------------------------------------------------------------------------
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
