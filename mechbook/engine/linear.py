@@ -126,7 +126,8 @@ class LinearSystem:
             with time_limit(30):
                 roots = sp.roots(poly, w)
         except Timeout:
-            roots = {}
+            raise UnsupportedError("closed-form roots of the secular equation (SymPy's roots "
+                                   "ran past its time limit of 30 s of CPU)") from None
         if sum(roots.values()) != poly.degree():
             raise UnsupportedError("closed-form roots of the secular equation")
         out = []
@@ -166,14 +167,15 @@ class LinearSystem:
 
     @cached_property
     def _gyroscopic_roots(self) -> dict:
-        """{root ω: multiplicity} of det(K − ω²M + iωC) = 0 ({} past the time limit)."""
+        """{root ω: multiplicity} of det(K − ω²M + iωC) = 0."""
         om = sp.Symbol("omega_root", positive=True)
         det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
         try:
             with time_limit(30):
                 return sp.roots(sp.Poly(det, om), om)
         except Timeout:
-            return {}
+            raise UnsupportedError("closed-form frequencies of a gyroscopic system (SymPy's "
+                                   "roots ran past its time limit of 30 s of CPU)") from None
 
     # ---- numeric -------------------------------------------------------------------------
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
