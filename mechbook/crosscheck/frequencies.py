@@ -58,10 +58,16 @@ def _measure(s: ModalSetup, mode: dict, amplitude: float, period: float) -> tupl
         raise MechbookError(f"integration failed: {sol.message}")
     times = np.asarray(sol.t_events[0])
     if len(times) < 3:
-        raise MechbookError(f"only {len(times)} zero crossings in {PERIODS + 1} linear periods")
+        raise _FewCrossings(f"only {len(times)} zero crossings in {PERIODS + 1} linear "
+                            "periods")
     j = np.arange(len(times))
     slope = np.polyfit(j, times, 1)[0]
     return 2 * np.pi / slope, len(times)
+
+
+class _FewCrossings(MechbookError):
+    """The mode's signal did not oscillate: at this amplitude the motion left the
+    equilibrium's well (a neighbour close by), or the mode does not oscillate at all."""
 
 
 def _zero_mode(s: ModalSetup, mode: dict, amplitude: float, horizon: float) -> float:
@@ -192,9 +198,15 @@ def _measure_mode(s: ModalSetup, mode: dict) -> dict:
     period = 2 * np.pi / omega
     nearest = float(s.engine[np.argmin(np.abs(s.engine - omega))]) if len(s.engine) else omega
     a = START_AMPLITUDE
-    for _ in range(8):
-        w1, _ = _measure(s, mode, a, period)
-        w2, crossings = _measure(s, mode, a / 2, period)
+    for attempt in range(8):
+        try:
+            w1, _ = _measure(s, mode, a, period)
+            w2, crossings = _measure(s, mode, a / 2, period)
+        except _FewCrossings:
+            if attempt == 7:
+                raise
+            a /= 4  # left a small well (another equilibrium close by): a smaller swing
+            continue
         shift = abs(w1 - w2) / omega / 3  # ω(a) − ω0 ∝ a²: the shift left at a/2
         if shift < SHIFT_TOL / 10:
             break
