@@ -52,7 +52,7 @@ def hand_hamiltonian(v: dict, theta, r, phi, p) -> float:
     (θ, r, φ) M = [[(m1 + m2) l², m2 l sin(φ−θ), m2 l r cos(φ−θ)], [·, m2, 0],
     [·, 0, m2 r²]]; a = ∂(−U)/∂q̇ = (0, 0, b r²/2), and U, linear in the velocities,
     leaves the energy function: h = T + V."""
-    m1, m2, l, k, a, b, g = (v[n] for n in ("m1", "m2", "l", "k", "a", "b", "g"))
+    m1, m2, l, k, a, b, g = (v[n] for n in ("m1", "m2", "l", "k", "a", "b", "g"))  # noqa: E741
     s, c = np.sin(phi - theta), np.cos(phi - theta)
     M = np.array([[(m1 + m2) * l**2, m2 * l * s, m2 * l * r * c],
                   [m2 * l * s, m2, 0.0],
