@@ -46,7 +46,8 @@ PERIODS = 4
 def _measure(s: ModalSetup, mode: dict, amplitude: float, period: float) -> tuple[float, int]:
     """Frequency from upward zero crossings of the mode's signal over PERIODS periods
     (DOP853 in the compiled loop where there is one, the crossings located as solve_ivp
-    locates them: mechbook.numerics.events)."""
+    locates them: mechbook.numerics.events); NaN with fewer than 3 crossings (no
+    oscillation at this amplitude)."""
     g = mode_signal(s, mode)
     g.direction = 1.0
     y0 = start_state(s, mode, amplitude)
@@ -58,16 +59,10 @@ def _measure(s: ModalSetup, mode: dict, amplitude: float, period: float) -> tupl
         raise MechbookError(f"integration failed: {sol.message}")
     times = np.asarray(sol.t_events[0])
     if len(times) < 3:
-        raise _FewCrossings(f"only {len(times)} zero crossings in {PERIODS + 1} linear "
-                            "periods")
+        return float("nan"), len(times)
     j = np.arange(len(times))
     slope = np.polyfit(j, times, 1)[0]
     return 2 * np.pi / slope, len(times)
-
-
-class _FewCrossings(MechbookError):
-    """The mode's signal did not oscillate: at this amplitude the motion left the
-    equilibrium's well (a neighbour close by), or the mode does not oscillate at all."""
 
 
 def _zero_mode(s: ModalSetup, mode: dict, amplitude: float, horizon: float) -> float:
@@ -198,19 +193,19 @@ def _measure_mode(s: ModalSetup, mode: dict) -> dict:
     period = 2 * np.pi / omega
     nearest = float(s.engine[np.argmin(np.abs(s.engine - omega))]) if len(s.engine) else omega
     a = START_AMPLITUDE
-    for attempt in range(8):
-        try:
-            w1, _ = _measure(s, mode, a, period)
-            w2, crossings = _measure(s, mode, a / 2, period)
-        except _FewCrossings:
-            if attempt == 7:
-                raise
-            a /= 4  # left a small well (another equilibrium close by): a smaller swing
+    for _ in range(8):
+        w1, few = _measure(s, mode, a, period)
+        w2, crossings = _measure(s, mode, a / 2, period)
+        if np.isnan(w1) or np.isnan(w2):  # no oscillation: the swing left a small well
+            a /= 4  # (another equilibrium close by), or the mode does not oscillate
             continue
         shift = abs(w1 - w2) / omega / 3  # ω(a) − ω0 ∝ a²: the shift left at a/2
         if shift < SHIFT_TOL / 10:
             break
         a /= 4
+    if np.isnan(w1) or np.isnan(w2):
+        raise MechbookError(f"only {min(few, crossings)} zero crossings in {PERIODS + 1} "
+                            f"linear periods, down to amplitude {4 * a:.0e}")
     extrapolated = w2 - (w1 - w2) / 3  # Richardson: remove the a² shift
     return {"measured": w2, "engine": nearest, "relative_error": abs(w2 - nearest) / nearest,
             "amplitude": a / 2, "shift": shift, "crossings": crossings,
