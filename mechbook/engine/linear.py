@@ -25,8 +25,17 @@ from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
 from mechbook.errors import MechbookError, UnsupportedError
 
-ZERO_TOL = 1e-9
+ZERO_TOL = 1e-9  # |ω²| below this (relative) is beyond what double precision decides:
+# such a value is decided again at 50 digits (numeric_frequencies) or 40 (numeric_stability),
+# never set to zero here
 ZERO_CLUSTER = 1e-6  # |p| below this (relative) is a zero exponent split by rounding
+MARGIN_DIGITS = 12  # at dps digits, |ω²| below 10^(MARGIN_DIGITS − dps) of the largest is 0
+
+
+def zero_below(dps: int) -> float:
+    """The relative size under which an ω² computed with `dps` digits is zero: what that
+    arithmetic cannot tell from zero, with MARGIN_DIGITS to spare (1e-38 at 50 digits)."""
+    return 10.0 ** (MARGIN_DIGITS - dps)
 
 
 @dataclass
@@ -211,17 +220,27 @@ class LinearSystem:
         M's diagonal one; when the problem is ill-conditioned there (cond(M) or the spread
         of the eigenvalues beyond 1e6, or gyroscopic terms spanning many decades) the
         eigenvalues are recomputed with 50-digit mpmath arithmetic (bench/extremes.py).
+        A zero frequency is one 50 digits cannot tell from zero (`zero_below`): an ω²
+        that double precision leaves near zero (a spread beyond 1e6) is always
+        recomputed, so a frequency 1e-5 of the largest stays what it is.
+        A mass matrix that is not positive definite (a coordinate chart's singular point,
+        z-x-z Euler angles at θ = 0) has no normal frequencies: MechbookError.
         """
         M, C, K = self.matrices(values)
         n = M.shape[0]
         if not np.any(C):
             d = 1.0 / np.sqrt(np.abs(np.diag(M)))
             Ms, Ks = M * np.outer(d, d), K * np.outer(d, d)
-            w2 = scipy.linalg.eigh(Ks, Ms, eigvals_only=True)
-            if _ill_conditioned(Ms, w2):
+            try:
+                w2 = scipy.linalg.eigh(Ks, Ms, eigvals_only=True)
+            except np.linalg.LinAlgError:
+                raise MechbookError("the mass matrix is not positive definite here (a "
+                                    "singular point of the coordinates?): no normal "
+                                    "frequencies") from None
+            if _ill_conditioned(Ms, w2) or _near_zero(w2):  # decided at 50 digits
                 w2 = self._precise_squared(values)
-            scale = max(1e-300, float(np.max(np.abs(w2))))
-            w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
+                scale = max(1e-300, float(np.max(np.abs(w2))))
+                w2 = np.where(np.abs(w2) <= zero_below(50) * scale, 0.0, w2)
             return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
@@ -294,8 +313,14 @@ class LinearSystem:
                 out[2 * n * n:].reshape(n, n))
 
     def numeric_stability(self, values: dict) -> str:
-        """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
-        return classify_matrices(*self.fast_matrices(values))
+        """'stable', 'unstable' or 'marginal' from the linearized system at `values`: in
+        double precision, or at 40 digits (`precise_stability`) where an ω² lies within
+        ZERO_TOL of zero, which double precision cannot decide (a stiff spring beside a
+        soft one at a parameter ratio of 1e8 is stable, not marginal)."""
+        M, C, K = self.fast_matrices(values)
+        if not decided_in_double(M, C, K):
+            return self.precise_stability(values)
+        return classify_matrices(M, C, K)
 
     def precise_stability(self, values: dict, dps: int = 40) -> str:
         """'stable', 'unstable' or 'marginal' with M, C, K and the eigenvalues in mpmath at
@@ -322,14 +347,14 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     n = M.shape[0]
     if not np.any(C):
         w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
-        scale = max(1.0, float(np.max(np.abs(w2))))
+        scale = float(np.max(np.abs(w2)))  # relative: no unit of ω² is special
         if np.any(w2 < -ZERO_TOL * scale):
             return "unstable"
         return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
     A = np.block([[np.zeros((n, n)), np.eye(n)],
                   [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam = np.linalg.eigvals(A)
-    scale = max(1.0, float(np.max(np.abs(lam))))
+    scale = float(np.max(np.abs(lam)))  # relative, as above
     # exponents at zero (a symmetry: an ignorable coordinate kept in the linearization, a
     # family of steady motions) split by rounding into a tiny cluster whose real parts mean
     # nothing; they are neutral here (their polynomial growth is `secular_growth`'s
@@ -338,6 +363,21 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     if np.any(live.real > 1e-8 * scale):
         return "unstable"
     return "stable"
+
+
+def decided_in_double(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> bool:
+    """Does `classify_matrices`' verdict stand on values double precision resolves? False
+    when, without velocity terms, some ω² lies within ZERO_TOL of zero (relative to the
+    largest): its sign and whether it is zero are for more digits to say. With velocity
+    terms the verdict stands (a zero cluster of exponents is neutral by design)."""
+    if np.any(C):
+        return True
+    try:
+        w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+    except (np.linalg.LinAlgError, ValueError):
+        return True  # no verdict in double; classify_matrices says what it can
+    scale = float(np.max(np.abs(w2)))
+    return scale == 0 or not np.any(np.abs(w2) <= ZERO_TOL * scale)
 
 
 def classify_mp(M, C, K, dps: int) -> str:
@@ -422,6 +462,13 @@ def _entry(x: sp.Expr, values: dict, digits: int, exact: bool = False):
     except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
         v = sp.N(sp.S(x).subs(values), digits)
         return mpmath.mpc(complex(v)) if exact else complex(v)
+
+
+def _near_zero(w2: np.ndarray) -> bool:
+    """Some ω² within ZERO_TOL of zero against the largest, an exact 0.0 included: double
+    precision cannot say whether it is zero (3 + 3e-16 rounds to 3 + 4.4e-16)."""
+    scale = float(np.max(np.abs(w2)))
+    return scale > 0 and bool(np.any(np.abs(w2) <= ZERO_TOL * scale))
 
 
 def _ill_conditioned(M: np.ndarray, w2: np.ndarray) -> bool:
