@@ -130,11 +130,12 @@ def main() -> None:
         print(f"[{i}/{len(ids)}] {pid} ({time.perf_counter() - t:.1f} s, "
               f"{time.perf_counter() - start:.0f} s in all): {shown}", file=sys.stderr,
               flush=True)
-    table = pd.DataFrame(rows)
+    table = pd.DataFrame(rows, columns=["problem", "system", "dof", "worst_relative_error",
+                                        "at", "false_zeros", "false_nonzeros", "note"])
     print(table.to_string(index=False, float_format=lambda v: f"{v:.2e}"))
-    done = table[table["note"] == ""] if len(table) else table
+    done = table[table["note"] == ""]
     bad = done[(done["worst_relative_error"] > TOLERANCE) | (done["false_zeros"] > 0)
-               | (done["false_nonzeros"] > 0)] if len(done) else done
+               | (done["false_nonzeros"] > 0)]
     names = ", ".join(bad["problem"] + ":" + bad["system"]) or "-"
     print(f"\n{len(done)} systems checked, {len(table) - len(done)} not applicable; "
           f"{len(done) - len(bad)} within {TOLERANCE:g} at every ratio with no false zero "

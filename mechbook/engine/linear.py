@@ -130,13 +130,14 @@ class LinearSystem:
         if self.gyroscopic:
             raise UnsupportedError("ω² roots of a gyroscopic system (use `frequencies`)")
         w = sp.Symbol("w")
-        poly = sp.Poly(sp.factor((self.K - w * self.M).det()), w)
         try:
-            with time_limit(30):
+            with time_limit(30):  # the determinant too: of 8 coordinates it runs for hours
+                poly = sp.Poly(sp.factor((self.K - w * self.M).det()), w)
                 roots = sp.roots(poly, w)
         except Timeout:
-            raise UnsupportedError("closed-form roots of the secular equation (SymPy's roots "
-                                   "ran past its time limit of 30 s of CPU)") from None
+            raise UnsupportedError("closed-form roots of the secular equation (its "
+                                   "determinant and roots ran past their time limit of 30 s "
+                                   "of CPU)") from None
         if sum(roots.values()) != poly.degree():
             raise UnsupportedError("closed-form roots of the secular equation")
         out = []
@@ -178,13 +179,14 @@ class LinearSystem:
     def _gyroscopic_roots(self) -> dict:
         """{root ω: multiplicity} of det(K − ω²M + iωC) = 0."""
         om = sp.Symbol("omega_root", positive=True)
-        det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
         try:
-            with time_limit(30):
+            with time_limit(30):  # the determinant too (it can run for hours)
+                det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
                 return sp.roots(sp.Poly(det, om), om)
         except Timeout:
-            raise UnsupportedError("closed-form frequencies of a gyroscopic system (SymPy's "
-                                   "roots ran past its time limit of 30 s of CPU)") from None
+            raise UnsupportedError("closed-form frequencies of a gyroscopic system (the "
+                                   "determinant and roots ran past their time limit of 30 s "
+                                   "of CPU)") from None
 
     # ---- numeric -------------------------------------------------------------------------
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
