@@ -124,9 +124,11 @@ def main() -> None:
         got = sweep(pid, args.decades, args.quick)
         rows += got
         worst = max((r["worst_relative_error"] for r in got if not r["note"]), default=None)
-        shown = "no frequencies about a default point" if worst is None else \
-            f"worst {worst:.1e}" + "".join(f"; {r['system']} {r['note']}" for r in got
-                                           if r["note"])
+        false = sum(r["false_zeros"] + r["false_nonzeros"] for r in got)
+        shown = ("no frequencies about a default point" if worst is None and not got else
+                 f"worst {worst:.1e}" if worst is not None else "") + \
+            (f", {false} false zero/nonzero" if false else "") + \
+            "".join(f"; {r['system']} {r['note']}" for r in got if r["note"])
         print(f"[{i}/{len(ids)}] {pid} ({time.perf_counter() - t:.1f} s, "
               f"{time.perf_counter() - start:.0f} s in all): {shown}", file=sys.stderr,
               flush=True)
