@@ -86,9 +86,13 @@ def test_a_true_pair_of_close_equilibria_stays_two(tmp_path, d):
 def test_polish_and_what_the_arithmetic_resolves():
     x = sp.Symbol("x")
     cond = [8 * x**3]  # the force of V = 2x⁴, a triple root at 0
-    f = lambda v: np.array([8 * v[0] ** 3])  # noqa: E731
-    jac = lambda v: np.array([[24 * v[0] ** 2]])  # noqa: E731
-    assert abs(polish(f, jac, np.array([1.8e-5]))[0]) < 1e-20  # linear convergence sped up
+    def fj(v):
+        return np.array([8 * v[0] ** 3]), np.array([[24 * v[0] ** 2]])
+
+    assert abs(polish(fj, np.array([1.8e-5]))[0]) < 1e-20  # linear convergence sped up
+    # no root near: exp(-x) only fades; the polish stops and keeps the start
+    fade = polish(lambda v: (np.exp(-v), -np.exp(-v)[None, :]), np.array([30.0]))
+    assert fade[0] == 30.0
     assert unresolved(cond, {x: sp.Float(1.8e-5, 30)}) is False  # a ghost: force resolved
     assert unresolved(cond, {x: sp.Float(0, 30)}) is True
     # cancellation: 1 - cos(x) at 1e-9 is below double precision's rounding of its terms

@@ -156,6 +156,8 @@ class Equilibria:
                 if not (np.all(np.isfinite(sol.x)) and
                         np.max(np.abs(f_num(sol.x))) < 1e-10):
                     continue
+            if any(np.allclose(sol.x[: len(q)], f, atol=1e-7) for f in found):
+                continue
             full = flat.polished(sol.x)  # a flat root's point moved onto it
             x = full[: len(q)]
             if not inside(self.sys, q, x, values):

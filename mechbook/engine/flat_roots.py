@@ -28,48 +28,54 @@ from mechbook.core.numeval import NotNumeric, evaluate
 FLAT = 1e-6  # the Jacobian's smallest singular value against its size over the starts
 ROUNDING = 1e-13  # a residual this small against the magnitude of its terms: double's noise
 POLISH_STEPS = 60
+STALL = 0.98  # steps shrinking slower than this three times running: nothing to polish
 SEGMENT_SAMPLES = 8  # points on the segment between two candidates (besides the ends)
+NEAR = 1e-3  # farther apart than this (relative) flat points are never one root: a root of
+# multiplicity m is blurred over u^(1/m) by double precision, 1e-4 at m = 4
 _U = np.finfo(float).eps
 
 
-def polish(f: Callable, jac: Callable, x: np.ndarray) -> np.ndarray:
+def polish(fj: Callable, x: np.ndarray) -> np.ndarray:
     """`x` moved onto the root Newton's method converges to: pseudo-inverse steps (a
     singular Jacobian does not stop it), each multiplied by the multiplicity
     m = 1/(1 − ρ) that the ratio ρ of successive steps shows when it converges linearly;
-    until a step is at rounding level. `x` itself if a step leaves the finite numbers or
-    the residual does not fall (nothing to polish: a start far from any root)."""
-    x = np.array(x, dtype=float)
-    best, best_res = x.copy(), _residual(f, x)
-    prev = None
+    until a step is at rounding level. `fj(x)`: (conditions, Jacobian) at x. The point of
+    least residual met is returned; `x` itself where the steps stop shrinking (no root
+    near: a region where the force only fades)."""
+    start = x = np.array(x, dtype=float)
+    best, best_res = x.copy(), float("inf")
+    prev, stalls = None, 0
     with np.errstate(all="ignore"):
         for _ in range(POLISH_STEPS):
-            F = np.asarray(f(x), float)
-            J = np.asarray(jac(x), float).reshape(len(F), len(x))
+            F, J = fj(x)
+            F = np.asarray(F, float)
+            J = np.asarray(J, float).reshape(len(F), len(x))
             if not (np.all(np.isfinite(F)) and np.all(np.isfinite(J))):
                 break
+            res = float(np.max(np.abs(F)))
+            if res <= best_res:
+                best, best_res = x.copy(), res
             step = np.linalg.pinv(J) @ F
             size = float(np.linalg.norm(step))
             if size <= 4 * _U * max(1.0, float(np.linalg.norm(x))):
-                x = x - step
+                last = x - step
+                F_last = np.asarray(fj(last)[0], float)
+                if np.all(np.isfinite(F_last)) and float(np.max(np.abs(F_last))) <= best_res:
+                    best = last
                 break
             m = 1.0
-            if prev is not None and 0.2 < size / prev < 0.98:
-                m = min(1.0 / (1.0 - size / prev), 50.0)  # linear convergence: a multiple root
+            if prev is not None:
+                ratio = size / prev
+                stalls = stalls + 1 if ratio >= STALL else 0
+                if stalls >= 3:
+                    return start
+                if 0.2 < ratio < STALL:
+                    m = min(1.0 / (1.0 - ratio), 50.0)  # linear convergence: m-fold root
             prev = size
             x = x - m * step
             if not np.all(np.isfinite(x)):
                 break
-            res = _residual(f, x)
-            if res <= best_res:
-                best, best_res = x.copy(), res
-    res = _residual(f, x)
-    return x if np.all(np.isfinite(x)) and res <= best_res else best
-
-
-def _residual(f: Callable, x: np.ndarray) -> float:
-    with np.errstate(all="ignore"):
-        F = np.asarray(f(x), float)
-    return float(np.max(np.abs(F))) if np.all(np.isfinite(F)) else float("inf")
+    return best
 
 
 def unresolved(conds: Sequence[sp.Expr], point: dict) -> bool | None:
@@ -138,7 +144,7 @@ class FlatRoots:
         return bool(np.linalg.svd(J, compute_uv=False)[-1] <= FLAT * self.scale)
 
     def polished(self, x):
-        return polish(self.f, self.jac, x) if self.is_flat(x) else x
+        return polish(lambda y: (self.f(y), self.jac(y)), x) if self.is_flat(x) else x
 
     def _sym(self):
         if self._made is None:
@@ -156,6 +162,9 @@ class FlatRoots:
 
     def same(self, a, b) -> bool:
         """Flat points `a` and `b` that the arithmetic cannot tell apart (one_root)."""
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        if np.max(np.abs(a - b)) > NEAR * max(1.0, float(np.max(np.abs(a)))):
+            return False
         if not (self.is_flat(a) and self.is_flat(b)):
             return False
         conds, unknowns = self._sym()

@@ -106,7 +106,7 @@ def screen(eq: Equilibria, values: dict, ranges: dict | None = None) -> Screen:
     converged = _newton(entries, n, starts.copy())
     flat = FlatRoots(lambda x: entries(np.asarray(x, float)[None, :])[0, :n + n * n], n,
                      scale, lambda: ([c._sympy_() for c in conds], [x._sympy_() for x in q]))
-    points = _distinct(entries, [flat.polished(x) for x in _coarse(converged)], n, flat)
+    points = _distinct(entries, converged, n, flat)
     found = []
     if points:
         for x, row in zip(points, entries(np.array(points)), strict=True):
@@ -149,29 +149,25 @@ def _newton(entries, n: int, X: np.ndarray) -> np.ndarray:
     return X[good]
 
 
-def _coarse(X: np.ndarray) -> list[np.ndarray]:
-    """The converged points with repeats (to SAME_POINT) dropped: what is left to polish."""
-    out: list[np.ndarray] = []
-    for x in X:
-        if not any(np.all(np.abs(x - r) <= SAME_POINT * np.maximum(1.0, np.abs(r)))
-                   for r in out):
-            out.append(x)
-    return out
-
-
-def _distinct(entries, X: list[np.ndarray], n: int, flat: FlatRoots) -> list[np.ndarray]:
+def _distinct(entries, X: np.ndarray, n: int, flat: FlatRoots) -> list[np.ndarray]:
     """One representative (the smallest) of each class of points the equations cannot
     tell apart (a shift between them, or a flat root's points the arithmetic does not
-    resolve); a flat point whose force is resolved is no equilibrium and is dropped."""
+    resolve: each new flat point is polished first); a flat point whose force is resolved
+    is no equilibrium and is dropped."""
     reps: list[np.ndarray] = []
-    for x in sorted(X, key=lambda x: (float(np.max(np.abs(x))), tuple(x))):
+
+    def known(x) -> bool:
         if any(np.all(np.abs(x - r) <= SAME_POINT * np.maximum(1.0, np.abs(r))) for r in reps):
+            return True
+        return bool(reps) and bool(np.any(_invariant(entries, np.array(reps) - x)))
+
+    for x in sorted(X, key=lambda x: (float(np.max(np.abs(x))), tuple(x))):
+        if known(x):
             continue
-        if reps and np.any(_invariant(entries, np.array(reps) - x)):
+        y = flat.polished(x)
+        if (y is not x and known(y)) or flat.spurious(y) or any(flat.same(r, y) for r in reps):
             continue
-        if flat.spurious(x) or any(flat.same(r, x) for r in reps):
-            continue
-        reps.append(x)
+        reps.append(y)
         if len(reps) > MAX_FOUND:
             raise UnsupportedError("numeric equilibria: not isolated (more than "
                                    f"{MAX_FOUND} distinct ones)")
