@@ -13,6 +13,7 @@ from systems import load_analysis as load
 
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import SpecError
+from mechbook.records import ProofPolicy
 from mechbook.verify.answers import load_answers
 from mechbook.verify.checker import check_problem
 
@@ -166,3 +167,29 @@ def test_diff_refuses_a_non_name(tmp_path):
         assert "declared name" in str(exc)
     else:  # pragma: no cover
         raise AssertionError("diff with respect to an expression was accepted")
+
+
+def test_proving_a_gyroscopic_frequency_whose_point_is_the_keys(tmp_path):
+    """`--prove` on the unreduced orbit (gyroscopic: C ≠ 0): the secular equation's roots in
+    ω are ±radial and 0 twice, with the key's own r0 in them. Choosing the real,
+    non-negative roots must evaluate them at the sampled point, r0 included (the system's
+    own values do not name r0: this raised "Cannot convert expression to float" for three
+    book parts), and ω = 0, a double root, is one zero frequency. The proof then passes,
+    and a 1e-6 wrong radial frequency still fails."""
+    an = load(tmp_path, ORBIT, "9401")
+    radial = f"sqrt(k/m + 3*({RATE})**2)"
+    part = {"part": "f", "quantity": "frequencies", "steady": {"phi": RATE},
+            "about": {"r": "r0"}, "assume": ["r0 > a"], "reduce": False}
+
+    def outcome(book: list[str]):
+        d = tmp_path / "answers" / "lim"
+        d.mkdir(parents=True, exist_ok=True)
+        f = d / "9401.yaml"
+        f.write_text(json.dumps({"problem": an.problem.id, "source": "test", "symbols": R0,
+                                 "parts": [{"cite": "t", **part, "book": book}]}))
+        return check_problem(an, load_answers(f), ProofPolicy(True, 10.0))[0]
+
+    both = outcome([radial, "0"])
+    assert (both.status, both.method) == ("pass", "symbolic"), both.detail
+    assert outcome([f"(1 + 1e-6)*{radial}", "0"]).status == "fail"
+    assert outcome([radial, radial]).status == "fail"

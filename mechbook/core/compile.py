@@ -12,7 +12,8 @@ equilibrium search, the cross-checks and region checks. Two entries:
 Backends (docs/numerics.md has the measurements that chose the default):
     llvm      SymEngine's Lambdify, LLVM-compiled, with cse (the default)
     symengine SymEngine's Lambdify, interpreted ("lambda" backend), with cse
-    sympy     SymPy's lambdify(cse=True) printing to `math` (one point) or NumPy (batches)
+    sympy     SymPy's lambdify(cse=True) printing to `math` (one point) or NumPy and SciPy's
+              special functions (batches, and a point `math` cannot take)
 A backend that cannot translate an expression hands over to the next. Nothing here parses
 text: the inputs are SymPy objects built by the safe parser or the engine, or SymEngine
 objects the engine built from those (`as_expr` refuses anything else).
@@ -30,6 +31,17 @@ from mechbook.core.backends import BACKENDS, DEFAULT_BACKEND  # the names' owner
 from mechbook.errors import UnsupportedError
 
 Compiled = Callable[[np.ndarray], np.ndarray]
+
+
+def numpy_modules() -> list:
+    """lambdify's namespaces for NumPy: SciPy's special functions (Γ) and the complete
+    elliptic integrals K(m), E(m) (scipy.special.ellipk, ellipe: the same parameter
+    m = k² as SymPy's), which neither SymEngine nor SymPy's printers translate. SciPy is
+    imported here, when an expression needs this fallback, not when mechbook starts."""
+    import scipy.special
+
+    return [{"elliptic_k": scipy.special.ellipk, "elliptic_e": scipy.special.ellipe},
+            "numpy", "scipy"]
 
 
 def as_expr(e) -> sp.Basic:
@@ -106,7 +118,7 @@ def _compile_sympy(args, exprs) -> Compiled:
         fn = sp.lambdify(args, exprs, modules="math", cse=True)
         fn(*([0.3] * len(args)))
     except (NameError, TypeError, ValueError, AttributeError, ZeroDivisionError):
-        fn = sp.lambdify(args, exprs, modules="numpy", cse=True)
+        fn = sp.lambdify(args, exprs, modules=numpy_modules(), cse=True)
         _untranslated(fn, len(args))
 
     nan = np.full(len(exprs), np.nan)
@@ -161,7 +173,7 @@ def compile_batch(args: Sequence[sp.Symbol], exprs: Sequence[sp.Expr],
         try:
             if name == "sympy":
                 fn = sp.lambdify([_sympy(a) for a in args], [_sympy(e) for e in exprs],
-                                 modules="numpy", cse=True)
+                                 modules=numpy_modules(), cse=True)
                 _untranslated(fn, len(args))
 
                 def batch(X, fn=fn):

@@ -27,6 +27,8 @@ _FUNCS = {
     sp.exp: mpmath.exp, sp.log: mpmath.log, sp.Abs: abs, sp.sign: mpmath.sign,
     sp.atan2: mpmath.atan2, sp.re: mpmath.re, sp.im: mpmath.im,
     sp.conjugate: mpmath.conj,
+    # one argument: the complete integrals K(m), E(m) (m = k², as in SymPy and mpmath)
+    sp.elliptic_k: mpmath.ellipk, sp.elliptic_e: mpmath.ellipe, sp.gamma: mpmath.gamma,
 }
 
 

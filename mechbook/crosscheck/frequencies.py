@@ -46,7 +46,8 @@ PERIODS = 4
 def _measure(s: ModalSetup, mode: dict, amplitude: float, period: float) -> tuple[float, int]:
     """Frequency from upward zero crossings of the mode's signal over PERIODS periods
     (DOP853 in the compiled loop where there is one, the crossings located as solve_ivp
-    locates them: mechbook.numerics.events)."""
+    locates them: mechbook.numerics.events); NaN with fewer than 3 crossings (no
+    oscillation at this amplitude)."""
     return crossing_frequency(s.model, mode_signal(s, mode), start_state(s, mode, amplitude),
                               amplitude, period)
 
@@ -55,7 +56,8 @@ def crossing_frequency(model, signal, y0: np.ndarray, amplitude: float,
                        period: float) -> tuple[float, int]:
     """(frequency, crossings) of `signal(t, y)` along the nonlinear motion from y0: its
     upward zero crossings over PERIODS + 1 periods, located as solve_ivp locates events,
-    fitted by least squares (DOP853 at rtol 1e-12, atol scaled to the amplitude)."""
+    fitted by least squares (DOP853 at rtol 1e-12, atol scaled to the amplitude); NaN with
+    fewer than 3 crossings."""
     signal.direction = 1.0
     scale = np.maximum(np.abs(y0), 1.0)
     sol = solve_with_events(model.native, model.rhs, (0.0, (PERIODS + 1) * period), y0,
@@ -65,7 +67,7 @@ def crossing_frequency(model, signal, y0: np.ndarray, amplitude: float,
         raise MechbookError(f"integration failed: {sol.message}")
     times = np.asarray(sol.t_events[0])
     if len(times) < 3:
-        raise MechbookError(f"only {len(times)} zero crossings in {PERIODS + 1} linear periods")
+        return float("nan"), len(times)
     j = np.arange(len(times))
     slope = np.polyfit(j, times, 1)[0]
     return 2 * np.pi / slope, len(times)
@@ -200,12 +202,18 @@ def _measure_mode(s: ModalSetup, mode: dict) -> dict:
     nearest = float(s.engine[np.argmin(np.abs(s.engine - omega))]) if len(s.engine) else omega
     a = START_AMPLITUDE
     for _ in range(8):
-        w1, _ = _measure(s, mode, a, period)
+        w1, few = _measure(s, mode, a, period)
         w2, crossings = _measure(s, mode, a / 2, period)
+        if np.isnan(w1) or np.isnan(w2):  # no oscillation: the swing left a small well
+            a /= 4  # (another equilibrium close by), or the mode does not oscillate
+            continue
         shift = abs(w1 - w2) / omega / 3  # ω(a) − ω0 ∝ a²: the shift left at a/2
         if shift < SHIFT_TOL / 10:
             break
         a /= 4
+    if np.isnan(w1) or np.isnan(w2):
+        raise MechbookError(f"only {min(few, crossings)} zero crossings in {PERIODS + 1} "
+                            f"linear periods, down to amplitude {4 * a:.0e}")
     extrapolated = w2 - (w1 - w2) / 3  # Richardson: remove the a² shift
     return {"measured": w2, "engine": nearest, "relative_error": abs(w2 - nearest) / nearest,
             "amplitude": a / 2, "shift": shift, "crossings": crossings,

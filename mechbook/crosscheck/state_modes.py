@@ -20,6 +20,7 @@ import scipy.linalg
 import sympy as sp
 
 from mechbook.crosscheck.frequencies import (
+    PERIODS,
     REL_TOL,
     SHIFT_TOL,
     START_AMPLITUDE,
@@ -148,4 +149,7 @@ def _run(s: _Setup, start: np.ndarray, weights: np.ndarray, amplitude: float,
     def signal(t, y):
         return float(np.real(np.dot(weights, s.deviation(t, y))))
 
-    return crossing_frequency(s.model, signal, y0, amplitude, period)[0]
+    measured, crossings = crossing_frequency(s.model, signal, y0, amplitude, period)
+    if measured != measured:
+        raise MechbookError(f"only {crossings} zero crossings in {PERIODS + 1} periods")
+    return measured

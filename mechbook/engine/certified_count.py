@@ -141,13 +141,10 @@ def _root_inside(g, x, h, lo, hi, boxes, dens, unknowns) -> int | None:
             return int(decided)
         if lo == hi:
             return None
-        mid = (lo + hi) / 2
-        if poly(mid) == 0:  # the polynomial's value at the midpoint (exact rationals)
-            lo = hi = mid
-        elif poly.count_roots(lo, mid) == 1:
-            hi = mid
-        else:
-            lo = mid
+        # SymPy's refinement of the isolating interval (a bisection by count_roots would
+        # count a neighbour's root on a shared end: 0 of x³ − x/10⁶ in [0, 1/2] with 10⁻³)
+        lo, hi = (sp.Rational(v) for v in poly.refine_root(lo, hi, eps=(hi - lo) / 4,
+                                                             check_sqf=True))
     return None
 
 

@@ -22,6 +22,7 @@ from mechbook.core.numeval import without_absent
 from mechbook.core.secalc import either, same, to_sympy
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
 from mechbook.engine.domains import clip_ranges, inside
+from mechbook.engine.flat_roots import FlatRoots, jacobian_scale
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
 from mechbook.engine.residual import is_zero, show_point
@@ -141,19 +142,32 @@ class Equilibria:
         mesh = np.array(np.meshgrid(*grids, indexing="ij")).reshape(len(q), -1).T
         if len(mesh) > 2000:
             mesh = mesh[np.random.default_rng(0).choice(len(mesh), 2000, replace=False)]
-        for x0 in mesh:
-            x0 = np.concatenate([x0, start_lambda(x0)])
+        starts = [np.concatenate([x0, start_lambda(x0)]) for x0 in mesh]
+        flat = FlatRoots(lambda x: np.concatenate([np.asarray(f_num(x), float),
+                                                   np.asarray(j_num(x), float).ravel()]), n,
+                         jacobian_scale(lambda X: np.array([j_num(x) for x in X]),
+                                        np.array(starts)),
+                         lambda: (conds, unknowns))
+        kept: list[np.ndarray] = []  # whole solutions (multipliers too), for flat_roots
+        for x0 in starts:
             with np.errstate(all="ignore"):
                 sol = scipy.optimize.root(lambda x: np.asarray(f_num(x), float), x0,
                                           jac=lambda x: np.asarray(j_num(x), float))
                 if not (np.all(np.isfinite(sol.x)) and
                         np.max(np.abs(f_num(sol.x))) < 1e-10):
                     continue
-            x = sol.x[: len(q)]
+            if any(np.allclose(sol.x[: len(q)], f, atol=1e-7) for f in found):
+                continue
+            full = flat.polished(sol.x)  # a flat root's point moved onto it
+            x = full[: len(q)]
             if not inside(self.sys, q, x, values):
                 continue
-            if not any(np.allclose(x, f, atol=1e-7) for f in found):
-                found.append(x)
+            if any(np.allclose(x, f, atol=1e-7) for f in found):
+                continue
+            if flat.spurious(full) or any(flat.same(k, full) for k in kept):
+                continue  # beside a flat root, not one; or one the arithmetic cannot part
+            found.append(x)
+            kept.append(full)
         return found
 
     def _multiplier_start(self, values: dict):

@@ -17,6 +17,7 @@ from mechbook.core.numeval import is_zero
 from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.core.secalc import euler_lagrange
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
+from mechbook.engine.affine import solve_unknowns
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.protocol import SystemLike
 from mechbook.model.system import motion_chains
@@ -151,7 +152,8 @@ class Dynamics:
                 with time_limit(60):
                     sol = solve_accelerations(M, f, list(self.qdd))
             except Timeout:
-                raise UnsupportedError("solving the mass matrix symbolically (too large)") from None
+                raise UnsupportedError("solving the mass matrix symbolically (too large: past "
+                                       "its time limit of 60 s of CPU)") from None
             return {a: self._simp(s) for a, s in zip(self.qdd, sol, strict=True)}
         A = self.velocity_jacobian
         b = self.constraint_bias
@@ -218,16 +220,12 @@ class Dynamics:
 
     @cached_property
     def velocities_of_momenta(self) -> dict[sp.Symbol, sp.Expr]:
-        """q̇(q, p, t) from p = ∂L/∂q̇ (linear when T is quadratic in the velocities)."""
-        eqs = [pi - mom for pi, mom in zip(self.p, self.momenta, strict=True)]
-        try:
-            with time_limit(60):
-                sol = sp.solve(eqs, self.qd, dict=True)
-        except Timeout:
-            sol = []
-        if len(sol) != 1:
-            raise UnsupportedError("Legendre transform: p = ∂L/∂q̇ not uniquely solvable for q̇")
-        return {v: self._simp(sol[0][v]) for v in self.qd}
+        """q̇(q, p, t) from p = ∂L/∂q̇: with T quadratic in the velocities p = M·q̇ + a, a
+        linear system in the mass matrix (engine.affine: LU, milliseconds); SymPy's solve
+        otherwise. A time limit that runs out is said so (UnsupportedError)."""
+        eqs = [mom - pi for pi, mom in zip(self.p, self.momenta, strict=True)]
+        sol = solve_unknowns(eqs, self.qd, "Legendre transform: q̇ from p = ∂L/∂q̇", 60)
+        return {v: self._simp(sol[v]) for v in self.qd}
 
     @cached_property
     def hamiltonian(self) -> sp.Expr:

@@ -26,7 +26,7 @@ from functools import cached_property
 import mpmath
 import sympy as sp
 
-from mechbook.core.timeout import Timeout, time_limit
+from mechbook.engine.affine import solve_within
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.steady import cyclic_check
 from mechbook.errors import UnsupportedError
@@ -57,15 +57,8 @@ class LevelSet:
         """(m(c), V_eff(c; P), the cyclic rates' ċ-free parts u(c; P))."""
         L = self.dyn.L
         eqs = [p - sp.diff(L, v) for p, v in zip(self.P, self.rates, strict=True)]
-        try:
-            with time_limit(30):
-                sol = sp.solve(eqs, self.rates, dict=True) if eqs else [{}]
-        except Timeout:
-            sol = []
-        if len(sol) != 1:
-            raise UnsupportedError("level set: the cyclic rates are not uniquely solvable "
-                                   "from their momenta")
-        rates = sol[0]
+        rates = solve_within(eqs, self.rates, "level set: the cyclic rates from their "
+                             "momenta", 30) if eqs else {}
         R = (L - sum((p * v for p, v in zip(self.P, self.rates, strict=True)), sp.S.Zero)
              ).subs(rates)
         mass = sp.diff(R, self.cdot, 2)

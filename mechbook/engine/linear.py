@@ -25,8 +25,17 @@ from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
 from mechbook.errors import MechbookError, UnsupportedError
 
-ZERO_TOL = 1e-9
+ZERO_TOL = 1e-9  # |ω²| below this (relative) is beyond what double precision decides:
+# such a value is decided again at 50 digits (numeric_frequencies) or 40 (numeric_stability),
+# never set to zero here
 ZERO_CLUSTER = 1e-6  # |p| below this (relative) is a zero exponent split by rounding
+MARGIN_DIGITS = 12  # at dps digits, |ω²| below 10^(MARGIN_DIGITS − dps) of the largest is 0
+
+
+def zero_below(dps: int) -> float:
+    """The relative size under which an ω² computed with `dps` digits is zero: what that
+    arithmetic cannot tell from zero, with MARGIN_DIGITS to spare (1e-38 at 50 digits)."""
+    return 10.0 ** (MARGIN_DIGITS - dps)
 
 
 @dataclass
@@ -117,12 +126,14 @@ class LinearSystem:
         if self.gyroscopic:
             raise UnsupportedError("ω² roots of a gyroscopic system (use `frequencies`)")
         w = sp.Symbol("w")
-        poly = sp.Poly(sp.factor((self.K - w * self.M).det()), w)
         try:
-            with time_limit(30):
+            with time_limit(30):  # the determinant too: of 8 coordinates it runs for hours
+                poly = sp.Poly(sp.factor((self.K - w * self.M).det()), w)
                 roots = sp.roots(poly, w)
         except Timeout:
-            roots = {}
+            raise UnsupportedError("closed-form roots of the secular equation (its "
+                                   "determinant and roots ran past their time limit of 30 s "
+                                   "of CPU)") from None
         if sum(roots.values()) != poly.degree():
             raise UnsupportedError("closed-form roots of the secular equation")
         out = []
@@ -132,27 +143,46 @@ class LinearSystem:
 
     @cached_property
     def frequencies(self) -> list[sp.Expr]:
-        """Symbolic normal angular frequencies ω ≥ 0 (with multiplicity)."""
+        """Symbolic normal angular frequencies ω ≥ 0 (with multiplicity); with gyroscopic
+        terms, the roots real and non-negative at the system's own values
+        (`frequencies_at` for a point that also names an answer key's symbols)."""
+        return self.frequencies_at(self.dyn.sys.numeric_values())
+
+    def frequencies_at(self, values: dict) -> list[sp.Expr]:
+        """The symbolic frequencies; a gyroscopic system's secular equation has 2n roots in
+        ω, and the n kept are those real and non-negative at `values`, which must give
+        every symbol of the roots a number (a steady motion's rate or tilt named by an
+        answer key is not among the system's parameters): UnsupportedError otherwise."""
         if not self.gyroscopic:
             return [try_simplify(sp.sqrt(r), 5) for r in self.squared_frequencies]
-        om = sp.Symbol("omega_root", positive=True)
-        det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
-        n = len(self.q)
-        try:
-            with time_limit(30):
-                roots = sp.roots(sp.Poly(det, om), om)
-        except Timeout:
-            roots = {}
-        # keep the n roots that are real and non-negative at the default parameters
-        values = self.dyn.sys.numeric_values()
         keep = []
-        for r, mult in roots.items():
-            v = complex(r.evalf(subs=values))
+        for r, mult in self._gyroscopic_roots.items():
+            left = sorted(map(str, r.free_symbols - set(values)))
+            if left:
+                raise UnsupportedError("choosing the real roots of a gyroscopic system's "
+                                       f"secular equation needs values of {', '.join(left)}")
+            if r == 0:  # ω = 0 is its own pair (±0): a zero exponent of multiplicity m
+                keep += [sp.S.Zero] * ((mult + 1) // 2)  # is m/2 zero frequencies
+                continue
+            v = _entry(r, values, 30)
             if abs(v.imag) < 1e-9 * (1 + abs(v)) and v.real >= -1e-12:
                 keep += [try_simplify(r, 5)] * mult
-        if len(keep) != n:
+        if len(keep) != len(self.q):
             raise UnsupportedError("closed-form frequencies of a gyroscopic system")
         return keep
+
+    @cached_property
+    def _gyroscopic_roots(self) -> dict:
+        """{root ω: multiplicity} of det(K − ω²M + iωC) = 0."""
+        om = sp.Symbol("omega_root", positive=True)
+        try:
+            with time_limit(30):  # the determinant too (it can run for hours)
+                det = sp.expand((self.K - om**2 * self.M + sp.I * om * self.C).det())
+                return sp.roots(sp.Poly(det, om), om)
+        except Timeout:
+            raise UnsupportedError("closed-form frequencies of a gyroscopic system (the "
+                                   "determinant and roots ran past their time limit of 30 s "
+                                   "of CPU)") from None
 
     # ---- numeric -------------------------------------------------------------------------
     def matrices(self, values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -191,17 +221,27 @@ class LinearSystem:
         M's diagonal one; when the problem is ill-conditioned there (cond(M) or the spread
         of the eigenvalues beyond 1e6, or gyroscopic terms spanning many decades) the
         eigenvalues are recomputed with 50-digit mpmath arithmetic (bench/extremes.py).
+        A zero frequency is one 50 digits cannot tell from zero (`zero_below`): an ω²
+        that double precision leaves near zero (a spread beyond 1e6) is always
+        recomputed, so a frequency 1e-5 of the largest stays what it is.
+        A mass matrix that is not positive definite (a coordinate chart's singular point,
+        z-x-z Euler angles at θ = 0) has no normal frequencies: MechbookError.
         """
         M, C, K = self.matrices(values)
         n = M.shape[0]
         if not np.any(C):
             d = 1.0 / np.sqrt(np.abs(np.diag(M)))
             Ms, Ks = M * np.outer(d, d), K * np.outer(d, d)
-            w2 = scipy.linalg.eigh(Ks, Ms, eigvals_only=True)
-            if _ill_conditioned(Ms, w2):
+            try:
+                w2 = scipy.linalg.eigh(Ks, Ms, eigvals_only=True)
+            except np.linalg.LinAlgError:
+                raise MechbookError("the mass matrix is not positive definite here (a "
+                                    "singular point of the coordinates?): no normal "
+                                    "frequencies") from None
+            if _ill_conditioned(Ms, w2) or _near_zero(w2):  # decided at 50 digits
                 w2 = self._precise_squared(values)
-            scale = max(1e-300, float(np.max(np.abs(w2))))
-            w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
+                scale = max(1e-300, float(np.max(np.abs(w2))))
+                w2 = np.where(np.abs(w2) <= zero_below(50) * scale, 0.0, w2)
             return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
@@ -274,8 +314,14 @@ class LinearSystem:
                 out[2 * n * n:].reshape(n, n))
 
     def numeric_stability(self, values: dict) -> str:
-        """'stable', 'unstable' or 'marginal' from the linearized system at `values`."""
-        return classify_matrices(*self.fast_matrices(values))
+        """'stable', 'unstable' or 'marginal' from the linearized system at `values`: in
+        double precision, or at 40 digits (`precise_stability`) where an ω² lies within
+        ZERO_TOL of zero, which double precision cannot decide (a stiff spring beside a
+        soft one at a parameter ratio of 1e8 is stable, not marginal)."""
+        M, C, K = self.fast_matrices(values)
+        if not decided_in_double(M, C, K):
+            return self.precise_stability(values)
+        return classify_matrices(M, C, K)
 
     def precise_stability(self, values: dict, dps: int = 40) -> str:
         """'stable', 'unstable' or 'marginal' with M, C, K and the eigenvalues in mpmath at
@@ -310,14 +356,14 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     n = M.shape[0]
     if not np.any(C):
         w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
-        scale = max(1.0, float(np.max(np.abs(w2))))
+        scale = float(np.max(np.abs(w2)))  # relative: no unit of ω² is special
         if np.any(w2 < -ZERO_TOL * scale):
             return "unstable"
         return "marginal" if np.any(np.abs(w2) <= ZERO_TOL * scale) else "stable"
     A = np.block([[np.zeros((n, n)), np.eye(n)],
                   [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam = np.linalg.eigvals(A)
-    scale = max(1.0, float(np.max(np.abs(lam))))
+    scale = float(np.max(np.abs(lam)))  # relative, as above
     # exponents at zero (a symmetry: an ignorable coordinate kept in the linearization, a
     # family of steady motions) split by rounding into a tiny cluster whose real parts mean
     # nothing; they are neutral here (their polynomial growth is `secular_growth`'s
@@ -326,6 +372,21 @@ def classify_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> str:
     if np.any(live.real > 1e-8 * scale):
         return "unstable"
     return "stable"
+
+
+def decided_in_double(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> bool:
+    """Does `classify_matrices`' verdict stand on values double precision resolves? False
+    when, without velocity terms, some ω² lies within ZERO_TOL of zero (relative to the
+    largest): its sign and whether it is zero are for more digits to say. With velocity
+    terms the verdict stands (a zero cluster of exponents is neutral by design)."""
+    if np.any(C):
+        return True
+    try:
+        w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+    except (np.linalg.LinAlgError, ValueError):
+        return True  # no verdict in double; classify_matrices says what it can
+    scale = float(np.max(np.abs(w2)))
+    return scale == 0 or not np.any(np.abs(w2) <= ZERO_TOL * scale)
 
 
 def classify_mp(M, C, K, dps: int) -> str:
@@ -410,6 +471,13 @@ def _entry(x: sp.Expr, values: dict, digits: int, exact: bool = False):
     except (NotNumeric, ZeroDivisionError, ValueError, TypeError):
         v = sp.N(sp.S(x).subs(values), digits)
         return mpmath.mpc(complex(v)) if exact else complex(v)
+
+
+def _near_zero(w2: np.ndarray) -> bool:
+    """Some ω² within ZERO_TOL of zero against the largest, an exact 0.0 included: double
+    precision cannot say whether it is zero (3 + 3e-16 rounds to 3 + 4.4e-16)."""
+    scale = float(np.max(np.abs(w2)))
+    return scale > 0 and bool(np.any(np.abs(w2) <= ZERO_TOL * scale))
 
 
 def _ill_conditioned(M: np.ndarray, w2: np.ndarray) -> bool:

@@ -15,6 +15,7 @@ from mechbook.core.expansion import trig_canonical
 from mechbook.core.numeval import is_zero
 from mechbook.core.rational import TooLarge, cancel
 from mechbook.core.timeout import Timeout, time_limit
+from mechbook.engine.affine import solve_within
 from mechbook.errors import UnsupportedError
 from mechbook.model.protocol import SystemLike
 from mechbook.model.system import System
@@ -138,16 +139,8 @@ def _solve_rates(momenta: list, values: list, rates: list, point: dict,
         rest = [p.subs({v: 0 for v in rates}) for p in momenta]  # p = J·rates + rest
         sol = J.LUsolve(sp.Matrix([pv - r for pv, r in zip(values, rest, strict=True)]))
         return dict(zip(rates, sol, strict=True))
-    try:
-        with time_limit(30):
-            sol = sp.solve([p - pv for p, pv in zip(momenta, values, strict=True)], rates,
-                           dict=True)
-    except Timeout:
-        sol = []
-    if len(sol) != 1:
-        raise UnsupportedError("steady motion: cyclic rates not uniquely solvable from "
-                               "their momenta")
-    return sol[0]
+    return solve_within([p - pv for p, pv in zip(momenta, values, strict=True)], rates,
+                        "steady motion: the cyclic rates from their momenta", 30)
 
 
 CANCEL_GROWTH = 8.0  # an expansion this many times the expression's size is not cancelled

@@ -8,7 +8,10 @@ grid of starts, all at once as arrays, finds the equilibria at the default value
 milliseconds, and M, C, K there say which are stable. Points that the equations cannot
 tell apart (a full turn of an angle, a shift along a symmetry of the whole system) count
 as one; an equilibrium that is not isolated (a free translation or a cyclic angle) is
-reported as such.
+reported as such. A flat equilibrium (a degenerate minimum, V = c·x⁴), where Newton's method
+converges slowly and stops at points around it whose force is small but not zero, is found
+as one: each converged point is polished and the points the arithmetic cannot tell apart
+merged (mechbook.engine.flat_roots).
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import sympy as sp
 
 from mechbook.core.compile import compile_batch
 from mechbook.engine.equilibria import Equilibria
+from mechbook.engine.flat_roots import FlatRoots, jacobian_scale
 from mechbook.engine.linear import classify_matrices
 from mechbook.errors import UnsupportedError
 
@@ -97,7 +101,12 @@ def screen(eq: Equilibria, values: dict, ranges: dict | None = None) -> Screen:
         raise UnsupportedError("numeric equilibria: a symbol without a default value (or "
                                "time) is left in the equations")
     entries = compile_batch(q, conds + jac + mc)
-    points = _distinct(entries, _newton(entries, n, _starts(q, ranges)), n)
+    starts = _starts(q, ranges)
+    scale = jacobian_scale(lambda X: entries(X)[:, n:n + n * n], starts)
+    converged = _newton(entries, n, starts.copy())
+    flat = FlatRoots(lambda x: entries(np.asarray(x, float)[None, :])[0, :n + n * n], n,
+                     scale, lambda: ([c._sympy_() for c in conds], [x._sympy_() for x in q]))
+    points = _distinct(entries, converged, n, flat)
     found = []
     if points:
         for x, row in zip(points, entries(np.array(points)), strict=True):
@@ -140,16 +149,25 @@ def _newton(entries, n: int, X: np.ndarray) -> np.ndarray:
     return X[good]
 
 
-def _distinct(entries, X: np.ndarray, n: int) -> list[np.ndarray]:
+def _distinct(entries, X: np.ndarray, n: int, flat: FlatRoots) -> list[np.ndarray]:
     """One representative (the smallest) of each class of points the equations cannot
-    tell apart."""
+    tell apart (a shift between them, or a flat root's points the arithmetic does not
+    resolve: each new flat point is polished first); a flat point whose force is resolved
+    is no equilibrium and is dropped."""
     reps: list[np.ndarray] = []
-    for x in sorted(X, key=lambda x: (float(np.max(np.abs(x))), tuple(x))):
+
+    def known(x) -> bool:
         if any(np.all(np.abs(x - r) <= SAME_POINT * np.maximum(1.0, np.abs(r))) for r in reps):
+            return True
+        return bool(reps) and bool(np.any(_invariant(entries, np.array(reps) - x)))
+
+    for x in sorted(X, key=lambda x: (float(np.max(np.abs(x))), tuple(x))):
+        if known(x):
             continue
-        if reps and np.any(_invariant(entries, np.array(reps) - x)):
+        y = flat.polished(x)
+        if (y is not x and known(y)) or flat.spurious(y) or any(flat.same(r, y) for r in reps):
             continue
-        reps.append(x)
+        reps.append(y)
         if len(reps) > MAX_FOUND:
             raise UnsupportedError("numeric equilibria: not isolated (more than "
                                    f"{MAX_FOUND} distinct ones)")

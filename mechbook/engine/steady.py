@@ -29,7 +29,7 @@ import mpmath
 import sympy as sp
 
 from mechbook.core.numeval import is_zero
-from mechbook.core.timeout import Timeout, time_limit
+from mechbook.engine.affine import solve_within
 from mechbook.engine.equilibria import Equilibria
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.routh import ReducedSystem
@@ -130,15 +130,8 @@ class SteadyFamily:
             raise UnsupportedError(f"steady motion: {len(others)} other cyclic rate(s) need as "
                                    f"many `hold:` relations, {len(eqs)} given")
         if others:
-            try:
-                with time_limit(20):
-                    sol = sp.solve(eqs, others, dict=True)
-            except Timeout:
-                sol = []
-            if len(sol) != 1 or set(sol[0]) != set(others):
-                raise UnsupportedError("steady motion: the `hold:` relations do not fix the "
-                                       "other cyclic rates uniquely")
-            rate_of.update(sol[0])
+            rate_of.update(solve_within(eqs, others, "steady motion: the other cyclic "
+                                        "rates from the `hold:` relations", 20))
         state = dict(point)
         state.update(at_rest)
         state.update(rate_of)
@@ -239,13 +232,7 @@ def effective_potential(dyn: Dynamics, cyclic: list[sp.Symbol],
     rest = {v: sp.S.Zero for v in sys.qd if v not in rates}
     L0 = dyn.L.subs(rest)
     eqs = [p - sp.diff(L0, v) for p, v in zip(momenta, rates, strict=True)]
-    try:
-        with time_limit(30):
-            sol = sp.solve(eqs, rates, dict=True)
-    except Timeout:
-        sol = []
-    if len(sol) != 1:
-        raise UnsupportedError("effective potential: the cyclic rates are not uniquely "
-                               "solvable from their momenta (a chart singularity?)")
+    sol = solve_within(eqs, rates, "effective potential: the cyclic rates from their "
+                       "momenta (not unique: a chart singularity?)", 30)
     routh = sum((p * v for p, v in zip(momenta, rates, strict=True)), sp.S.Zero) - L0
-    return routh.subs(sol[0])
+    return routh.subs(sol)

@@ -6,15 +6,18 @@ layer's batch entry, SymEngine LLVM) and evaluates them for a whole block of poi
 time, then solves every point's eigenproblem with NumPy's stacked (batched) solvers:
 
     no velocity terms   Cholesky of the diagonally scaled M, then `eigvalsh` of
-                        L⁻¹ K L⁻ᵀ: ω² for each point (the same scaling and zero tolerance
-                        as `LinearSystem.numeric_frequencies`)
+                        L⁻¹ K L⁻ᵀ: ω² for each point (the same scaling as
+                        `LinearSystem.numeric_frequencies`; a nonzero ω² within ZERO_TOL
+                        of the largest is zero in float64, and its point counts as one
+                        float64 cannot resolve, below)
     gyroscopic/damped   `eigvals` of the state-space matrix [[0, I], [−M⁻¹K, −M⁻¹C]]
 
 Points where the matrices do not evaluate (a steady motion that does not exist there, say)
 or M is not positive definite come out undefined (NaN, stability code UNDEFINED); points the
 float64 path cannot resolve (cond(M) or the spread of ω² beyond 1e6, as in
 `LinearSystem.numeric_frequencies`) are counted, and recomputed with 50 digits while there
-are few of them (`PRECISE_LIMIT`). `precise_*` give the 30-digit path at single points, for
+are few of them (`PRECISE_LIMIT`), where ω² is zero only below what those digits resolve
+(`linear.zero_below`). `precise_*` give the 30-digit path at single points, for
 the accuracy statement a sweep prints (float64 against 30 digits at sampled points).
 """
 
@@ -27,7 +30,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import DEFAULT_BACKEND, compile_batch
-from mechbook.engine.linear import ZERO_TOL, LinearSystem
+from mechbook.engine.linear import ZERO_TOL, LinearSystem, zero_below
 from mechbook.errors import InputError, UnsupportedError
 
 STABLE, MARGINAL, UNSTABLE, UNDEFINED = 1, 0, -1, -2
@@ -361,8 +364,8 @@ class LinearSweep:
             lam = lam[np.argsort(-lam.imag)]
             return np.sort(np.abs(lam.imag[: self.n]))
         w2 = self.lin._precise_squared(values, dps)
-        scale = max(1e-300, float(np.max(np.abs(w2))))
-        w2 = np.where(np.abs(w2) < ZERO_TOL * scale, 0.0, w2)
+        scale = max(1e-300, float(np.max(np.abs(w2))))  # zero: what dps digits cannot
+        w2 = np.where(np.abs(w2) <= zero_below(dps) * scale, 0.0, w2)  # tell from zero
         return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
 
     def precise_stability(self, values: dict, dps: int = 30) -> tuple[int, np.ndarray]:
@@ -373,10 +376,11 @@ class LinearSweep:
             scale = max(1.0, float(np.max(np.abs(lam))))
             return (UNSTABLE if lam.real.max() > GROWTH_TOL * scale else STABLE), lam
         w2 = np.sort(self.lin._precise_squared(values, dps))
-        s1 = max(1.0, float(np.max(np.abs(w2))))
-        if np.any(w2 < -ZERO_TOL * s1):
+        s1 = float(np.max(np.abs(w2)))  # as LinearSystem.precise_stability: relative, at
+        tiny = zero_below(dps) * s1  # what dps digits resolve
+        if np.any(w2 < -tiny):
             return UNSTABLE, w2
-        if np.any(np.abs(w2) <= ZERO_TOL * s1):
+        if np.any(np.abs(w2) <= tiny):
             return MARGINAL, w2
         return STABLE, w2
 

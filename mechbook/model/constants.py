@@ -14,9 +14,23 @@ from __future__ import annotations
 
 import math
 
+import mpmath
 import sympy as sp
 
 _NOT_FINITE = (sp.zoo, sp.oo, -sp.oo, sp.nan)
+
+
+def _real_mp(f):
+    """An mpmath function at double precision, refused (ValueError) where it is not real:
+    K(m) and E(m) are complex for m > 1."""
+    def value(*args):
+        with mpmath.workprec(53):
+            v = f(*args)
+        if mpmath.im(v) != 0:
+            raise ValueError("not real")
+        return float(mpmath.re(v))
+
+    return value
 
 
 _FUNCTIONS = {
@@ -28,6 +42,8 @@ _FUNCTIONS = {
     sp.asinh: math.asinh, sp.acosh: math.acosh, sp.atanh: math.atanh,
     sp.exp: math.exp, sp.log: math.log, sp.Abs: abs,
     sp.sign: lambda x: math.copysign(1.0, x) if x else 0.0,
+    sp.elliptic_k: _real_mp(mpmath.ellipk), sp.elliptic_e: _real_mp(mpmath.ellipe),
+    sp.gamma: math.gamma,
 }
 
 

@@ -47,7 +47,15 @@ FUNCTIONS: dict[str, object] = {
     "asinh": sp.asinh, "acosh": sp.acosh, "atanh": sp.atanh,
     "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt, "Abs": sp.Abs, "abs": sp.Abs,
     "sign": sp.sign, "cbrt": sp.cbrt,
+    # special functions books write periods with: the complete elliptic integrals of the
+    # first and second kind in SymPy's (and mpmath's) parameter m = k², K(m) and E(m)
+    # (a pendulum of amplitude θ0: T = 4·sqrt(l/g)·K(sin²(θ0/2))), and Euler's Γ(x)
+    "elliptic_k": sp.elliptic_k, "elliptic_e": sp.elliptic_e, "gamma": sp.gamma,
 }
+# function names a problem or answer key may also declare as names of its own (gamma is a
+# common parameter, coordinate or angle): where it does, the name is its own and a call of
+# the function is refused
+DECLARABLE = frozenset({"gamma"})
 def _diff(expr, var, times=1):
     """diff(expr, x[, n]): the derivative with respect to a declared name (at most 6th)."""
     if not isinstance(var, sp.Symbol):
@@ -258,6 +266,9 @@ class _Builder:
             raise self.fail(node, "only calls of whitelisted functions by name are allowed")
         name = node.func.id
         op = self.names.get(name)
+        if op is not None and not isinstance(op, Operator) and name in FUNCTIONS:
+            raise self.fail(node, f"{name!r} is a declared name here, so {name}() is not the "
+                                  "function: rename it to use the function")
         if name not in FUNCTIONS and not isinstance(op, Operator):
             known = [*FUNCTIONS, *(k for k, v in self.names.items() if isinstance(v, Operator))]
             hint = did_you_mean(name, known)

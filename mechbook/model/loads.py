@@ -96,7 +96,8 @@ def average_over(sys, expr: sp.Expr, spec: dict) -> sp.Expr:
         expr = _average(expr, x, lo, hi)
         if expr is None:
             raise sys._error(sub, f"could not average over {name} (not a trigonometric "
-                             "polynomial, and SymPy's integral did not finish)")
+                             "polynomial, and SymPy's integral found no closed form within "
+                             f"its time limit of {INTEGRAL_SECONDS:g} s of CPU)")
     return expr
 
 

@@ -17,13 +17,13 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
-from mechbook.model.expr import CONSTANTS, FUNCTIONS, Operator, parse
+from mechbook.model.expr import CONSTANTS, DECLARABLE, FUNCTIONS, Operator, parse
 from mechbook.model.limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, loads
 
 T = sp.Symbol("t", real=True)
-RESERVED = {"t"} | set(CONSTANTS) | set(FUNCTIONS)
+RESERVED = {"t"} | set(CONSTANTS) | (set(FUNCTIONS) - DECLARABLE)
 SYSTEM_KEYS = ("coordinates", "driven", "particles", "rigid_bodies", "gravity", "springs",
                "kinetic", "potential", "lagrangian", "velocity_potential", "constraints",
                "velocity_constraints", "rolling",

@@ -119,11 +119,11 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
     match the book's exactly; the numeric multiset comparison has already decided."""
     if not ctx.policy.prove:
         return None
+    pt = ctx.sampler.draw()
     try:
-        engine = list(lin.frequencies)
+        engine = list(lin.frequencies_at(pt))  # the key's symbols (a steady rate) valued too
     except UnsupportedError:
         return None
-    pt = ctx.sampler.draw()
     eng_vals = numbers(engine, pt)
     used = set()
     for b in book:
