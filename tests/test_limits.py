@@ -237,7 +237,7 @@ def test_special_files_are_refused_without_reading(tmp_path, kind):
     start = time.perf_counter()
     with pytest.raises(SpecError, match="not a regular file|cannot read"):
         load_problem(path)
-    assert time.perf_counter() - start < 2.0
+    assert time.perf_counter() - start < 10.0  # a hang would be minutes
 
 
 def test_too_many_coordinates_and_the_limit_itself(tmp_path):
@@ -283,7 +283,7 @@ def test_tree_size_counts_shared_subexpressions_each_time():
         e = sp.Mul(e, e + 2, evaluate=False)
     start = time.perf_counter()
     assert tree_size(e) > 2**40
-    assert time.perf_counter() - start < 1.0
+    assert time.perf_counter() - start < 10.0  # a hang would be minutes
     with pytest.raises(MechbookError, match="substituted"):
         parse("y + 1", {"y": e})
     small = sp.Add(*[x**i for i in range(50)])
@@ -443,7 +443,7 @@ def test_constants_are_judged_in_double_precision_without_hanging(text):
     start = time.perf_counter()
     with pytest.raises(MechbookError, match="double precision|not real|no finite real"):
         parse(text)
-    assert time.perf_counter() - start < 1.0
+    assert time.perf_counter() - start < 10.0  # a hang would be minutes
 
 
 def test_constants_textbooks_use_pass():
