@@ -62,6 +62,7 @@ from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
 from mechbook.app.store_cache import Cached, cached, durations  # noqa: F401 - re-exported
 from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's readers
+    FORMAT,
     StoreError,
     _opened,
     _reason,
@@ -69,6 +70,7 @@ from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's r
     problems,
     read,
     read_simulation,
+    refusal,
 )
 from mechbook.app.store_repair import _salvage
 from mechbook.app.text import storable
@@ -81,7 +83,6 @@ if TYPE_CHECKING:
     from mechbook.model.problem import Problem
 
 DEFAULT_PATH = DEFAULT_STORE
-FORMAT = 1
 _STR = h5py.string_dtype("utf-8")
 log = logging.getLogger("mechbook.store")
 DAMAGED = ".damaged-"  # a damaged store is moved aside to <name>.damaged-<UTC time>
@@ -175,10 +176,26 @@ def _signature(path: Path) -> tuple:
     return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
 
 
+def _foreign(path: Path) -> str | None:
+    """Why the file at `path` is not a store this mechbook may write (HDF5 made by
+    something else, a newer store format), or None (a store of ours, or not HDF5 at all:
+    then it is damage, judged by `damage`)."""
+    try:
+        f = h5py.File(path, "r")
+    except Exception:  # noqa: BLE001 - not readable as HDF5: damage
+        return None
+    with f:
+        return refusal(f)
+
+
 def _ensure_sound(path: Path, shown: Path) -> None:
-    """Before an edit: a damaged store is moved aside and rebuilt from what still reads."""
+    """Before an edit: a damaged store is moved aside and rebuilt from what still reads; a
+    file that is not a store of this mechbook's format is refused (StoreError), whole."""
     if _SOUND.get(str(path)) == _signature(path):
         return
+    foreign = _foreign(path)
+    if foreign is not None:
+        raise StoreError(shown, foreign)
     why = damage(path)
     if why is None:
         _SOUND[str(path)] = _signature(path)

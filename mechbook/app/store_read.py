@@ -2,25 +2,51 @@
 whether the whole file reads (`damage`). Readers take no lock: the store is only ever
 replaced by a rename (mechbook.app.store), so a reader sees the old file or the new one.
 Every failure to read is a StoreError naming what is damaged and how to recover.
+
+A store may come from anywhere, so nothing is taken on trust: everything is read within
+the bounds of mechbook.app.store_bounds (a small file can declare gigabytes), a file that is
+HDF5 but not a mechbook store, or of a newer store format, is refused with the reason
+(`refusal`), and a record is read only whole and well-formed: the attributes a check always
+writes, known outcomes, cross-checks of bounded JSON. `damage` applies the very same reading
+to every record, so what `show` calls damaged is what the next write moves aside.
 """
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import h5py
 import numpy as np
 
+from mechbook.app.bounded import json_value
+from mechbook.app.store_bounds import (
+    _SCALE_ATTRS,  # noqa: F401 - the dimension scales' bookkeeping (store_repair)
+    Oversized,
+    attribute,
+    attributes,
+    dataset,
+    member,
+    new_budget,
+    walk,
+)
 from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE
 from mechbook.model.hints import MAX_LISTED, did_you_mean
+from mechbook.records import Status
 
 DEFAULT_PATH = DEFAULT_STORE
-_SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
+FORMAT = 1  # the store format this mechbook reads and writes (the root's `format` attribute)
+
+# what a check writes on every problem and every part, since the first store format
+_PROBLEM_ATTRS = {"title": str, "source": str, "problem_sha256": str, "date": str,
+                  "mechbook": str, "duration_s": (int, float)}
+_CHECK_ATTRS = {"quantity": str, "cite": str, "status": str, "method": str, "detail": str,
+                "seconds": (int, float)}
+_GROUPS = ("systems", "checks", "crosschecks", "simulations")
 
 
 class StoreError(MechbookError):
@@ -31,13 +57,44 @@ class StoreError(MechbookError):
         super().__init__(f"cannot {action} the store {path}: {reason}")
 
 
+class Damaged(ValueError):
+    """A record that is not what a check writes (a missing attribute, an unknown outcome)."""
+
+
 def _reason(exc: BaseException) -> str:
     """What went wrong, in one line (OSError's text without its errno prefix)."""
     if isinstance(exc, OSError) and exc.strerror and not exc.filename:
         return exc.strerror
     if isinstance(exc, OSError) and exc.strerror:
         return f"{exc.strerror} ({exc.filename})"
+    if isinstance(exc, RecursionError):
+        return "nested too deeply"
+    if isinstance(exc, MemoryError):
+        return "too large to read"
     return (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+
+
+def refusal(f: h5py.File) -> str | None:
+    """Why the open HDF5 file `f` is not a store this mechbook may read or write (None: it
+    is one): no `format` attribute (HDF5 made by something else), or a format it does not
+    know. Such a file is refused, never moved aside or rebuilt: it is not mechbook's."""
+    try:
+        if "format" not in f.attrs:
+            return ("it is an HDF5 file but not a mechbook store (it has no `format` "
+                    "attribute): mechbook reads and writes only its own stores; give another "
+                    "path")
+        value = attribute(f, "format")
+    except Exception as exc:  # noqa: BLE001 - an unreadable root: damage, judged elsewhere
+        return None if not isinstance(exc, Oversized) else f"its format attribute: {exc}"
+    if isinstance(value, np.generic):
+        value = value.item()
+    if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+        return (f"its format attribute is {value!r}, not a mechbook store format: mechbook "
+                "reads and writes only its own stores; give another path")
+    if value > FORMAT:
+        return (f"it is in store format {value}, newer than this mechbook's ({FORMAT}): read "
+                "and write it with the newer mechbook that made it, or give another path")
+    return None
 
 
 @contextmanager
@@ -56,6 +113,9 @@ def _opened(path: str | Path) -> Iterator[h5py.File]:
                          "(the next `mechbook check` into it moves it aside and rebuilds it "
                          "from what can still be read)", "read") from None
     with f:
+        why = refusal(f)
+        if why is not None:
+            raise StoreError(path, why, "read")
         yield f
 
 
@@ -78,11 +138,13 @@ def there(name: str, names: list[str], what: str) -> str:
 def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
     """One problem's record as plain Python data (NotFoundError, also a KeyError, naming
     those stored if it is absent; FileNotFoundError if there is no store; StoreError naming
-    what is damaged)."""
+    what is damaged). A problem that only has simulations stored has `checked` False and
+    no attributes."""
     path = Path(path)
     with _opened(path) as f:
         try:
-            present = "problems" in f and pid in f["problems"]
+            root = _member(f, "problems")
+            present = pid in root
             stored = [] if present else _names(f, "problems")
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, "the list of problems", exc) from None
@@ -90,38 +152,83 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
             raise NotFoundError(f"{pid} is not in {path} ({there(pid, stored, 'problem')}); "
                                 f"run `mechbook check {pid}`")
         try:
-            return _read_problem(f["problems"][pid])
+            return _read_problem(member(root, pid))
         except Exception as exc:  # noqa: BLE001 - damage inside the record, described
             raise _damaged(path, f"the stored record of {pid}", exc) from None
 
 
-def _read_problem(g: h5py.Group) -> dict:
-    out = {"attrs": {k: _plain(v) for k, v in g.attrs.items()}, "systems": {}, "checks": []}
-    for sname in _member(g, "systems"):
-        s = g["systems"][sname]
+def _group(obj, what: str) -> h5py.Group:
+    if not isinstance(obj, h5py.Group):
+        raise Damaged(f"{what} is not a group")
+    return obj
+
+
+def _typed(attrs: dict, wanted: dict, where: str) -> None:
+    for key, kind in wanted.items():
+        if key not in attrs:
+            raise Damaged(f"{where} lacks its attribute {key!r}")
+        if not isinstance(attrs[key], kind) or isinstance(attrs[key], bool):
+            raise Damaged(f"{where}: the attribute {key!r} is {attrs[key]!r}")
+
+
+def _read_problem(g) -> dict:
+    """A problem's record, read whole and checked to be what a check writes (Damaged,
+    Oversized or HDF5's own errors otherwise)."""
+    g = _group(g, f"the entry {g.name}")
+    attrs = {k: _plain(v) for k, v in attributes(g).items()}
+    checked = any(k in attrs for k in _PROBLEM_ATTRS) or any(k in g for k in _GROUPS[:3])
+    if checked:
+        _typed(attrs, _PROBLEM_ATTRS, g.name)
+    out = {"attrs": attrs, "systems": {}, "checks": [], "checked": checked}
+    systems = _member(g, "systems")
+    for sname in systems:
+        s = _group(member(systems, sname), f"the system {sname}")
         entry = {"symbolic": {}, "numeric": {}, "notes": {}}
         for kind in entry:
             if kind in s:
-                for name, obj in _walk(s[kind]):
+                for name, obj in walk(_group(member(s, kind), f"{s.name}/{kind}")):
                     _collect(entry[kind], name, obj)
         out["systems"][sname] = entry
-    for part in _member(g, "checks"):
-        c = g["checks"][part]
-        out["checks"].append({"part": part, **{k: _plain(v) for k, v in c.attrs.items()}})
-    out["checks"].sort(key=lambda c: c.get("index", 0))
+    checks = _member(g, "checks")
+    for part in checks:
+        c = _group(member(checks, part), f"the check of part {part}")
+        a = {k: _plain(v) for k, v in attributes(c).items()}
+        _typed(a, _CHECK_ATTRS, c.name)
+        if a["status"] not in set(Status):
+            raise Damaged(f"{c.name}: the status {a['status']!r} is not an outcome")
+        out["checks"].append({"part": part, **a})
+    out["checks"].sort(key=lambda c: c.get("index", 0) if isinstance(c.get("index", 0), int)
+                       else 0)
     out["crosschecks"] = _crosschecks(g)
-    out["simulations"] = sorted(_member(g, "simulations").keys())
+    sims = _member(g, "simulations")
+    out["simulations"] = sorted(sims.keys())
+    for name in out["simulations"]:
+        _group(member(sims, name), f"the simulation {name}")
     return out
 
 
 def _crosschecks(g: h5py.Group) -> list[dict]:
+    from mechbook.records import CrossCheck
+
     out = []
     group = _member(g, "crosschecks")
     for key in group:
-        entry = {k: _plain(v) for k, v in group[key].attrs.items()}
+        if not key.isdigit() or len(key) > 9:
+            raise Damaged(f"the cross-check entry {key!r} is not numbered")
+        entry = {k: _plain(v) for k, v in attributes(
+            _group(member(group, key), f"the cross-check {key}")).items()}
         for k in ("parts", "modes"):
             if isinstance(entry.get(k), str):
-                entry[k] = json.loads(entry[k])
+                try:
+                    entry[k] = json_value(entry[k])
+                except ValueError as exc:
+                    raise Damaged(f"{group.name}/{key}: {k}: {exc}") from None
+                if not isinstance(entry[k], list):
+                    raise Damaged(f"{group.name}/{key}: {k} is not a list")
+        if entry.get("status") not in set(Status):
+            raise Damaged(f"{group.name}/{key}: the status {entry.get('status')!r} is not "
+                          "an outcome")
+        CrossCheck.from_dict(entry)
         out.append((int(key), entry))
     return [e for _, e in sorted(out, key=lambda x: x[0])]
 
@@ -136,19 +243,22 @@ def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dic
             stored = there(name, _names(f, "problems", pid, "simulations"), "simulation")
             raise NotFoundError(f"no simulation {name!r} of {pid} in {path} ({stored})") \
                 from None
-        try:
-            out = {"attrs": {k: _plain(v) for k, v in s.attrs.items()}, "arrays": {},
-                   "array_attrs": {}}
-
-            def visit(key, obj):
-                if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
-                    out["arrays"][key] = np.array(obj[()])
-                    out["array_attrs"][key] = {k: _plain(v) for k, v in obj.attrs.items()
-                                               if k not in _SCALE_ATTRS}
-
-            s.visititems(visit)
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, f"the simulation {name} of {pid}", exc) from None
+        try:
+            return _read_simulation(s)
+        except Exception as exc:  # noqa: BLE001
+            raise _damaged(path, f"the simulation {name} of {pid}", exc) from None
+
+
+def _read_simulation(s) -> dict:
+    s = _group(s, f"the simulation {s.name}")
+    out = {"attrs": {k: _plain(v) for k, v in attributes(s).items()}, "arrays": {},
+           "array_attrs": {}}
+    for key, obj in walk(s):
+        if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
+            out["arrays"][key] = np.array(dataset(obj))
+            out["array_attrs"][key] = {k: _plain(v) for k, v in attributes(obj).items()}
     return out
 
 
@@ -165,57 +275,85 @@ def _names(f: h5py.File, *keys: str) -> list[str]:
     """The names under f[keys[0]][keys[1]]..., [] where any of them is absent."""
     group = f
     for key in keys:
-        if key not in group:
+        if not isinstance(group, h5py.Group) or key not in group:
             return []
-        group = group[key]
-    return sorted(group)
+        group = member(group, key)
+    return sorted(group) if isinstance(group, h5py.Group) else []
 
 
 def _member(group: h5py.Group, name: str):
-    """group[name], {} if there is none; an entry that is listed but cannot be opened (h5py's
-    `get` gives None for it, which reads as absent) raises: it is damage, not absence."""
-    return group[name] if name in group else {}
+    """group[name] (a group), {} if there is none; an entry that is listed but cannot be
+    opened (h5py's `get` gives None for it, which reads as absent) raises: it is damage,
+    not absence; so does a link that is not a plain one, and anything but a group."""
+    return _group(member(group, name), f"{group.name.rstrip('/')}/{name}") \
+        if name in group else {}
 
 
 def _walk(group: h5py.Group, prefix: str = "") -> Iterator[tuple[str, object]]:
-    """(relative name, object) of everything under `group`, parents first. By the groups'
-    own listings, as `read` finds things (HDF5's visititems walks the metadata another way
-    and fails on damage that leaves every member readable)."""
-    for name in group:
-        obj = group[name]  # raises if listed but unreadable
-        yield prefix + name, obj
-        if isinstance(obj, h5py.Group):
-            yield from _walk(obj, f"{prefix}{name}/")
+    """(relative name, object) of everything under `group`, parents first, bounded
+    (mechbook.app.store_bounds.walk)."""
+    return walk(group, prefix=prefix)
 
 
-def _read_all(group: h5py.Group) -> None:
-    """Read every attribute, dataset and string under `group` (raises on damage)."""
-    _attrs(group)
-    for _, obj in _walk(group):
-        _attrs(obj)
+def _read_all(group: h5py.Group, budget: list[int] | None = None) -> None:
+    """Read every attribute, dataset and string under `group`, within the bounds (raises on
+    damage, on anything oversized, and past `budget` objects)."""
+    _decoded(attributes(group, budget))
+    for _, obj in walk(group, budget):
+        _decoded(attributes(obj, budget))
         if isinstance(obj, h5py.Dataset):
-            _decoded(obj[()])
-
-
-def _attrs(obj) -> dict:
-    return {k: _decoded(obj.attrs[k]) for k in obj.attrs if k not in _SCALE_ATTRS}
+            _decoded(dataset(obj))
 
 
 def _decoded(v):
     """A value read from HDF5 with its strings decoded (UnicodeDecodeError if damaged)."""
     if isinstance(v, bytes):
         return v.decode("utf-8")
+    if isinstance(v, dict):
+        return {k: _decoded(x) for k, x in v.items()}
     if isinstance(v, np.ndarray) and v.dtype.kind == "O":
         return [_decoded(x) for x in v.ravel()]
     return v
 
 
+def check_entry(top: str, name: str | None, obj, budget: list[int] | None = None) -> None:
+    """Read one top-level entry of a store (a problem, the sweeps of a problem, or anything
+    else at the top) as its readers will, whole: raises on any damage. `damage` and the
+    rebuild of a damaged store judge every entry by this, so that a record `show` or a
+    check's cache would call damaged is never called sound."""
+    if isinstance(obj, h5py.Group):
+        _read_all(obj, budget)
+    else:
+        _decoded(attributes(obj, budget))
+        _decoded(dataset(obj))
+    if top == "problems" and name is not None:
+        _read_problem(obj)
+        sims = _member(obj, "simulations")
+        for sim in sims:
+            _read_simulation(member(sims, sim))
+    elif top == "sweeps" and name is not None:
+        from mechbook.app.sweep_io import _read_sweep
+
+        for sweep in _group(obj, f"the sweeps of {name}"):
+            _read_sweep(member(obj, sweep))
+
+
 def damage(path: str | Path) -> str | None:
-    """What is wrong with the store at `path` (None: every object and attribute reads, and
-    every string is UTF-8). Reads the whole file once."""
+    """What is wrong with the store at `path` (None: every entry reads whole, as
+    `check_entry` reads it). Reads the whole file once, within the bounds."""
+    budget = new_budget()
     try:
         with h5py.File(path, "r") as f:
-            _read_all(f)
+            _decoded(attributes(f, budget))
+            for top in f:
+                obj = member(f, top)
+                if top in ("problems", "sweeps"):
+                    obj = _group(obj, f"/{top}")
+                    for name in obj:
+                        check_entry(top, name, member(obj, name), budget)
+                    _decoded(attributes(obj, budget))
+                else:
+                    check_entry(top, None, obj, budget)
     except Exception as exc:  # noqa: BLE001 - any failure to read is damage, described
         return _reason(exc)
     return None
@@ -223,12 +361,12 @@ def damage(path: str | Path) -> str | None:
 
 def _collect(target: dict, name: str, obj) -> None:
     if isinstance(obj, h5py.Dataset):
-        data = obj[()]
+        data = dataset(obj)
         target[name] = data.decode() if isinstance(data, bytes) else (
             np.array(data) if obj.dtype.kind == "f" else _plain(data))
 
 
-def _plain(v):
+def _plain(v) -> Any:
     if isinstance(v, bytes):
         return v.decode()
     if isinstance(v, np.generic):
