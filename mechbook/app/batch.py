@@ -26,6 +26,7 @@ import importlib
 import math
 import multiprocessing as mp
 import os
+import signal
 import time
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
@@ -83,6 +84,9 @@ def _worker(conn: Connection, base: Path, options: Any, task: Task, run_pid: int
     from mechbook.app.lifeline import die_with
     from mechbook.app.quiet import install
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
+    for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
+        signal.signal(ends, signal.SIG_DFL)
     die_with(run_pid)
     install()  # a stray warning or unraisable exception: the debug log, not the terminal
     settle()
@@ -124,9 +128,14 @@ GC_THRESHOLDS = (10_000, 20, 100)  # young collections ~14 times rarer than Pyth
 
 
 def _context():
+    from mechbook.app.lifeline import sweep_stale_folders
+
+    sweep_stale_folders()  # what runs killed with their fork server left
     ctx = mp.get_context("forkserver")
-    # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap
-    ctx.set_forkserver_preload([*PRELOAD, "mechbook.app.frozen"])
+    # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap;
+    # mechbook.app.forkstart first: the server ignores Ctrl-C and removes its socket's
+    # folder when it ends (even after its run was killed)
+    ctx.set_forkserver_preload(["mechbook.app.forkstart", *PRELOAD, "mechbook.app.frozen"])
     return ctx
 
 
@@ -173,6 +182,22 @@ class Batch:
         self.failed = failed
         self._ctx = _context()
         self._slots: list[_Slot] = []
+        self._kept = False  # inside `with`: idle workers stay for the next run
+
+    def __enter__(self) -> Batch:
+        """Keep the workers between runs (`mechbook watch`: each save is checked by a
+        worker that has checked before); they are retired when the block ends."""
+        self._kept = True
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._kept = False
+        self._retire_all()
+
+    def _retire_all(self) -> None:
+        for slot in self._slots:
+            self._retire(slot, kill=slot.pid is not None)
+        self._slots = []
 
     def _spawn(self) -> _Slot:
         parent, child = self._ctx.Pipe()
@@ -204,15 +229,17 @@ class Batch:
             return self._serial(ids)
         todo = list(ids)
         done: dict[Hashable, Any] = {}
+        finished = False
         try:
-            self._slots = [self._spawn() for _ in range(min(self.options.workers, len(todo)))]
+            want = min(self.options.workers, len(todo))
+            self._slots += [self._spawn() for _ in range(want - len(self._slots))]
             while len(done) < len(ids):
                 self._assign(todo)
                 self._collect(done)
+            finished = True
         finally:
-            for slot in self._slots:
-                self._retire(slot, kill=slot.pid is not None)
-            self._slots = []
+            if not (finished and self._kept):
+                self._retire_all()
         return [done[pid] for pid in ids]
 
     def _serial(self, ids: list[Hashable]) -> list[Any]:

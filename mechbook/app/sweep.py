@@ -336,13 +336,30 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
     from mechbook.app.lifeline import die_with
 
     parts: dict[int, dict] = {}
-    with ProcessPoolExecutor(jobs, mp_context=_context(), initializer=die_with,
-                             initargs=(os.getpid(),)) as pool:
+    pool = ProcessPoolExecutor(jobs, mp_context=_context(), initializer=die_with,
+                               initargs=(os.getpid(),))
+    try:
         futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
         for fut in as_completed(futures):
             parts[futures[fut]] = fut.result()
             progress(len(parts), len(ranges))
+    except BaseException:  # Ctrl-C (the workers ignore it) or a block's error: stop now
+        _kill_workers(pool)
+        raise
+    pool.shutdown()
     return parts
+
+
+def _kill_workers(pool) -> None:
+    """Stop a process pool at once: its workers killed, its queue dropped (shutdown alone
+    would wait for every block queued)."""
+    kill = getattr(pool, "kill_workers", None)  # Python 3.14
+    if kill is not None:
+        kill()
+    else:
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _provenance(sweeper: Sweeper, parts: dict, accuracy: dict) -> dict:

@@ -31,8 +31,23 @@ from mechbook.app.cli import (
 from mechbook.app.cli.common import say, set_logging
 from mechbook.version import __version__
 
+INTERRUPTED = 130  # the shell's convention for a command ended by Ctrl-C (128 + SIGINT)
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+
+class _Group(click.Group):
+    """The command group; Ctrl-C ends any command with one line and exit status 130, never
+    a traceback or click's "Aborted!" with status 1 (the workers ignore SIGINT: the run
+    stops them, mechbook.app.batch)."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            say("\ninterrupted", err=True)
+            raise click.exceptions.Exit(INTERRUPTED) from None
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="mechbook")
 @click.option("--root", "root_dir", type=click.Path(file_okay=False, path_type=Path),
               default=None,
