@@ -61,51 +61,74 @@ def restore(side: str | Path, store: str | Path | None = None,
     """Write the results kept in the side file `side` into `store` (the user's choice), or
     else into the store each names, which must lie inside the tree `base`:
     (problems, simulations). MechbookError (file:line and why) if a line is not a result
-    mechbook kept, or names a store it may not write; then nothing is written."""
+    mechbook kept, or names a store it may not write; then nothing is written.
+
+    Two passes over the open file: every line checked first, then written, the problems
+    of consecutive lines for one store in one edit (up to BATCH of them): a side file of
+    many lines costs a few rewrites of the store, not one per line, and memory holds one
+    batch, never the whole file."""
     side = Path(side)
-    entries = list(_entries(side, store, base))
-    problems = simulations = 0
-    for entry in entries:
-        if entry.record is not None:
-            write([entry.record], entry.target)
-            problems += 1
-        else:
-            write_simulation(*entry.simulation, path=entry.target)
-            simulations += 1
-    return problems, simulations
-
-
-def _entries(side: Path, store: str | Path | None, base: str | Path | None):
-    """Every line of the side file checked, before anything is written."""
-    out = []
     try:
         with regular_file(side, 2**62) as fh:
-            number = 0
-            while True:
-                line = fh.readline(MAX_LINE_BYTES + 1)
-                if not line:
-                    break
-                number += 1
-                if len(line) > MAX_LINE_BYTES:
-                    raise MechbookError(f"{side}:{number}: a line of more than "
-                                        f"{MAX_LINE_BYTES} bytes: not a kept result")
-                if not line.strip():
-                    continue
-                try:
-                    out.append(_entry(json_value(line), number, store, base))
-                except (BadEntry, MechbookError) as exc:
-                    raise MechbookError(f"{side}:{number}: {exc}") from None
-                except (ValueError, TypeError, KeyError, UnicodeDecodeError,
-                        RecursionError) as exc:
-                    raise MechbookError(f"{side}:{number}: not a kept result "
-                                        f"({_one_line(exc)})") from None
+            count = sum(1 for _ in _entries(fh, side, store, base))
+            if not count:
+                raise MechbookError(f"{side}: no kept results in it")
+            fh.seek(0)
+            return _write_all(_entries(fh, side, store, base))
     except Unreadable as exc:
         raise MechbookError(str(exc)) from None
     except OSError as exc:
         raise MechbookError(f"cannot read {side}: {exc.strerror or exc}") from None
-    if not out:
-        raise MechbookError(f"{side}: no kept results in it")
-    return out
+
+
+BATCH = 100  # problems written in one edit of a store
+
+
+def _write_all(entries) -> tuple[int, int]:
+    problems = simulations = 0
+    pending: list[ProblemRecord] = []
+    target: Path | None = None
+
+    def flush() -> None:
+        if pending:
+            write(list(pending), target)
+            pending.clear()
+
+    for entry in entries:
+        if entry.record is not None:
+            if entry.target != target or len(pending) >= BATCH:
+                flush()
+                target = entry.target
+            pending.append(entry.record)
+            problems += 1
+        else:
+            flush()
+            write_simulation(*entry.simulation, path=entry.target)
+            simulations += 1
+    flush()
+    return problems, simulations
+
+
+def _entries(fh, side: Path, store: str | Path | None, base: str | Path | None):
+    """Every line of the open side file, checked (MechbookError naming the line)."""
+    number = 0
+    while True:
+        line = fh.readline(MAX_LINE_BYTES + 1)
+        if not line:
+            return
+        number += 1
+        if len(line) > MAX_LINE_BYTES:
+            raise MechbookError(f"{side}:{number}: a line of more than {MAX_LINE_BYTES} "
+                                "bytes: not a kept result")
+        if not line.strip():
+            continue
+        try:
+            yield _entry(json_value(line), number, store, base)
+        except (BadEntry, MechbookError) as exc:
+            raise MechbookError(f"{side}:{number}: {exc}") from None
+        except (ValueError, TypeError, KeyError, UnicodeDecodeError, RecursionError) as exc:
+            raise MechbookError(f"{side}:{number}: not a kept result ({_one_line(exc)})") \
+                from None
 
 
 def _one_line(exc: BaseException) -> str:

@@ -46,6 +46,8 @@ _PROBLEM_ATTRS = {"title": str, "source": str, "problem_sha256": str, "date": st
                   "mechbook": str, "duration_s": (int, float)}
 _CHECK_ATTRS = {"quantity": str, "cite": str, "status": str, "method": str, "detail": str,
                 "seconds": (int, float)}
+_CROSSCHECK_ATTRS = {"name": str, "kind": str, "system": str, "detail": str,
+                     "error": (int, float), "seconds": (int, float)}
 _GROUPS = ("systems", "checks", "crosschecks", "simulations")
 
 
@@ -225,9 +227,16 @@ def _crosschecks(g: h5py.Group) -> list[dict]:
                     raise Damaged(f"{group.name}/{key}: {k}: {exc}") from None
                 if not isinstance(entry[k], list):
                     raise Damaged(f"{group.name}/{key}: {k} is not a list")
+        if not all(isinstance(p, str) for p in entry.get("parts") or []) or \
+                not all(isinstance(m, dict) for m in entry.get("modes") or []):
+            raise Damaged(f"{group.name}/{key}: its parts or modes are not what a check "
+                          "writes")
         if entry.get("status") not in set(Status):
             raise Damaged(f"{group.name}/{key}: the status {entry.get('status')!r} is not "
                           "an outcome")
+        for k, kind in _CROSSCHECK_ATTRS.items():
+            if k in entry and (not isinstance(entry[k], kind) or isinstance(entry[k], bool)):
+                raise Damaged(f"{group.name}/{key}: the attribute {k!r} is {entry[k]!r}")
         CrossCheck.from_dict(entry)
         out.append((int(key), entry))
     return [e for _, e in sorted(out, key=lambda x: x[0])]

@@ -84,7 +84,28 @@ def load(out: Path) -> dict[str, dict]:
     pages = data.get("pages")
     if not isinstance(pages, dict):
         return {}
-    return {pid: entry for pid, entry in pages.items() if isinstance(entry, dict)}
+    good = {pid: entry for pid, entry in pages.items() if _sound(entry)}
+    if len(good) < len(pages):
+        log.warning("the report's page list %s holds %d entries that are not what a report "
+                    "writes: their pages are built again", path, len(pages) - len(good))
+    return good
+
+
+def _sound(entry) -> bool:
+    """An entry as `build_report` writes it: {"key": str, "index": {"title": str, "parts":
+    [{"part": str, "quantity": str, "origin": str, "cite": str}]}, "seconds": number}."""
+    if not isinstance(entry, dict) or not isinstance(entry.get("key", ""), str):
+        return False
+    if not isinstance(entry.get("seconds", 0), int | float):
+        return False
+    index = entry.get("index", {})
+    if not isinstance(index, dict) or not isinstance(index.get("title", ""), str):
+        return False
+    parts = index.get("parts", [])
+    return isinstance(parts, list) and all(
+        isinstance(p, dict) and all(isinstance(p.get(k, ""), str)
+                                    for k in ("part", "quantity", "origin", "cite"))
+        and "part" in p for p in parts)
 
 
 def save(out: Path, pages: dict[str, dict]) -> None:
