@@ -54,9 +54,8 @@ def test_a_side_file_cannot_make_restore_write_outside_the_tree(tree, tmp_path):
     outside.mkdir()
     (tree / "results").mkdir()
     (tree / "results" / "linked.h5").symlink_to(outside / "through-a-link.h5")
-    cases = {"absolute": str(outside / "absolute.h5"), "relative": "../outside/relative.h5",
-             "linked": "results/linked.h5"}
-    for name, named in cases.items():
+    for named in (str(outside / "absolute.h5"), "../outside/relative.h5",
+                  "results/linked.h5"):
         side = _side(tree, _line(store_path=named))
         res = mechbook("--root", tree, "restore", side, cwd=tree)
         _clean_refusal(res, f"{side}:1:", "outside the tree", f"--store {named}")
