@@ -34,8 +34,9 @@ from mechbook.errors import MechbookError
 from mechbook.model.ids import check_id
 from mechbook.records import CrossCheck, Outcome, Results, Status
 
-MAX_LINE_BYTES = 2**30  # one kept result; the largest `simulate` can make (10^6 samples of
-# 16 coordinates, their velocities and monitors) is about 0.7 GB of JSON
+MAX_LINE_BYTES = 256 * 2**20  # one kept result, read whole (with its JSON, about twice that
+# in memory); a simulation of the default 2001 samples is under 1 MB. One of more (over three
+# million numbers) is refused with the line: rerun it with a store that can be written
 MAX_NAME = 200  # characters of a result's, part's or system's name
 _NAME = re.compile(r"[^/\x00-\x1f\x7f]{1,200}")  # one HDF5 path component
 _SYSTEM = re.compile(r"[A-Za-z0-9_+-][A-Za-z0-9._+-]{0,99}")

@@ -60,6 +60,7 @@ import numpy as np
 
 from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
+from mechbook.app.store_bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
 from mechbook.app.store_cache import Cached, cached, durations  # noqa: F401 - re-exported
 from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's readers
     FORMAT,
@@ -226,7 +227,7 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     if kept in root:
         root.move(kept, f"{pid}/simulations")
     g.attrs.update({
-        "title": storable(rec.title), "source": storable(rec.source),
+        "title": _text(rec.title), "source": _text(rec.source),
         "problem_sha256": rec.problem_sha256, "answers_sha256": rec.answers_sha256,
         "engine_sha256": engine_sha256(), "mechbook": __version__,
         "sympy": version("sympy"), "numpy": np.__version__, "h5py": h5py.__version__,
@@ -236,18 +237,18 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     for res in rec.results:
         s = g.require_group("systems").create_group(res.system, track_order=True)
         for key, text in res.text.items():
-            s.create_dataset(f"symbolic/{key}", data=storable(text), dtype=_STR)
+            s.create_dataset(f"symbolic/{key}", data=_text(text, MAX_TEXT_BYTES), dtype=_STR)
         for key, arr in res.arrays.items():
             s.create_dataset(f"numeric/{key}", data=np.asarray(arr, dtype=float))
         for key, text in res.notes.items():
-            s.create_dataset(f"notes/{key}", data=storable(text), dtype=_STR)
+            s.create_dataset(f"notes/{key}", data=_text(text, MAX_TEXT_BYTES), dtype=_STR)
     checks = g.create_group("checks")
     for i, o in enumerate(rec.outcomes):
         c = checks.create_group(o.part)
         c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
-                        "cite": storable(o.cite), "status": str(o.status),
-                        "method": storable(o.method), "detail": storable(o.detail),
-                        "seconds": float(o.seconds), "power": storable(o.power)})
+                        "cite": _text(o.cite), "status": str(o.status),
+                        "method": _text(o.method), "detail": _text(o.detail),
+                        "seconds": float(o.seconds), "power": _text(o.power)})
     if rec.crosschecks:
         cross = g.create_group("crosschecks", track_order=True)
         for i, x in enumerate(rec.crosschecks):
@@ -318,9 +319,24 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        return storable(v)
+        return _text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    return json.dumps(v)
+    return _text(json.dumps(v), cut=False)
+
+
+def _text(text: str, limit: int = MAX_ATTRIBUTE_BYTES, cut: bool = True) -> str:
+    """`text` as the store holds it (mechbook.app.text.storable) and as its readers will
+    read it back: no longer than their bound (mechbook.app.store_bounds), cut with a note
+    if it is longer (a title or an error's detail of megabytes), or, for JSON that cutting
+    would break (`cut` False), a ValueError."""
+    text = storable(str(text))
+    if len(text) * 4 <= limit or len(text.encode("utf-8")) <= limit:
+        return text
+    if not cut:  # a ValueError inside an edit: the write's StoreError, naming the store
+        raise ValueError(f"a value of {len(text)} characters is more than the store reads "
+                         f"back ({limit} bytes)")
+    keep = limit // 4 - 100
+    return f"{text[:keep]} [... {len(text) - keep} more characters not stored]"
 
 

@@ -15,7 +15,8 @@ everything read from a store goes through this module:
 - only the types mechbook writes (numbers, booleans, strings); a dataset whose data lies in
   other files (HDF5's external storage, a virtual dataset) or a soft or external link is
   refused, so nothing outside the store is ever read through it;
-- walks are bounded in depth and in the number of objects (a group may hold itself).
+- walks are bounded in depth, in members per group (counted before the group is listed)
+  and in the number of objects (a group may hold itself).
 
 Every refusal is an `Oversized` (a ValueError): to a reader it is damage, described.
 """
@@ -34,8 +35,9 @@ MAX_ATTRIBUTE_BYTES = 2**20  # one attribute; HDF5 keeps mechbook's under 64 KiB
 MAX_STRINGS = 4096  # strings in one dataset or attribute (mechbook writes one, or a
 # simulation's coordinate names)
 MAX_TEXT_BYTES = 64 * 2**20  # the strings of one dataset together
-MAX_OBJECTS = 1_000_000  # groups, datasets and attributes walked in one store (a full
-# check of the book stores about 30,000)
+MAX_OBJECTS = 200_000  # groups, datasets and attributes walked in one store (a full check
+# of the book stores about 14,000)
+MAX_MEMBERS = 10_000  # members of one group inside a record (a check writes a few hundred)
 MAX_DEPTH = 24  # nesting of groups (mechbook's deepest is about 9)
 _SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
 _NUMERIC = "fiub"  # float, signed and unsigned integers, booleans (an HDF5 enum)
@@ -53,30 +55,36 @@ def _size_text(n: float) -> str:
     return f"{n:.0f} bytes"
 
 
-def _check(what: str, shape, dtype: np.dtype, limit: int) -> bool:
-    """Whether `what` is variable-length text (to be read string by string); Oversized if
-    its declared size or its type is not what a store may hold."""
+def _check(what, shape, dtype: np.dtype, limit: int) -> bool:
+    """Whether it is variable-length text (to be read string by string); Oversized if its
+    declared size or its type is not what a store may hold. `what()` names it (called only
+    for the message: naming an HDF5 object costs a call into the library)."""
     count = int(np.prod(shape, dtype=object)) if shape else (0 if shape is None else 1)
-    vlen = h5py.check_string_dtype(dtype)
-    if vlen is not None and vlen.length is None:
+    if dtype.kind == "O":
+        vlen = h5py.check_string_dtype(dtype)
+        if vlen is None or vlen.length is not None:
+            raise Oversized(f"{what()} is of the type {dtype}, which a mechbook store never "
+                            "holds")
         if count > MAX_STRINGS:
-            raise Oversized(f"{what} declares {count} strings (at most {MAX_STRINGS})")
+            raise Oversized(f"{what()} declares {count} strings (at most {MAX_STRINGS})")
         return True
     if dtype.kind not in _NUMERIC and dtype.kind != "S":
-        raise Oversized(f"{what} is of the type {dtype}, which a mechbook store never holds")
+        raise Oversized(f"{what()} is of the type {dtype}, which a mechbook store never holds")
     if count * dtype.itemsize > limit:
-        raise Oversized(f"{what} declares {_size_text(count * dtype.itemsize)} of data "
+        raise Oversized(f"{what()} declares {_size_text(count * dtype.itemsize)} of data "
                         f"(at most {_size_text(limit)} are read)")
     return False
 
 
 def dataset(d: h5py.Dataset) -> Any:
     """The value of `d`, read only within the bounds (Oversized otherwise)."""
-    what = f"the dataset {d.name}"
+    def what() -> str:
+        return f"the dataset {d.name}"
+
     plist = d.id.get_create_plist()
     if plist.get_layout() not in (h5py.h5d.COMPACT, h5py.h5d.CONTIGUOUS, h5py.h5d.CHUNKED) \
             or plist.get_external_count():
-        raise Oversized(f"{what} keeps its data in other files (external or virtual "
+        raise Oversized(f"{what()} keeps its data in other files (external or virtual "
                         "storage): not read")
     if not _check(what, d.shape, d.dtype, MAX_DATASET_BYTES):
         return d[()]
@@ -87,43 +95,62 @@ def dataset(d: h5py.Dataset) -> Any:
         value = d[index]
         total += len(value) if isinstance(value, bytes | str) else 0
         if total > MAX_TEXT_BYTES:
-            raise Oversized(f"{what} holds more than {_size_text(MAX_TEXT_BYTES)} of text")
+            raise Oversized(f"{what()} holds more than {_size_text(MAX_TEXT_BYTES)} of text")
         out.append(value)
     return np.array(out, dtype=object).reshape(d.shape)
 
 
-def _text(what: str, value: Any, limit: int = MAX_TEXT_BYTES) -> Any:
+def _text(what, value: Any, limit: int = MAX_TEXT_BYTES) -> Any:
     if isinstance(value, bytes | str) and len(value) > limit:
-        raise Oversized(f"{what} holds {_size_text(len(value))} of text (at most "
+        raise Oversized(f"{what()} holds {_size_text(len(value))} of text (at most "
                         f"{_size_text(limit)})")
     return value
 
 
-def attribute(obj, name: str) -> Any:
-    """The attribute `name` of `obj`, read only within the bounds (Oversized otherwise)."""
-    what = f"the attribute {name!r} of {obj.name}"
-    aid = obj.attrs.get_id(name)
-    if _check(what, aid.shape, aid.dtype, MAX_ATTRIBUTE_BYTES):
-        return _text(what, obj.attrs[name], MAX_ATTRIBUTE_BYTES)
-    return obj.attrs[name]
+def attribute(obj, name: str, attrs=None) -> Any:
+    """The attribute `name` of `obj`, read only within the bounds (Oversized otherwise);
+    `attrs`: obj.attrs, where the caller has it already."""
+    attrs = obj.attrs if attrs is None else attrs
+
+    def what() -> str:
+        return f"the attribute {name!r} of {obj.name}"
+
+    aid = attrs.get_id(name)
+    shape, dtype = aid.shape, aid.dtype
+    if shape is None:  # HDF5's empty dataspace
+        return h5py.Empty(dtype)
+    if dtype.subdtype is not None:
+        raise Oversized(f"{what()} is of the type {dtype}, which a mechbook store never holds")
+    text = _check(what, shape, dtype, MAX_ATTRIBUTE_BYTES)
+    # read through the attribute already open, as h5py's attrs[name] does, without opening
+    # it and converting its type a second time (a store holds ten thousand attributes)
+    value = np.zeros(shape, dtype=dtype)
+    aid.read(value, mtype=h5py.h5t.py_create(dtype))
+    if text:
+        strings = [_text(what, b.decode("utf-8", "surrogateescape") if isinstance(b, bytes)
+                         else b, MAX_ATTRIBUTE_BYTES) for b in value.flat]
+        value = np.array(strings, dtype=dtype).reshape(value.shape)
+    return value[()] if value.ndim == 0 else value
 
 
 def attributes(obj, budget: list[int] | None = None) -> dict[str, Any]:
     """Every attribute of `obj` but the dimension scales' bookkeeping, each read within
     the bounds; `budget` ([objects left]) counts them against a walk's bound."""
+    attrs = obj.attrs
     out = {}
-    for name in obj.attrs:
+    for name in attrs:
         if budget is not None:
-            spend(budget, obj.name)
+            spend(budget, obj)
         if name not in _SCALE_ATTRS:
-            out[name] = attribute(obj, name)
+            out[name] = attribute(obj, name, attrs)
     return out
 
 
-def spend(budget: list[int], where: str) -> None:
+def spend(budget: list[int], where) -> None:
     budget[0] -= 1
     if budget[0] < 0:
-        raise Oversized(f"more than {MAX_OBJECTS} objects (at {where}): not a mechbook store")
+        raise Oversized(f"more than {MAX_OBJECTS} objects (at {where.name}): not a mechbook "
+                        "store")
 
 
 def member(group: h5py.Group, name: str):
@@ -143,13 +170,23 @@ def walk(group: h5py.Group, budget: list[int] | None = None, prefix: str = "",
     that leaves every member readable); bounded in depth and, with `budget`, in count."""
     if level > MAX_DEPTH:
         raise Oversized(f"{group.name} is nested more than {MAX_DEPTH} levels deep")
-    for name in group:
+    for name in members(group):
         if budget is not None:
-            spend(budget, group.name)
+            spend(budget, group)
         obj = member(group, name)  # raises if listed but unreadable
         yield prefix + name, obj
         if isinstance(obj, h5py.Group):
             yield from walk(obj, budget, f"{prefix}{name}/", level + 1)
+
+
+def members(group: h5py.Group) -> list[str]:
+    """The names in `group`, if there are at most MAX_MEMBERS (HDF5 counts them without
+    listing them); Oversized otherwise."""
+    count = len(group)
+    if count > MAX_MEMBERS:
+        raise Oversized(f"{group.name} holds {count} members (at most {MAX_MEMBERS} in a "
+                        "record)")
+    return list(group)
 
 
 def new_budget() -> list[int]:

@@ -30,6 +30,7 @@ from mechbook.app.store_bounds import (
     attributes,
     dataset,
     member,
+    members,
     new_budget,
     walk,
 )
@@ -173,52 +174,74 @@ def _typed(attrs: dict, wanted: dict, where: str) -> None:
             raise Damaged(f"{where}: the attribute {key!r} is {attrs[key]!r}")
 
 
-def _read_problem(g) -> dict:
-    """A problem's record, read whole and checked to be what a check writes (Damaged,
-    Oversized or HDF5's own errors otherwise)."""
+def _read_problem(g, budget: list[int] | None = None) -> dict:
+    """A problem's record, read whole (every attribute and dataset of it, within the
+    bounds; its simulations only by name: each is read on its own) and checked to be what
+    a check writes: Damaged, Oversized or HDF5's own errors otherwise."""
     g = _group(g, f"the entry {g.name}")
-    attrs = {k: _plain(v) for k, v in attributes(g).items()}
+    unknown = sorted(set(g) - set(_GROUPS))
+    if unknown:
+        raise Damaged(f"{g.name} holds {unknown[0]!r}, which a check never writes")
+    attrs = {k: _plain(v) for k, v in attributes(g, budget).items()}
     checked = any(k in attrs for k in _PROBLEM_ATTRS) or any(k in g for k in _GROUPS[:3])
     if checked:
         _typed(attrs, _PROBLEM_ATTRS, g.name)
     out = {"attrs": attrs, "systems": {}, "checks": [], "checked": checked}
     systems = _member(g, "systems")
-    for sname in systems:
+    if systems:
+        attributes(systems, budget)
+    for sname in members(systems) if systems else ():
         s = _group(member(systems, sname), f"the system {sname}")
+        attributes(s, budget)
         entry = {"symbolic": {}, "numeric": {}, "notes": {}}
-        for kind in entry:
-            if kind in s:
-                for name, obj in walk(_group(member(s, kind), f"{s.name}/{kind}")):
-                    _collect(entry[kind], name, obj)
+        unknown = sorted(set(s) - set(entry))
+        if unknown:
+            raise Damaged(f"{s.name} holds {unknown[0]!r}, which a check never writes")
+        for kind in s:
+            group = _group(member(s, kind), f"{s.name}/{kind}")
+            attributes(group, budget)
+            for name, obj in walk(group, budget):
+                attributes(obj, budget)
+                _collect(entry[kind], name, obj)
         out["systems"][sname] = entry
     checks = _member(g, "checks")
-    for part in checks:
+    if checks:
+        attributes(checks, budget)
+    for part in members(checks) if checks else ():
         c = _group(member(checks, part), f"the check of part {part}")
-        a = {k: _plain(v) for k, v in attributes(c).items()}
+        if len(c):
+            raise Damaged(f"{c.name} holds members, which a check never writes")
+        a = {k: _plain(v) for k, v in attributes(c, budget).items()}
         _typed(a, _CHECK_ATTRS, c.name)
         if a["status"] not in set(Status):
             raise Damaged(f"{c.name}: the status {a['status']!r} is not an outcome")
         out["checks"].append({"part": part, **a})
     out["checks"].sort(key=lambda c: c.get("index", 0) if isinstance(c.get("index", 0), int)
                        else 0)
-    out["crosschecks"] = _crosschecks(g)
+    out["crosschecks"] = _crosschecks(g, budget)
     sims = _member(g, "simulations")
-    out["simulations"] = sorted(sims.keys())
+    if sims:
+        attributes(sims, budget)
+    out["simulations"] = sorted(members(sims)) if sims else []
     for name in out["simulations"]:
         _group(member(sims, name), f"the simulation {name}")
     return out
 
 
-def _crosschecks(g: h5py.Group) -> list[dict]:
+def _crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dict]:
     from mechbook.records import CrossCheck
 
     out = []
     group = _member(g, "crosschecks")
-    for key in group:
+    if group:
+        attributes(group, budget)
+    for key in members(group) if group else ():
         if not key.isdigit() or len(key) > 9:
             raise Damaged(f"the cross-check entry {key!r} is not numbered")
-        entry = {k: _plain(v) for k, v in attributes(
-            _group(member(group, key), f"the cross-check {key}")).items()}
+        x = _group(member(group, key), f"the cross-check {key}")
+        if len(x):
+            raise Damaged(f"{x.name} holds members, which a check never writes")
+        entry = {k: _plain(v) for k, v in attributes(x, budget).items()}
         for k in ("parts", "modes"):
             if isinstance(entry.get(k), str):
                 try:
@@ -260,14 +283,19 @@ def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dic
             raise _damaged(path, f"the simulation {name} of {pid}", exc) from None
 
 
-def _read_simulation(s) -> dict:
+def _read_simulation(s, budget: list[int] | None = None) -> dict:
+    """A stored simulation, read whole within the bounds: its float arrays and their
+    attributes (every other dataset and attribute read too, so damage anywhere shows)."""
     s = _group(s, f"the simulation {s.name}")
-    out = {"attrs": {k: _plain(v) for k, v in attributes(s).items()}, "arrays": {},
+    out = {"attrs": {k: _plain(v) for k, v in attributes(s, budget).items()}, "arrays": {},
            "array_attrs": {}}
-    for key, obj in walk(s):
-        if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
-            out["arrays"][key] = np.array(dataset(obj))
-            out["array_attrs"][key] = {k: _plain(v) for k, v in attributes(obj).items()}
+    for key, obj in walk(s, budget):
+        attrs = {k: _plain(v) for k, v in attributes(obj, budget).items()}
+        if isinstance(obj, h5py.Dataset):
+            value = dataset(obj)
+            if obj.dtype.kind == "f":
+                out["arrays"][key] = np.array(value)
+                out["array_attrs"][key] = attrs
     return out
 
 
@@ -326,25 +354,26 @@ def _decoded(v):
 
 
 def check_entry(top: str, name: str | None, obj, budget: list[int] | None = None) -> None:
-    """Read one top-level entry of a store (a problem, the sweeps of a problem, or anything
-    else at the top) as its readers will, whole: raises on any damage. `damage` and the
-    rebuild of a damaged store judge every entry by this, so that a record `show` or a
-    check's cache would call damaged is never called sound."""
-    if isinstance(obj, h5py.Group):
+    """Read one top-level entry of a store (a problem with its simulations, the sweeps of a
+    problem, or anything else at the top) as its readers will, whole: raises on any damage.
+    `damage` and the rebuild of a damaged store judge every entry by this, so that a record
+    `show` or a check's cache would call damaged is never called sound."""
+    if top == "problems" and name is not None:
+        _read_problem(obj, budget)
+        sims = _member(obj, "simulations")
+        for sim in sims:
+            _read_simulation(member(sims, sim), budget)
+    elif top == "sweeps" and name is not None:
+        from mechbook.app.sweep_io import _read_sweep
+
+        attributes(_group(obj, f"the sweeps of {name}"), budget)
+        for sweep in obj:
+            _read_sweep(member(obj, sweep), budget)
+    elif isinstance(obj, h5py.Group):
         _read_all(obj, budget)
     else:
         _decoded(attributes(obj, budget))
         _decoded(dataset(obj))
-    if top == "problems" and name is not None:
-        _read_problem(obj)
-        sims = _member(obj, "simulations")
-        for sim in sims:
-            _read_simulation(member(sims, sim))
-    elif top == "sweeps" and name is not None:
-        from mechbook.app.sweep_io import _read_sweep
-
-        for sweep in _group(obj, f"the sweeps of {name}"):
-            _read_sweep(member(obj, sweep))
 
 
 def damage(path: str | Path) -> str | None:

@@ -14,7 +14,13 @@ from pathlib import Path
 import h5py
 
 from mechbook.app.store_bounds import _SCALE_ATTRS, attribute, dataset, member, new_budget, walk
-from mechbook.app.store_read import _decoded, check_entry
+from mechbook.app.store_read import (
+    _decoded,
+    _member,
+    _read_problem,
+    _read_simulation,
+    check_entry,
+)
 
 
 def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
@@ -42,6 +48,9 @@ def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
                 continue
             for name in (children if children is not None else [None]):
                 where = f"/{top}/{name}" if name is not None else f"/{top}"
+                if top == "problems" and name is not None:
+                    _salvage_problem(src, out, name, budget, kept, lost)
+                    continue
                 try:
                     entry = member(src[top], name) if name is not None else member(src, top)
                     check_entry(top, name, entry, budget)
@@ -60,13 +69,52 @@ def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
     return kept, lost
 
 
-def _copy_group(src: h5py.Group, dst: h5py.Group) -> None:
+def _salvage_problem(src: h5py.File, out: h5py.File, pid: str, budget: list[int],
+                     kept: list[str], lost: list[str]) -> None:
+    """A problem's record and each of its simulations, kept or lost apart: a damaged
+    simulation costs only itself, a damaged record not its simulations."""
+    where = f"/problems/{pid}"
+    try:
+        entry = member(member(src, "problems"), pid)
+        _read_problem(entry, budget)
+        dst = out.require_group("problems").create_group(pid, track_order=True)
+        _copy_group(entry, dst, skip=("simulations",))
+        kept.append(where)
+    except Exception:  # noqa: BLE001 - the record is damaged: left out
+        if where in out:
+            del out[where]
+        lost.append(where)
+        dst = None
+    try:
+        sims = _member(member(member(src, "problems"), pid), "simulations")
+        names = list(sims)
+    except Exception:  # noqa: BLE001 - no readable list of simulations
+        return
+    for name in names:
+        at = f"{where}/simulations/{name}"
+        try:
+            sim = member(sims, name)
+            _read_simulation(sim, budget)
+            if dst is None:  # the record is lost: its simulations stand alone
+                dst = out.require_group("problems").create_group(pid, track_order=True)
+            _copy_group(sim, dst.require_group("simulations").create_group(
+                name, track_order=True))
+            kept.append(at)
+        except Exception:  # noqa: BLE001
+            if at in out:
+                del out[at]
+            lost.append(at)
+
+
+def _copy_group(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = ()) -> None:
     """Copy a subtree between files as plain data (object references, which dimension
     scales are made of, do not survive a copy between files: the scales are re-attached by
-    their paths inside the subtree)."""
+    their paths inside the subtree); the members named in `skip` are left out."""
     dst.attrs.update(_raw_attrs(src))
     scales, links = [], []
     for name, obj in walk(src):
+        if name.split("/", 1)[0] in skip:
+            continue
         if isinstance(obj, h5py.Group):
             dst.create_group(name, track_order=True).attrs.update(_raw_attrs(obj))
             continue

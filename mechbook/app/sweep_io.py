@@ -55,12 +55,14 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        from mechbook.app.text import storable
+        from mechbook.app.store import _text
 
-        return storable(v)
+        return _text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    return json.dumps(v, default=float)
+    from mechbook.app.store import _text
+
+    return _text(json.dumps(v, default=float), cut=False)
 
 
 def write_store(result, name: str, path: str | Path) -> Path:
@@ -111,19 +113,21 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
                              "read") from None
 
 
-def _read_sweep(g) -> dict:
+def _read_sweep(g, budget: list[int] | None = None) -> dict:
     """A stored sweep, read whole within the store's bounds (mechbook.app.store_bounds);
     raises on damage."""
     from mechbook.app.store_bounds import attributes, dataset, member
 
     if not isinstance(g, h5py.Group):
         raise ValueError(f"{g.name} is not a group")
-    attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in attributes(g).items()}
+    attrs = {k: (v.decode() if isinstance(v, bytes) else v)
+             for k, v in attributes(g, budget).items()}
     coords, vars_ = {}, {}
     for key in g:
         d = member(g, key)
         if not isinstance(d, h5py.Dataset):
             raise ValueError(f"{d.name} is not a dataset")
+        attributes(d, budget)
         if d.is_scale:
             coords[key] = dataset(d)
     for key in g:

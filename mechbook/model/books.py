@@ -19,6 +19,7 @@ when books.yaml is read, with the line.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -83,7 +84,17 @@ def books(base: str | Path) -> dict[str, Book]:
     try:
         st = path.stat()
     except OSError:
+        if path.is_symlink():  # dangling or looping: not "no books.yaml"
+            raise MechbookError(f"{path}: a symbolic link that leads nowhere "
+                                f"({os.readlink(path)}): remove it or point it at a file "
+                                "inside the tree") from None
         return {}
+    if path.is_symlink():
+        top, real = os.path.realpath(base), os.path.realpath(path)
+        if os.path.commonpath([top, real]) != top:
+            raise MechbookError(f"{path}: a symbolic link to {real}, outside the tree {base}: "
+                                "books.yaml is read only from inside the tree (copy the file "
+                                "in)")
     stamp = (st.st_mtime_ns, st.st_size)
     hit = _CACHE.get(path)
     if hit is None or hit[0] != stamp:
