@@ -691,9 +691,9 @@ def run_regex(where: Path, spec: dict) -> tuple[str, str]:
     """books.yaml with the user's pattern: read it, then list and resolve problems whose
     numbers could make a backtracking matcher run for ever; the batch's time limit is the
     judge of a hang."""
+    from mechbook.errors import MechbookError
     from mechbook.model.books import load_books
     from mechbook.model.catalog import all_ids, problem_path
-    from mechbook.errors import MechbookError
 
     tree = where / "tree"
     (tree / "problems" / "lim").mkdir(parents=True)
