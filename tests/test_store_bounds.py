@@ -200,3 +200,23 @@ def test_a_problem_with_only_simulations_stored_says_so(tmp_path):
     assert "no check is stored, only simulations" in res.stdout
     assert "simulation stored: /problems/lim-2031/simulations/main-RK4" in res.stdout
     assert store.damage(path) is None
+
+
+def test_a_damaged_simulation_costs_only_itself(tree):
+    """The rebuild keeps a record whose simulation is damaged, and the record's other
+    simulations: each is kept or lost apart."""
+    path = _store(tree)
+    for name in ("main-RK4", "main-DOP853"):
+        store.write_simulation("lim-2101", name, {"t": np.linspace(0, 1, 5)}, {}, None, path)
+    with h5py.File(path, "a") as f:
+        d = f.create_dataset("problems/lim-2101/simulations/main-RK4/bomb", shape=(10**9,),
+                             dtype="f8", chunks=(1 << 16,), compression="gzip")
+        d[:10] = 1.0
+    res = mechbook("--root", tree, "check", "lim-2102", "-j", "1", "--no-crosscheck",
+                   "--fresh", cwd=tree)
+    _clean(res)
+    assert res.returncode == 0
+    assert "lost here, kept in the damaged file): /problems/lim-2101/simulations/main-RK4" \
+        in res.stderr, res.stderr
+    rec = store.read("lim-2101", path)
+    assert rec["checked"] and rec["simulations"] == ["main-DOP853"]
