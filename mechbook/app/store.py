@@ -35,7 +35,8 @@ it is moved aside to `<name>.damaged-<time>`, rebuilt from every problem, simula
 sweep that can still be read whole, and a warning says what was kept and what was lost.
 Readers (`show`, `report`) raise StoreError naming what is damaged.
 
-The modules beside this one: store_read (reading, StoreError), store_cache (the warm-run
+The modules beside this one: store_read (reading, StoreError), store_check (records read
+whole and checked, `damage`), store_bounds (every read bounded), store_cache (the warm-run
 cache and durations), store_repair (rebuilding a damaged file). Their public names are
 importable from here too.
 """

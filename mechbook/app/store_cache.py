@@ -13,7 +13,8 @@ import h5py
 
 from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.store_bounds import attribute, attributes, member
-from mechbook.app.store_read import DEFAULT_PATH, _crosschecks, _member, _plain, _reason, refusal
+from mechbook.app.store_check import _crosschecks, _member, _plain, _reason, refusal
+from mechbook.app.store_read import DEFAULT_PATH
 from mechbook.records import CrossCheck, Outcome
 
 log = logging.getLogger("mechbook.store")

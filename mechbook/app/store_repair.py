@@ -1,7 +1,7 @@
 """Rebuilding a damaged store: every problem, sweep and top-level entry that still reads
 whole is copied into a new file (mechbook.app.store moves the damaged one aside first).
 
-"Reads whole" is judged as the readers judge it (mechbook.app.store_read.check_entry, within
+"Reads whole" is judged as the readers judge it (mechbook.app.store_check.check_entry, within
 the bounds of mechbook.app.store_bounds), and the copy reads within the same bounds, so an
 entry the readers would call damaged is never copied, and copying never takes more memory
 than reading.
@@ -14,7 +14,7 @@ from pathlib import Path
 import h5py
 
 from mechbook.app.store_bounds import _SCALE_ATTRS, attribute, dataset, member, new_budget, walk
-from mechbook.app.store_read import (
+from mechbook.app.store_check import (
     _decoded,
     _member,
     _read_problem,

@@ -95,6 +95,7 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
     """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; NotFoundError
     (also a KeyError) naming the problem's stored sweeps if it is absent, StoreError naming
     what is damaged."""
+    from mechbook.app.store_check import _read_sweep
     from mechbook.app.store_read import StoreError, _names, _opened, _reason, there
 
     with _opened(path) as f:
@@ -111,31 +112,6 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
         except Exception as exc:  # noqa: BLE001 - damage inside the sweep, described
             raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
                              "read") from None
-
-
-def _read_sweep(g, budget: list[int] | None = None) -> dict:
-    """A stored sweep, read whole within the store's bounds (mechbook.app.store_bounds);
-    raises on damage."""
-    from mechbook.app.store_bounds import attributes, dataset, member
-
-    if not isinstance(g, h5py.Group):
-        raise ValueError(f"{g.name} is not a group")
-    attrs = {k: (v.decode() if isinstance(v, bytes) else v)
-             for k, v in attributes(g, budget).items()}
-    coords, vars_ = {}, {}
-    for key in g:
-        d = member(g, key)
-        if not isinstance(d, h5py.Dataset):
-            raise ValueError(f"{d.name} is not a dataset")
-        attributes(d, budget)
-        if d.is_scale:
-            coords[key] = dataset(d)
-    for key in g:
-        d = g[key]
-        if not d.is_scale:
-            dims = tuple(d.dims[i][0].name.rsplit("/", 1)[-1] for i in range(d.ndim))
-            vars_[key] = (dims, dataset(d))
-    return {"attrs": attrs, "coords": coords, "variables": vars_}
 
 
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:

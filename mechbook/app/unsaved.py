@@ -129,10 +129,3 @@ class Saver:
                          "anywhere (" + "; ".join(self.side.failures) + "): check again "
                          "once the cause is fixed")
         return lines
-
-
-def restore(side: Path, store: Path | None = None, base: Path | None = None) -> tuple[int, int]:
-    """Write the results kept in a side file into a store (mechbook.app.restore)."""
-    from mechbook.app.restore import restore as restore_side
-
-    return restore_side(side, store, base)

@@ -22,7 +22,7 @@ def command(ctx: click.Context, files: tuple[Path, ...], store_path: Path | None
     Without --store, each result goes to the store it was meant for, and only if that lies
     inside the tree; the whole file is checked before anything is written."""
     from mechbook.app.outputs import resolve_path
-    from mechbook.app.unsaved import restore as restore_file
+    from mechbook.app.restore import restore as restore_file
     from mechbook.model.catalog import root
 
     given = ctx.obj.get("root_opt")
