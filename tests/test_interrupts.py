@@ -11,6 +11,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -18,6 +19,16 @@ import pytest
 from hostile import ROOT, limited
 
 pytestmark = pytest.mark.slow
+
+
+@pytest.fixture
+def short_tmp() -> Path:
+    """A temporary directory of the test's own, with a short path: the fork server's
+    socket lives in it, and a socket's path is at most 107 bytes (pytest's tmp_path under
+    xdist is longer than that leaves room for)."""
+    path = Path(tempfile.mkdtemp(prefix="mbt-", dir="/tmp"))
+    yield path
+    shutil.rmtree(path, ignore_errors=True)
 
 
 @pytest.fixture
@@ -59,10 +70,9 @@ def _alive(pids: set[int]) -> set[int]:
                                             (("check", "-j", "2", "--no-store"), 8.0),
                                             (("report", "-j", "2", "--no-simulate"), 3.0),
                                             (("report", "-j", "2", "--no-simulate"), 10.0)])
-def test_ctrl_c_ends_a_run_with_130_and_no_traceback(tree, tmp_path, command, delay):
+def test_ctrl_c_ends_a_run_with_130_and_no_traceback(tree, short_tmp, command, delay):
     """At 1 s the fork server is still importing the engine; later the workers are busy."""
-    tmpdir = tmp_path / "tmp"
-    tmpdir.mkdir()
+    tmpdir = short_tmp
     proc = _start(tree, tmpdir, *command)
     time.sleep(delay)
     family = _descendants(proc.pid) | {proc.pid}
@@ -79,11 +89,10 @@ def test_ctrl_c_ends_a_run_with_130_and_no_traceback(tree, tmp_path, command, de
 
 
 @pytest.mark.parametrize("how", ["SIGKILL", "SIGTERM", "group SIGTERM", "group SIGHUP"])
-def test_a_killed_run_leaves_no_pymp_folder(tree, tmp_path, how):
+def test_a_killed_run_leaves_no_pymp_folder(tree, short_tmp, how):
     """On 0834a76 every kill left the fork server's socket folder behind (only a run that
     exits removes it); now the fork server, which ends with its run, removes it."""
-    tmpdir = tmp_path / "tmp"
-    tmpdir.mkdir()
+    tmpdir = short_tmp
     proc = _start(tree, tmpdir, "check", "-j", "2", "--no-store")
     time.sleep(6)
     assert list(tmpdir.glob("pymp-*")), "the run made no folder: nothing tested"
@@ -99,11 +108,10 @@ def test_a_killed_run_leaves_no_pymp_folder(tree, tmp_path, how):
     assert not list(tmpdir.glob("pymp-*"))
 
 
-def test_the_next_run_removes_what_a_run_killed_with_its_fork_server_left(tree, tmp_path):
+def test_the_next_run_removes_what_a_run_killed_with_its_fork_server_left(tree, short_tmp):
     """SIGKILL to the whole group leaves no process to clean up: the folder stays until
     the next run, which removes it (it is marked with the dead run's process id)."""
-    tmpdir = tmp_path / "tmp"
-    tmpdir.mkdir()
+    tmpdir = short_tmp
     proc = _start(tree, tmpdir, "check", "-j", "2", "--no-store")
     time.sleep(6)
     os.killpg(proc.pid, signal.SIGKILL)

@@ -158,6 +158,17 @@ def settle(preload: bool = False) -> None:
     gc.set_threshold(*GC_THRESHOLDS)
 
 
+def _cannot_start(exc: OSError) -> str:
+    """Why worker processes could not be started, and what to do."""
+    import tempfile
+
+    why = exc.strerror or str(exc)
+    return (f"cannot start worker processes ({why}): their fork server needs a socket in "
+            f"the temporary directory {tempfile.gettempdir()}, which must exist, be writable "
+            "and have a short path (a socket's path is at most 107 bytes): set TMPDIR to "
+            "one, or use --serial")
+
+
 def _rss_mb(os_pid: int) -> float:
     """Resident memory of a process in MB (0 if it cannot be read)."""
     try:
@@ -204,8 +215,13 @@ class Batch:
         proc = self._ctx.Process(target=_worker, daemon=True,
                                  args=(child, self.base, self.options.run, self.task,
                                        os.getpid()))
-        proc.start()
-        child.close()
+        try:
+            proc.start()
+        except OSError as exc:  # the fork server's socket cannot be made or reached
+            parent.close()
+            raise MechbookError(_cannot_start(exc)) from None
+        finally:
+            child.close()
         return _Slot(proc, parent)
 
     def _retire(self, slot: _Slot, kill: bool = False) -> None:
