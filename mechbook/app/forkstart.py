@@ -8,28 +8,36 @@ Two things only the server itself can do:
 - Its socket's folder (`pymp-*` in the temporary directory) goes with it. The run that
   started the server removes that folder at its exit, unless it was killed (SIGKILL, or
   SIGTERM's default action): then the server, which ends when the run's end of its pipe
-  closes, removes it on its way out; a SIGTERM or SIGHUP to the server itself (a whole
-  process group ended) ends it the same way. Only a SIGKILL of the server as well leaves
-  the folder: the next run removes it (mechbook.app.lifeline.sweep_stale_folders).
+  closes, removes it on its way out, once the run that marked the folder is gone; a
+  SIGTERM or SIGHUP to the server itself (a whole process group ended) ends it the same
+  way. Only a SIGKILL of the server as well leaves the folder: the next run removes it
+  (mechbook.app.lifeline.sweep_stale_folders).
 """
 
 from __future__ import annotations
 
 import atexit
 import os
-import shutil
 import signal
+
+_SERVER = os.getpid()  # the fork server; its workers inherit this module, and never end by
+# way of atexit (they leave with os._exit), but a removal is the server's alone all the same
 
 
 def _remove_socket_folder() -> None:
+    """The folder of this server's socket, if the run that started it is gone (a server
+    that ends while its run lives, say by a SIGTERM of its own, leaves it to the run)."""
     from multiprocessing import forkserver
 
+    from mechbook.app.lifeline import remove_if_abandoned
+
     address = getattr(forkserver._forkserver, "_forkserver_address", None)
-    if not isinstance(address, str) or not address or address.startswith("\0"):
+    if os.getpid() != _SERVER or not isinstance(address, str) or not address \
+            or address.startswith("\0"):
         return
     folder = os.path.dirname(address)
     if os.path.basename(folder).startswith("pymp-"):
-        shutil.rmtree(folder, ignore_errors=True)
+        remove_if_abandoned(folder)
 
 
 def _end(signum, frame):

@@ -98,6 +98,7 @@ def sweep_stale_folders() -> None:
 
     try:
         mine = util.get_temp_dir()
+        os.makedirs(mine, mode=0o700, exist_ok=True)  # removed under this process: made again
         open(os.path.join(mine, f"{MARK}{os.getpid()}"), "a").close()
     except OSError:
         return
@@ -112,9 +113,35 @@ def sweep_stale_folders() -> None:
             info = os.lstat(folder)
             if folder == mine or not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():
                 continue
-            marks = [m for m in os.listdir(folder) if m.startswith(MARK)]
+            marks = os.listdir(folder)
         except OSError:
             continue
-        pids = [m[len(MARK):] for m in marks]
-        if pids and all(p.isdigit() and not _alive(int(p)) for p in pids):
+        if _abandoned(marks):
             shutil.rmtree(folder, ignore_errors=True)
+
+
+def _abandoned(marks: list[str]) -> bool:
+    """Whether a folder with these names in it is a run's whose runs are all gone."""
+    pids = [m[len(MARK):] for m in marks if m.startswith(MARK)]
+    return bool(pids) and all(p.isdigit() and not _alive(int(p)) for p in pids)
+
+
+def remove_if_abandoned(folder: str, wait: float = 2.0) -> None:
+    """Remove the multiprocessing folder `folder` once the runs that marked it are gone,
+    waiting up to `wait` seconds for them (the fork server calls it as it ends: a signal to
+    the whole process group reaches the server and its run at once, and the run may take
+    a moment to die; a run that lives on keeps its folder)."""
+    end = time.monotonic() + wait
+    while True:
+        try:
+            info = os.lstat(folder)
+            if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():
+                return
+            if _abandoned(os.listdir(folder)):
+                shutil.rmtree(folder, ignore_errors=True)
+                return
+        except OSError:
+            return
+        if time.monotonic() > end:
+            return
+        time.sleep(0.05)
