@@ -348,7 +348,7 @@ def run_init(where: Path, spec: dict) -> tuple[str, str]:
     cwd = os.getcwd()
     os.chdir(root)
     try:
-        res = CliRunner().invoke(main, ["init", name])
+        res = CliRunner().invoke(main, ["init", "--", name])  # a name may start with "-"
     finally:
         os.chdir(cwd)
     moved = guard.changed()

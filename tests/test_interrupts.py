@@ -21,6 +21,10 @@ from hostile import ROOT, limited
 pytestmark = pytest.mark.slow
 
 
+SWEEP = ("sweep", "lim-2031", "--quantity", "stability", "--about", "theta=pi", "--param",
+         "omega=0.5:10:3000", "--param", "b=0.1:1:3000", "--no-store", "-j", "2")
+
+
 @pytest.fixture
 def short_tmp() -> Path:
     """A temporary directory of the test's own, with a short path: the fork server's
@@ -69,7 +73,8 @@ def _alive(pids: set[int]) -> set[int]:
 @pytest.mark.parametrize("command, delay", [(("check", "-j", "2", "--no-store"), 1.0),
                                             (("check", "-j", "2", "--no-store"), 8.0),
                                             (("report", "-j", "2", "--no-simulate"), 3.0),
-                                            (("report", "-j", "2", "--no-simulate"), 10.0)])
+                                            (("report", "-j", "2", "--no-simulate"), 10.0),
+                                            (SWEEP, 3.5), (SWEEP, 4.5), (SWEEP, 8.0)])
 def test_ctrl_c_ends_a_run_with_130_and_no_traceback(tree, short_tmp, command, delay):
     """At 1 s the fork server is still importing the engine; later the workers are busy."""
     tmpdir = short_tmp
@@ -126,3 +131,16 @@ def test_the_next_run_removes_what_a_run_killed_with_its_fork_server_left(tree, 
     assert again.returncode == 0, err
     assert not left[0].exists()
     assert foreign.exists()
+
+
+def test_a_local_sweep_leaves_nothing_in_the_temporary_directory(tree, short_tmp):
+    """A sweep's pool workers wrote their scratch copies of the tree (mechbook-tree-*) to
+    the temporary directory and never removed them (they end by os._exit, and their atexit
+    never runs); they now go into the run's own folder, which goes with the run."""
+    proc = _start(tree, short_tmp, "sweep", "lim-2031", "--quantity", "stability",
+                  "--about", "theta=pi", "--param", "omega=0.5:10:40", "--param",
+                  "b=0.1:1:30", "--no-store", "-j", "2")
+    _, err = proc.communicate(timeout=600)
+    assert proc.returncode == 0, err
+    time.sleep(1)
+    assert list(short_tmp.iterdir()) == []

@@ -28,7 +28,8 @@ import multiprocessing as mp
 import os
 import signal
 import time
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
@@ -139,6 +140,45 @@ def _context():
     return ctx
 
 
+@contextmanager
+def deferred_interrupt() -> Iterator[None]:
+    """Ctrl-C held back until the block ends (then raised): for the moments a process is
+    being started, when an interrupt would leave one started but not yet recorded, to run
+    on without its run or fail on the terminal."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: pending.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
+    if pending:
+        raise KeyboardInterrupt
+
+
+def start_server() -> None:
+    """Start the fork server (and multiprocessing's resource tracker) if it is not running,
+    with SIGINT ignored from the new processes' first instruction: a signal's disposition
+    SIG_IGN survives exec, so a Ctrl-C while their interpreters start up (before
+    mechbook.app.forkstart is imported) cannot kill them with a "Fatal Python error" on
+    the terminal. This process ignores SIGINT only for the instant of the spawn."""
+    import threading
+    from multiprocessing import forkserver
+
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
+
+
 def settle(preload: bool = False) -> None:
     """Keep the garbage collector off what was imported: the objects alive now (the
     engine's modules: SymPy, SciPy, NumPy, mechbook; with `preload`, PRELOAD imported
@@ -216,7 +256,9 @@ class Batch:
                                  args=(child, self.base, self.options.run, self.task,
                                        os.getpid()))
         try:
-            proc.start()
+            start_server()
+            with deferred_interrupt():  # started and recorded, or not started at all
+                proc.start()
         except OSError as exc:  # the fork server's socket cannot be made or reached
             parent.close()
             raise MechbookError(_cannot_start(exc)) from None
