@@ -138,9 +138,10 @@ def test_a_local_sweep_leaves_nothing_in_the_temporary_directory(tree, short_tmp
     the temporary directory and never removed them (they end by os._exit, and their atexit
     never runs); they now go into the run's own folder, which goes with the run."""
     proc = _start(tree, short_tmp, "sweep", "lim-2031", "--quantity", "stability",
-                  "--about", "theta=pi", "--param", "omega=0.5:10:40", "--param",
-                  "b=0.1:1:30", "--no-store", "-j", "2")
-    _, err = proc.communicate(timeout=600)
+                  "--about", "theta=pi", "--param", "omega=0.5:10:1000", "--param",
+                  "b=0.1:1:1400", "--no-store", "-j", "2")  # blocks enough for a pool
+    out, err = proc.communicate(timeout=600)
     assert proc.returncode == 0, err
+    assert "2 local processes" in out + err, out + err
     time.sleep(1)
     assert list(short_tmp.iterdir()) == []
