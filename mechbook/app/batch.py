@@ -160,6 +160,18 @@ def deferred_interrupt() -> Iterator[None]:
         raise KeyboardInterrupt
 
 
+def kill_pool(pool) -> None:
+    """Stop a concurrent.futures process pool at once: its workers killed, its queue dropped
+    (shutdown alone would wait for every task queued; its workers ignore Ctrl-C)."""
+    kill = getattr(pool, "kill_workers", None)  # Python 3.14
+    if kill is not None:
+        kill()
+    else:
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+
+
 def start_server() -> None:
     """Start the fork server (and multiprocessing's resource tracker) if it is not running,
     with SIGINT ignored from the new processes' first instruction: a signal's disposition

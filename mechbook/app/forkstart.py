@@ -41,6 +41,13 @@ def _remove_socket_folder() -> None:
 
 
 def _end(signum, frame):
+    """SIGTERM or SIGHUP: the server ends by way of atexit (which removes its folder); a
+    worker forked from it that has not yet set its own handlers dies as by default (its run
+    terminates it as it exits), never raising inside the fork's own bookkeeping."""
+    if os.getpid() != _SERVER:
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+        return
     raise SystemExit(128 + signum)
 
 

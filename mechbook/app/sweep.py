@@ -333,7 +333,7 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import util
 
-    from mechbook.app.batch import _context, deferred_interrupt, start_server
+    from mechbook.app.batch import _context, deferred_interrupt, kill_pool, start_server
     from mechbook.app.distributed import use_scratch
 
     parts: dict[int, dict] = {}
@@ -345,29 +345,17 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
         try:
             futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
         except BaseException:
-            _kill_workers(pool)
+            kill_pool(pool)
             raise
     try:
         for fut in as_completed(futures):
             parts[futures[fut]] = fut.result()
             progress(len(parts), len(ranges))
     except BaseException:  # Ctrl-C (the workers ignore it) or a block's error: stop now
-        _kill_workers(pool)
+        kill_pool(pool)
         raise
     pool.shutdown()
     return parts
-
-
-def _kill_workers(pool) -> None:
-    """Stop a process pool at once: its workers killed, its queue dropped (shutdown alone
-    would wait for every block queued)."""
-    kill = getattr(pool, "kill_workers", None)  # Python 3.14
-    if kill is not None:
-        kill()
-    else:
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
-            process.kill()
-    pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _provenance(sweeper: Sweeper, parts: dict, accuracy: dict) -> dict:
