@@ -78,4 +78,6 @@ def describe(exc: BaseException) -> str:
     if isinstance(exc, MechbookError):
         return str(exc)
     logging.getLogger(FAULTS).debug("%s: %s", type(exc).__name__, exc, exc_info=exc)
+    if isinstance(exc, MemoryError):  # its message is usually empty: "MemoryError: "
+        return f"ran out of memory (MemoryError{': ' + str(exc) if str(exc) else ''})"
     return f"{type(exc).__name__}: {exc}"

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import fuzz_faults as faults
+import fuzz_surfaces as surfaces
 from ruamel.yaml import YAML
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,11 +69,29 @@ KINDS = {
     "symlinks": "a problem file, answer key or book folder replaced by a link: outside the "
                 "tree (with a marker that must never be read), dangling, looping, /dev/zero, "
                 "a FIFO, a directory, or inside the tree",
+    "restore": "a side file of kept results with hostile lines (ids, fields, values, nesting, "
+               "formats, stores outside the tree or that are not stores) or itself a FIFO, "
+               "/dev/zero, a directory, a link; restored as from inside the tree "
+               "(tests/fuzz_surfaces.py)",
+    "init": "`mechbook init NAME` over dangling and linked files and folders, FIFOs, files "
+            "where folders go, overlong and empty names",
+    "watch": "watch's poll and check with its problem file, answer key or books.yaml replaced "
+             "by a FIFO, /dev/zero, a directory, links, a sparse 3 GB file, random bytes",
+    "pagelist": "the report's page list as a FIFO, /dev/zero, a directory, links, nested or "
+                "random JSON, entries of the wrong shape, bytes; its old temporary names "
+                "planted as links",
+    "hdf5": "stores from elsewhere: compressed and unallocated bombs, huge attributes, foreign "
+            "HDF5, unknown formats, soft, external and hard-cycle links, external and virtual "
+            "storage, deep and many groups, damaged records",
+    "regex": "books.yaml with a user's pattern: catastrophic backtracking on numbers of up to "
+             "80 characters, backreferences, lookaround, huge and invalid patterns",
 }
 
 # shares of a run: a `check` case costs ~50 validations, so that kind gets a small share
 WEIGHTS = {"text": 20, "structure": 22, "expression": 26, "hostile": 14, "counts": 16,
-           "check": 1, "store": 8, "strings": 6, "options": 4, "symlinks": 3}
+           "check": 1, "store": 8, "strings": 6, "options": 4, "symlinks": 3,
+           "restore": 4, "init": 3, "watch": 3, "pagelist": 3, "hdf5": 6, "regex": 3}
+SURFACES = ("restore", "init", "watch", "pagelist", "hdf5", "regex")  # issue 33
 
 HOSTILE_EXPRESSIONS = [
     "1/0", "0/0", "1/0*{x}", "sqrt(-1)*{x}**2", "sqrt(-{p})", "log(0)", "log(-1)", "asin(2)",
@@ -451,6 +470,8 @@ def generate(index: int, seed_value: int, pool: list[Seed], kinds: list[str]) ->
         which, text, _ = _counts(rng, seed)
         target = ppath if which == "problem" else apath
         files[target] = text
+    elif kind in SURFACES:
+        return Case(index, kind, {}, "", mode=kind, spec=surfaces.GENERATORS[kind](rng))
     elif kind == "store":
         return Case(index, kind, {}, "", mode="store", spec=faults.store_spec(rng))
     elif kind == "options":
@@ -489,7 +510,7 @@ def write_case(case: Case, where: Path) -> Path:
     if case.mode == "symlink":
         faults.make_links(where, case.target, case.spec["link"])
         return where
-    if case.mode in ("store", "options"):
+    if case.mode in ("store", "options", *SURFACES):
         (where / "spec.json").write_text(json.dumps(case.spec))
         return where
     target = where / case.target
@@ -510,7 +531,7 @@ def _item(case: Case, where: Path, target: Path) -> str:
         return f"check:{where}:{case.target}"
     if case.mode == "symlink":
         return f"symlink:{where}:{_pid(case.target)}"
-    if case.mode in ("store", "options"):
+    if case.mode in ("store", "options", *SURFACES):
         return f"{case.mode}:{where}"
     return f"{'strings' if case.mode == 'strings' else 'validate'}:{target}"
 
@@ -536,6 +557,10 @@ def _classify(item: str, stage) -> tuple[str, str]:
     logging.getLogger("mechbook").setLevel(logging.ERROR)  # a moved store's warning: expected
     mode, _, rest = item.partition(":")
     try:
+        if mode in SURFACES:
+            stage(mode)
+            return surfaces.RUNNERS[mode](Path(rest), json.loads((Path(rest) / "spec.json")
+                                                                 .read_text()))
         if mode == "store":
             stage("store")
             return faults.run_store(Path(rest), json.loads((Path(rest) / "spec.json")
@@ -631,8 +656,10 @@ def run_cases(cases: list[Case], workdir: Path, jobs: int = 2, keep: Path | None
 
 
 def _copy_regular(src: str, dst: str) -> None:
-    if os.path.isfile(src):
+    if os.path.isfile(src) and os.path.getsize(src) <= 1 << 24:
         shutil.copy2(src, dst)
+    elif os.path.isfile(src):  # a sparse file of gigabytes: its size is what matters
+        Path(dst + ".SPECIAL").write_text(f"a file of {os.path.getsize(src)} bytes: {src}\n")
     else:
         Path(dst + ".SPECIAL").write_text(f"not a regular file: {src}\n")
 
@@ -662,7 +689,7 @@ def fuzz(cases: int, seed: int = 1, jobs: int = 2, kinds: list[str] | None = Non
     return out
 
 
-BAD = ("crash", "hang", "bomb", "died", "lost", "leak", "unsafe")
+BAD = ("crash", "hang", "bomb", "died", "lost", "leak", "unsafe", "outside")
 
 
 def summary(results: list[Result]) -> str:

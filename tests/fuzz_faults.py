@@ -174,7 +174,8 @@ def run_store(where: Path, spec: dict) -> tuple[str, str]:
     way `check` does (mechbook.app.unsaved.Saver): it must be in the store or in the side
     file named, and every record readable before must still be readable."""
     import mechbook.app.store as store
-    from mechbook.app.unsaved import Saver, restore
+    from mechbook.app.restore import restore
+    from mechbook.app.unsaved import Saver
 
     rng = random.Random(spec["seed"])
     path = where / "results" / "mechbook.h5"

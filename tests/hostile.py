@@ -88,3 +88,34 @@ def tmpfs(where: Path, size: str = "1m", readonly: bool = False):
         yield where
     finally:
         subprocess.run(["umount", "-l", str(where)], capture_output=True)
+
+
+MEMORY_GB = 2.0  # the address space a command of the tests may take (issue 33)
+
+
+def limited(memory_gb: float = MEMORY_GB):
+    """A preexec_fn: the child's address space bounded (a read without bound then fails in
+    the child, never fills the machine) and SIGINT at its default (a shell that runs the
+    tests in the background ignores it for its children)."""
+    import resource
+    import signal
+
+    def setup() -> None:
+        limit = int(memory_gb * 2**30)
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    return setup
+
+
+def mechbook(*args, cwd: Path | None = None, timeout: float = 300, env: dict | None = None,
+             memory_gb: float = MEMORY_GB, stdin=subprocess.DEVNULL):
+    """A real `mechbook` process (this checkout's), its memory bounded: CompletedProcess
+    (text); subprocess.TimeoutExpired if it runs past `timeout` (a hang)."""
+    import sys
+
+    full = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]), **(env or {}))
+    return subprocess.run([sys.executable, "-m", "mechbook", *[str(a) for a in args]],
+                          cwd=cwd, capture_output=True, text=True, timeout=timeout, env=full,
+                          preexec_fn=limited(memory_gb), stdin=stdin)

@@ -170,3 +170,58 @@ def test_the_options_kind_reports_an_unbounded_option(monkeypatch):
     param = next(p for p in main.commands["check"].params if "--timeout" in p.opts)
     monkeypatch.setattr(param, "type", click.FLOAT)
     assert faults.run_options(spec)[0] == "unsafe"
+
+
+# ---- the kinds of issue 33 can fail ------------------------------------------------------------
+def test_the_restore_kind_reports_a_write_outside_the_tree(tmp_path, monkeypatch):
+    """A restore that takes a side file's store on trust (as 0834a76 did) writes where the
+    file says: 'outside'."""
+    import fuzz_surfaces as surfaces
+
+    from mechbook.app import restore
+
+    spec = {"lines": 1, "seed": 7, "special": None, "store": "absolute-outside",
+            "mutate": "none"}
+    (tmp_path / "case-1").mkdir()
+    assert surfaces.run_restore(tmp_path / "case-1", spec)[0] == "refused"
+    monkeypatch.setattr(restore, "_target", lambda named, store, base: named)
+    (tmp_path / "case-2").mkdir()
+    status, message = surfaces.run_restore(tmp_path / "case-2", spec)
+    assert status == "outside" and "absolute.h5" in message
+
+
+def test_the_init_kind_reports_a_write_through_a_link(tmp_path, monkeypatch):
+    """Files written by following what is there (0834a76's init): 'outside'."""
+    import fuzz_surfaces as surfaces
+
+    from mechbook.app import init
+
+    spec = {"plant": "linked-folder", "seed": 1, "name": "tree"}
+    (tmp_path / "case-1").mkdir()
+    assert surfaces.run_init(tmp_path / "case-1", spec)[0] == "refused"
+
+    def naive(target):
+        for dest in init.FILES.values():
+            path = target / dest
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text("x")
+        return []
+
+    monkeypatch.setattr(init, "init_tree", naive)
+    (tmp_path / "case-2").mkdir()
+    assert surfaces.run_init(tmp_path / "case-2", spec)[0] == "outside"
+
+
+def test_the_hdf5_kind_reports_a_leak_through_an_external_link(tmp_path, monkeypatch):
+    """A store whose links are followed (as on 0834a76) reads a file outside it: 'leak'."""
+    import fuzz_surfaces as surfaces
+
+    from mechbook.app import store_bounds, store_read
+
+    spec = {"fault": "external", "records": 1, "seed": 4}
+    (tmp_path / "case-1").mkdir()
+    assert surfaces.run_hdf5(tmp_path / "case-1", spec)[0] == "ok"  # moved aside, rebuilt
+    for module in (store_bounds, store_read):
+        monkeypatch.setattr(module, "member", lambda group, name: group[name])
+    (tmp_path / "case-2").mkdir()
+    assert surfaces.run_hdf5(tmp_path / "case-2", spec)[0] == "leak"

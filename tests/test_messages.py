@@ -45,10 +45,37 @@ def test_a_system_that_is_not_physical_is_refused_with_the_reason(tmp_path, old,
     assert not (tmp_path / "s.h5").exists()  # refused whole: nothing stored
 
 
-def test_massless_parts_held_by_constraints_and_statics_stay_valid():
+BOB = "particles:\n  bob:\n    mass: {mass}\n    position: [l*sin(theta), -l*cos(theta)]\n"
+SINGULAR = [  # issue 33: accepted by validate on 0834a76, then "array must not contain infs"
+    ("kinetic: 0\npotential: -m*g*l*cos(theta)\n", "kinetic: the system is not physical: "
+     "its kinetic energy is zero"),
+    ("kinetic: 0*thetadot\npotential: -m*g*l*cos(theta)\n", "its kinetic energy is zero"),
+    ("particles:\n  bob:\n    mass: m\n    position: [l, 0]\npotential: m*g*l*theta**2\n",
+     "coordinates: the system is not physical: its kinetic energy is zero"),
+    ("kinetic: m*l**4*thetadot**4\npotential: -m*g*l*cos(theta)\n",
+     "theta carries no inertia (the kinetic energy has no part quadratic in its velocity"),
+]
+
+
+@pytest.mark.parametrize("system, message", SINGULAR)
+def test_a_system_without_inertia_is_refused_by_validate_and_check(tmp_path, system, message):
+    base = pendulum_tree(tmp_path)
+    path = base / "problems" / "lim" / "2101.yaml"
+    text = path.read_text().replace(BOB.format(mass="m"), system).replace("gravity: {}\n", "")
+    path.write_text(text)
+    result = run("validate", path)
+    assert result.exit_code == 1, result.output
+    assert f"{path}:" in result.stderr and message in result.stderr, result.stderr
+    checked = check(base, "--store", tmp_path / "s.h5")
+    assert checked.exit_code == 1 and message in checked.stdout, checked.output
+    assert "infs or NaNs" not in checked.output and "Traceback" not in checked.output
+    assert not (tmp_path / "s.h5").exists()
+
+
+def test_massless_parts_held_by_constraints_stay_valid():
     """Symon 9-8's massless pulleys are held by strings (constraints): the mass matrix is
-    positive definite along what the constraints allow; a potential-only system has no
-    mass matrix. Every committed problem validates (tests/test_cli.py)."""
+    positive definite along what the constraints allow. Every committed problem validates
+    (tests/test_cli.py)."""
     for rel in ("problems/symon/09-08.yaml", "problems/lim/2031.yaml"):
         assert run("validate", ROOT / rel).exit_code == 0
 

@@ -205,3 +205,34 @@ def test_a_model_where_symengine_leaves_a_derivative_is_built_by_sympy(tmp_path)
                    step=1e-3)
     assert sim.trajectory.success and sim.trajectory.q.shape[1] > 100
     assert np.max(np.abs(sim.trajectory.q[0])) <= 0.5 + 1e-3  # energy kept: never far out
+
+
+# ---- issue 33: hostile numbers on the command line end in a message that names them ------
+@pytest.mark.parametrize("args, message", [
+    (["--method", "RK4", "--step", "1e-300"], "1e+301 steps (at most 1e+10)"),
+    (["--method", "RK4", "--t-end", "5e-324"], "too short to divide into steps"),
+    (["--param", "m=nan"], "--param m=nan: unknown name 'nan'"),
+    (["--param", "m=1e308"], "--param m=1e308: number 1e308 out of range"),
+    (["--init", "theta=1e308"], "--init theta=1e308: number 1e308 out of range"),
+    (["--init", "thetadot=("], "--init thetadot=(: syntax error"),
+])
+def test_hostile_simulate_options_are_refused_by_name(args, message):
+    """On 0834a76: OverflowError (a C long of 1e301 steps), and --param/--init values blamed
+    on problems/lim/2031.yaml:1."""
+    from hostile import run
+
+    res = run("--root", ROOT, "simulate", "lim-2031", "--no-store", *args)
+    assert res.exit_code == 1, res.output
+    assert message in res.output, res.output
+    assert "2031.yaml:1" not in res.output and "Error: simulate lim-2031: " not in res.output
+
+
+@pytest.mark.parametrize("t_end", ["1e-300", "1e-200", "5e-324"])
+def test_a_tiny_span_simulates_and_its_drift_rate_is_a_number(t_end):
+    """--t-end 1e-300 ended in "LinAlgError: SVD did not converge" (the drift's fit in
+    time squared underflowed)."""
+    from hostile import run
+
+    res = run("--root", ROOT, "simulate", "lim-2031", "--no-store", "--t-end", t_end)
+    assert res.exit_code == 0, res.output
+    assert "drift of energy_function" in res.output and "LinAlg" not in res.output

@@ -24,7 +24,7 @@ from hostile import ROOT, can_mount, check, pendulum_tree, run, tmpfs
 import mechbook.app.outputs as outputs
 import mechbook.app.store as store
 import mechbook.app.unsaved as unsaved
-from mechbook.app.unsaved import restore
+from mechbook.app.restore import restore
 
 
 def _side_file(text: str) -> Path:

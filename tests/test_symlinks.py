@@ -95,3 +95,21 @@ def test_a_linked_book_folder_that_leaves_the_tree_is_refused(tmp_path):
     result = check(base, "--no-store")
     assert result.exit_code == 1
     assert "outside" in result.output and "must stay inside the tree" in result.output
+
+
+def test_books_yaml_linked_from_outside_the_tree_is_refused(tmp_path):
+    """Issue 33 (found by the fuzzer's watch kind): books.yaml as a link to a file outside
+    the tree was read, and its text shown in the error. It is held to the rule of problem
+    files: read only from inside the tree."""
+    base = pendulum_tree(tmp_path / "tree")
+    outside = tmp_path / "outside.yaml"
+    outside.write_text(f"{SECRET}\n")
+    (base / "books.yaml").unlink()
+    (base / "books.yaml").symlink_to(outside)
+    res = run("--root", base, "list")
+    assert res.exit_code == 1
+    assert "outside the tree" in res.output and SECRET not in res.output
+    (base / "books.yaml").unlink()
+    (base / "books.yaml").symlink_to(tmp_path / "nowhere.yaml")
+    res = run("--root", base, "check", "--serial", "lim-2101", "--no-store")
+    assert res.exit_code == 1 and "leads nowhere" in res.output

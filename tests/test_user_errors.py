@@ -100,6 +100,7 @@ def _store(tmp_path, *groups: str):
 
     path = tmp_path / "s.h5"
     with h5py.File(path, "w") as f:
+        f.attrs["format"] = 1  # what every mechbook store holds
         for g in groups:
             f.create_group(g)
     return path

@@ -119,3 +119,107 @@ def test_watch_names_a_missing_problem(tmp_path):
     assert result.returncode == 1
     assert "no problem" in result.stderr or "2099" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+# ---- issue 33: what an editor or a user can leave behind, and the limits of `check` ------
+def _watch(tree: Path, *args: str):
+    """A real `mechbook watch`, its address space bounded to 2 GB (a read without bound
+    then fails in it instead of filling the machine), its lines read on a thread."""
+    from hostile import limited
+
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, "-m", "mechbook", "--root", str(tree), "watch",
+                             *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, env=env, preexec_fn=limited())
+    lines: queue.Queue = queue.Queue()
+    threading.Thread(target=_reader, args=(proc, lines), daemon=True).start()
+    return proc, lines
+
+
+def _stop(proc) -> None:
+    proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
+@pytest.mark.slow
+def test_watch_survives_special_files_and_links_in_place_of_its_files(tmp_path):
+    """On 0834a76 a FIFO in place of the problem file blocked the watch for ever (later
+    saves were missed) and a link to /dev/zero was read until memory ran out; a FIFO or
+    /dev/zero as books.yaml the same. Each is now noticed, said, and the watch goes on."""
+    tree = _tree(tmp_path)
+    problem = tree / "problems" / "lim" / "2031.yaml"
+    good = problem.read_bytes()
+    books = tree / "books.yaml"
+    books_text = books.read_bytes()
+    proc, lines = _watch(tree, "lim-2031", "--no-crosscheck")
+    seen: list[str] = []
+
+    def replace(path: Path, how: str) -> None:
+        path.unlink()
+        if how == "fifo":
+            os.mkfifo(path)
+        elif how == "devzero":
+            path.symlink_to("/dev/zero")
+        elif how == "large":
+            path.write_bytes(b"# " + b"x" * 300_000 + b"\n")
+        else:
+            path.write_bytes(how)
+
+    try:
+        assert "6 pass" in _until(lines, r"lim-2031: .*checked in", seen)
+        _until(lines, "waiting for a change", seen)
+        for path, how, said in [(problem, "fifo", "not a regular file"),
+                                (problem, "devzero", "/dev/zero"),
+                                (problem, "large", "file too large"),
+                                (books, "fifo", "not a regular file"),
+                                (books, "devzero", "read only from inside the tree")]:
+            replace(path, how)
+            line = _until(lines, r"^lim-2031: ", seen, timeout=60)
+            assert said in line, (how, line)
+            _until(lines, "waiting for a change", seen, timeout=60)
+            replace(path, good if path == problem else books_text)
+            assert "6 pass" in _until(lines, r"lim-2031: .*checked in", seen, timeout=60)
+            _until(lines, "waiting for a change", seen, timeout=60)
+    finally:
+        _stop(proc)
+    assert proc.returncode == 0
+    assert not any("Traceback" in s or "MemoryError" in s for s in seen)
+
+
+def _bomb_tree(tmp: Path) -> Path:
+    """The starter tree whose problem's potential, (r + theta + m + k + l0 + g)**64, makes
+    the check of its Lagrangian expand it: gigabytes within a minute."""
+    subprocess.run([sys.executable, "-m", "mechbook", "init", str(tmp / "tree")], check=True,
+                   capture_output=True)
+    path = tmp / "tree" / "problems" / "mybook" / "1.1.yaml"
+    text = path.read_text("utf-8").split("springs:")[0]
+    path.write_text(text + 'potential: "(r + theta + m + k + l0 + g)**64"\n', "utf-8")
+    return tmp / "tree"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("limit, said", [(["--memory", "700"], "exceeded the memory bound of "
+                                                               "700 MB while in stage"),
+                                         (["--timeout", "5", "--memory", "0"],
+                                          "exceeded the time limit of 5 s while in stage")])
+def test_watch_checks_under_the_limits_of_check(tmp_path, limit, said):
+    """On 0834a76 watch had a CPU limit only, no memory bound: this 400-byte problem grew
+    to gigabytes and ended in "MemoryError: " with no reason. Each check now runs in a
+    worker under check's --timeout and --memory, stopped from outside, and the watch goes
+    on."""
+    tree = _bomb_tree(tmp_path)
+    proc, lines = _watch(tree, "mybook-1.1", "--no-crosscheck", *limit)
+    seen: list[str] = []
+    try:
+        line = _until(lines, r"^mybook-1.1: ", seen, timeout=240)
+        assert said in line, line
+        _until(lines, "waiting for a change", seen, timeout=60)
+    finally:
+        _stop(proc)
+    assert proc.returncode == 0
+    assert "stopped watching" in "\n".join(seen + [ln for ln in iter(lambda: lines.get(
+        timeout=10), None)])

@@ -26,8 +26,10 @@ import importlib
 import math
 import multiprocessing as mp
 import os
+import signal
 import time
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
@@ -83,6 +85,9 @@ def _worker(conn: Connection, base: Path, options: Any, task: Task, run_pid: int
     from mechbook.app.lifeline import die_with
     from mechbook.app.quiet import install
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
+    for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
+        signal.signal(ends, signal.SIG_DFL)
     die_with(run_pid)
     install()  # a stray warning or unraisable exception: the debug log, not the terminal
     settle()
@@ -124,10 +129,66 @@ GC_THRESHOLDS = (10_000, 20, 100)  # young collections ~14 times rarer than Pyth
 
 
 def _context():
+    from mechbook.app.lifeline import sweep_stale_folders
+
+    sweep_stale_folders()  # what runs killed with their fork server left
     ctx = mp.get_context("forkserver")
-    # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap
-    ctx.set_forkserver_preload([*PRELOAD, "mechbook.app.frozen"])
+    # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap;
+    # mechbook.app.forkstart first: the server ignores Ctrl-C and removes its socket's
+    # folder when it ends (even after its run was killed)
+    ctx.set_forkserver_preload(["mechbook.app.forkstart", *PRELOAD, "mechbook.app.frozen"])
     return ctx
+
+
+@contextmanager
+def deferred_interrupt() -> Iterator[None]:
+    """Ctrl-C held back until the block ends (then raised): for the moments a process is
+    being started, when an interrupt would leave one started but not yet recorded, to run
+    on without its run or fail on the terminal."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: pending.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
+    if pending:
+        raise KeyboardInterrupt
+
+
+def kill_pool(pool) -> None:
+    """Stop a concurrent.futures process pool at once: its workers killed, its queue dropped
+    (shutdown alone would wait for every task queued; its workers ignore Ctrl-C)."""
+    kill = getattr(pool, "kill_workers", None)  # Python 3.14
+    if kill is not None:
+        kill()
+    else:
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+
+
+def start_server() -> None:
+    """Start the fork server (and multiprocessing's resource tracker) if it is not running,
+    with SIGINT ignored from the new processes' first instruction: a signal's disposition
+    SIG_IGN survives exec, so a Ctrl-C while their interpreters start up (before
+    mechbook.app.forkstart is imported) cannot kill them with a "Fatal Python error" on
+    the terminal. This process ignores SIGINT only for the instant of the spawn."""
+    import threading
+    from multiprocessing import forkserver
+
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
 
 
 def settle(preload: bool = False) -> None:
@@ -147,6 +208,17 @@ def settle(preload: bool = False) -> None:
         gc.collect()  # garbage now would be frozen with the rest, never to be collected
         gc.freeze()
     gc.set_threshold(*GC_THRESHOLDS)
+
+
+def _cannot_start(exc: OSError) -> str:
+    """Why worker processes could not be started, and what to do."""
+    import tempfile
+
+    why = exc.strerror or str(exc)
+    return (f"cannot start worker processes ({why}): their fork server needs a socket in "
+            f"the temporary directory {tempfile.gettempdir()}, which must exist, be writable "
+            "and have a short path (a socket's path is at most 107 bytes): set TMPDIR to "
+            "one, or use --serial")
 
 
 def _rss_mb(os_pid: int) -> float:
@@ -173,14 +245,37 @@ class Batch:
         self.failed = failed
         self._ctx = _context()
         self._slots: list[_Slot] = []
+        self._kept = False  # inside `with`: idle workers stay for the next run
+
+    def __enter__(self) -> Batch:
+        """Keep the workers between runs (`mechbook watch`: each save is checked by a
+        worker that has checked before); they are retired when the block ends."""
+        self._kept = True
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._kept = False
+        self._retire_all()
+
+    def _retire_all(self) -> None:
+        for slot in self._slots:
+            self._retire(slot, kill=slot.pid is not None)
+        self._slots = []
 
     def _spawn(self) -> _Slot:
         parent, child = self._ctx.Pipe()
         proc = self._ctx.Process(target=_worker, daemon=True,
                                  args=(child, self.base, self.options.run, self.task,
                                        os.getpid()))
-        proc.start()
-        child.close()
+        try:
+            start_server()
+            with deferred_interrupt():  # started and recorded, or not started at all
+                proc.start()
+        except OSError as exc:  # the fork server's socket cannot be made or reached
+            parent.close()
+            raise MechbookError(_cannot_start(exc)) from None
+        finally:
+            child.close()
         return _Slot(proc, parent)
 
     def _retire(self, slot: _Slot, kill: bool = False) -> None:
@@ -204,15 +299,17 @@ class Batch:
             return self._serial(ids)
         todo = list(ids)
         done: dict[Hashable, Any] = {}
+        finished = False
         try:
-            self._slots = [self._spawn() for _ in range(min(self.options.workers, len(todo)))]
+            want = min(self.options.workers, len(todo))
+            self._slots += [self._spawn() for _ in range(want - len(self._slots))]
             while len(done) < len(ids):
                 self._assign(todo)
                 self._collect(done)
+            finished = True
         finally:
-            for slot in self._slots:
-                self._retire(slot, kill=slot.pid is not None)
-            self._slots = []
+            if not (finished and self._kept):
+                self._retire_all()
         return [done[pid] for pid in ids]
 
     def _serial(self, ids: list[Hashable]) -> list[Any]:

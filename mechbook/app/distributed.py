@@ -59,6 +59,20 @@ def tree_files(pid: str, base: Path) -> dict[str, bytes]:
 
 
 _TREES: dict[str, Path] = {}  # per worker process: content hash -> scratch tree
+# where the scratch trees go: the temporary directory on a Dask worker; in a local pool's
+# worker, the run's own multiprocessing folder (set by `use_scratch`), which goes with the
+# run even when it is killed (mechbook.app.lifeline): a pool's workers end by os._exit,
+# and their atexit never runs
+SCRATCH: str | None = None
+
+
+def use_scratch(run_pid: int, folder: str) -> None:
+    """A local pool worker's initializer: die with the run, keep scratch trees in `folder`."""
+    from mechbook.app.lifeline import die_with
+
+    global SCRATCH
+    die_with(run_pid)
+    SCRATCH = folder
 
 
 def materialize(files: dict[str, bytes]) -> Path:
@@ -68,7 +82,7 @@ def materialize(files: dict[str, bytes]) -> Path:
         digest.update(name.encode() + b"\0" + files[name] + b"\0")
     key = digest.hexdigest()
     if key not in _TREES or not _TREES[key].exists():
-        base = Path(tempfile.mkdtemp(prefix="mechbook-tree-"))
+        base = Path(tempfile.mkdtemp(prefix="mechbook-tree-", dir=SCRATCH))
         atexit.register(shutil.rmtree, base, True)  # removed when the worker exits
         (base / "problems").mkdir()
         for name, data in files.items():
@@ -179,9 +193,10 @@ class Sidecar:
         self._conn: Connection | None = None
 
     def _start(self) -> None:
-        from mechbook.app.batch import _context
+        from mechbook.app.batch import _context, start_server
 
         ctx = _context()
+        start_server()
         parent, child = ctx.Pipe()
         self._proc = ctx.Process(target=_sidecar_loop, args=(child,), daemon=True)
         self._proc.start()

@@ -114,7 +114,7 @@ def _tracebacks(into: list[str]) -> Iterator[None]:
 
 def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: Stage,
            start: float, loaded: Problem | None = None) -> None:
-    from mechbook.app.validate import build_systems, part_faults
+    from mechbook.app.validate import validated_parts
     from mechbook.crosscheck import crosscheck_problem
     from mechbook.engine.analysis import (
         Analysis,  # the engine: imported only where a problem is checked
@@ -136,8 +136,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
                                 f"file is {problem.id!r}")
         analysis = Analysis(problem)
         stage("validating")  # a malformed file is refused whole: nothing is stored for it
-        build_systems(problem)
-        faults = part_faults(key, analysis)
+        faults = validated_parts(problem, key, analysis, apath)  # under validate's limit
         if faults:  # each malformed part says where; the others are not checked
             run.outcomes = [Outcome(problem.id, p.name, p.quantity, p.data["cite"], Status.ERROR,
                                     detail=faults[p.name], origin=p.data.get("origin", "book"))

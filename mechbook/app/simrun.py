@@ -58,7 +58,7 @@ class SimReport:
 
 def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -> SimReport:
     """The batch task: load, derive, integrate, (plot); errors become report.error."""
-    from mechbook.app.validate import build_systems
+    from mechbook.app.validate import build_limit, build_systems
     from mechbook.core.compile import DEFAULT_BACKEND
     from mechbook.engine.analysis import Analysis
     from mechbook.model.catalog import problem_path
@@ -71,7 +71,8 @@ def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -
         problem = load_problem(problem_path(request.problem_id, base))
         report.problem_id = problem.id
         stage("validating")
-        build_systems(problem)  # a system that is not physical is refused with the reason
+        with build_limit(problem.doc.file):  # validate's limit, and its message
+            build_systems(problem)  # a system that is not physical is refused with the reason
         analysis = Analysis(problem)
         stage("deriving and integrating")
         sim = simulate(analysis, request.system, init=parse_assignments(request.init),

@@ -35,7 +35,8 @@ it is moved aside to `<name>.damaged-<time>`, rebuilt from every problem, simula
 sweep that can still be read whole, and a warning says what was kept and what was lost.
 Readers (`show`, `report`) raise StoreError naming what is damaged.
 
-The modules beside this one: store_read (reading, StoreError), store_cache (the warm-run
+The modules beside this one: store_read (reading, StoreError), store_check (records read
+whole and checked, `damage`), store_bounds (every read bounded), store_cache (the warm-run
 cache and durations), store_repair (rebuilding a damaged file). Their public names are
 importable from here too.
 """
@@ -60,8 +61,10 @@ import numpy as np
 
 from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
+from mechbook.app.store_bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
 from mechbook.app.store_cache import Cached, cached, durations  # noqa: F401 - re-exported
 from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's readers
+    FORMAT,
     StoreError,
     _opened,
     _reason,
@@ -69,6 +72,7 @@ from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's r
     problems,
     read,
     read_simulation,
+    refusal,
 )
 from mechbook.app.store_repair import _salvage
 from mechbook.app.text import storable
@@ -81,7 +85,6 @@ if TYPE_CHECKING:
     from mechbook.model.problem import Problem
 
 DEFAULT_PATH = DEFAULT_STORE
-FORMAT = 1
 _STR = h5py.string_dtype("utf-8")
 log = logging.getLogger("mechbook.store")
 DAMAGED = ".damaged-"  # a damaged store is moved aside to <name>.damaged-<UTC time>
@@ -175,10 +178,26 @@ def _signature(path: Path) -> tuple:
     return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
 
 
+def _foreign(path: Path) -> str | None:
+    """Why the file at `path` is not a store this mechbook may write (HDF5 made by
+    something else, a newer store format), or None (a store of ours, or not HDF5 at all:
+    then it is damage, judged by `damage`)."""
+    try:
+        f = h5py.File(path, "r")
+    except Exception:  # noqa: BLE001 - not readable as HDF5: damage
+        return None
+    with f:
+        return refusal(f)
+
+
 def _ensure_sound(path: Path, shown: Path) -> None:
-    """Before an edit: a damaged store is moved aside and rebuilt from what still reads."""
+    """Before an edit: a damaged store is moved aside and rebuilt from what still reads; a
+    file that is not a store of this mechbook's format is refused (StoreError), whole."""
     if _SOUND.get(str(path)) == _signature(path):
         return
+    foreign = _foreign(path)
+    if foreign is not None:
+        raise StoreError(shown, foreign)
     why = damage(path)
     if why is None:
         _SOUND[str(path)] = _signature(path)
@@ -209,7 +228,7 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     if kept in root:
         root.move(kept, f"{pid}/simulations")
     g.attrs.update({
-        "title": storable(rec.title), "source": storable(rec.source),
+        "title": _text(rec.title), "source": _text(rec.source),
         "problem_sha256": rec.problem_sha256, "answers_sha256": rec.answers_sha256,
         "engine_sha256": engine_sha256(), "mechbook": __version__,
         "sympy": version("sympy"), "numpy": np.__version__, "h5py": h5py.__version__,
@@ -219,18 +238,18 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     for res in rec.results:
         s = g.require_group("systems").create_group(res.system, track_order=True)
         for key, text in res.text.items():
-            s.create_dataset(f"symbolic/{key}", data=storable(text), dtype=_STR)
+            s.create_dataset(f"symbolic/{key}", data=_text(text, MAX_TEXT_BYTES), dtype=_STR)
         for key, arr in res.arrays.items():
             s.create_dataset(f"numeric/{key}", data=np.asarray(arr, dtype=float))
         for key, text in res.notes.items():
-            s.create_dataset(f"notes/{key}", data=storable(text), dtype=_STR)
+            s.create_dataset(f"notes/{key}", data=_text(text, MAX_TEXT_BYTES), dtype=_STR)
     checks = g.create_group("checks")
     for i, o in enumerate(rec.outcomes):
         c = checks.create_group(o.part)
         c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
-                        "cite": storable(o.cite), "status": str(o.status),
-                        "method": storable(o.method), "detail": storable(o.detail),
-                        "seconds": float(o.seconds), "power": storable(o.power)})
+                        "cite": _text(o.cite), "status": str(o.status),
+                        "method": _text(o.method), "detail": _text(o.detail),
+                        "seconds": float(o.seconds), "power": _text(o.power)})
     if rec.crosschecks:
         cross = g.create_group("crosschecks", track_order=True)
         for i, x in enumerate(rec.crosschecks):
@@ -301,9 +320,24 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        return storable(v)
+        return _text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    return json.dumps(v)
+    return _text(json.dumps(v), cut=False)
+
+
+def _text(text: str, limit: int = MAX_ATTRIBUTE_BYTES, cut: bool = True) -> str:
+    """`text` as the store holds it (mechbook.app.text.storable) and as its readers will
+    read it back: no longer than their bound (mechbook.app.store_bounds), cut with a note
+    if it is longer (a title or an error's detail of megabytes), or, for JSON that cutting
+    would break (`cut` False), a ValueError."""
+    text = storable(str(text))
+    if len(text) * 4 <= limit or len(text.encode("utf-8")) <= limit:
+        return text
+    if not cut:  # a ValueError inside an edit: the write's StoreError, naming the store
+        raise ValueError(f"a value of {len(text)} characters is more than the store reads "
+                         f"back ({limit} bytes)")
+    keep = limit // 4 - 100
+    return f"{text[:keep]} [... {len(text) - keep} more characters not stored]"
 
 

@@ -12,7 +12,9 @@ from pathlib import Path
 import h5py
 
 from mechbook.app.fingerprint import engine_sha256
-from mechbook.app.store_read import DEFAULT_PATH, _crosschecks, _member, _plain, _reason
+from mechbook.app.store_bounds import attribute, attributes, member
+from mechbook.app.store_check import _crosschecks, _member, _plain, _reason, refusal
+from mechbook.app.store_read import DEFAULT_PATH
 from mechbook.records import CrossCheck, Outcome
 
 log = logging.getLogger("mechbook.store")
@@ -41,6 +43,8 @@ def cached(wanted: dict[str, tuple[str, str]], path: str | Path = DEFAULT_PATH,
     engine = engine_sha256()
     try:
         with h5py.File(path, "r") as f:
+            if refusal(f) is not None:  # not a store of ours: no hits (its write is refused)
+                return {}
             root = _member(f, "problems")
             for pid, shas in wanted.items():
                 try:
@@ -61,8 +65,8 @@ def _cached_one(root, pid: str, shas: tuple[str, str], engine: str,
                 crosschecks: bool) -> Cached | None:
     if pid not in root:
         return None
-    g = root[pid]
-    a = {k: _plain(v) for k, v in g.attrs.items()}
+    g = member(root, pid)
+    a = {k: _plain(v) for k, v in attributes(g).items()}
     if (a.get("problem_sha256"), a.get("answers_sha256"), a.get("engine_sha256")) != \
             (*shas, engine):
         return None
@@ -82,10 +86,14 @@ def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
     out = {}
     try:
         with h5py.File(path, "r") as f:
+            if refusal(f) is not None:
+                return out
             root = _member(f, "problems")
             for pid in root:
                 try:
-                    out[pid] = float(root[pid].attrs.get("duration_s", 0.0))
+                    g = member(root, pid)
+                    out[pid] = float(attribute(g, "duration_s")) if "duration_s" in g.attrs \
+                        else 0.0
                 except Exception:  # noqa: BLE001 - damaged: no duration known
                     continue
     except Exception:  # noqa: BLE001 - damaged store: no durations
@@ -98,7 +106,7 @@ def _outcomes(pid: str, g: h5py.Group) -> list[Outcome]:
     rows = []
     checks = _member(g, "checks")
     for part in checks:
-        a = {k: _plain(v) for k, v in checks[part].attrs.items()}
+        a = {k: _plain(v) for k, v in attributes(member(checks, part)).items()}
         rows.append((a.get("index", 0), Outcome(pid, part, **{k: a[k] for k in fields
                                                               if k in a})))
     return [o for _, o in sorted(rows, key=lambda r: r[0])]

@@ -1,5 +1,10 @@
 """Rebuilding a damaged store: every problem, sweep and top-level entry that still reads
 whole is copied into a new file (mechbook.app.store moves the damaged one aside first).
+
+"Reads whole" is judged as the readers judge it (mechbook.app.store_check.check_entry, within
+the bounds of mechbook.app.store_bounds), and the copy reads within the same bounds, so an
+entry the readers would call damaged is never copied, and copying never takes more memory
+than reading.
 """
 
 from __future__ import annotations
@@ -8,7 +13,14 @@ from pathlib import Path
 
 import h5py
 
-from mechbook.app.store_read import _SCALE_ATTRS, _decoded, _read_all, _walk
+from mechbook.app.store_bounds import _SCALE_ATTRS, attribute, dataset, member, new_budget, walk
+from mechbook.app.store_check import (
+    _decoded,
+    _member,
+    _read_problem,
+    _read_simulation,
+    check_entry,
+)
 
 
 def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
@@ -16,6 +28,7 @@ def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
     reads whole into `out`; ([kept], [lost]) by name."""
     kept: list[str] = []
     lost: list[str] = []
+    budget = new_budget()
     try:
         src = h5py.File(path, "r")
     except Exception:  # noqa: BLE001 - nothing readable at all: an empty store
@@ -27,21 +40,26 @@ def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
             return kept, ["the whole file"]
         for top in tops:
             try:
-                children = list(src[top].keys()) if isinstance(src[top], h5py.Group) else None
+                obj = member(src, top)
+                children = list(obj.keys()) if isinstance(obj, h5py.Group) and \
+                    top in ("problems", "sweeps") else None
             except Exception:  # noqa: BLE001
                 lost.append(f"/{top}")
                 continue
             for name in (children if children is not None else [None]):
                 where = f"/{top}/{name}" if name is not None else f"/{top}"
+                if top == "problems" and name is not None:
+                    _salvage_problem(src, out, name, budget, kept, lost)
+                    continue
                 try:
-                    obj = src[where]
-                    if isinstance(obj, h5py.Group):
-                        _read_all(obj)
-                        _copy_group(obj, out.require_group(top).create_group(
+                    entry = member(src[top], name) if name is not None else member(src, top)
+                    check_entry(top, name, entry, budget)
+                    if isinstance(entry, h5py.Group):
+                        _copy_group(entry, out.require_group(top).create_group(
                             name, track_order=True) if name is not None
                             else out.create_group(top, track_order=True))
                     else:
-                        _copy_dataset(obj, out.require_group(top) if name else out,
+                        _copy_dataset(entry, out.require_group(top) if name else out,
                                       name or top)
                     kept.append(where)
                 except Exception:  # noqa: BLE001 - that entry is damaged: left out
@@ -51,13 +69,52 @@ def _salvage(path: Path, out: h5py.File) -> tuple[list[str], list[str]]:
     return kept, lost
 
 
-def _copy_group(src: h5py.Group, dst: h5py.Group) -> None:
+def _salvage_problem(src: h5py.File, out: h5py.File, pid: str, budget: list[int],
+                     kept: list[str], lost: list[str]) -> None:
+    """A problem's record and each of its simulations, kept or lost apart: a damaged
+    simulation costs only itself, a damaged record not its simulations."""
+    where = f"/problems/{pid}"
+    try:
+        entry = member(member(src, "problems"), pid)
+        _read_problem(entry, budget)
+        dst = out.require_group("problems").create_group(pid, track_order=True)
+        _copy_group(entry, dst, skip=("simulations",))
+        kept.append(where)
+    except Exception:  # noqa: BLE001 - the record is damaged: left out
+        if where in out:
+            del out[where]
+        lost.append(where)
+        dst = None
+    try:
+        sims = _member(member(member(src, "problems"), pid), "simulations")
+        names = list(sims)
+    except Exception:  # noqa: BLE001 - no readable list of simulations
+        return
+    for name in names:
+        at = f"{where}/simulations/{name}"
+        try:
+            sim = member(sims, name)
+            _read_simulation(sim, budget)
+            if dst is None:  # the record is lost: its simulations stand alone
+                dst = out.require_group("problems").create_group(pid, track_order=True)
+            _copy_group(sim, dst.require_group("simulations").create_group(
+                name, track_order=True))
+            kept.append(at)
+        except Exception:  # noqa: BLE001
+            if at in out:
+                del out[at]
+            lost.append(at)
+
+
+def _copy_group(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = ()) -> None:
     """Copy a subtree between files as plain data (object references, which dimension
     scales are made of, do not survive a copy between files: the scales are re-attached by
-    their paths inside the subtree)."""
+    their paths inside the subtree); the members named in `skip` are left out."""
     dst.attrs.update(_raw_attrs(src))
     scales, links = [], []
-    for name, obj in _walk(src):
+    for name, obj in walk(src):
+        if name.split("/", 1)[0] in skip:
+            continue
         if isinstance(obj, h5py.Group):
             dst.create_group(name, track_order=True).attrs.update(_raw_attrs(obj))
             continue
@@ -75,10 +132,10 @@ def _copy_group(src: h5py.Group, dst: h5py.Group) -> None:
 
 
 def _copy_dataset(obj: h5py.Dataset, dst: h5py.Group, name: str) -> None:
-    d = dst.create_dataset(name, data=obj[()], dtype=obj.dtype,
+    d = dst.create_dataset(name, data=dataset(obj), dtype=obj.dtype,
                            compression=obj.compression)
     d.attrs.update(_raw_attrs(obj))
 
 
 def _raw_attrs(obj) -> dict:
-    return {k: obj.attrs[k] for k in obj.attrs if k not in _SCALE_ATTRS}
+    return {k: attribute(obj, k) for k in obj.attrs if k not in _SCALE_ATTRS}

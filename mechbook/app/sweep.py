@@ -333,17 +333,30 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
                         progress: Callable[[int, int], None]) -> dict:
     """Every block on a pool of `jobs` local processes (that die with this one)."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
+    from multiprocessing import util
 
-    from mechbook.app.batch import _context
-    from mechbook.app.lifeline import die_with
+    from mechbook.app.batch import _context, deferred_interrupt, kill_pool, start_server
+    from mechbook.app.distributed import use_scratch
 
     parts: dict[int, dict] = {}
-    with ProcessPoolExecutor(jobs, mp_context=_context(), initializer=die_with,
-                             initargs=(os.getpid(),)) as pool:
-        futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
+    context = _context()
+    start_server()
+    with deferred_interrupt():  # its workers are started as the blocks are submitted
+        pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=use_scratch,
+                                   initargs=(os.getpid(), util.get_temp_dir()))
+        try:
+            futures = {pool.submit(block_of, spec, a, b): a for a, b in ranges}
+        except BaseException:
+            kill_pool(pool)
+            raise
+    try:
         for fut in as_completed(futures):
             parts[futures[fut]] = fut.result()
             progress(len(parts), len(ranges))
+    except BaseException:  # Ctrl-C (the workers ignore it) or a block's error: stop now
+        kill_pool(pool)
+        raise
+    pool.shutdown()
     return parts
 
 

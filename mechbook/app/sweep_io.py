@@ -55,12 +55,14 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        from mechbook.app.text import storable
+        from mechbook.app.store import _text
 
-        return storable(v)
+        return _text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    return json.dumps(v, default=float)
+    from mechbook.app.store import _text
+
+    return _text(json.dumps(v, default=float), cut=False)
 
 
 def write_store(result, name: str, path: str | Path) -> Path:
@@ -93,6 +95,7 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
     """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; NotFoundError
     (also a KeyError) naming the problem's stored sweeps if it is absent, StoreError naming
     what is damaged."""
+    from mechbook.app.store_check import _read_sweep
     from mechbook.app.store_read import StoreError, _names, _opened, _reason, there
 
     with _opened(path) as f:
@@ -101,39 +104,33 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
         except KeyError:
             stored = there(name, _names(f, "sweeps", pid), "sweep")
             raise NotFoundError(f"no sweep {name!r} of {pid} in {path} ({stored})") from None
+        except Exception as exc:  # noqa: BLE001 - a damaged listing, described
+            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
+                             "read") from None
         try:
-            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
-            coords, vars_ = {}, {}
-            for key in g:
-                if g[key].is_scale:
-                    coords[key] = g[key][()]
-            for key in g:
-                d = g[key]
-                if not d.is_scale:
-                    dims = tuple(d.dims[i][0].name.rsplit("/", 1)[-1] for i in range(d.ndim))
-                    vars_[key] = (dims, d[()])
+            return _read_sweep(g)
         except Exception as exc:  # noqa: BLE001 - damage inside the sweep, described
             raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
                              "read") from None
-    return {"attrs": attrs, "coords": coords, "variables": vars_}
 
 
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
     """(name, one-line description) of a problem's stored sweeps (a damaged entry is one
     line that says so)."""
-    from mechbook.app.store_read import _reason
+    from mechbook.app.store_bounds import attributes, member
+    from mechbook.app.store_read import _reason, refusal
 
     out = []
     try:
         with h5py.File(path, "r") as f:
-            if "sweeps" not in f or pid not in f["sweeps"]:
+            if refusal(f) is not None or "sweeps" not in f or pid not in f["sweeps"]:
                 return out
-            group = f["sweeps"][pid]
+            group = member(member(f, "sweeps"), pid)
             for name in group:
                 try:
-                    g = group[name]
+                    g = member(group, name)
                     a = {k: (v.decode() if isinstance(v, bytes) else v)
-                         for k, v in g.attrs.items()}
+                         for k, v in attributes(g).items()}
                 except Exception as exc:  # noqa: BLE001 - one damaged entry, said so
                     out.append((name, f"damaged ({_reason(exc)})"))
                     continue

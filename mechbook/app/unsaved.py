@@ -23,10 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from mechbook.app.store import ProblemRecord, StoreError, write, write_simulation
+from mechbook.app.store import ProblemRecord, StoreError, write
 from mechbook.app.text import json_safe
-from mechbook.errors import MechbookError
-from mechbook.records import Outcome, Results
 
 FORMAT = 1
 
@@ -55,8 +53,9 @@ class SideFile:
 
     def keep(self, kind: str, payload: dict) -> Path | None:
         """Append one result; the side file's path, or None if no place would take it."""
-        line = json.dumps(json_safe({"format": FORMAT, "kind": kind, "store": str(self.store),
-                                     **payload}), default=_plain) + "\n"
+        line = json.dumps(json_safe({"format": FORMAT, "kind": kind,
+                                     "store": str(self.store.absolute()), **payload}),
+                          default=_plain) + "\n"
         places = [self.path.parent] if self.path is not None else _places(self.store)
         for place in places:
             path = self.path or place / (f"{self.store.name}.unsaved-"
@@ -123,47 +122,10 @@ class Saver:
         if self.side.path is not None:
             lines.append(f"error: the results of {self.side.count} problem(s) were not "
                          f"stored; they are kept in {self.side.path} (`mechbook restore "
-                         f"{self.side.path}` stores them once the cause is fixed)")
+                         f"{self.side.path} --store {self.store.absolute()}` stores them "
+                         "once the cause is fixed)")
         if self.lost:
             lines.append(f"error: the results of {', '.join(self.lost)} could not be kept "
                          "anywhere (" + "; ".join(self.side.failures) + "): check again "
                          "once the cause is fixed")
         return lines
-
-
-def restore(side: Path, store: Path | None = None) -> tuple[int, int]:
-    """Write the results kept in a side file into `store` (default: the store each was
-    meant for): (problems, simulations)."""
-    problems = simulations = 0
-    try:
-        lines = Path(side).read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MechbookError(f"cannot read {side}: {exc}") from None
-    for number, line in enumerate(lines, 1):
-        try:
-            entry = json.loads(line)
-            target = store or Path(entry["store"])
-            if entry.get("kind") == "problem":
-                write([_record(entry["record"])], target)
-                problems += 1
-            elif entry.get("kind") == "simulation":
-                write_simulation(entry["problem_id"], entry["name"],
-                                 {k: np.asarray(v, dtype=float)
-                                  for k, v in entry["arrays"].items()},
-                                 entry["attrs"], entry.get("array_attrs"), target)
-                simulations += 1
-            else:
-                raise ValueError(f"unknown kind {entry.get('kind')!r}")
-        except StoreError:
-            raise
-        except (ValueError, KeyError, TypeError) as exc:
-            raise MechbookError(f"{side}:{number}: not a kept result ({exc})") from None
-    return problems, simulations
-
-
-def _record(data: dict) -> ProblemRecord:
-    results = [Results(r["system"], r["text"], {k: np.asarray(v, dtype=float)
-                                                 for k, v in r["arrays"].items()}, r["notes"])
-               for r in data.get("results", [])]
-    outcomes = [Outcome(**o) for o in data.get("outcomes", [])]
-    return ProblemRecord(**{**data, "results": results, "outcomes": outcomes})

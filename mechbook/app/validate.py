@@ -9,6 +9,8 @@ well under a second.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -34,13 +36,8 @@ def validate_file(path: str | Path) -> str:
     if isinstance(doc.data, dict) and "parts" in doc.data:
         return _validate_answers(path)
     problem = load_problem(path)
-    try:
-        with hard_time_limit(BUILD_SECONDS):
-            build_systems(problem)
-    except Timeout:
-        raise SpecError(f"building the problem's systems took more than {BUILD_SECONDS:g} s "
-                        "of CPU time (the book's problems take under 1 s): an expression is "
-                        "too large or too deep for the engine", str(path)) from None
+    with build_limit(path):
+        build_systems(problem)
     decl = declared(problem)
     return (f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s), "
             f"{len(decl.vectors)} vector(s), {len(decl.tensors)} tensor(s), "
@@ -62,7 +59,7 @@ def _validate_answers(path: Path) -> str:
         raise key.doc.error(("problem",), str(exc)) from None
     try:
         problem = load_problem(ppath)
-        with hard_time_limit(BUILD_SECONDS):  # its problem's systems are built on the way
+        with build_limit(ppath, path):  # its problem's systems are built on the way
             check_expressions(key, Analysis(problem))
     except SpecError as exc:
         if exc.file is None or Path(exc.file).resolve() != ppath.resolve():
@@ -70,12 +67,44 @@ def _validate_answers(path: Path) -> str:
         err = SpecError(f"its problem file is invalid: {exc}", str(path))
         err.problem_file = str(ppath)  # the command line says so once per file
         raise err from None
-    except Timeout:
-        raise SpecError(f"checking the answer key's expressions (and building its problem "
-                        f"{ppath.name}) took more than {BUILD_SECONDS:g} s of CPU time (the "
-                        "book's take under 1 s): an expression is too large or too deep for "
-                        "the engine", str(path)) from None
     return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
+
+
+@contextmanager
+def build_limit(path: str | Path, key: str | Path | None = None) -> Iterator[None]:
+    """BUILD_SECONDS of CPU time for building a problem's systems (and parsing its answer
+    key's expressions, with `key`): past it, a SpecError naming the file."""
+    try:
+        with hard_time_limit(BUILD_SECONDS):
+            yield
+    except Timeout:
+        raise _too_slow(path, key) from None
+
+
+def _too_slow(path: str | Path, key: str | Path | None) -> SpecError:
+    if key is None:
+        return SpecError(f"building the problem's systems took more than {BUILD_SECONDS:g} s "
+                         "of CPU time (the book's problems take under 1 s): an expression is "
+                         "too large or too deep for the engine", str(path))
+    return SpecError(f"checking the answer key's expressions (and building its problem "
+                     f"{Path(path).name}) took more than {BUILD_SECONDS:g} s of CPU time (the "
+                     "book's take under 1 s): an expression is too large or too deep for the "
+                     "engine", str(key))
+
+
+def validated_parts(problem, key, analysis: Analysis, key_path: str | Path) -> dict[str, str]:
+    """What `mechbook check` validates before any part (every system built, every part's
+    expressions parsed: `part_faults`), under the limit `validate` has for the same work:
+    a problem that `validate` refuses in BUILD_SECONDS is refused by the check as soon, not
+    after its whole --timeout. SpecError (naming the file it was in) past the limit."""
+    blame: list = [problem.doc.file, None]
+    try:
+        with hard_time_limit(BUILD_SECONDS):
+            build_systems(problem)
+            blame[1] = key_path
+            return part_faults(key, analysis)
+    except Timeout:
+        raise _too_slow(*blame) from None
 
 
 def build_systems(problem) -> None:

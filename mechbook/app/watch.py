@@ -1,25 +1,35 @@
 """`mechbook watch ID`: check a problem again each time its files are saved.
 
 Writing a problem is a loop of edit, save, check. A fresh `mechbook check` process spends
-most of its second importing SymPy, SciPy and the engine; here they are imported once and
-the process stays, so a save is answered in about the time the check itself takes (a few
-tenths of a second for a problem with one degree of freedom). The problem file, its answer
-key and books.yaml are polled (their size, time and content hash: an editor's save that
-changes nothing is not a change); each check runs in this process under a CPU time limit,
-and its outcome is printed part by part, with the detail of every part that did not pass
-and the notes (warnings) of the run. Nothing is written to the store.
+most of its second importing SymPy, SciPy and the engine; here a worker process of the batch
+machinery (mechbook.app.batch), forked from a server that imported them once, checks every
+save and stays for the next one, so a save is answered in about the time the check itself
+takes (a few tenths of a second for a problem with one degree of freedom). Each check has
+the limits of `mechbook check`: a wall-clock time limit and a memory bound, enforced from
+outside (a check past either is stopped, said so with its stage, and a fresh worker waits
+for the next save).
+
+The problem file, its answer key and books.yaml are polled: their size, time and content
+hash (an editor's save that changes nothing is not a change). Only a regular file of at most
+the size a problem file may have is read; a FIFO, a device, a link to /dev/zero or an
+oversized file is noticed by its kind and size, never read, and the check then says what is
+wrong with it. Each outcome is printed part by part, with the detail of every part that did
+not pass and the notes (warnings) of the run. Nothing is written to the store.
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
 import resource
+import stat
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from mechbook.app.console import STATUS_ORDER
+from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.errors import MechbookError
 from mechbook.records import Status
 
@@ -34,21 +44,33 @@ def _cpu() -> float:
 @dataclass(frozen=True)
 class WatchOptions:
     crosscheck: bool = True
-    seconds: float = 120.0  # CPU time allowed per check
+    timeout: float = DEFAULT_TIMEOUT  # wall-clock seconds per check, as `mechbook check`
+    memory_mb: float = DEFAULT_MEMORY_MB  # resident memory per check (0: no bound)
     poll: float = POLL_SECONDS
     runs: int = 0  # stop after this many checks (0: until interrupted; for tests)
 
 
 def _signature(paths: list[Path]) -> tuple:
-    """What a change is: a file's size, time and content (a touch alone is not one)."""
+    """What a change is: a file's kind, size, time and content (a touch alone is not one).
+    Only a regular file of at most the size a problem file may have is read."""
+    from mechbook.app.bounded import Unreadable, read_regular
+    from mechbook.model.limits import MAX_FILE_BYTES
+
     out = []
     for path in paths:
         try:
             st = path.stat()
-            out.append((st.st_size, st.st_mtime_ns, hashlib.sha256(path.read_bytes())
-                        .hexdigest() if st.st_size < 1 << 20 else ""))
         except OSError:
             out.append(None)
+            continue
+        if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_FILE_BYTES:
+            out.append((st.st_size, st.st_mtime_ns, f"mode {st.st_mode:o}"))
+            continue
+        try:
+            digest = hashlib.sha256(read_regular(path, MAX_FILE_BYTES)).hexdigest()
+        except Unreadable as exc:
+            digest = exc.reason
+        out.append((st.st_size, st.st_mtime_ns, digest))
     return tuple(out)
 
 
@@ -59,12 +81,29 @@ def _changed(old: tuple, new: tuple) -> bool:
                for a, b in zip(old, new, strict=True))
 
 
-def report_lines(run, seconds: float, cpu: float) -> list[str]:
+def check_in_worker(pid: str, base: Path, options, stage) -> tuple:
+    """The batch task: one check (mechbook.app.run), and the CPU time it took here."""
+    from mechbook.app.run import run_problem
+
+    cpu = _cpu()
+    run = run_problem(pid, base, options, stage=stage)
+    return run, _cpu() - cpu
+
+
+def check_stopped(pid: str, why: str, seconds: float, stage: str) -> tuple:
+    """The batch's result for a check stopped from outside (a limit, a dead worker)."""
+    from mechbook.app.run import ProblemRun
+
+    return ProblemRun(pid, error=why, seconds=seconds, stage=stage), None
+
+
+def report_lines(run, seconds: float, cpu: float | None) -> list[str]:
     """The outcome of one check as lines: a summary, then each part that did not pass."""
     from collections import Counter
 
     if run.error:
-        return [f"{run.pid}: {run.error}", f"  ({seconds:.2f} s, CPU {cpu:.2f} s)"]
+        spent = f"{seconds:.2f} s" + (f", CPU {cpu:.2f} s" if cpu is not None else "")
+        return [f"{run.pid}: {run.error}", f"  ({spent})"]
     counts = Counter(o.status for o in run.outcomes)
     summary = ", ".join(f"{counts[s]} {s}" for s in STATUS_ORDER if counts[s]) or "no parts"
     lines = [f"{run.pid}: {summary}  (checked in {seconds:.2f} s, CPU {cpu:.2f} s)"]
@@ -83,55 +122,47 @@ def watch(pid: str, base: Path, say: Callable[[str], None],
           options: WatchOptions = WatchOptions()) -> int:
     """Check `pid` now and after every change of its files; returns the number of checks
     run (when `options.runs` stops it, or the user interrupts)."""
-    from mechbook.app.run import RunOptions, run_problem
-    from mechbook.core.timeout import Timeout, hard_time_limit
-    from mechbook.model.catalog import answer_path, problem_path
+    from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.app.run import RunOptions
+    from mechbook.model.ids import split_id
 
-    paths = [problem_path(pid, base), answer_path(pid, base), base / "books.yaml"]
+    book, number = split_id(pid)
+    paths = [base / "problems" / book / f"{number}.yaml",
+             base / "answers" / book / f"{number}.yaml", base / "books.yaml"]
     say(f"watching {', '.join(str(p.relative_to(base)) for p in paths[:2])} "
         "(Ctrl-C to stop)")
-    import mechbook.crosscheck  # noqa: F401 - the engine, once: every save is answered warm
-    import mechbook.verify.checker  # noqa: F401
-
+    limits = BatchOptions(jobs=1, timeout=options.timeout, memory_mb=options.memory_mb,
+                          run=RunOptions(crosscheck=options.crosscheck))
     last = None
     done = 0
-    stage = {"at": "loading"}
-
-    def reached(text: str) -> None:
-        stage["at"] = text
-
     try:
-        while True:
-            now = _signature(paths)
-            if not _changed(last, now):
-                time.sleep(options.poll)
-                continue
-            if last is not None:
-                names = [str(p.relative_to(base)) for p, a, b in zip(paths, last, now,
-                                                                      strict=True) if a != b]
-                say(f"\n{', '.join(names)} changed: checking {pid} again")
-            last = now
-            if now[0] is None:
-                say(f"{paths[0]}: no such file (yet)")
-                continue
-            start, cpu = time.perf_counter(), _cpu()
-            stage["at"] = "loading"
-            try:
-                with hard_time_limit(options.seconds):
-                    run = run_problem(pid, base, RunOptions(crosscheck=options.crosscheck),
-                                      stage=reached)
-            except Timeout:
-                say(f"{pid}: gave up after {options.seconds:g} s of CPU time in "
-                    f"{stage['at']}")
-            except MechbookError as exc:
-                say(f"{pid}: {exc}")
-            else:
-                for line in report_lines(run, time.perf_counter() - start, _cpu() - cpu):
-                    say(line)
-            done += 1
-            if options.runs and done >= options.runs:
-                return done
-            say("waiting for a change ...")
+        with Batch(base, limits, task=check_in_worker, failed=check_stopped) as batch:
+            while True:
+                now = _signature(paths)
+                if not _changed(last, now):
+                    time.sleep(options.poll)
+                    continue
+                if last is not None:
+                    names = [str(p.relative_to(base)) for p, a, b in zip(paths, last, now,
+                                                                          strict=True)
+                             if a != b]
+                    say(f"\n{', '.join(names)} changed: checking {pid} again")
+                last = now
+                if now[0] is None and not os.path.lexists(paths[0]):
+                    say(f"{paths[0]}: no such file (yet)")
+                    continue
+                start = time.perf_counter()
+                try:
+                    run, cpu = batch.run([pid])[0]
+                except MechbookError as exc:
+                    say(f"{pid}: {exc}")
+                else:
+                    for line in report_lines(run, time.perf_counter() - start, cpu):
+                        say(line)
+                done += 1
+                if options.runs and done >= options.runs:
+                    return done
+                say("waiting for a change ...")
     except KeyboardInterrupt:
         say("stopped watching")
     return done

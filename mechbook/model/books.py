@@ -9,12 +9,19 @@ an entry there and the files under problems/<book>/ and answers/<book>/; no code
 With books.yaml present, an id whose book it does not declare, or whose number does not look
 like that book's, is refused with the reason. A tree without books.yaml (a scratch tree in a
 test) accepts any well-formed id.
+
+`numbers` is written by whoever writes books.yaml, so it is matched by RE2 (google-re2), whose
+matching time is linear in the number's length whatever the pattern: a pattern such as
+`(a+)+b`, which makes Python's backtracking `re` run for minutes on a 36-letter number, is
+answered at once. RE2 refuses what cannot be matched that way (backreferences, lookaround)
+when books.yaml is read, with the line.
 """
 
 from __future__ import annotations
 
-import re
+import os
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 
 from mechbook.errors import MechbookError
@@ -37,7 +44,7 @@ class Book:
     doc: str = ""
 
     def matches(self, number: str) -> bool:
-        return re.fullmatch(self.numbers, number) is not None
+        return compiled(self.numbers).fullmatch(number) is not None
 
     @property
     def label(self) -> str:
@@ -46,6 +53,26 @@ class Book:
 
     def as_dict(self) -> dict:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+MAX_PATTERN_MEMORY = 8 * 2**20  # bytes RE2 may spend on one compiled pattern
+
+
+@cache
+def compiled(pattern: str):
+    """`pattern` compiled by RE2 (linear-time matching); ValueError saying why it cannot
+    be (a syntax error, a backreference or lookaround, a pattern too large)."""
+    import re2
+
+    options = re2.Options()
+    options.log_errors = False  # the message goes into the error, not to stderr
+    options.max_mem = MAX_PATTERN_MEMORY
+    try:
+        return re2.compile(pattern, options)
+    except re2.error as exc:
+        why = exc.args[0] if exc.args else exc
+        why = why.decode("utf-8", "replace") if isinstance(why, bytes) else str(why)
+        raise ValueError(why) from None
 
 
 _CACHE: dict[Path, tuple[tuple, dict[str, Book]]] = {}
@@ -57,7 +84,17 @@ def books(base: str | Path) -> dict[str, Book]:
     try:
         st = path.stat()
     except OSError:
+        if path.is_symlink():  # dangling or looping: not "no books.yaml"
+            raise MechbookError(f"{path}: a symbolic link that leads nowhere "
+                                f"({os.readlink(path)}): remove it or point it at a file "
+                                "inside the tree") from None
         return {}
+    if path.is_symlink():
+        top, real = os.path.realpath(base), os.path.realpath(path)
+        if os.path.commonpath([top, real]) != top:
+            raise MechbookError(f"{path}: a symbolic link to {real}, outside the tree {base}: "
+                                "books.yaml is read only from inside the tree (copy the file "
+                                "in)")
     stamp = (st.st_mtime_ns, st.st_size)
     hit = _CACHE.get(path)
     if hit is None or hit[0] != stamp:
@@ -79,9 +116,12 @@ def load_books(path: str | Path) -> dict[str, Book]:
         if entry["id"] in out:
             raise doc.error(where + ("id",), f"book {entry['id']!r} is declared twice")
         try:
-            re.compile(entry["numbers"])
-        except re.error as exc:
-            raise doc.error(where + ("numbers",), f"not a regular expression: {exc}") from None
+            compiled(entry["numbers"])
+        except ValueError as exc:
+            raise doc.error(where + ("numbers",), f"not a regular expression mechbook can "
+                            f"match ({exc}; backreferences and lookaround are not "
+                            "supported: matching must take time linear in the number's "
+                            "length)") from None
         book = Book(**entry)
         if not book.matches(book.example):
             raise doc.error(where + ("example",), f"example {book.example!r} does not match "

@@ -55,17 +55,24 @@ def fast_data(text: str, file: str, check_events) -> Any:
     if yaml is None or _ODD.search(text):
         return None
     try:
-        events = list(yaml.parse(text, Loader=_Loader))
-        if any(getattr(ev, "version", None) or getattr(ev, "tags", None) for ev in events):
-            return None  # a %YAML or %TAG directive: the round-trip parser's business
-        for ev in events:  # libyaml marks a plain scalar's style '', ruamel.yaml None
-            if getattr(ev, "style", None) == "":
-                ev.style = None
-        check_events(events, file)
+        check_events(_events(text), file)  # as they come: a limit stops the parser early
         node = yaml.compose(text, Loader=_Loader)
         return _plain(node)
     except (yaml.YAMLError, SpecError, _Unsure, RecursionError, ValueError, OverflowError):
         return None
+
+
+def _events(text: str):
+    """libyaml's events one by one, as ruamel.yaml would give them (a plain scalar's style
+    None, not ''): never the whole list first. libyaml takes time quadratic in the nesting
+    to parse a document to its end (120 KB of '[' took 45 s), while the limits refuse it at
+    its 33rd level, a few events in."""
+    for ev in yaml.parse(text, Loader=_Loader):
+        if getattr(ev, "version", None) or getattr(ev, "tags", None):
+            raise _Unsure("a %YAML or %TAG directive: the round-trip parser's business")
+        if getattr(ev, "style", None) == "":
+            ev.style = None
+        yield ev
 
 
 def _plain(node) -> Any:

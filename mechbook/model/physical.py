@@ -6,9 +6,11 @@ singular; the engine then fails deep inside (a Cholesky factorization, an eigens
 every part would report that instead of the cause. The file is refused when its system is
 built (`mechbook validate`, and before any part of `mechbook check`), with the reason and the
 line: each particle's and body's mass must be positive at the parameters' values, and the
-Hessian of the Lagrangian in the velocities (the mass matrix) must be positive definite at
-some of a few random points. A system whose Lagrangian holds no velocity at all (a statics
-problem: equilibria of a potential) has no mass matrix and is not judged.
+Hessian of the Lagrangian in the velocities (the mass matrix), taken at rest, must be positive
+definite at some of a few random points. A system with free coordinates whose Lagrangian holds
+no velocity at all (`kinetic: 0`, or particles whose positions lost their coordinates) has no
+inertia and is refused too; a kinetic energy that is not quadratic at rest (m*xdot**4) has a
+singular mass matrix there, which is what the engine linearizes with.
 """
 
 from __future__ import annotations
@@ -60,8 +62,15 @@ def _number(expr) -> float | None:
 def _mass_matrix(system, values: dict) -> None:
     lag = system.lagrangian
     qd = list(system.qd)
-    if not qd or not lag.has(*qd):
-        return  # no velocities: statics, nothing to judge
+    if not qd:
+        return  # no free coordinate: nothing moves, nothing to judge
+    if not lag.has(*qd):
+        where = ("kinetic",) if "kinetic" in system.spec else ("coordinates",)
+        raise system.problem.doc.error(
+            system.path + where,
+            "the system is not physical: its kinetic energy is zero (the Lagrangian holds no "
+            f"velocity of {', '.join(system.coord_names)}): every coordinate needs mass or "
+            "inertia, or make it a constraint or a driven coordinate")
     try:
         hess, jac, args = _derivatives(system)
     except Exception:  # noqa: BLE001 - SymEngine cannot take it: the engine judges later
@@ -69,18 +78,21 @@ def _mass_matrix(system, values: dict) -> None:
     rng = random.Random(SEED)
     known = {str(k): float(v) for k, v in values.items()}
     coords = {str(q) for q in system.q}
+    velocities = {str(v) for v in qd}
     domains = {str(q): d for q, d in getattr(system, "domains", {}).items()}
     seen = []
     for _ in range(POINTS):
         point = {a: known[a] if a in known else (domains[a].sample(rng, values) if a in domains
                                                  else rng.uniform(-2.5, 2.5)) if a in coords
                  else rng.uniform(0.3, 1.7) * rng.choice((1, -1)) for a in args}
-        try:
-            m, j = _at(hess, jac, args, point)
-        except (TypeError, ValueError, ZeroDivisionError, OverflowError, RuntimeError):
+        # the mass matrix at rest (the velocities 0) where it evaluates: what the engine
+        # linearizes with; a kinetic energy such as m*xdot**4 has none there
+        at = _evaluated(hess, jac, args, {a: 0.0 if a in velocities else v
+                                          for a, v in point.items()}) \
+            or _evaluated(hess, jac, args, point)
+        if at is None:
             continue
-        if not np.all(np.isfinite(m)) or not np.all(np.isfinite(j)):
-            continue
+        m, j = at
         full = m
         if j.size:  # the velocities the constraints allow: the null space of J
             _, sv, vt = np.linalg.svd(j)
@@ -119,6 +131,17 @@ def _derivatives(system) -> tuple[list, list, list[str]]:
     return hess, jac, sorted(args)
 
 
+def _evaluated(hess: list, jac: list, args: list[str], point: dict):
+    """(mass matrix, constraints' Jacobian) at `point` if every entry is finite, else None."""
+    try:
+        m, j = _at(hess, jac, args, point)
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError, RuntimeError):
+        return None
+    if not np.all(np.isfinite(m)) or not np.all(np.isfinite(j)):
+        return None
+    return m, j
+
+
 def _at(hess: list, jac: list, args: list[str], point: dict) -> tuple[np.ndarray, np.ndarray]:
     import symengine as se
 
@@ -137,9 +160,13 @@ def _refuse(system, seen: list, constrained: bool, drawn: list[str]) -> None:
                for _, f, _ in seen)]
     where = ", ".join(f"{a}={point[a]:.3g}" for a in drawn) or "every point"
     if zero:
-        why = (f"{', '.join(zero)} carr{'y' if len(zero) > 1 else 'ies'} no inertia (the "
-               "kinetic energy does not depend on its velocity): every coordinate needs mass "
-               "or inertia, or make it a constraint or a driven coordinate")
+        moving = [c for c, v in zip(system.coord_names, system.qd, strict=True)
+                  if c in zero and system.lagrangian.has(v)]
+        how = ("the kinetic energy has no part quadratic in its velocity, so none at rest"
+               if moving else "the kinetic energy does not depend on its velocity")
+        why = (f"{', '.join(zero)} carr{'y' if len(zero) > 1 else 'ies'} no inertia ({how}): "
+               "every coordinate needs mass or inertia, or make it a constraint or a driven "
+               "coordinate")
     elif eig[0] < 0:
         why = (f"the kinetic energy is not positive definite in the velocities (the mass "
                f"matrix has eigenvalue {eig[0]:.3g} at {where}): masses and moments of "

@@ -46,6 +46,8 @@ from mechbook.numerics.methods import (  # noqa: F401 - the names, re-exported
 )
 from mechbook.numerics.model import Model, structure
 
+MAX_STEPS = 10**10  # steps of one fixed-step run: far more than any run's time limit allows
+
 
 class IntegratorError(MechbookError):
     """The method does not apply to this system, or its iteration failed."""
@@ -145,9 +147,19 @@ class FixedStep(Integrator):
     def _grid(self, t_span) -> tuple[int, float]:
         t0, t1 = map(float, t_span)
         h = self.options.get("step") or (t1 - t0) / 10_000
-        if h <= 0 or t1 <= t0:
-            raise IntegratorError("a fixed-step method needs t1 > t0 and step > 0")
-        steps = max(1, math.ceil((t1 - t0) / h - 1e-9))
+        if not t1 > t0:
+            raise IntegratorError("a fixed-step method needs t1 > t0")
+        if not h > 0:
+            raise IntegratorError(f"the span {t1 - t0:g} is too short to divide into steps "
+                                  "(its ten-thousandth is 0 in double precision)"
+                                  if not self.options.get("step") else
+                                  "a fixed-step method needs a step > 0")
+        count = (t1 - t0) / h
+        if not count <= MAX_STEPS:  # also inf and NaN: a step 1e-300 made a C long overflow
+            raise IntegratorError(f"a step of {h:g} over a span of {t1 - t0:g} is {count:.3g} "
+                                  f"steps (at most {MAX_STEPS:.0e}): take a larger step or a "
+                                  "shorter span")
+        steps = max(1, math.ceil(count - 1e-9))
         return steps, (t1 - t0) / steps
 
     def _wanted(self, t_span, t_eval, steps: int, h: float) -> np.ndarray:

@@ -101,8 +101,13 @@ def drifts(model: Model, traj: Trajectory) -> list[Drift]:
             extra = float(np.max(np.abs(momenta)))
         scale = max(abs(q0), extra, 1e-300)
         rate = 0.0
-        if len(traj.t) > 2 and traj.t[-1] > traj.t[0]:
-            rate = float(np.polyfit(traj.t - traj.t[0], dev / scale, 1)[0])
+        span = float(traj.t[-1] - traj.t[0]) if len(traj.t) else 0.0
+        if len(traj.t) > 2 and span > 0 and np.all(np.isfinite(dev)):
+            # fitted in time scaled to [0, 1], then per unit time: a span of 1e-300 squared
+            # underflows, and NumPy's fit then fails ("SVD did not converge")
+            slope = float(np.polyfit((traj.t - traj.t[0]) / span, dev / scale, 1)[0])
+            with np.errstate(over="ignore"):
+                rate = float(np.float64(slope) / span)
         out.append(Drift(name, vals, q0, float(np.max(np.abs(dev))), float(dev[-1]), scale,
                          rate))
     return out

@@ -26,7 +26,7 @@ import sympy as sp
 
 from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.errors import MechbookError, SpecError, UnsupportedError
 from mechbook.model.manifold import manifold_of
 from mechbook.numerics.accuracy import choose
 from mechbook.numerics.domain import check_start, within_domains
@@ -96,6 +96,15 @@ def parse_assignments(items: list[str] | tuple[str, ...]) -> dict[str, str]:
     return out
 
 
+def _option_value(problem, flag: str, name: str, text: str, names: dict):
+    """`text` of `flag name=text` read by the safe parser; its fault is the option's (a
+    MechbookError naming it), never blamed on a line of the problem file."""
+    try:
+        return problem.parse(str(text), (), names)
+    except SpecError as exc:
+        raise MechbookError(f"{flag} {name}={text}: {exc.bare}") from None
+
+
 def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[str, str],
                   values: dict, search: float | None = None) -> tuple[np.ndarray, np.ndarray, str]:
     """(q0, q̇0, where they came from) from `initial:` and the command-line overrides, or
@@ -122,8 +131,10 @@ def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[s
             raise MechbookError(f"initial value for {key!r}: not a coordinate or a velocity "
                                 f"(coordinates: {', '.join(sys.coord_names)}; velocities "
                                 "add 'dot')")
-        path = ("initial", key) if key not in overrides else ()
-        expr = analysis.problem.parse(str(text), sys.path + path, names)
+        if key in overrides:  # the command line's: its errors name the option, not the file
+            expr = _option_value(analysis.problem, "--init", key, text, names)
+        else:
+            expr = analysis.problem.parse(str(text), sys.path + ("initial", key), names)
         if expr.free_symbols & (set(sys.q) | set(sys.qd) | set(sys.qdd) | {sys.t}):
             raise MechbookError(f"initial value for {key!r} must be a number or use only "
                                 "parameters")
@@ -131,6 +142,9 @@ def initial_state(analysis: Analysis, system_name: str | None, overrides: dict[s
             target[i] = float(sp.N(expr.subs(values)))
         except (TypeError, ValueError) as exc:
             raise MechbookError(f"initial value for {key!r} does not evaluate: {exc}") from None
+        if not np.isfinite(target[i]):
+            raise MechbookError(f"initial value for {key!r} is {target[i]}: not a finite "
+                                "number")
     manifold = manifold_of(sys)
     if manifold is not None:
         q0, qd0, solved = _on_manifold(analysis, sys, manifold, values, q0, qd0, given,
@@ -211,11 +225,13 @@ def parameter_values(analysis: Analysis, overrides: dict[str, str] | None) -> di
         if name not in problem.parameters:
             raise MechbookError(f"--param {name}: not a parameter of {problem.id} (parameters: "
                                 f"{', '.join(problem.parameters)})")
-        expr = problem.parse(str(text), (), problem.names())
+        expr = _option_value(problem, "--param", name, text, problem.names())
         try:
             value = float(sp.N(expr.subs(problem.values())))
         except (TypeError, ValueError) as exc:
             raise MechbookError(f"--param {name}: does not evaluate: {exc}") from None
+        if not np.isfinite(value):
+            raise MechbookError(f"--param {name}={text}: is {value}, not a finite number")
         param = problem.parameters[name]
         if param.positive and not value > 0:
             raise MechbookError(f"--param {name}: the parameter is positive, got {value}")

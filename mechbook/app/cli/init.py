@@ -12,14 +12,17 @@ from mechbook.errors import MechbookError
 
 
 @click.command("init")
-@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
-def command(directory: Path) -> None:
+@click.argument("directory", type=click.Path(file_okay=False))
+def command(directory: str) -> None:
     """Start a tree of your own in DIRECTORY: books.yaml, an example problem and its answer
     key (which `mechbook check` passes), and a Makefile. Nothing is overwritten."""
     from mechbook.app.init import init_tree
 
     try:
-        written = init_tree(directory)
+        if not directory.strip():  # '' would be the current directory: never implied
+            raise MechbookError("no directory named: give the directory to start the tree "
+                                "in (`mechbook init mytree`)")
+        written = init_tree(Path(directory))
     except MechbookError as exc:
         raise click.ClickException(for_terminal(str(exc))) from None
     for path in written:

@@ -60,7 +60,15 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     page = PageOptions(seconds=seconds, simplify_seconds=simplify_seconds,
                        simplify_budget=5 * simplify_seconds, simulate=not no_simulate,
                        t_end=t_end, simulate_seconds=seconds)
-    index = build_report(base, in_tree(ctx, store_path), in_tree(ctx, out_dir), ids,
-                         ReportOptions(jobs, serial, page),
-                         log=lambda text: say(text, err=True))
+    out = in_tree(ctx, out_dir)
+    try:
+        index = build_report(base, in_tree(ctx, store_path), out, ids,
+                             ReportOptions(jobs, serial, page),
+                             log=lambda text: say(text, err=True))
+    except MechbookError as exc:
+        raise click.ClickException(str(exc)) from None
+    except OSError as exc:  # the report's folder: read-only, full, a file where a folder goes
+        raise click.ClickException(f"cannot write the report in {out}: "
+                                   f"{exc.strerror or exc}"
+                                   + (f" ({exc.filename})" if exc.filename else "")) from None
     say(f"report written to {index}")

@@ -33,8 +33,12 @@ def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
         raise click.ClickException(for_terminal(str(exc))) from None
     except FileNotFoundError as exc:  # no store at all; a problem not in it: NotFoundError
         raise click.ClickException(str(exc)) from None
-    _results(problem_id, rec)
-    _checks(rec)
+    if rec.get("checked", True):
+        _results(problem_id, rec)
+        _checks(rec)
+    else:
+        say(f"{problem_id}: no check is stored, only simulations (`mechbook check "
+            f"{problem_id}` stores one)")
     for name in rec.get("simulations", []):
         say(f"simulation stored: /problems/{problem_id}/simulations/{name}")
     from mechbook.app.sweep_io import stored_sweeps

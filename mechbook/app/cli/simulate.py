@@ -165,7 +165,7 @@ def _store(report, name: str | None, path: Path) -> bool:
             "problem_id": report.problem_id, "name": run_name, "arrays": report.arrays,
             "attrs": report.settings, "array_attrs": report.array_attrs})
         say(f"error: {exc}", err=True)
-        say(f"error: the simulation is kept in {side} (`mechbook restore {side}` stores "
-            "it once the cause is fixed)" if side else
+        say(f"error: the simulation is kept in {side} (`mechbook restore {side} --store "
+            f"{path.absolute()}` stores it once the cause is fixed)" if side else
             "error: the simulation could not be kept anywhere", err=True)
         return False

@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
+import os
+
 import click
 
 from mechbook.app import options as opt
-from mechbook.app.cli.common import problem_id_argument, resolve_root, say
+from mechbook.app.cli.common import (
+    memory_option,
+    problem_id_argument,
+    resolve_root,
+    say,
+    timeout_option,
+)
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import problem_path
@@ -14,26 +22,39 @@ from mechbook.model.catalog import problem_path
 @click.command("watch")
 @problem_id_argument()
 @click.option("--no-crosscheck", is_flag=True, help="Check the book's answers only.")
-@click.option("--seconds", type=opt.seconds(), default=120.0, show_default=True,
-              help="CPU seconds allowed for each check.")
+@timeout_option("Wall-clock seconds allowed for each check (as `mechbook check`); a check "
+                "that takes longer is stopped and reported with the stage it was in.")
+@memory_option("Resident memory (MB) allowed for each check (0: no bound).")
+@click.option("--seconds", type=opt.seconds(), default=None, hidden=True,
+              help="The time limit of each check (older name of --timeout).")
 @click.option("--runs", type=click.IntRange(min=0), default=0, hidden=True,
               help="Stop after this many checks (tests).")
 @click.pass_context
-def command(ctx: click.Context, problem_id: str, no_crosscheck: bool, seconds: float,
-            runs: int) -> None:
+def command(ctx: click.Context, problem_id: str, no_crosscheck: bool, timeout: float,
+            memory_mb: float, seconds: float | None, runs: int) -> None:
     """Check a problem now and again each time its problem file or answer key is saved,
     with the engine kept loaded (a save is answered in the time the check takes, a few
-    tenths of a second for a small problem). Ctrl-C stops; nothing is stored."""
+    tenths of a second for a small problem). Each check runs in a worker process under the
+    limits of `mechbook check` (--timeout, --memory). Ctrl-C stops; nothing is stored."""
     from mechbook.app.watch import WatchOptions
     from mechbook.app.watch import watch as watch_problem
+    from mechbook.model.ids import split_id
 
     base = resolve_root(ctx)
     try:
-        path = problem_path(problem_id, base)
+        book, number = split_id(problem_id)
+        plain = base / "problems" / book / f"{number}.yaml"
+        try:
+            problem_path(problem_id, base)
+        except MechbookError:
+            if not os.path.lexists(plain):  # a link gone bad: watched, the check says why
+                raise
     except MechbookError as exc:
         raise click.ClickException(for_terminal(str(exc))) from None
-    if not path.exists():
-        raise click.ClickException(f"no problem {problem_id} (no file {path}; "
+    if not os.path.lexists(plain):
+        raise click.ClickException(f"no problem {problem_id} (no file {plain}; "
                                    "`mechbook list` shows the problems there are)")
     watch_problem(problem_id, base, say,
-                  WatchOptions(crosscheck=not no_crosscheck, seconds=seconds, runs=runs))
+                  WatchOptions(crosscheck=not no_crosscheck,
+                               timeout=seconds if seconds is not None else timeout,
+                               memory_mb=memory_mb, runs=runs))

@@ -13,8 +13,6 @@ line per page otherwise. The index is written last, from the store and the pages
 
 from __future__ import annotations
 
-import os
-import shutil
 import sys
 import time
 from collections import Counter
@@ -253,7 +251,7 @@ def _bench_figure(base: Path, out: Path, pid: str, name: str, systems: int) -> s
         return None
     dest = out / "figures" / pid / f"work-precision-{name}.png"
     dest.parent.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(src, dest)
+    _write_file(dest, src.read_bytes())
     return dest.name
 
 
@@ -261,7 +259,15 @@ def _copy_assets(dest: Path) -> None:
     dest.mkdir(parents=True, exist_ok=True)
     for item in resources.files("mechbook.app.report").joinpath("assets").iterdir():
         if item.is_file():
-            (dest / item.name).write_bytes(item.read_bytes())
+            _write_file(dest / item.name, item.read_bytes())
+
+
+def _write_file(path: Path, data: bytes) -> None:
+    """A file of the report replaced whole by a new one (never written through a link)."""
+    from mechbook.app.outputs import replaced
+
+    with replaced(path) as fh:
+        fh.write(data)
 
 
 _ENV = None
@@ -293,9 +299,9 @@ def _num(x) -> str:
 def render(template: str, path: Path, **context) -> None:
     """Write a page atomically; a string that cannot be UTF-8 (a lone surrogate from an
     old store) is written as an escape instead of ending the report."""
+    from mechbook.app.outputs import replaced
     from mechbook.app.text import unicode_safe
 
     text = _environment().get_template(template).render(**context)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(unicode_safe(text), encoding="utf-8")
-    os.replace(tmp, path)
+    with replaced(path) as fh:  # a new file renamed into place: never written through a link
+        fh.write(unicode_safe(text).encode("utf-8"))

@@ -1,0 +1,57 @@
+"""Imported first by the batch's fork server (mechbook.app.batch), before the engine.
+
+Two things only the server itself can do:
+- Ctrl-C is the run's business. The terminal sends SIGINT to every process of its group,
+  and the server spends its first seconds importing the engine, where a KeyboardInterrupt
+  would print a traceback; from here on it ignores SIGINT (Python's fork server does so
+  itself only after its imports), and so do the workers it forks. The run stops them.
+- Its socket's folder (`pymp-*` in the temporary directory) goes with it. The run that
+  started the server removes that folder at its exit, unless it was killed (SIGKILL, or
+  SIGTERM's default action): then the server, which ends when the run's end of its pipe
+  closes, removes it on its way out, once the run that marked the folder is gone; a
+  SIGTERM or SIGHUP to the server itself (a whole process group ended) ends it the same
+  way. Only a SIGKILL of the server as well leaves the folder: the next run removes it
+  (mechbook.app.lifeline.sweep_stale_folders).
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import signal
+
+_SERVER = os.getpid()  # the fork server; its workers inherit this module, and never end by
+# way of atexit (they leave with os._exit), but a removal is the server's alone all the same
+
+
+def _remove_socket_folder() -> None:
+    """The folder of this server's socket, if the run that started it is gone (a server
+    that ends while its run lives, say by a SIGTERM of its own, leaves it to the run)."""
+    from multiprocessing import forkserver
+
+    from mechbook.app.lifeline import remove_if_abandoned
+
+    address = getattr(forkserver._forkserver, "_forkserver_address", None)
+    if os.getpid() != _SERVER or not isinstance(address, str) or not address \
+            or address.startswith("\0"):
+        return
+    folder = os.path.dirname(address)
+    if os.path.basename(folder).startswith("pymp-"):
+        remove_if_abandoned(folder)
+
+
+def _end(signum, frame):
+    """SIGTERM or SIGHUP: the server ends by way of atexit (which removes its folder); a
+    worker forked from it that has not yet set its own handlers dies as by default (its run
+    terminates it as it exits), never raising inside the fork's own bookkeeping."""
+    if os.getpid() != _SERVER:
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+        return
+    raise SystemExit(128 + signum)
+
+
+signal.signal(signal.SIGINT, signal.SIG_IGN)
+signal.signal(signal.SIGTERM, _end)
+signal.signal(signal.SIGHUP, _end)
+atexit.register(_remove_socket_folder)
