@@ -329,8 +329,9 @@ class CheckResult:
 
     def to_frame(self):
         """The outcomes as a pandas DataFrame (needs pandas: pip install mechbook[data])."""
-        import pandas as pd
+        from mechbook.core.optional import require
 
+        pd = require("pandas", "data", "CheckResult.to_frame()")
         return pd.DataFrame([o.as_dict() for o in self.outcomes])
 
     def __repr__(self) -> str:

@@ -23,11 +23,9 @@ class Frames(NamedTuple):
 
 def results(store: str | Path = DEFAULT_STORE) -> Frames:
     """Read a store written by `mechbook check` into three DataFrames."""
-    try:
-        import pandas as pd
-    except ImportError:  # pragma: no cover - depends on the installation
-        raise ImportError("mechbook.results needs pandas: pip install 'mechbook[data]'") \
-            from None
+    from mechbook.core.optional import require
+
+    pd = require("pandas", "data", "mechbook.results()")
     from mechbook.app.store import problems, read
 
     path = Path(store)
