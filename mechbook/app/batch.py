@@ -173,6 +173,12 @@ class Batch:
         self.failed = failed
         self._ctx = _context()
         self._slots: list[_Slot] = []
+        self.stopped = False
+
+    def stop(self) -> None:
+        """Hand out no more items and end the run (an `on_done` may call it: `check -x`);
+        items still running are stopped, and `run` returns the results it has."""
+        self.stopped = True
 
     def _spawn(self) -> _Slot:
         parent, child = self._ctx.Pipe()
@@ -199,26 +205,28 @@ class Batch:
 
     def run(self, ids: list[Hashable]) -> list[Any]:
         """Run the task on `ids` (distinct; in the order given: put the longest first);
-        results in that order."""
+        results in that order (those finished, after `stop`)."""
         if self.options.serial:
             return self._serial(ids)
         todo = list(ids)
         done: dict[Hashable, Any] = {}
         try:
             self._slots = [self._spawn() for _ in range(min(self.options.workers, len(todo)))]
-            while len(done) < len(ids):
+            while len(done) < len(ids) and not self.stopped:
                 self._assign(todo)
                 self._collect(done)
         finally:
             for slot in self._slots:
                 self._retire(slot, kill=slot.pid is not None)
             self._slots = []
-        return [done[pid] for pid in ids]
+        return [done[pid] for pid in ids if pid in done]
 
     def _serial(self, ids: list[Hashable]) -> list[Any]:
         """In this process, one after another: no limits, but a debugger can follow."""
         out = []
         for pid in ids:
+            if self.stopped:
+                break
             self.on_start(pid)
             run = self.task(pid, self.base, self.options.run, lambda text: None)
             self.on_done(run)

@@ -134,6 +134,11 @@ class ClusterBatch:
         self.base = base
         self.options = options or BatchOptions()
         self.on_done = on_done or (lambda run: None)
+        self.stopped = False
+
+    def stop(self) -> None:
+        """Submit no more and cancel what is queued or running (`check -x`)."""
+        self.stopped = True
 
     def run(self, ids: list[str]) -> list[ProblemRun]:
         as_completed = dask_distributed().as_completed
@@ -153,7 +158,10 @@ class ClusterBatch:
                     run = ProblemRun(pid, error=f"on the cluster: {type(exc).__name__}: {exc}")
                 done[pid] = run
                 self.on_done(run)
-        return [done[pid] for pid in ids]
+                if self.stopped:
+                    client.cancel([f for f in futures if not f.done()])
+                    break
+        return [done[pid] for pid in ids if pid in done]
 
 
 # ---- a child process with limits, for work that is not a whole check ------------------------

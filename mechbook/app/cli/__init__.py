@@ -1,5 +1,6 @@
 """The `mechbook` command line: the group `main` and its commands, one module each (check,
-listing, solve, validate, watch, show, simulate, sweep, report, restore, init, completion);
+listing, solve, validate, watch, show, simulate, sweep, report, restore, init, schema,
+completion);
 what they share (printing, the tree's root, option decorators) is in `common`.
 
 Only click and a few small modules are imported at the top of every module here: --help,
@@ -21,6 +22,7 @@ from mechbook.app.cli import (
     listing,
     report,
     restore,
+    schema,
     show,
     simulate,
     solve,
@@ -51,5 +53,5 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
 
 # one module per command (`mechbook --help` lists them by name)
 for _module in (listing, solve, check, validate, watch, show, simulate, sweep, report, restore,
-                init, completion):
+                init, schema, completion):
     main.add_command(_module.command)
