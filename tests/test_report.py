@@ -226,7 +226,7 @@ def faults(page, trouble: list[str]) -> list[str]:
     return out
 
 
-SHOWN = ("lim-2031", "symon-09-01", "symon-12-27", "toy-3.2")  # pages kept as screenshots
+SHOWN = ("lim-2031", "lim-2035", "symon-09-01", "symon-12-27", "toy-3.2")  # kept as screenshots
 
 
 @pytest.fixture(scope="module")
