@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 
-.PHONY: check test test-quick test-mutation test-min lint fuzz report bench bench-check bench-sweep bench-power clean
+.PHONY: check test test-quick test-mutation test-min test-install lint fuzz report bench bench-check bench-sweep bench-power clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -29,7 +29,8 @@ test-quick: $(STAMP)  ## the suite without the slow tests, for every change (~30
 	$(BIN)/python -m pytest -q -n auto -m 'not slow'
 
 # The oldest versions pyproject.toml's ranges allow (.ci/min_versions.py), mechbook itself
-# installed as a wheel (not editable), and a short suite: the lower bounds are tested.
+# built by the oldest setuptools allowed (no build isolation) and installed as a wheel (not
+# editable), and a short suite: the lower bounds are tested.
 MIN = .venv-min
 MIN_TESTS = tests/test_expr.py tests/test_loading.py tests/test_domains.py \
             tests/test_author_loop.py tests/test_watch.py
@@ -37,13 +38,21 @@ test-min:  ## the oldest dependency versions allowed, a short suite and a check 
 	rm -rf $(MIN)
 	$(PYTHON) -m venv $(MIN)
 	$(PYTHON) .ci/min_versions.py > $(MIN)/min-constraints.txt
-	$(MIN)/bin/python -m pip install --quiet -c $(MIN)/min-constraints.txt . pytest
+	$(MIN)/bin/python -m pip install --quiet -c $(MIN)/min-constraints.txt setuptools
+	$(MIN)/bin/python -m pip install --quiet --no-build-isolation \
+	    -c $(MIN)/min-constraints.txt . pytest
 	cd $(MIN) && bin/python -c "import mechbook, numpy, sympy; \
 	    print('mechbook', mechbook.__file__, 'numpy', numpy.__version__, 'sympy', sympy.__version__)"
 	$(MIN)/bin/pytest -q -p no:cacheprovider $(MIN_TESTS)
 	rm -rf $(MIN)/tree && $(MIN)/bin/mechbook init $(MIN)/tree
 	$(MIN)/bin/mechbook --root $(MIN)/tree check
 	$(MIN)/bin/mechbook check lim-2031 symon-10-05 --no-store
+
+# The README's install instructions, run as written (.ci/readme_install.py): a copy of the
+# tracked files, `pip install .` in a clean venv with its dependencies from the index, then
+# `mechbook init`, `check` and `report`; a wheel built and installed into another venv.
+test-install:  ## install by the README's own words in clean venvs, then init, check, report (~5 min)
+	$(PYTHON) .ci/readme_install.py
 
 fuzz: $(STAMP)   ## 10,000 mutated and hostile problem/answer files under time and memory limits (~30 min)
 	$(BIN)/python tests/fuzz.py --cases 10000 --seed 1 --keep results/fuzz \

@@ -1,6 +1,8 @@
-"""Print a pip constraints file pinning every dependency of pyproject.toml to the lowest
-version its range allows (`name>=X,<Y` -> `name==X`): the minimum-versions CI job
-(`make test-min`) installs with it, so that the lower bounds are tested, not assumed."""
+"""Print a pip constraints file pinning every dependency of pyproject.toml, and every build
+requirement (setuptools), to the lowest version its range allows (`name>=X,<Y` ->
+`name==X`): the minimum-versions CI job (`make test-min`) installs with it, and builds
+mechbook without build isolation with that setuptools, so that the lower bounds are
+tested, not assumed."""
 
 from __future__ import annotations
 
@@ -13,8 +15,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> int:
-    project = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))["project"]
-    for spec in project["dependencies"]:
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))
+    specs = [*config["project"]["dependencies"], *config["build-system"]["requires"]]
+    for spec in specs:
         m = re.match(r"\s*([A-Za-z0-9_.\-]+)\s*(\[[^\]]*\])?\s*(.*)", spec)
         name, ranges = m.group(1), m.group(3)
         low = re.search(r">=\s*([0-9][^,;\s]*)", ranges)

@@ -47,6 +47,18 @@ class InputError(MechbookError, ValueError):
     the message says what is expected. Also a ValueError, for callers that catch one."""
 
 
+class MissingDependencyError(MechbookError, ImportError):
+    """An optional dependency that is not installed: the message names what needs it and
+    the extra that installs it (`pip install 'mechbook[extra]'`). Also an ImportError, as
+    pandas and SciPy raise for their optional parts."""
+
+    def __init__(self, module: str, extra: str, purpose: str):
+        self.module, self.extra = module, extra
+        super().__init__(f"{purpose} needs {module.split('.')[0]}, which is not installed: "
+                         f"pip install 'mechbook[{extra}]'")
+        self.name = module
+
+
 class UnsupportedError(MechbookError):
     """The engine cannot compute this yet; names the capability that is missing."""
 
@@ -69,6 +81,14 @@ class WrongAnswerError(MechbookError):
 class NotEquilibriumError(WrongAnswerError):
     """A point (or steady motion) named by an answer does not satisfy the equations of motion:
     the answer is wrong, which is a fail, not a missing capability."""
+
+
+def message(exc: MechbookError | KeyError) -> str:
+    """A user error's text: a MechbookError's own; a plain KeyError's without the quotes
+    its str() puts around the missing key."""
+    if isinstance(exc, MechbookError):
+        return str(exc)
+    return str(exc).strip("'\"")
 
 
 def describe(exc: BaseException) -> str:

@@ -144,3 +144,65 @@ def test_mathml_dots_velocities_and_accelerations():
     assert f'<msub><mover accent="true"><mi>x</mi>{dot}&#168;</mo></mover><mi>1</mi></msub>' \
         in out  # ẍ₁: the dots on the letter, not on the subscript
     assert "&#969;" in out and "ddot" not in out
+
+
+# ---- the habits of SymPy and pandas users (issue 34 item 5) -----------------------------------
+def test_equilibria_are_indexed_by_name_or_symbol(hoop):
+    down = next(e for e in hoop.equilibria if e[theta] == sp.pi)
+    assert down["theta"] == down[theta] == sp.pi
+    assert "theta" in down and down.get("theta") == sp.pi and down.get("phi") is None
+    with pytest.raises(KeyError):
+        down["phi"]  # noqa: B018
+
+
+def test_params_on_every_numeric_method(hoop):
+    """At omega = 8 the off-axis frequency is omega*sqrt(1 - (g/(b*omega**2))**2) (the
+    hand derivation above), on every method that computes a number."""
+    off = {"theta": "acos(-g/(b*omega**2))"}
+    hand = 8 * np.sqrt(1 - (9.81 / (0.5 * 64)) ** 2)
+    (w,) = hoop.frequencies(about=off, numeric=True, params={"omega": 8})
+    assert w == pytest.approx(hand, rel=1e-12)
+    assert hoop.frequencies(about=off, numeric=True, params={omega: "4*2"}) == [w]
+    (expr,) = hoop.frequencies(about=off, params={"omega": 8})
+    assert float(expr.subs({b: 0.5, g: 9.81})) == pytest.approx(hand, rel=1e-12)
+    assert hoop.modes(about=off, params={"omega": 8})[0][0] == pytest.approx(hand, rel=1e-9)
+    lin = hoop.linearize(about=off)
+    assert lin.frequencies(params={"omega": 8})[0] == pytest.approx(hand, rel=1e-9)
+    assert lin.stability(params={"omega": 8}) in ("stable", "marginal")
+    # the bottom is stable below omega^2 = g/b and unstable above: params decide
+    bottom = hoop.linearize(about={"theta": "pi"})
+    assert bottom.stability(params={"omega": 6}) == "unstable"
+    assert bottom.stability(params={"omega": 2}) != "unstable"
+    f6, f8 = hoop.ode_function(), hoop.ode_function(params={"omega": 8})
+    y = f6.initial({"theta": 1.0})
+    # theta'' = sin(theta)*(omega^2*cos(theta) + g/b) from the Lagrangian above
+    for f, om in ((f6, 6), (f8, 8)):
+        assert f(0.0, y)[1] == pytest.approx(np.sin(1) * (om**2 * np.cos(1) + 9.81 / 0.5),
+                                             rel=1e-12)
+
+
+def test_a_parameter_name_that_is_not_one_is_refused(hoop):
+    with pytest.raises(KeyError, match="'omgea' is not a parameter.*did you mean 'omega'"):
+        hoop.frequencies(about={"theta": "pi"}, numeric=True, params={"omgea": 8})
+    with pytest.raises(KeyError, match="'omgea' is not a parameter"):
+        hoop.linearize(about={"theta": "pi"}).stability(params={"omgea": 8})
+    with pytest.raises(ValueError, match="positive"):
+        hoop.modes(about={"theta": "pi"}, params={"b": -1})
+
+
+def test_changing_the_defaults_is_refused_not_ignored(hoop):
+    assert dict(hoop.parameters) == {"m": 0.1, "b": 0.5, "omega": 6.0, "g": 9.81}
+    with pytest.raises(TypeError, match="params="):
+        hoop.parameters["omega"] = 8
+    with pytest.raises(TypeError, match="params="):
+        del hoop.parameters["omega"]
+
+
+def test_simulate_names_the_keyword_it_takes(hoop):
+    for wrong, meant in (("initial", "init"), ("parameters", "params"), ("y0", "init"),
+                         ("rtoll", "rtol")):
+        with pytest.raises(TypeError, match=f"unexpected keyword argument '{wrong}'.*"
+                                            f"'{meant}'"):
+            hoop.simulate(t_end=1, **{wrong: 1})
+    run = hoop.simulate(t_end=0.5, init={theta: 1.0}, params={"omega": 8}, points=11)
+    assert run.q[0, 0] == 1.0 and "omega=8" in run.run.settings()["parameters"]

@@ -408,3 +408,38 @@ def test_docs_table_names_every_app_module():
         if rel.stem not in words:
             missing.append(rel.as_posix())
     assert not missing, f"docs/architecture.md's table does not name: {missing}"
+
+
+# ---- no module that nothing uses -------------------------------------------------------------
+ENTRY_POINTS = {"mechbook.__main__"}  # `python -m mechbook`
+
+
+def unused_modules(known: dict[str, Path], users: list[Path]) -> list[str]:
+    """The modules of `known` that no other file imports (a mechbook module, a benchmark or
+    a test: imports inside functions count) and no mechbook module names as a string (a
+    fork server's preload list), and that are no entry point."""
+    used: set[str] = set()
+    for path in [*known.values(), *users]:
+        own = next((m for m, p in known.items() if p == path), None)
+        for name in imports(path):
+            if name != own:
+                parts = name.split(".")
+                used |= {".".join(parts[:i]) for i in range(1, len(parts) + 1)}
+    text = "\n".join(p.read_text(encoding="utf-8") for p in known.values())
+    named = set(re.findall(r"[\"'](mechbook(?:\.\w+)+)[\"']", text))
+    return sorted(m for m in known if m not in used | named | ENTRY_POINTS)
+
+
+def test_every_module_is_used_somewhere():
+    """A module nothing imports is dead code that still has to be read and kept (issue 34
+    found mechbook/app/report/figures.py so)."""
+    users = sorted([*(ROOT / "bench").rglob("*.py"), *(ROOT / "tests").rglob("*.py")])
+    assert unused_modules(modules(), users) == []
+
+
+def test_the_unused_module_test_can_fail(tmp_path):
+    known = dict(modules())
+    orphan = tmp_path / "orphan.py"
+    orphan.write_text('"""Nobody imports me."""\n', encoding="utf-8")
+    known["mechbook.app.orphan"] = orphan
+    assert "mechbook.app.orphan" in unused_modules(known, [])

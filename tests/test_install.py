@@ -5,7 +5,10 @@ The wheel is built by pip (with build isolation, from pyproject.toml) and instal
 new venv without its dependencies; those are borrowed from the test's own environment by a
 path file (appended after the venv's own site-packages, and without running that
 environment's .pth files, so its editable mechbook stays out). The wheel must carry
-everything a new user needs: the schemas, the report's assets, the starter tree, py.typed.
+everything a new user needs: the schemas, the report's assets, the starter tree, py.typed,
+the documentation pages (`mechbook docs`), the license and the metadata (an SPDX license,
+classifiers, the extras). `make test-install` goes further, by the README's own words
+(.ci/readme_install.py): a clean venv with its dependencies from the index.
 """
 
 from __future__ import annotations
@@ -33,8 +36,15 @@ def test_init_and_check_from_a_wheel_in_a_fresh_venv(tmp_path):
     for needed in ("mechbook/py.typed", "mechbook/app/starter/problem.yaml",
                    "mechbook/app/starter/Makefile", "mechbook/model/schemas/problem.json",
                    "mechbook/app/report/assets/animate.js",
-                   "mechbook/app/report/templates/problem.html"):
+                   "mechbook/app/report/templates/problem.html",
+                   "mechbook/docs/schema.md", "mechbook/docs/answers.md",
+                   "mechbook/docs/images/sweep-lim-2031-stability.png",
+                   "mechbook-0.1.0.dist-info/licenses/LICENSE"):
         assert needed in names, needed
+    metadata = zipfile.ZipFile(wheel).read("mechbook-0.1.0.dist-info/METADATA").decode()
+    assert "License-Expression: MIT" in metadata  # SPDX (PEP 639), no deprecated table
+    assert "Classifier: Topic :: Scientific/Engineering :: Physics" in metadata
+    assert "Provides-Extra: xarray" in metadata
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=300)
     py = venv / "bin" / "python"
@@ -59,3 +69,10 @@ def test_init_and_check_from_a_wheel_in_a_fresh_venv(tmp_path):
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert "3 parts: 3 pass" in checked.stdout
     assert "Traceback" not in checked.stderr and "Warning" not in checked.stderr
+    # the docs the messages name come with the wheel
+    page = subprocess.run([str(mechbook), "docs", "schema"], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120)
+    assert page.returncode == 0 and page.stdout.startswith("# Problem files"), page.stderr
+    where = subprocess.run([str(mechbook), "docs", "--path"], capture_output=True, text=True,
+                           cwd=tmp_path, timeout=120)
+    assert where.stdout.strip().startswith(str(venv)), where.stdout

@@ -6,9 +6,15 @@ no exception's text appears anywhere, the animation runs, and the index's filter
 Screenshots of a few pages are kept in results/test-artifacts/report/ to be looked at.
 
 The report is built once, for a scratch tree holding lim-2031 (every part passes),
-symon-09-01 (two errata, long equations), symon-10-05 (identities for all tensors),
-symon-12-27 (steady motions: structured answers) and toy-3.2 (a third book declared only in
-data). Without Chromium the browser tests are skipped, saying why; the rest still run.
+lim-2035 (a double pendulum: rods and a pivot in the animation), symon-09-01 (two errata,
+long equations), symon-10-05 (identities for all tensors), symon-12-27 (steady motions:
+structured answers) and toy-3.2 (a third book declared only in data). Without Chromium the
+browser tests are skipped, saying why; the rest still run.
+
+What a reader trips on is checked on every page too (issue 34): an expression shown
+unsimplified says so; numbers name the parameter point they were computed at; the
+animation draws the links; no absolute path; legends off the curves; no Python `True`; one
+minus glyph; no formula line ending in a lone bracket.
 """
 
 from __future__ import annotations
@@ -32,8 +38,8 @@ ARTIFACTS = ROOT / "results" / "test-artifacts" / "report"
 CHROMIUM = Path("/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-COPIED = ("lim/2031", "symon/09-01", "symon/10-05", "symon/12-27")
-PROBLEMS = ("lim-2031", "symon-09-01", "symon-10-05", "symon-12-27", "toy-3.2")
+COPIED = ("lim/2031", "lim/2035", "symon/09-01", "symon/10-05", "symon/12-27")
+PROBLEMS = ("lim-2031", "lim-2035", "symon-09-01", "symon-10-05", "symon-12-27", "toy-3.2")
 EXCEPTION_TEXT = re.compile(r"Traceback|\b[A-Z][A-Za-z]*(?:Error|Exception)\b")
 
 
@@ -220,7 +226,7 @@ def faults(page, trouble: list[str]) -> list[str]:
     return out
 
 
-SHOWN = ("lim-2031", "symon-09-01", "symon-12-27", "toy-3.2")  # pages kept as screenshots
+SHOWN = ("lim-2031", "lim-2035", "symon-09-01", "symon-12-27", "toy-3.2")  # kept as screenshots
 
 
 @pytest.fixture(scope="module")
@@ -333,6 +339,172 @@ def test_every_page_of_a_full_report(browser):
     found = []
     for path in pages(Path(where)):
         page, trouble = open_page(browser, path)
-        found += [f"{path.name}: {f}" for f in faults(page, trouble)]
+        found += [f"{path.name}: {f}" for f in faults(page, trouble) + reading_faults(page, [])]
         page.close()
     assert found == [], "\n".join(found[:40])
+
+
+# ---- what a reader trips on (issue 34) ------------------------------------------------------
+READING = r"""() => {
+  const out = [];
+  const text = document.body.innerText;
+  const py = text.match(/\b(True|False|None)\b/);
+  if (py) out.push(`a Python value on the page: ${py[0]}`);
+  for (const mo of document.querySelectorAll("math mo"))
+    if (mo.textContent.trim() === "-") {
+      out.push("a hyphen for a minus sign in a formula"); break;
+    }
+  for (const mn of document.querySelectorAll("math mn"))
+    if (mn.textContent.trim().startsWith("-")) {
+      out.push("a hyphen in a number: " + mn.textContent); break;
+    }
+  for (const t of document.querySelectorAll("svg.chart text"))
+    if (/^-\d/.test(t.textContent.trim())) {
+      out.push("a hyphen in a tick: " + t.textContent); break;
+    }
+  for (const row of document.querySelectorAll("math mtd > mrow")) {
+    const kids = row.children;
+    if (!kids.length) continue;
+    if (kids[kids.length - 1].textContent.trim() === "(") out.push("a formula line ends in '('");
+    if (kids[0].tagName.toLowerCase() === "mo" && kids[0].textContent.trim() === ")")
+      out.push("a formula line starts with ')'");
+  }
+  for (const svg of document.querySelectorAll("svg.chart")) {
+    const plot = svg.querySelector("rect.plot");
+    if (!plot) { out.push("a chart without its plotting area"); continue; }
+    const p = plot.getBBox();
+    for (const g of svg.querySelectorAll(".legend")) {
+      const b = g.getBBox();
+      if (b.x < p.x + p.width && b.x + b.width > p.x &&
+          b.y < p.y + p.height && b.y + b.height > p.y)
+        out.push(`a legend on the curves: ${g.textContent}`);
+    }
+    if (!svg.querySelector(".legend") && svg.querySelectorAll("polyline, circle").length)
+      out.push("a chart without a legend");
+  }
+  return out;
+}"""
+
+
+def reading_faults(page, roots: list[str]) -> list[str]:
+    """What a reader trips on, in a loaded page (READING), and any of `roots` (absolute
+    paths of the machine that built the report) in its text or markup."""
+    out = page.evaluate(READING)
+    html = page.content()
+    out += [f"an absolute path: {r}" for r in roots if r in html]
+    return out
+
+
+def test_every_page_reads_well(report, tree, browser):
+    roots = sorted({str(tree), str(tree.resolve()), str(tree.parent.resolve())})
+    for path in pages(report):
+        page, _ = open_page(browser, path)
+        assert reading_faults(page, roots) == [], path.name
+        page.close()
+
+
+def test_the_reading_checks_catch_what_they_should(browser, tmp_path):
+    bad = tmp_path / "bad.html"
+    bad.write_text(
+        '<!DOCTYPE html><html><body><p>stable True</p><p>/home/someone/tree/x.yaml</p>'
+        '<math><mtable><mtr><mtd><mrow><mi>a</mi><mo>-</mo><mi>b</mi><mo>(</mo></mrow>'
+        '</mtd></mtr><mtr><mtd><mrow><mo>)</mo><mn>-2</mn></mrow></mtd></mtr></mtable></math>'
+        '<svg class="chart" width="300" height="200" xmlns="http://www.w3.org/2000/svg">'
+        '<rect class="plot" x="40" y="20" width="200" height="150"/>'
+        '<g class="legend"><text x="50" y="40">theta</text></g>'
+        '<polyline points="40,20 240,170"/><text x="30" y="190">-0.1</text></svg>'
+        "</body></html>", encoding="utf-8")
+    page, _ = open_page(browser, bad)
+    found = " | ".join(reading_faults(page, ["/home/someone/tree"]))
+    page.close()
+    for sign in ("Python value on the page: True", "hyphen for a minus", "hyphen in a number",
+                 "hyphen in a tick", "ends in '('", "starts with ')'", "legend on the curves",
+                 "absolute path"):
+        assert sign in found, (sign, found)
+
+
+def test_the_index_names_the_store_inside_the_tree(report, tree):
+    index = (report / "index.html").read_text("utf-8")
+    assert "<code>results/mechbook.h5</code>" in index
+    assert str(tree) not in index and str(tree.resolve()) not in index
+
+
+def test_shown_values_name_their_parameter_point(report, browser):
+    """toy-3.2's frequencies at one point: the note says which (k and m, the defaults),
+    with the values the Parameters table gives."""
+    page, _ = open_page(browser, report / "problems" / "toy-3.2.html")
+    notes = page.eval_on_selector_all(
+        "section.part .note.point", "ns => ns.map(n => [n.innerText, "
+        "[...n.querySelectorAll('math')].map(m => m.textContent.replace(/\\s/g, ''))])")
+    table = dict(page.eval_on_selector_all(
+        "#parameters + table tbody tr",
+        "rows => rows.map(r => [r.cells[0].innerText.trim(), r.cells[1].innerText.trim()])"))
+    page.close()
+    assert notes and table, (notes, table)
+    for text, pairs in notes:
+        assert "(the default values)" in text and "book" in text and "engine" in text, text
+        assert sorted(pairs) == sorted(f"{n}={v}" for n, v in table.items()), (pairs, table)
+
+
+def test_the_animation_draws_rods_and_pivots(report, browser):
+    """lim-2035's double pendulum: a rod from the pivot to the upper bob and one between
+    the bobs, found in the motion (their lengths stay 3l and 4l while they turn); the
+    canvas is dark along each rod at the frame drawn."""
+    page, trouble = open_page(browser, report / "problems" / "lim-2035.html")
+    page.click("figure.animation button")  # pause, then read the frame drawn
+    page.wait_for_timeout(100)
+    trouble = list(trouble)  # the page's own (the readback below warns of itself)
+    samples = page.evaluate("""() => {
+      const fig = document.querySelector("figure.animation");
+      const data = JSON.parse(fig.querySelector("script.motion").textContent);
+      const canvas = fig.querySelector("canvas"), ctx = canvas.getContext("2d");
+      const frame = Number(fig.dataset.frame);
+      const [x0, x1, y0, y1] = data.box;
+      const scale = Math.min(canvas.width / (x1 - x0), canvas.height / (y1 - y0));
+      const ox = (canvas.width - scale * (x1 - x0)) / 2;
+      const oy = (canvas.height - scale * (y1 - y0)) / 2;
+      const px = (p) => [ox + (p[0] - x0) * scale, canvas.height - oy - (p[1] - y0) * scale];
+      const at = (e) => typeof e === "number" ? data.bodies[e].path[frame] : e;
+      return data.links.map(([a, b]) => [0.35, 0.5, 0.65].map((f) => {
+        const [ax, ay] = px(at(a)), [bx, by] = px(at(b));
+        const x = Math.round(ax + f * (bx - ax)), y = Math.round(ay + f * (by - ay));
+        const d = ctx.getImageData(x, y, 1, 1).data;
+        return d[0] + d[1] + d[2];
+      }));
+    }""")
+    motion = json.loads(page.locator("figure.animation script.motion").text_content())
+    page.close()
+    assert not trouble, trouble
+    assert sorted(str(link) for link in motion["links"]) == ["[0, 1]", "[0, [0.0, 0.0]]"]
+    assert [p["at"] for p in motion["pivots"]] == [[0.0, 0.0]]
+    assert len(samples) == 2 and all(max(s) < 3 * 120 for s in samples), samples
+
+
+@pytest.fixture(scope="module")
+def unsimplified(tree, report) -> Path:
+    """lim-2031's page with simplification off: every derived expression as derived."""
+    out = tree / "results" / "report-unsimplified"
+    built = CliRunner().invoke(main, ["--root", str(tree), "report", "lim-2031", "--serial",
+                                      "--no-simulate", "--simplify-seconds", "0", "--out",
+                                      str(out)])
+    assert built.exit_code == 0, built.output
+    return out / "problems" / "lim-2031.html"
+
+
+def test_unsimplified_forms_say_so(unsimplified, report, browser):
+    page, _ = open_page(browser, unsimplified)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / "lim-2031-unsimplified.png"), full_page=True)
+    blocks = page.eval_on_selector_all(
+        ".block", "bs => bs.map(b => [b.querySelector('h3').innerText, "
+                  "!!b.querySelector('.unsimplified'), b.querySelector('.unsimplified') ? "
+                  "b.querySelector('.unsimplified').getBoundingClientRect().height : 0])")
+    page.close()
+    said = {title: (note, height) for title, note, height in blocks}
+    for title in ("Lagrangian L = T − V", "Kinetic energy T", "Equations of motion (Lagrange)"):
+        assert said[title][0] and said[title][1] > 0, (title, said)
+    text = unsimplified.read_text("utf-8")
+    assert "not simplified: simplification is off (--simplify-seconds 0)" in text
+    # with the defaults, toy-3.2's small expressions are simplified, and nothing says not
+    toy = (report / "problems" / "toy-3.2.html").read_text("utf-8")
+    assert 'class="note unsimplified"' not in toy

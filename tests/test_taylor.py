@@ -14,7 +14,7 @@ from scipy.linalg import expm
 from scipy.special import ellipj, ellipk
 from systems import pendulum
 
-from mechbook.errors import UnsupportedError
+from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.integrators import integrate
 from mechbook.numerics.measure import first_event, measure, signal_functions
 from mechbook.numerics.model import build_model
@@ -224,8 +224,12 @@ def test_simulate_with_taylor_and_its_fallback(tmp_path):
     assert sim.trajectory.method == "taylor" and sim.trajectory.success
     assert len(sim.trajectory.t) == 101
     assert sim.drifts[0].relative < 1e-14
+    # asked for by name, taylor is used or refused (issue 34): never another method
     well = load_analysis(tmp_path, ABS_WELL, "9204")
-    sim = simulate(well, init={"x": "0.5"}, t_span=(0, 5), method="taylor")
+    with pytest.raises(MechbookError, match="taylor method cannot run.*no heyoka translation"):
+        simulate(well, init={"x": "0.5"}, t_span=(0, 5), method="taylor")
+    # chosen by --accuracy (taylor is the rule's method at 1e-10), it falls back, saying so
+    sim = simulate(well, init={"x": "0.5"}, t_span=(0, 5), accuracy=1e-10)
     assert sim.trajectory.method == "DOP853"
     assert any("taylor method unavailable" in n and "no heyoka translation" in n
                for n in sim.notes)

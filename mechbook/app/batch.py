@@ -246,6 +246,7 @@ class Batch:
         self._ctx = _context()
         self._slots: list[_Slot] = []
         self._kept = False  # inside `with`: idle workers stay for the next run
+        self.stopped = False
 
     def __enter__(self) -> Batch:
         """Keep the workers between runs (`mechbook watch`: each save is checked by a
@@ -261,6 +262,11 @@ class Batch:
         for slot in self._slots:
             self._retire(slot, kill=slot.pid is not None)
         self._slots = []
+
+    def stop(self) -> None:
+        """Hand out no more items and end the run (an `on_done` may call it: `check -x`);
+        items still running are stopped, and `run` returns the results it has."""
+        self.stopped = True
 
     def _spawn(self) -> _Slot:
         parent, child = self._ctx.Pipe()
@@ -294,7 +300,7 @@ class Batch:
 
     def run(self, ids: list[Hashable]) -> list[Any]:
         """Run the task on `ids` (distinct; in the order given: put the longest first);
-        results in that order."""
+        results in that order (those finished, after `stop`)."""
         if self.options.serial:
             return self._serial(ids)
         todo = list(ids)
@@ -303,19 +309,21 @@ class Batch:
         try:
             want = min(self.options.workers, len(todo))
             self._slots += [self._spawn() for _ in range(want - len(self._slots))]
-            while len(done) < len(ids):
+            while len(done) < len(ids) and not self.stopped:
                 self._assign(todo)
                 self._collect(done)
-            finished = True
+            finished = not self.stopped  # stopped: what still runs is stopped
         finally:
             if not (finished and self._kept):
                 self._retire_all()
-        return [done[pid] for pid in ids]
+        return [done[pid] for pid in ids if pid in done]
 
     def _serial(self, ids: list[Hashable]) -> list[Any]:
         """In this process, one after another: no limits, but a debugger can follow."""
         out = []
         for pid in ids:
+            if self.stopped:
+                break
             self.on_start(pid)
             run = self.task(pid, self.base, self.options.run, lambda text: None)
             self.on_done(run)

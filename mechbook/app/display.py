@@ -3,7 +3,9 @@
 `p.eom` is a list of equations and `p.momenta` a dict: Jupyter printed them as text (only a
 lone SymPy object has its own LaTeX). `MathList` and `MathDict` are a list and a dict in
 every way (equality, indexing, JSON of their items) that also give Jupyter LaTeX (one item
-per row, aligned) and MathML (mechbook.app.mathml, the report's printer).
+per row, aligned) and MathML (mechbook.app.mathml, the report's printer). A `MathDict`
+keyed by symbols is indexed by their names too (`p.equilibria[0]["theta"]`), as `about=`
+takes them.
 """
 
 from __future__ import annotations
@@ -39,6 +41,24 @@ class MathDict(dict):
     def __init__(self, *args, label=None, **kwargs):
         super().__init__(*args, **kwargs)
         self._label = label
+
+    def _key(self, key):
+        """A name stands for the symbol of that name (`about=` takes names too), as long
+        as the dict has no key that is the name itself."""
+        if isinstance(key, str) and not dict.__contains__(self, key):
+            for k in self:
+                if isinstance(k, sp.Symbol) and k.name == key:
+                    return k
+        return key
+
+    def __getitem__(self, key):
+        return super().__getitem__(self._key(key))
+
+    def __contains__(self, key) -> bool:
+        return super().__contains__(self._key(key))
+
+    def get(self, key, default=None):
+        return super().get(self._key(key), default)
 
     def _shown(self) -> dict:
         if self._label is None:

@@ -121,15 +121,19 @@ def _relocated(run: ProblemRun, here: str, there: str) -> ProblemRun:
     return run
 
 
+def dask_distributed():
+    """dask.distributed, or MissingDependencyError with the install line (before anything
+    else of a run on the cluster imports it)."""
+    from mechbook.core.optional import require
+
+    return require("dask.distributed", "cluster", "--scheduler (a Dask cluster)")
+
+
 def connect(address: str):
     """A Dask client of the scheduler at `address` (a clear error if none answers)."""
+    client = dask_distributed().Client
     try:
-        from dask.distributed import Client
-    except ImportError:
-        raise MechbookError("--scheduler needs Dask distributed: pip install "
-                            "'mechbook[cluster]'") from None
-    try:
-        return Client(address, timeout="10s")
+        return client(address, timeout="10s")
     except (OSError, TimeoutError) as exc:
         raise MechbookError(f"no Dask scheduler answers at {address}: {exc}") from None
 
@@ -144,10 +148,14 @@ class ClusterBatch:
         self.base = base
         self.options = options or BatchOptions()
         self.on_done = on_done or (lambda run: None)
+        self.stopped = False
+
+    def stop(self) -> None:
+        """Submit no more and cancel what is queued or running (`check -x`)."""
+        self.stopped = True
 
     def run(self, ids: list[str]) -> list[ProblemRun]:
-        from dask.distributed import as_completed
-
+        as_completed = dask_distributed().as_completed
         done: dict[str, ProblemRun] = {}
         with connect(self.address) as client:
             # in the order given (the longest first), as the local pool does
@@ -164,7 +172,10 @@ class ClusterBatch:
                     run = ProblemRun(pid, error=f"on the cluster: {type(exc).__name__}: {exc}")
                 done[pid] = run
                 self.on_done(run)
-        return [done[pid] for pid in ids]
+                if self.stopped:
+                    client.cancel([f for f in futures if not f.done()])
+                    break
+        return [done[pid] for pid in ids if pid in done]
 
 
 # ---- a child process with limits, for work that is not a whole check ------------------------

@@ -22,12 +22,32 @@ class Frames(NamedTuple):
 
 
 def results(store: str | Path = DEFAULT_STORE) -> Frames:
-    """Read a store written by `mechbook check` into three DataFrames."""
-    try:
-        import pandas as pd
-    except ImportError:  # pragma: no cover - depends on the installation
-        raise ImportError("mechbook.results needs pandas: pip install 'mechbook[data]'") \
-            from None
+    """Read a store written by `mechbook check` into three DataFrames.
+
+    Parameters
+    ----------
+    store : str or pathlib.Path, default results/mechbook.h5
+        The HDF5 store.
+
+    Returns
+    -------
+    Frames
+        (checks, crosschecks, timings): one row per answer part, per cross-check, per
+        problem.
+
+    Raises
+    ------
+    MissingDependencyError
+        Without pandas (``pip install 'mechbook[data]'``); an ImportError too.
+
+    Examples
+    --------
+    >>> checks, crosschecks, timings = mechbook.results("results/mechbook.h5")  # doctest: +SKIP
+    >>> checks.groupby("status").size()                                         # doctest: +SKIP
+    """
+    from mechbook.core.optional import require
+
+    pd = require("pandas", "data", "mechbook.results()")
     from mechbook.app.store import problems, read
 
     path = Path(store)
@@ -35,30 +55,10 @@ def results(store: str | Path = DEFAULT_STORE) -> Frames:
         raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
     checks, cross, timings = [], [], []
     for pid in problems(path):
-        rec = read(pid, path)
-        a = rec["attrs"]
-        book = pid.split("-", 1)[0]
-        for c in rec["checks"]:
-            checks.append({"problem": pid, "book": book, "part": c["part"],
-                           "quantity": c.get("quantity", ""), "origin": c.get("origin", "book"),
-                           "status": c.get("status", ""), "method": c.get("method", ""),
-                           "detail": c.get("detail", ""), "cite": c.get("cite", ""),
-                           "seconds": float(c.get("seconds", 0.0))})
-        for x in rec.get("crosschecks", []):
-            cross.append({"problem": pid, "book": book, "name": x.get("name", ""),
-                          "kind": x.get("kind", ""), "system": x.get("system", ""),
-                          "status": x.get("status", ""), "error": float(x.get("error", "nan")),
-                          "parts": ", ".join(x.get("parts") or []),
-                          "detail": x.get("detail", ""),
-                          "seconds": float(x.get("seconds", 0.0))})
-        timings.append({"problem": pid, "book": book, "title": a.get("title", ""),
-                        "duration_s": float(a.get("duration_s", 0.0)),
-                        "parts": len(rec["checks"]),
-                        "check_s": sum(float(c.get("seconds", 0.0)) for c in rec["checks"]),
-                        "crosscheck_s": sum(float(x.get("seconds", 0.0))
-                                            for x in rec.get("crosschecks", [])),
-                        "date": a.get("date", ""), "mechbook": a.get("mechbook", ""),
-                        "sympy": a.get("sympy", ""), "numpy": a.get("numpy", "")})
+        rows = _rows(pid, read(pid, path))
+        checks += rows[0]
+        cross += rows[1]
+        timings.append(rows[2])
     columns = {"checks": ["problem", "book", "part", "quantity", "origin", "status", "method",
                           "detail", "cite", "seconds"],
                "crosschecks": ["problem", "book", "name", "kind", "system", "status", "error",
@@ -68,3 +68,27 @@ def results(store: str | Path = DEFAULT_STORE) -> Frames:
     return Frames(pd.DataFrame(checks, columns=columns["checks"]),
                   pd.DataFrame(cross, columns=columns["crosschecks"]),
                   pd.DataFrame(timings, columns=columns["timings"]))
+
+
+def _rows(pid: str, rec: dict) -> tuple[list[dict], list[dict], dict]:
+    """One stored problem as rows: its parts, its cross-checks, its timing."""
+    a = rec["attrs"]
+    book = pid.split("-", 1)[0]
+    checks = [{"problem": pid, "book": book, "part": c["part"],
+               "quantity": c.get("quantity", ""), "origin": c.get("origin", "book"),
+               "status": c.get("status", ""), "method": c.get("method", ""),
+               "detail": c.get("detail", ""), "cite": c.get("cite", ""),
+               "seconds": float(c.get("seconds", 0.0))} for c in rec["checks"]]
+    cross = [{"problem": pid, "book": book, "name": x.get("name", ""),
+              "kind": x.get("kind", ""), "system": x.get("system", ""),
+              "status": x.get("status", ""), "error": float(x.get("error", "nan")),
+              "parts": ", ".join(x.get("parts") or []), "detail": x.get("detail", ""),
+              "seconds": float(x.get("seconds", 0.0))} for x in rec.get("crosschecks", [])]
+    timing = {"problem": pid, "book": book, "title": a.get("title", ""),
+              "duration_s": float(a.get("duration_s", 0.0)), "parts": len(rec["checks"]),
+              "check_s": sum(float(c.get("seconds", 0.0)) for c in rec["checks"]),
+              "crosscheck_s": sum(float(x.get("seconds", 0.0))
+                                  for x in rec.get("crosschecks", [])),
+              "date": a.get("date", ""), "mechbook": a.get("mechbook", ""),
+              "sympy": a.get("sympy", ""), "numpy": a.get("numpy", "")}
+    return checks, cross, timing

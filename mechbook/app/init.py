@@ -2,7 +2,9 @@
 
 The starter tree (mechbook/app/starter, shipped in the package) holds books.yaml with one
 book, one example problem (a pendulum on a spring, its radius declared positive) with its
-answer key, and a Makefile with the usual targets. Nothing is overwritten: a file that
+answer key, and a Makefile with the usual targets; and the JSON Schemas of those files
+under schemas/, which the first line of each names for an editor's YAML language server
+(mechbook.app.editor). Nothing is overwritten: a file that
 exists already is refused, naming it.
 
 Nothing is written outside DIR either. DIR itself may be a link to a directory (the user
@@ -19,6 +21,8 @@ import stat
 from importlib import resources
 from pathlib import Path
 
+from mechbook.app.editor import DIRECTORY, NAMES
+from mechbook.app.editor import text as schema_text
 from mechbook.errors import MechbookError
 
 FILES = {"books.yaml": "books.yaml", "problem.yaml": "problems/mybook/1.1.yaml",
@@ -112,16 +116,19 @@ def init_tree(target: str | Path) -> list[Path]:
     """Write the starter tree into `target` (created if needed); the files written."""
     target = Path(target)
     _names_fit(target)
+    contents = {f"{DIRECTORY}/{name}.json": schema_text(name).encode("utf-8")
+                for name in NAMES}  # first: the files' modelines name these
+    source = resources.files("mechbook.app").joinpath("starter")
+    contents.update((dest, source.joinpath(name).read_bytes()) for name, dest in FILES.items())
     top = _top(target)
     try:
-        for dest in FILES.values():
+        for dest in contents:
             why = _clash(top, dest, target)
             if why is not None:
                 raise MechbookError(why)
         written = []
-        source = resources.files("mechbook.app").joinpath("starter")
-        for name, dest in FILES.items():
-            _write(top, dest, target, source.joinpath(name).read_bytes())
+        for dest, data in contents.items():
+            _write(top, dest, target, data)
             written.append(target / dest)
     finally:
         os.close(top)

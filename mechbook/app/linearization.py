@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from mechbook.errors import NotFoundError
 from mechbook.model.manifold import Freedoms, manifold_of
 
 
@@ -55,27 +56,74 @@ class Linearization:
     engine: object  # the engine's own linear system (LinearSystem or StateSpaceSystem)
     values: dict  # the default parameter values
 
-    def exponents(self, values: dict | None = None) -> np.ndarray:
-        """The exponents p of e^{pt} solutions (eigenvalues of A) at `values` ({parameter
-        symbol or name: number}; default: the parameters' defaults)."""
+    def exponents(self, params: dict | None = None) -> np.ndarray:
+        """The exponents p of e^{pt} solutions: the eigenvalues of A.
+
+        Parameters
+        ----------
+        params : dict, optional
+            Parameter values instead of the defaults, {name or symbol: number}.
+
+        Returns
+        -------
+        numpy.ndarray
+            The complex exponents.
+
+        Examples
+        --------
+        >>> lin.exponents(params={"W": 3})        # doctest: +SKIP
+        """
         from mechbook.engine.response import exponents
 
-        return exponents(self.engine, self._at(values))
+        return exponents(self.engine, self._at(params))
 
-    def frequencies(self, values: dict | None = None) -> np.ndarray:
-        """The oscillation frequencies at `values` (NaN marks a growing mode)."""
-        return np.asarray(self.engine.numeric_frequencies(self._at(values)))
+    def frequencies(self, params: dict | None = None) -> np.ndarray:
+        """The oscillation frequencies.
 
-    def stability(self, values: dict | None = None) -> str:
-        """'stable', 'unstable' or 'marginal' at `values`."""
-        return self.engine.numeric_stability(self._at(values))
+        Parameters
+        ----------
+        params : dict, optional
+            Parameter values instead of the defaults, {name or symbol: number}.
 
-    def _at(self, values: dict | None) -> dict:
+        Returns
+        -------
+        numpy.ndarray
+            One angular frequency per oscillating mode; NaN marks a growing mode.
+
+        Examples
+        --------
+        >>> lin.frequencies(params={"W": 3})      # doctest: +SKIP
+        """
+        return np.asarray(self.engine.numeric_frequencies(self._at(params)))
+
+    def stability(self, params: dict | None = None) -> str:
+        """Whether small motions about the point stay small.
+
+        Parameters
+        ----------
+        params : dict, optional
+            Parameter values instead of the defaults, {name or symbol: number}.
+
+        Returns
+        -------
+        str
+            'stable', 'unstable' or 'marginal'.
+
+        Examples
+        --------
+        >>> lin.stability(params={"W": 0.5})      # doctest: +SKIP
+        'unstable'
+        """
+        return self.engine.numeric_stability(self._at(params))
+
+    def _at(self, params: dict | None) -> dict:
         out = dict(self.values)
         by_name = {str(k): k for k in out}
-        for k, v in (values or {}).items():
-            key = by_name.get(str(k), k)
-            out[key] = v
+        for k, v in (params or {}).items():
+            if str(k) not in by_name:  # a value nothing reads would change nothing
+                raise NotFoundError(f"{str(k)!r} is not a parameter here (parameters: "
+                                    f"{', '.join(sorted(by_name))})")
+            out[by_name[str(k)]] = v
         return {k: sp.Float(float(v), 30) for k, v in out.items()}
 
 

@@ -6,8 +6,9 @@ into pieces at the places a mathematician breaks a line — between the terms of
 factors of a product, inside a bracket or a function's argument — each piece with its
 estimated width (the characters of SymPy's text), and the pieces are packed greedily into
 rows of at most `width` characters; an equation's '=' starts a row. A bracket opened on one
-row may close on a later one (with its exponent), and a product's denominator is written
-first as a factor 1/d. A piece that cannot be cut (a long fraction) keeps its own row.
+row may close on a later one (with its exponent), but never ends a row or starts one
+alone; a product's denominator is written first as a factor 1/d. A piece that cannot be
+cut (a long fraction) keeps its own row.
 """
 
 from __future__ import annotations
@@ -38,7 +39,32 @@ def rows(expr, width: int, inner: Callable[[object], str]) -> list[str] | None:
     return lines if len(lines) > 1 else None
 
 
+OPEN, CLOSE = "<mo>(</mo>", "<mo>)</mo>"
+
+
+def _glued(pieces: list[Piece]) -> list[Piece]:
+    """An opening bracket joined to what follows it, and a closing one (with its exponent)
+    to what precedes it: a row never ends in '(' nor starts with ')', which a browser
+    would draw alone and stretched to the row's height."""
+    out: list[Piece] = []
+    carry: Piece | None = None
+    for text, size in pieces:
+        if carry is not None:
+            text, size, carry = carry[0] + text, carry[1] + size, None
+        if text.startswith((CLOSE, "<msup>" + CLOSE)) and out:
+            prev_text, prev_size = out.pop()
+            text, size = prev_text + text, prev_size + size
+        if text.endswith(OPEN):
+            carry = (text, size)
+            continue
+        out.append((text, size))
+    if carry is not None:
+        out.append(carry)
+    return out
+
+
 def _pack(pieces: list[Piece], width: int) -> list[str]:
+    pieces = _glued(pieces)
     out, current, used = [], "", 0
     for text, size in pieces:
         if current and used + size > width:
@@ -74,7 +100,7 @@ def _pieces(expr, width: int, inner) -> list[Piece]:  # noqa: C901 - one case pe
             negative = term.could_extract_minus_sign()
             shown = -term if negative else term
             sub = _pieces(shown, width, inner)
-            sign = "<mo>−</mo>" if negative else ("<mo>+</mo>" if i else "")
+            sign = "<mo>\u2212</mo>" if negative else ("<mo>+</mo>" if i else "")
             sub[0] = (sign + sub[0][0], sub[0][1] + (2 if sign else 0))
             out += sub
         return out

@@ -3,7 +3,8 @@
 SymPy's presentation printer does the work; this module adds only what a mechanics reader
 expects and SymPy's MathML printer lacks: a velocity `thetadot` printed θ̇ and an
 acceleration `thetaddot` θ̈ (SymPy's LaTeX printer already does this), with dots drawn large
-enough to read at 100 % (browsers draw U+02D9 as a speck: θ̇ read as θ²), equations, lists
+enough to read at 100 % (browsers draw U+02D9 as a speck: θ̇ read as θ²), one minus sign
+(U+2212, where SymPy writes a hyphen), equations, lists
 and mappings laid out one per row, and a long sum broken into lines of about `width`
 characters, so that an equation fits its column instead of scrolling.
 """
@@ -53,14 +54,31 @@ class _Printer(MathMLPresentationPrinter):
 
     _print_Dummy = _print_Symbol
 
+    def _print_BooleanTrue(self, expr):  # SymPy draws Python's `True`
+        return self._text("true")
+
+    def _print_BooleanFalse(self, expr):
+        return self._text("false")
+
+    def _text(self, text: str):
+        node = self.dom.createElement("mtext")
+        node.appendChild(self.dom.createTextNode(text))
+        return node
+
+
+MINUS = "\u2212"  # the minus sign; SymPy's printer writes the hyphen-minus '-'
+
 
 def inner(expr) -> str:
-    """The MathML of one SymPy object (no <math> wrapper)."""
+    """The MathML of one SymPy object (no <math> wrapper), every minus sign U+2212 (the
+    line breaker's too: one glyph in a formula, never a hyphen beside a minus)."""
     if isinstance(expr, bool):
         expr = sp.true if expr else sp.false
     if isinstance(expr, (int, float)):
         expr = as_expr(expr)  # a Python number, never text
-    return _Printer({"mat_delim": "["}).doprint(expr)
+    out = _Printer({"mat_delim": "["}).doprint(expr)
+    return out.replace("<mo>-</mo>", f"<mo>{MINUS}</mo>").replace(
+        "<mn>-", f"<mo>{MINUS}</mo><mn>")
 
 
 def math(expr, display: bool = True, width: int | None = WIDTH) -> str:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.outputs import OutputError, output_file, resolve_path
 from mechbook.app.run import ProblemRun, RunOptions, cached_runs, run_problem
+from mechbook.app.selection import select
 from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, problem_path
 
@@ -47,6 +48,7 @@ class CheckOptions:
     fresh: bool = False  # recompute everything (the store is still written)
     batch: BatchOptions = BatchOptions()
     scheduler: str | None = None  # a Dask scheduler's address (else $MECHBOOK_SCHEDULER)
+    exitfirst: bool = False  # stop at the first problem that fails (pytest's -x)
 
     @property
     def run(self) -> RunOptions:
@@ -62,6 +64,7 @@ class CheckReport:
     store: Path
     saver: Saver | None = None  # None: nothing was to be written
     cached: list[str] = field(default_factory=list)  # ids answered from the store
+    stopped: list[str] = field(default_factory=list)  # not checked: -x stopped the run
 
     @property
     def store_error(self) -> str | None:
@@ -84,10 +87,11 @@ class CheckReport:
 
 
 def resolve_ids(ids: Sequence[str], base: Path) -> tuple[list[str], dict[str, ProblemRun]]:
-    """The named ids, or all of the tree's, each looked up once (mechbook.model.ids: one
-    grammar). A named id that is malformed or has no file is a MechbookError; a file of the
-    tree whose name is no good id is returned as an error run of its own (`refused`)."""
-    named = list(ids)
+    """The named ids (patterns and books expanded: mechbook.app.selection), or all of the
+    tree's, each looked up once (mechbook.model.ids: one grammar). A named id that is
+    malformed or has no file is a MechbookError; a file of the tree whose name is no good
+    id is returned as an error run of its own (`refused`)."""
+    named = select(ids, base)
     out = named or all_ids(base)
     refused: dict[str, ProblemRun] = {}
     for pid in out:
@@ -130,6 +134,7 @@ class CheckService:
         """Check `ids` (from `resolve`): answer what the store still holds, run the rest
         the longest first on the pool or the cluster, write each as it finishes; every run,
         cached or new, is handed to `on_done` as it is known."""
+        from mechbook.app.formats import failures
         from mechbook.app.store import durations
         from mechbook.app.unsaved import Saver
 
@@ -143,19 +148,26 @@ class CheckService:
             if pid in runs:
                 on_done(runs[pid])
         saver = Saver(self.store)
+        past = durations(self.store)
+        todo = sorted((pid for pid in ids if pid not in runs),
+                      key=lambda pid: -past.get(pid, float("inf")))
+        if opts.exitfirst and failures(list(runs.values())):
+            todo = []  # a failure known already: -x checks nothing more
+        batch = self._batch(todo, lambda run: None)
 
         def finished(run: ProblemRun) -> None:
             on_done(run)
             if run.record is not None and opts.write:
                 saver.save(run.record)  # never raises: a failure keeps the record aside
+            if opts.exitfirst and failures([run]):
+                batch.stop()
 
-        past = durations(self.store)
-        todo = sorted((pid for pid in ids if pid not in runs),
-                      key=lambda pid: -past.get(pid, float("inf")))
-        for run in self._batch(todo, finished).run(todo):
+        batch.on_done = finished
+        for run in batch.run(todo):
             runs[run.pid] = run
-        return CheckReport([runs[pid] for pid in ids], self.store,
-                           saver if opts.write else None, cached)
+        return CheckReport([runs[pid] for pid in ids if pid in runs], self.store,
+                           saver if opts.write else None, cached,
+                           [pid for pid in ids if pid not in runs])
 
     def _batch(self, todo: list[str], finished: OnDone):
         """The cluster when a scheduler is named and there is work, else the local pool

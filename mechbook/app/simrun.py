@@ -16,7 +16,7 @@ from typing import Any
 
 from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.run import Stage
-from mechbook.errors import MechbookError, describe
+from mechbook.errors import MechbookError, describe, message
 
 
 @dataclass(frozen=True)
@@ -82,7 +82,7 @@ def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -
                        parameters=parse_assignments(request.params), rtol=request.rtol,
                        atol=request.atol, max_step=request.max_step, step=request.step)
     except (MechbookError, KeyError) as exc:
-        report.error = str(exc).strip("'\"")
+        report.error = message(exc)
         return report
     except Exception as exc:  # noqa: BLE001 - a message; the traceback to the debug log
         report.error = f"simulate {request.problem_id}: {describe(exc)}"

@@ -315,10 +315,9 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
 def _on_cluster(spec: SweepSpec, ranges: list[tuple[int, int]], scheduler: str,
                 timeout: float, memory_mb: float, progress: Callable[[int, int], None]) -> dict:
     """Every block on the Dask cluster, each under the limits on its worker."""
-    from dask.distributed import as_completed
+    from mechbook.app.distributed import connect, dask_distributed
 
-    from mechbook.app.distributed import connect
-
+    as_completed = dask_distributed().as_completed
     parts: dict[int, dict] = {}
     with connect(scheduler) as client:
         futures = {client.submit(cluster_block, spec, a, b, timeout, memory_mb,

@@ -137,6 +137,10 @@ def _index(i) -> int:
 
 def _entry(t, i, j=None):
     """Component T_ij (1-based) of a tensor, or v_i of a vector."""
+    if j is None and _tensor(t):
+        raise TypeError("a tensor's entry takes two indices: entry(T, i, j)")
+    if j is not None and _vector(t):
+        raise TypeError("a vector's entry takes one index: entry(v, i)")
     if j is None:
         _need("vector", _vector, t)
         return t[_index(i), 0]
@@ -155,11 +159,43 @@ def _col(t, j):
     return _im(t[:, _index(j)])
 
 
+VARIABLE = "var"  # the label of a `for_all` variable's symbol, x.var (verify.instances)
+
+
+def for_all_name(symbol) -> str | None:
+    """The `for_all` name a symbol of a generic object belongs to (x of x.var, T of T.12),
+    None for a parameter or any other plain name (those never hold a '.')."""
+    if isinstance(symbol, sp.Symbol) and "." in symbol.name:
+        return symbol.name.split(".", 1)[0]
+    return None
+
+
+def is_variable(symbol) -> bool:
+    """A `for_all` name of kind `variable`: it stays a symbol while a statement is built
+    (from the generic objects or from one instance), so calculus may act on it."""
+    return isinstance(symbol, sp.Symbol) and symbol.name.endswith("." + VARIABLE)
+
+
+def _calculus_symbol(s, verb: str) -> sp.Symbol:
+    """The symbol that `verb` (differentiate with respect to, integrate over, ...) acts on:
+    a parameter or a `for_all` variable. Any other `for_all` object is a number at each of
+    the instances a statement may be built from (mechbook.verify.instances), so it is
+    refused always, whichever way the statement is built."""
+    if is_variable(s) or (isinstance(s, sp.Symbol) and for_all_name(s) is None):
+        return s
+    owners = sorted({n for x in getattr(s, "free_symbols", ()) if (n := for_all_name(x))})
+    if owners:
+        name = owners[0]
+        raise TypeError(f"to {verb} {name!r}, declare it a variable (for_all: {{{name}: "
+                        f"variable}}): a `for_all` object of another kind is drawn as "
+                        "numbers at each instance")
+    raise TypeError(f"{verb} a plain symbol: a parameter, or a `for_all` name of kind "
+                    "`variable` (for_all: {x: variable})")
+
+
 def _diff(x, s):
-    """d/ds of a scalar, vector or tensor; s a parameter or a generic scalar."""
-    if not isinstance(s, sp.Symbol):
-        raise TypeError("differentiate with respect to a plain symbol (a parameter, or a "
-                        "`for_all` scalar)")
+    """d/ds of a scalar, vector or tensor; s a parameter or a `for_all` variable."""
+    s = _calculus_symbol(s, "differentiate with respect to")
     if isinstance(x, sp.MatrixBase):  # entry by entry (SymPy's Matrix.diff goes through
         # its array-derivative machinery, several times slower for the same entries)
         return _im(x.applyfunc(lambda e: derivative(e, s)))
@@ -167,10 +203,9 @@ def _diff(x, s):
 
 
 def _coordinates(r) -> list[sp.Symbol]:
+    """The position [x, y, z] of grad and div: three parameters or `for_all` variables."""
     _need("vector", _vector, r)
-    if not all(isinstance(c, sp.Symbol) for c in r):
-        raise TypeError("the position must be a vector of three plain symbols [x, y, z]")
-    return list(r)
+    return [_calculus_symbol(c, "differentiate along") for c in r]
 
 
 def _grad(x, r):
@@ -196,8 +231,7 @@ def _div(x, r):
 def _subs(x, s, v):
     """x with the symbol s replaced by the scalar v (a boundary value, a change of
     variables)."""
-    if not isinstance(s, sp.Symbol):
-        raise TypeError("substitute for a plain symbol")
+    s = _calculus_symbol(s, "substitute for")
     _need("scalar", _scalar, v)
     return _im(x.xreplace({s: v})) if isinstance(x, sp.MatrixBase) else x.xreplace({s: v})
 
@@ -205,8 +239,7 @@ def _subs(x, s, v):
 def _integral(f, s, lo, hi):
     """The definite integral of a scalar over s from lo to hi (SymPy's integrate; an
     integral it cannot do in closed form is an error)."""
-    if not isinstance(s, sp.Symbol):
-        raise TypeError("integrate over a plain symbol")
+    s = _calculus_symbol(s, "integrate over")
     _need("scalar", _scalar, f, lo, hi)
     out = sp.integrate(f, (s, lo, hi))
     if out.has(sp.Integral):

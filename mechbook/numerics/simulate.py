@@ -252,6 +252,7 @@ def simulate(analysis: Analysis, system_name: str | None = None, *,
     `options` go to the integrator (rtol, atol, max_step for SciPy's methods; step for the
     fixed-step ones). SciPy's methods report at `points` evenly spaced times."""
     start = time.perf_counter()
+    asked = method  # a method the caller asked for is used or refused, never replaced
     problem = analysis.problem
     sys = analysis.system(system_name)
     values = parameter_values(analysis, parameters)
@@ -292,7 +293,10 @@ def simulate(analysis: Analysis, system_name: str | None = None, *,
     except UnsupportedError as exc:
         if method != "taylor":
             raise
-        # heyoka missing, or an expression it cannot take: the SciPy path, saying so
+        if asked == "taylor":  # asked for by name: an error, not another method
+            raise MechbookError(f"the taylor method cannot run: {exc.capability}; choose "
+                                "another method (or none)") from None
+        # chosen by `accuracy`, and heyoka refused the system: the SciPy path, saying so
         method = "DOP853"
         if accuracy is not None:
             picked = choose(accuracy, method=method, periods=None if not stiff.rates

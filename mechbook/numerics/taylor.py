@@ -37,12 +37,13 @@ def available() -> bool:
 
 
 def _hy():
+    from mechbook.core.optional import require
+    from mechbook.errors import MissingDependencyError
+
     try:
-        import heyoka
-    except ImportError:
-        raise UnsupportedError("the Taylor backend needs heyoka (pip install "
-                               "'mechbook[taylor]')") from None
-    return heyoka
+        return require("heyoka", "taylor", "the Taylor method")
+    except MissingDependencyError as exc:  # unsupported here: callers may go another way
+        raise UnsupportedError(str(exc)) from None
 
 
 @dataclass

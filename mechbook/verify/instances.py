@@ -18,8 +18,9 @@ numerator over a common denominator expanded to 0 (a polynomial normal form, in 
 core.rational; SymPy's `cancel` within a time limit for the largest), or, with `--prove`,
 `simplify` — and the verdict says which of the three it got: symbolic, exact(…) or
 numeric(…). Exact values at rational points are computed in SymEngine too. Symbols of
-kind `variable` (differentiated or integrated in the statement) stay symbols while it is
-built from an instance.
+kind `variable` (differentiated or integrated in the statement) and the parameters stay
+symbols while it is built from an instance: calculus acts on them the same way on either
+path (mechbook.model.tensorfuncs refuses any other `for_all` object as its variable).
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from mechbook.core.rational import (
     vanishes_identically,
 )
 from mechbook.core.timeout import Timeout, time_limit
+from mechbook.model.tensorfuncs import VARIABLE
 from mechbook.verify.compare import Sampler, Verdict, value_and_scale
 
 KINDS = ("scalar", "positive", "angle", "variable", "vector", "unit_vector", "tensor",
@@ -69,7 +71,7 @@ def generic(name: str, kind: str) -> list:
     if kind == "scalar":
         return [_syms(name, ("x",))[0]]
     if kind == "variable":  # kept a symbol while the statement is built (calculus)
-        return [_syms(name, ("var",))[0]]
+        return [_syms(name, (VARIABLE,))[0]]
     if kind == "positive":
         return [_syms(name, ("x",), positive=True)[0]]
     if kind == "angle":  # drawn in (-3, 3) rad
@@ -131,12 +133,6 @@ def generic_symbols(branch: dict) -> list[sp.Symbol]:
     for obj in branch.values():
         out |= obj.free_symbols
     return sorted(out, key=str)
-
-
-def is_variable(symbol: sp.Symbol) -> bool:
-    """A `variable` (differentiated, integrated or substituted for in the statement): it
-    keeps its symbol while the statement is built, and gets its value afterwards."""
-    return symbol.name.endswith(".var")
 
 
 def decide(names_at: Names, build: Build, symbols: Sequence[sp.Symbol],

@@ -1,5 +1,6 @@
 """The `mechbook` command line: the group `main` and its commands, one module each (check,
-listing, solve, validate, watch, show, simulate, sweep, report, restore, init, completion);
+listing, solve, validate, watch, show, simulate, sweep, report, restore, init, schema, docs,
+completion);
 what they share (printing, the tree's root, option decorators) is in `common`.
 
 Only click and a few small modules are imported at the top of every module here: --help,
@@ -17,10 +18,12 @@ import click
 from mechbook.app.cli import (
     check,
     completion,
+    docs,
     init,
     listing,
     report,
     restore,
+    schema,
     show,
     simulate,
     solve,
@@ -60,7 +63,10 @@ class _Group(click.Group):
                    "$MECHBOOK_ROOT).")
 @click.pass_context
 def main(ctx: click.Context, root_dir: Path | None) -> None:
-    """mechbook: textbook mechanics problems as Lagrangian systems, checked against the book."""
+    """mechbook: textbook mechanics problems as Lagrangian systems, checked against the book.
+
+    The documentation pages that help texts and messages name (docs/*.md) come with
+    mechbook: `mechbook docs` lists them, `mechbook docs schema` prints one."""
     ctx.ensure_object(dict)
     ctx.obj["root_opt"] = root_dir
     set_logging()
@@ -71,5 +77,5 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
 
 # one module per command (`mechbook --help` lists them by name)
 for _module in (listing, solve, check, validate, watch, show, simulate, sweep, report, restore,
-                init, completion):
+                init, schema, docs, completion):
     main.add_command(_module.command)

@@ -57,13 +57,22 @@ from mechbook.errors import MechbookError
                    "mechbook/app/schemas/check-result.json), progress stays on stderr.")
 @click.option("--junit-xml", "junit_path", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="Also write the outcomes as JUnit XML here (for CI).")
+@click.option("-x", "--exitfirst", is_flag=True,
+              help="Stop at the first problem that fails or errors (the others are reported "
+                   "as not checked).")
+@click.option("--lf", "--last-failed", "last_failed", is_flag=True,
+              help="Check only the problems that failed or errored when last checked (all "
+                   "of them when none did), as pytest's --lf.")
 @click.pass_context
 def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
             no_store: bool, verbose: bool, fresh: bool, no_crosscheck: bool, jobs: int,
             timeout: float, memory_mb: float, serial: bool, prove: bool,
             prove_seconds: float, scheduler: str | None, fmt: str,
-            junit_path: Path | None) -> None:
+            junit_path: Path | None, exitfirst: bool, last_failed: bool) -> None:
     """Check problems against their answer keys (all by default); exit 1 on any fail.
+
+    PROBLEM_IDS are ids (lim-2031), patterns over ids ('mybook-*', quoted for the shell)
+    or a book's id (mybook: all its problems).
 
     Problems run in parallel worker processes, the longest first; each finished problem is
     written to the store at once, so an interrupted run keeps what it finished and the next
@@ -83,15 +92,47 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     batch = BatchOptions(jobs, timeout, memory_mb, serial=serial, run=RunOptions(
         crosscheck=not no_crosscheck, policy=ProofPolicy(prove, prove_seconds)))
     service = CheckService(base, CheckOptions(store_path, write=not no_store, fresh=fresh,
-                                              batch=batch, scheduler=scheduler))
+                                              batch=batch, scheduler=scheduler,
+                                              exitfirst=exitfirst))
     try:
         ids = service.resolve(problem_ids)
     except MechbookError as exc:
         raise click.ClickException(str(exc)) from None
+    if last_failed:
+        ids = _last_failed(service.store, ids)
     checked_output(junit_path, "JUnit XML file")
     set_logging(verbose)
     report = _run(service, ids, verbose)
+    if not no_store:
+        _remember(report)
     _print(report, base, fmt, verbose, junit_path)
+
+
+def _last_failed(store: Path, ids: list[str]) -> list[str]:
+    """Of `ids`, those that failed when last checked; all of them when none did."""
+    from mechbook.app.selection import last_failed
+
+    failed = last_failed(store)
+    chosen = [pid for pid in ids if pid in failed]
+    if chosen:
+        say(f"--lf: checking the {len(chosen)} of {len(ids)} problem(s) that failed when "
+            "last checked", err=True)
+        return chosen
+    say(f"--lf: no problem failed when last checked: checking all {len(ids)}", err=True)
+    return ids
+
+
+def _remember(report) -> None:
+    """Record which problems failed now, for `--lf` (a note if it cannot be written)."""
+    from mechbook.app.formats import failures
+    from mechbook.app.selection import lastfailed_path, record
+
+    try:
+        record(report.store, [r.pid for r in report.runs],
+               [r.pid for r in report.runs if failures([r])])
+    except OSError as exc:
+        say(f"note: the failures are not recorded for --lf ({lastfailed_path(report.store)}:"
+            f" {exc.strerror})", err=True)
 
 
 def _refuse_serial_limits(ctx: click.Context, serial: bool) -> None:
@@ -157,5 +198,9 @@ def _print(report, base: Path, fmt: str, verbose: bool, junit_path: Path | None)
     bad = failures(ordered)
     if bad:
         click.echo(f"{bad} failure(s)", err=True)
+    if report.stopped:
+        click.echo(f"stopped at the first failure (-x): {len(report.stopped)} problem(s) "
+                   f"not checked: {', '.join(report.stopped[:10])}"
+                   + (" ..." if len(report.stopped) > 10 else ""), err=True)
     if bad or report.store_error is not None or unwritten:
         sys.exit(1)

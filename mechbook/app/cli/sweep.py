@@ -29,7 +29,7 @@ from mechbook.app.cli.common import (
 )
 from mechbook.app.sweep_spec import QUANTITIES
 from mechbook.core.backends import DEFAULT_BACKEND
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, message
 
 
 @click.command("sweep")
@@ -101,7 +101,7 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
         result = run_sweep(spec, base, jobs=jobs, scheduler=address,
                            timeout=timeout, memory_mb=memory_mb, samples=samples)
     except (MechbookError, KeyError) as exc:
-        raise click.ClickException(str(exc).strip("'\"")) from None
+        raise click.ClickException(message(exc)) from None
     run_name = name or "-".join([quantity] + [a.name for a in axes])
     failed = not _write(result, base, path, run_name, out_path, stored=not no_store)
     if plot_path is not None:

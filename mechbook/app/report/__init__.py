@@ -3,7 +3,7 @@
     build      the index and one page per problem (pages computed on worker processes)
     page       one problem's page: the derivation as MathML, book and engine side by side
     values     the book's value and the engine's counterpart of an answer part
-    figures    mode shapes and the frequency cross-check (PNG)
+    svg        the charts (inline SVG); animation the bodies' motion as frames for a canvas
     templates/ the pages (Jinja2, autoescaped); assets/ the style sheet and the filter script
 
 Mathematics is SymPy's presentation MathML (mechbook.app.mathml), which browsers render

@@ -79,9 +79,10 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
                   "book": declared.get(b)}
                  for b in sorted({e["book"] for e in problems_index})]
     index = out / "index.html"
-    render("index.html", index, problems=problems_index, rows=rows, books=book_list,
-           statuses=[*STATUSES, NOT_CHECKED], counts=counts, version=__version__,
-           store=str(store), date=datetime.now(UTC).isoformat(timespec="seconds"),
+    render("index.html", index, tree=base, problems=problems_index, rows=rows,
+           books=book_list, statuses=[*STATUSES, NOT_CHECKED], counts=counts,
+           version=__version__, store=shown_path(store, base),
+           date=datetime.now(UTC).isoformat(timespec="seconds"),
            errata=[r for r in rows if r["status"] == Status.ERRATUM],
            unsupported=[r for r in rows if r["status"] == Status.UNSUPPORTED])
     return index
@@ -156,8 +157,8 @@ def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
                         "origin": p.get("origin", ""), "cite": p.get("cite", "")}
                        for p in page.get("parts", [])]}
     entry = _index_entry(pid, index, stored, declared)
-    render("problem.html", task.out / "problems" / f"{pid}.html", page=page, stored=stored,
-           entry=entry, version=__version__)
+    render("problem.html", task.out / "problems" / f"{pid}.html", tree=base, page=page,
+           stored=stored, entry=entry, version=__version__)
     return {"pid": pid, "index": index, "seconds": time.monotonic() - start}
 
 
@@ -169,11 +170,12 @@ def _write_failed(base: Path, out: Path, pid: str, stored: dict | None, why: str
     """A page that says it could not be built, and why (in words)."""
     page = {"id": pid, "title": ((stored or {}).get("attrs") or {}).get("title", ""),
             "source": "", "description": "", "notes_text": "", "parameters": [],
-            "conditions": [], "systems": [], "parts": [], "crosscheck_figures": {},
+            "conditions": [], "defaults": "", "systems": [], "parts": [],
+            "crosscheck_figures": {},
             "page_notes": [f"this page could not be built: {why}"]}
     entry = _index_entry(pid, {"title": page["title"]}, stored, books(base))
-    render("problem.html", out / "problems" / f"{pid}.html", page=page, stored=stored,
-           entry=entry, version=__version__)
+    render("problem.html", out / "problems" / f"{pid}.html", tree=base, page=page,
+           stored=stored, entry=entry, version=__version__)
 
 
 def _read_one(pid: str, store: Path) -> tuple[dict | None, str | None]:
@@ -296,12 +298,30 @@ def _num(x) -> str:
     return f"{x:.6g}"
 
 
-def render(template: str, path: Path, **context) -> None:
-    """Write a page atomically; a string that cannot be UTF-8 (a lone surrogate from an
-    old store) is written as an escape instead of ending the report."""
+def shown_path(path: Path, tree: Path) -> str:
+    """A path as a shared report may show it: relative to the tree when inside it, else
+    its name alone (an absolute path would tell where the report was built, and whose)."""
+    try:
+        return Path(path).resolve().relative_to(Path(tree).resolve()).as_posix()
+    except ValueError:
+        return Path(path).name
+
+
+def _unleak(text: str, tree: Path) -> str:
+    """Every path under the tree in the page's text (an error message's file, say) made
+    relative to it."""
+    for prefix in {str(Path(tree).resolve()), str(Path(tree).absolute())}:
+        text = text.replace(prefix + "/", "")
+    return text
+
+
+def render(template: str, path: Path, tree: Path, **context) -> None:
+    """Write a page atomically, with the tree's own paths made relative (`_unleak`); a
+    string that cannot be UTF-8 (a lone surrogate from an old store) is written as an
+    escape instead of ending the report."""
     from mechbook.app.outputs import replaced
     from mechbook.app.text import unicode_safe
 
-    text = _environment().get_template(template).render(**context)
+    text = _unleak(_environment().get_template(template).render(**context), tree)
     with replaced(path) as fh:  # a new file renamed into place: never written through a link
         fh.write(unicode_safe(text).encode("utf-8"))

@@ -78,12 +78,10 @@ def _row(page, sys_, point: dict, lin, values: dict) -> dict:
     row["frequencies"] = _modes_text(freqs, rates)
     if not np.any(C) and row["stability"] in ("stable", "marginal") and M.shape[0] > 1:
         row["modes"] = _shapes(M, K)
-    if M.shape[0] == 1 and not np.any(C):
-        exact = page.step("exact frequency", lambda: page.readable(
-            sp.sqrt(lin.K[0, 0] / lin.M[0, 0])))
-        if exact is not None and row["stability"] == "stable":
-            row["exact"] = page.show(sp.Eq(sp.Symbol("omega_1"), exact, evaluate=False),
-                                     simplify=False)
+    if M.shape[0] == 1 and not np.any(C) and row["stability"] == "stable":
+        exact = sp.Eq(sp.Symbol("omega_1"), sp.sqrt(lin.K[0, 0] / lin.M[0, 0]),
+                      evaluate=False)
+        row["exact"] = page.step("exact frequency", lambda: page.show(exact)) or ""
     return row
 
 

@@ -9,7 +9,8 @@ from the stored matrices at the default values. What the check did not need and 
 little — the kinetic and potential energies (built with the system), momenta, the energy
 function — is derived under a short limit; a short simulation of the full equations gives
 the page its charts and the animation of the bodies. Only what is shown is simplified for
-reading, each expression within `simplify_seconds` and all within `simplify_budget`.
+reading, each expression within `simplify_seconds` and all within `simplify_budget`; an
+expression left as derived says so, and why, above it.
 
 A step that fails or runs out leaves one line under "Not shown", with the reason in
 words: never an exception's text. The outcomes themselves come from the store: this module
@@ -18,6 +19,7 @@ decides nothing.
 
 from __future__ import annotations
 
+import html
 import logging
 import time
 from dataclasses import dataclass, field
@@ -28,7 +30,7 @@ import sympy as sp
 from mechbook.app.mathml import math
 from mechbook.app.report import svg
 from mechbook.app.report.derivation import StoredSystem
-from mechbook.core.timeout import Timeout, hard_time_limit, try_simplify
+from mechbook.core.timeout import Timeout, hard_time_limit, time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError, describe
 from mechbook.model.catalog import answer_path, problem_path
@@ -36,6 +38,7 @@ from mechbook.model.problem import load_problem
 
 LONGEST = 6000  # characters of SymPy text beyond which an expression is not typeset
 MAX_POINTS = 8  # equilibria shown per system
+SMALL = 30  # operations: an expression simplified even when the page's budget is spent
 log = logging.getLogger("mechbook.faults")
 
 
@@ -58,6 +61,7 @@ class Page:
     budget: float = 0.0
     timings: list[tuple[str, float]] = field(default_factory=list)  # the slow steps
     simplifying: float = 0.0
+    raw: set = field(default_factory=set)  # why expressions were left as derived
 
     def step(self, label: str, fn, seconds: float | None = None):
         """fn() within the step limit; None (and a line under "Not shown") if it cannot."""
@@ -91,26 +95,63 @@ class Page:
             return obj.applyfunc(self.readable)
         if isinstance(obj, sp.Equality):
             return sp.Eq(self.readable(obj.lhs), self.readable(obj.rhs), evaluate=False)
-        if not isinstance(obj, sp.Expr) or obj.is_Atom or self.budget <= 0:
+        if not isinstance(obj, sp.Expr) or obj.is_Atom:
+            return obj
+        seconds = min(self.options.simplify_seconds, self.budget)
+        if seconds <= 0 < self.options.simplify_seconds and sp.count_ops(obj) <= SMALL:
+            seconds = self.options.simplify_seconds  # past the budget, but costs little
+        if seconds <= 0:
+            self.raw.add(UNSIMPLIFIED["off" if self.options.simplify_seconds <= 0
+                                      else "budget"].format(o=self.options))
             return obj
         start = time.monotonic()
         try:
-            out = try_simplify(obj, min(self.options.simplify_seconds, self.budget))
-        except Timeout:  # the alarm arrived just after simplify returned
+            with time_limit(seconds):
+                out = sp.simplify(obj)
+        except Timeout:  # too long (or the alarm arrived just after simplify returned)
             out = obj
+            why = "slow" if seconds >= self.options.simplify_seconds else "budget"
+            self.raw.add(UNSIMPLIFIED[why].format(o=self.options))
         spent = time.monotonic() - start
         self.budget -= spent
         self.simplifying += spent
         return out
 
     def show(self, obj, simplify: bool = True) -> str:
-        """MathML of a result (simplified for reading), or a note when it is too long."""
+        """MathML of a result (simplified for reading) — with a note saying so when it is
+        shown as derived, unsimplified, and why — or a note when it is too long."""
+        self.raw = set()
         if simplify:
             obj = self.readable(obj)
         if len(sp.sstr(obj)) > LONGEST:
             return ('<p class="note">too long to typeset here (`mechbook solve` prints '
                     "it)</p>")
-        return math(obj)
+        if not simplify and _compound(obj):
+            self.raw.add("shown as derived")
+        note = "".join(f'<p class="note unsimplified">not simplified: {html.escape(why)}</p>'
+                       for why in sorted(self.raw))
+        return note + math(obj)
+
+
+UNSIMPLIFIED = {  # why an expression is shown as the engine derived it
+    "slow": "simplifying it takes longer than {o.simplify_seconds:g} s "
+            "(mechbook report --simplify-seconds)",
+    "budget": "the page's {o.simplify_budget:g} s for simplifying were spent "
+              "(mechbook report --simplify-seconds raises both)",
+    "off": "simplification is off (--simplify-seconds 0)",
+}
+
+
+def _compound(obj) -> bool:
+    """Something a simplification could change (not a lone number or symbol)."""
+    if isinstance(obj, list | tuple):
+        return any(_compound(o) for o in obj)
+    if isinstance(obj, dict):
+        return any(_compound(v) for v in obj.values())
+    if isinstance(obj, sp.MatrixBase | sp.Equality):
+        return any(_compound(a) for a in (obj if isinstance(obj, sp.MatrixBase)
+                                         else obj.args))
+    return isinstance(obj, sp.Expr) and not obj.is_Atom
 
 
 def _short(text: str) -> str:
@@ -124,6 +165,7 @@ def build_page(pid: str, base: Path, stored: dict | None,
     """Everything the problem's page shows, as plain data (HTML fragments, numbers)."""
     from mechbook.app.report.parts import parts
     from mechbook.app.report.systems import system_section
+    from mechbook.app.report.values import point_math
 
     start = time.monotonic()
     page = Page(options, budget=options.simplify_budget)
@@ -135,6 +177,8 @@ def build_page(pid: str, base: Path, stored: dict | None,
            "parameters": [(n, p.value, p.doc) for n, p in problem.parameters.items()
                           if not _coefficient(problem, n)],
            "conditions": [math(c, display=False) for c in problem.conditions],
+           "defaults": page.step("the default values", lambda: point_math(problem.values(),
+                                                                          problem)) or "",
            "systems": [], "parts": [], "crosscheck_figures": {}}
     apath = answer_path(pid, base)
     key = page.step("the answer key", lambda: _answers(apath)) if apath.exists() else None

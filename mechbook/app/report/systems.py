@@ -144,10 +144,24 @@ def _simulation(page, analysis, name: str, sys_, rows: list[dict]) -> dict | Non
     return {"charts": charts,
             "motion": json.dumps(motion).replace("</", "<\\/") if motion else None,
             "drifts": [(d.name, float(d.relative)) for d in sim.drifts],
-            "method": ", ".join(f"{k}={v}" for k, v in traj.settings.items()),
+            "method": settings_text(traj.settings),
             "initial": ", ".join(f"{k} = {v:.4g}" for k, v in sim.initial.items()),
             "initial_source": source, "t_end": float(traj.t[-1]),
             "samples": len(traj.t), "notes": list(sim.notes)}
+
+
+def settings_text(settings: dict) -> str:
+    """An integrator's settings for a reader: `DOP853, rtol 1e-08, atol 1e-10, compiled`
+    (a flag by its name, never a Python True or False)."""
+    out = []
+    for key, value in settings.items():
+        if key == "method":
+            out.insert(0, str(value))
+        elif isinstance(value, bool):
+            out.append(key if value else f"not {key}")
+        elif value is not None:
+            out.append(f"{key} {value:.3g}" if isinstance(value, float) else f"{key} {value}")
+    return ", ".join(out)
 
 
 def _inside(sys_, q, values: dict) -> float:

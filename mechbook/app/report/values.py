@@ -22,7 +22,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
-from mechbook.app.mathml import math
+from mechbook.app.mathml import MINUS, NS, identifier_mathml, math
 from mechbook.app.report.derivation import StoredSystem
 from mechbook.app.report.syntax import syntax_math
 from mechbook.engine.periodic import time_dependent
@@ -60,8 +60,8 @@ def book_math(ctx: Context | None, value, sub: tuple = ("book",)) -> str:
             rows.append(f'<div class="kv"><span class="key">{_esc(k)}</span>'
                         f'<div class="val">{book_math(ctx, v, sub + (k,))}</div></div>')
         return "".join(rows)
-    if isinstance(value, bool):
-        return f"<code>{value}</code>"
+    if isinstance(value, bool):  # as a reader says it, not as Python spells it
+        return f'<span class="flag">{"yes" if value else "no"}</span>'
     if ctx is not None:
         try:
             return math(parse_shown(ctx, value, sub))
@@ -165,19 +165,49 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
 
 
 def numeric_pair(ctx: Context, view: StoredSystem | None,
-                 values: dict) -> tuple[list[float], list[float]] | None:
-    """(book, engine) values at one admissible parameter point for the quantities that are
-    lists of numbers (frequencies, periods), else None. The engine's are the stored linear
-    system's frequencies there."""
+                 values: dict) -> tuple[list[float], list[float], str] | None:
+    """(book, engine, the point) at one admissible parameter point for the quantities that
+    are lists of numbers (frequencies, periods), else None. The engine's are the stored
+    linear system's frequencies there; the point is said as MathML (point_math)."""
     shown = display_of(ctx.part.quantity)
     if shown not in ("frequency_list", "period_list") or "limit" in ctx.part.data:
         return None
+    pt = ctx.sampler.default()
+    pair = _numeric_pair(ctx, view, values, pt, shown)
+    if pair is None:
+        return None
+    return (*pair, point_math(pt, ctx.analysis.problem))
+
+
+def point_math(point: dict, problem) -> str:
+    """Where numbers were computed: the parameters' values there, as inline MathML, and
+    whether they are the defaults (a condition may rule the defaults out)."""
+    defaults = problem.values()
+    shown = [(p.symbol, point[p.symbol]) for p in problem.parameters.values()
+             if p.symbol in point]
+    if not shown:
+        return ""
+    same = all(abs(float(v) - float(defaults[s])) <= 1e-12 * max(1.0, abs(defaults[s]))
+               for s, v in shown)
+    pairs = ", ".join(f'<math xmlns="{NS}" display="inline">{identifier_mathml(s.name)}'
+                      f"<mo>=</mo>{_number(float(v))}</math>" for s, v in shown)
+    return pairs + (" (the default values)" if same else
+                    " (a random admissible point: the defaults break a condition)")
+
+
+def _number(x: float) -> str:
+    text = f"{x:.6g}"
+    return (f"<mo>{MINUS}</mo><mn>{text[1:]}</mn>" if text.startswith("-")
+            else f"<mn>{text}</mn>")
+
+
+def _numeric_pair(ctx: Context, view: StoredSystem | None, values: dict, pt: dict,
+                  shown: str) -> tuple[list[float], list[float]] | None:
     lin = part_linear(ctx, view, values)
     if lin is None:
         return None
     book = ctx.part.data.get("book")
     items = book if isinstance(book, list) else [book]
-    pt = ctx.sampler.default()
     exprs = [ctx.parse(v, ("book", i)) for i, v in enumerate(items)]
     if lin.first_order:  # its frequencies are stored at the default values only
         stored = lin.numeric.get("frequencies")

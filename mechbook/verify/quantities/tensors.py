@@ -16,6 +16,7 @@ import sympy as sp
 from mechbook.core.compile import as_expr
 from mechbook.errors import ExpressionError
 from mechbook.model.tensorexpr import kind, parse_tensor, parse_tensor_equation
+from mechbook.model.tensorfuncs import for_all_name, is_variable
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 from mechbook.verify.instances import (
@@ -24,7 +25,6 @@ from mechbook.verify.instances import (
     branches,
     decide,
     generic_symbols,
-    is_variable,
     rational_point,
 )
 from mechbook.verify.registration import ESTIMATE, NAME, quantity, registered
@@ -65,12 +65,14 @@ def check(ctx: Context, build) -> Verdict:
 
 
 def _names(ctx: Context, branch: dict, point: dict | None) -> dict:
-    """The part's names with the branch's generic objects and `define:`, everything at
-    `point` (numbers for the symbols) unless None."""
+    """The part's names with the branch's generic objects and `define:`; at `point` (unless
+    None) the generic objects are numbers, but for the `variable`s: those and the
+    parameters stay symbols until the statement is built, so that calculus acts on them
+    as it does on the generic statement (mechbook.model.tensorfuncs)."""
     names = dict(ctx.names)
     names.update(branch)
-    if point is not None:  # numbers for every symbol but the `variable`s, which stay
-        early = {k: v for k, v in point.items() if not is_variable(k)}  # until the end
+    if point is not None:
+        early = {k: v for k, v in point.items() if for_all_name(k) and not is_variable(k)}
         names = {k: v.xreplace(early) if isinstance(v, sp.Basic) else v
                  for k, v in names.items()}
     for k, v in (ctx.part.data.get("define") or {}).items():
@@ -346,9 +348,10 @@ def _vec(ctx: Context, spec, sub: tuple, names: dict) -> sp.Matrix:
 @quantity('identity',
           book='equation `lhs = rhs` (scalars, vectors or tensors; `= 0` for a zero one), '
                'or a list of them',
-          how=('holds for every instance of `for_all:` ({name: kind}: scalar, positive, '
-               'angle, vector, unit_vector, tensor, symmetric, antisymmetric, diagonal, '
-               'rotation, improper_rotation, orthogonal) and at random parameter points: '
+          how=('holds for every instance of `for_all:` ({name: kind}: '
+               + ', '.join(KINDS) + '; `variable` is the kind `diff()`, `grad()`, `div()`, '
+               '`subs()` and `integral()` act on, besides the parameters) and at random '
+               'parameter points: '
                'decided on 12 random instances, exactly (rational arithmetic) when the '
                'statement is rational in them, else in 30-digit arithmetic; then proved '
                'for the generic objects by a polynomial normal form (the numerator '

@@ -28,6 +28,42 @@
       ctx.lineTo(bx, by); ctx.strokeStyle = "#888"; ctx.lineWidth = 1; ctx.stroke();
     }
     function at(end) { return typeof end === "number" ? data.bodies[end].path[frame] : end; }
+    function link(a, b) {                        // a rod: a thick dark line
+      const [ax, ay] = px(a), [bx, by] = px(b);
+      ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx, by);
+      ctx.strokeStyle = "#333"; ctx.lineWidth = 3; ctx.lineCap = "round"; ctx.stroke();
+    }
+    function pivot(p) {          // a fixed hinge: a triangle on hatching, away from its body
+      const [x, y] = px(p.at);
+      const sx = p.side[0], sy = -p.side[1], nx = -sy, ny = sx;  // screen y points down
+      const bx = x + 11 * sx, by = y + 11 * sy;
+      ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(bx + 7 * nx, by + 7 * ny);
+      ctx.lineTo(bx - 7 * nx, by - 7 * ny); ctx.closePath();
+      ctx.fillStyle = "#fff"; ctx.fill(); ctx.strokeStyle = "#333"; ctx.lineWidth = 1.5;
+      ctx.stroke(); ctx.beginPath();
+      for (let i = -9; i <= 9; i += 4.5) {
+        ctx.moveTo(bx + i * nx, by + i * ny);
+        ctx.lineTo(bx + i * nx + 5 * sx - 3 * nx, by + i * ny + 5 * sy - 3 * ny);
+      }
+      ctx.lineWidth = 1; ctx.stroke();
+    }
+    function outline(o) {                        // a body's shape, turned as it turns
+      const c = data.bodies[o.body].path[frame];
+      const r = o.turns ? o.turns[frame] : null;
+      const place = (p) => r ? [c[0] + r[0] * p[0] + r[1] * p[1] + r[2] * p[2],
+                                c[1] + r[3] * p[0] + r[4] * p[1] + r[5] * p[2]]
+                             : [c[0] + p[0], c[1] + p[1]];
+      ctx.strokeStyle = COLOURS[o.body % COLOURS.length]; ctx.lineWidth = 1.6;
+      o.lines.forEach((line, i) => {
+        if (o.axes) ctx.strokeStyle = ["#d62728", "#2ca02c", "#1f77b4"][i % 3];
+        ctx.beginPath();
+        line.forEach((p, k) => {
+          const [x, y] = px(place(p));
+          if (k === 0) ctx.moveTo(x, y); else ctx.lineTo(x, y);
+        });
+        ctx.stroke();
+      });
+    }
     function draw() {
       ctx.clearRect(0, 0, canvas.width, canvas.height);
       data.bodies.forEach((b, k) => {            // the path so far, faint
@@ -39,6 +75,9 @@
         ctx.strokeStyle = COLOURS[k % COLOURS.length] + "55"; ctx.lineWidth = 1; ctx.stroke();
       });
       data.springs.forEach((s) => spring(at(s[0]), at(s[1])));
+      (data.links || []).forEach((s) => link(at(s[0]), at(s[1])));
+      (data.pivots || []).forEach(pivot);
+      (data.outlines || []).forEach(outline);
       data.bodies.forEach((b, k) => {
         const [x, y] = px(b.path[frame]);
         const r = 4 + 6 * Math.cbrt(masses[k] / heaviest);
@@ -46,6 +85,7 @@
         ctx.fillStyle = COLOURS[k % COLOURS.length]; ctx.fill();
       });
       label.textContent = "t = " + data.t[frame].toFixed(2);
+      figure.dataset.frame = frame;              // which frame is drawn (for the tests)
     }
     function tick(now) {
       if (playing && now - last > 40) {
