@@ -21,9 +21,11 @@ Layout (one group per problem, replaced whole on each run of that problem):
                                         drift_rate); t and coordinate are HDF5 dimension
                                         scales, so xarray (h5netcdf) opens the group
 
-A run copies the current file, edits the copy and renames it over the original, so an
-interrupted run leaves the previous file whole and readable (mechbook.app.outputs: the copy
-is an anonymous file until an instant before the rename, so a killed run leaves no temporary
+A run edits a copy of the current file in memory, writes it member by member into a new
+file (so that the space of what it replaced is not kept: a store's size depends on its
+contents, not on how many runs wrote it) and renames that over the original, so an
+interrupted run leaves the previous file whole and readable (mechbook.app.outputs: the new
+file is anonymous until an instant before the rename, so a killed run leaves no temporary
 file). Rewriting a problem's checks keeps its stored simulations; storing a simulation
 replaces only that simulation.
 
@@ -44,6 +46,7 @@ importable from here too.
 from __future__ import annotations
 
 import fcntl
+import io
 import json
 import logging
 import os
@@ -74,7 +77,7 @@ from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's r
     read_simulation,
     refusal,
 )
-from mechbook.app.store_repair import _salvage
+from mechbook.app.store_repair import _salvage, compact
 from mechbook.app.text import storable
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE
@@ -155,11 +158,13 @@ def _atomic_edit(path: str | Path) -> Iterator[h5py.File]:
             remove_stale(real)  # what a writer killed mid-write left (we hold the lock)
             if real.exists():
                 _ensure_sound(real, shown)
-            with replaced(real, copy=True) as fh:
-                with h5py.File(fh, "r+" if real.exists() else "w") as f:
+            with replaced(real) as fh:
+                image = io.BytesIO(real.read_bytes() if real.exists() else b"")
+                with h5py.File(image, "r+" if real.exists() else "w") as f:
                     f.attrs["format"] = FORMAT
                     entered = True
                     yield f
+                compact(image, fh)  # the edit's freed space left behind
             _SOUND[str(real)] = _signature(real)
     except StoreError:
         raise

@@ -10,6 +10,7 @@ than reading.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import BinaryIO
 
 import h5py
 
@@ -106,17 +107,32 @@ def _salvage_problem(src: h5py.File, out: h5py.File, pid: str, budget: list[int]
             lost.append(at)
 
 
+def compact(image: BinaryIO, out: BinaryIO) -> None:
+    """Write the store in the file `image` into `out` as a new file. HDF5 never gives back
+    the space of a deleted or replaced group, so a store edited in place grew with every run
+    (four `check --fresh` runs: 65 to 108 kB with nothing new); copied member by member the
+    file holds what is in it, and its size depends on its contents alone."""
+    with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
+        _copy_group(src, dst)
+
+
+def _tracked(group: h5py.Group) -> bool:
+    """Whether `group` lists its members in the order they were made (else by name)."""
+    return bool(group.id.get_create_plist().get_link_creation_order())
+
+
 def _copy_group(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = ()) -> None:
     """Copy a subtree between files as plain data (object references, which dimension
     scales are made of, do not survive a copy between files: the scales are re-attached by
-    their paths inside the subtree); the members named in `skip` are left out."""
+    their paths inside the subtree); the members named in `skip` are left out. A group keeps
+    its order of members (made, or by name)."""
     dst.attrs.update(_raw_attrs(src))
     scales, links = [], []
     for name, obj in walk(src):
         if name.split("/", 1)[0] in skip:
             continue
         if isinstance(obj, h5py.Group):
-            dst.create_group(name, track_order=True).attrs.update(_raw_attrs(obj))
+            dst.create_group(name, track_order=_tracked(obj)).attrs.update(_raw_attrs(obj))
             continue
         _copy_dataset(obj, dst, name)
         if obj.is_scale:
