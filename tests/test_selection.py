@@ -5,6 +5,7 @@ to an editor (`mechbook schema`, and the modelines `mechbook init` writes)."""
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import jsonschema
@@ -83,6 +84,27 @@ def test_last_failed_reruns_only_the_failures(tree):
     rest = check(tree, "--lf")
     assert "no problem failed when last checked: checking all 3" in rest.stderr
     assert checked(rest) == ["mybook-1.1", "mybook-1.2", "mybook-1.3"]
+
+
+@pytest.mark.parametrize("kind", ["fifo", "devzero", "deep"])
+def test_a_hostile_record_of_failures_is_not_followed(tree, kind):
+    """The record beside the store is anyone's to replace: a FIFO (reading would wait for
+    ever), a link to /dev/zero (reading would never end) or JSON nested too deep reads as
+    no record, and the next run replaces it with a file of its own."""
+    assert check(tree).exit_code == 1
+    record = tree / "results" / ".mechbook.h5.lastfailed.json"
+    assert json.loads(record.read_text("utf-8")) == {"failed": ["mybook-1.2"]}
+    record.unlink()
+    if kind == "fifo":
+        os.mkfifo(record)
+    elif kind == "devzero":
+        record.symlink_to("/dev/zero")
+    else:
+        record.write_text("[" * 100_000 + "]" * 100_000, "utf-8")
+    res = check(tree, "--lf")
+    assert "no problem failed when last checked: checking all 3" in res.stderr
+    assert record.is_file() and not record.is_symlink()
+    assert json.loads(record.read_text("utf-8")) == {"failed": ["mybook-1.2"]}
 
 
 def test_schema_prints_and_writes(tmp_path):

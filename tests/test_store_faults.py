@@ -25,6 +25,7 @@ import mechbook.app.outputs as outputs
 import mechbook.app.store as store
 import mechbook.app.unsaved as unsaved
 from mechbook.app.restore import restore
+from mechbook.app.selection import lastfailed_path
 
 
 def _side_file(text: str) -> Path:
@@ -123,13 +124,17 @@ def test_a_failing_file_system_by_fault_injection(tmp_path, monkeypatch, fault):
     path = tmp_path / "out" / "mechbook.h5"
     assert check(base, "lim-2101", "--store", path).exit_code == 0
     before = path.read_bytes()
+    record = lastfailed_path(path)  # --lf's record of the first run: no failures
+    recorded = record.read_bytes()
     _fail_store_writes(monkeypatch, fault)
     result = check(base, "--fresh", "--store", path)
     assert os.strerror(fault) in result.stderr
     side = _assert_kept(result, base, path, ["lim-2101", "lim-2102"], monkeypatch)
     assert side.parent == path.parent
     assert path.read_bytes() == before
-    assert sorted(p.name for p in path.parent.iterdir()) == sorted([path.name, side.name])
+    assert record.read_bytes() == recorded  # a run whose store failed records nothing
+    assert sorted(p.name for p in path.parent.iterdir()) == sorted([path.name, side.name,
+                                                                     record.name])
 
 
 def test_json_output_says_the_store_failed(tmp_path, monkeypatch):

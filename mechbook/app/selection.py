@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import fnmatch
 import json
-import os
 import re
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+from mechbook.app.bounded import Unreadable, json_value, read_regular
+from mechbook.app.outputs import replaced
 from mechbook.errors import NotFoundError
 from mechbook.model.catalog import all_ids
 from mechbook.model.ids import BOOK, ID, split_id
@@ -61,15 +62,18 @@ def _matching(arg: str, tree: list[str], base: Path) -> list[str]:
 
 
 # ---- the last failures -----------------------------------------------------------------------
+MAX_RECORD_BYTES = 16 << 20  # the ids of far more problems than any tree holds
+
+
 def lastfailed_path(store: Path) -> Path:
     return store.with_name(f".{store.name}.lastfailed.json")
 
 
 def last_failed(store: Path) -> set[str]:
     """The ids that failed when last checked (none when nothing was recorded)."""
-    try:
-        data = json.loads(lastfailed_path(store).read_text("utf-8"))
-    except (OSError, ValueError):
+    try:  # anyone may have put a FIFO, a link to /dev/zero or deep JSON there: bounded
+        data = json_value(read_regular(lastfailed_path(store), MAX_RECORD_BYTES))
+    except (OSError, ValueError, Unreadable):
         return set()
     failed = data.get("failed") if isinstance(data, dict) else None
     return {p for p in failed if isinstance(p, str)} if isinstance(failed, list) else set()
@@ -82,6 +86,7 @@ def record(store: Path, checked: Iterable[str], failed: Iterable[str]) -> None:
     now = (last_failed(store) - set(checked)) | failed
     path = lastfailed_path(store)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps({"failed": sorted(now)}, indent=1) + "\n", "utf-8")
-    os.replace(tmp, path)
+    # a new file renamed into place: a killed or failed write leaves nothing behind, and a
+    # link put at the path is replaced, never written through
+    with replaced(path) as fh:
+        fh.write((json.dumps({"failed": sorted(now)}, indent=1) + "\n").encode("utf-8"))

@@ -103,7 +103,7 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     checked_output(junit_path, "JUnit XML file")
     set_logging(verbose)
     report = _run(service, ids, verbose)
-    if not no_store:
+    if not no_store and report.store_error is None:  # a store not written: its record neither
         _remember(report)
     _print(report, base, fmt, verbose, junit_path)
 
