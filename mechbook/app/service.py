@@ -163,8 +163,12 @@ class CheckService:
                 batch.stop()
 
         batch.on_done = finished
-        for run in batch.run(todo):
-            runs[run.pid] = run
+        try:
+            for run in batch.run(todo):
+                runs[run.pid] = run
+        finally:
+            if opts.write:
+                saver.finish()  # the store written anew once, with what it holds
         return CheckReport([runs[pid] for pid in ids if pid in runs], self.store,
                            saver if opts.write else None, cached,
                            [pid for pid in ids if pid not in runs])

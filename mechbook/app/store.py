@@ -21,13 +21,14 @@ Layout (one group per problem, replaced whole on each run of that problem):
                                         drift_rate); t and coordinate are HDF5 dimension
                                         scales, so xarray (h5netcdf) opens the group
 
-A run edits a copy of the current file in memory, writes it member by member into a new
-file (so that the space of what it replaced is not kept: a store's size depends on its
-contents, not on how many runs wrote it) and renames that over the original, so an
+A write edits a copy of the current file and renames it over the original, so an
 interrupted run leaves the previous file whole and readable (mechbook.app.outputs: the new
 file is anonymous until an instant before the rename, so a killed run leaves no temporary
-file). Rewriting a problem's checks keeps its stored simulations; storing a simulation
-replaces only that simulation.
+file). A single write edits the copy in memory and writes it anew with only what it holds
+(mechbook.app.store_compact: HDF5 keeps the space of a replaced group); a check writes each
+problem as it finishes without that and compacts once at its end, so a store's size depends
+on its contents, not on how many runs wrote it. Rewriting a problem's checks keeps its
+stored simulations; storing a simulation replaces only that simulation.
 
 Nothing fails quietly. A write that cannot be made (a read-only or full file system, a
 directory or device at the path) raises StoreError with the path and the reason; the command
@@ -66,6 +67,7 @@ from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
 from mechbook.app.store_bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
 from mechbook.app.store_cache import Cached, cached, durations  # noqa: F401 - re-exported
+from mechbook.app.store_compact import compact
 from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's readers
     FORMAT,
     StoreError,
@@ -77,7 +79,7 @@ from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's r
     read_simulation,
     refusal,
 )
-from mechbook.app.store_repair import _salvage, compact
+from mechbook.app.store_repair import _salvage
 from mechbook.app.text import storable
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE
@@ -117,11 +119,14 @@ class ProblemRecord:
                    list(outcomes), duration, answers_sha256, list(crosschecks))
 
 
-def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH) -> Path:
+def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH,
+          compacted: bool = True) -> Path:
     """Add or replace the given problems in the store, atomically; StoreError (path and
-    reason) if that cannot be done, and then the store is as it was."""
+    reason) if that cannot be done, and then the store is as it was. `compacted=False`
+    leaves the space of what was replaced in the file (a run writing problem after problem
+    compacts once, at its end: `compact_store`)."""
     records = list(records)
-    with _atomic_edit(path) as f:
+    with _atomic_edit(path, compacted) as f:
         root = f.require_group("problems")
         for rec in records:
             _write_problem(root, rec)
@@ -142,10 +147,19 @@ def _locked(directory: Path) -> Iterator[None]:
         os.close(fd)  # closing releases the lock
 
 
+def compact_store(path: str | Path = DEFAULT_PATH) -> None:
+    """Write the store anew with only what it holds (mechbook.app.store_compact), atomically;
+    StoreError as for `write`."""
+    if Path(path).exists():
+        with _atomic_edit(path):
+            pass
+
+
 @contextmanager
-def _atomic_edit(path: str | Path) -> Iterator[h5py.File]:
-    """An open copy of the store (or a new file) that replaces `path` only on success.
-    Every failure, whatever raised it (the file system, HDF5), is a StoreError."""
+def _atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File]:
+    """An open copy of the store (or a new file) that replaces `path` only on success,
+    written anew with only what it holds when `compacted`. Every failure, whatever raised
+    it (the file system, HDF5), is a StoreError."""
     shown = Path(path)
     try:
         real = output_file(shown, "store")
@@ -158,13 +172,15 @@ def _atomic_edit(path: str | Path) -> Iterator[h5py.File]:
             remove_stale(real)  # what a writer killed mid-write left (we hold the lock)
             if real.exists():
                 _ensure_sound(real, shown)
-            with replaced(real) as fh:
-                image = io.BytesIO(real.read_bytes() if real.exists() else b"")
+            with replaced(real, copy=not compacted) as fh:
+                image = fh if not compacted else \
+                    io.BytesIO(real.read_bytes() if real.exists() else b"")
                 with h5py.File(image, "r+" if real.exists() else "w") as f:
                     f.attrs["format"] = FORMAT
                     entered = True
                     yield f
-                compact(image, fh)  # the edit's freed space left behind
+                if compacted:
+                    compact(image, fh)  # the edit's freed space left behind
             _SOUND[str(real)] = _signature(real)
     except StoreError:
         raise

@@ -10,7 +10,6 @@ than reading.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import BinaryIO
 
 import h5py
 
@@ -105,15 +104,6 @@ def _salvage_problem(src: h5py.File, out: h5py.File, pid: str, budget: list[int]
             if at in out:
                 del out[at]
             lost.append(at)
-
-
-def compact(image: BinaryIO, out: BinaryIO) -> None:
-    """Write the store in the file `image` into `out` as a new file. HDF5 never gives back
-    the space of a deleted or replaced group, so a store edited in place grew with every run
-    (four `check --fresh` runs: 65 to 108 kB with nothing new); copied member by member the
-    file holds what is in it, and its size depends on its contents alone."""
-    with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
-        _copy_group(src, dst)
 
 
 def _tracked(group: h5py.Group) -> bool:

@@ -14,6 +14,7 @@ because a reader can see what it holds.
 from __future__ import annotations
 
 import json
+import logging
 import os
 import tempfile
 from dataclasses import asdict
@@ -23,8 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from mechbook.app.store import ProblemRecord, StoreError, write
+from mechbook.app.store import ProblemRecord, StoreError, compact_store, write
 from mechbook.app.text import json_safe
+
+log = logging.getLogger("mechbook.store")
 
 FORMAT = 1
 
@@ -107,12 +110,23 @@ class Saver:
 
     def save(self, record: ProblemRecord) -> None:
         try:
-            write([record], self.store)
+            write([record], self.store, compacted=False)  # compacted once, by `finish`
             self.written += 1
         except StoreError as exc:
             self.error = self.error or exc
             if self.side.keep("problem", {"record": asdict(record)}) is None:
                 self.lost.append(record.problem_id)
+
+    def finish(self) -> None:
+        """At the run's end: the store written anew with only what it holds, if this run
+        wrote to it. Its results are stored already: a store that cannot be compacted now
+        is said in a warning (it will be at the next run's end), not an error."""
+        if not self.written or self.error is not None:
+            return
+        try:
+            compact_store(self.store)
+        except StoreError as exc:
+            log.warning("the store was not compacted (%s); its results are stored", exc)
 
     def report(self) -> list[str]:
         """The lines that say what went wrong and where the results went (empty: none)."""
