@@ -220,6 +220,6 @@ def test_watch_checks_under_the_limits_of_check(tmp_path, limit, said):
         _until(lines, "waiting for a change", seen, timeout=60)
     finally:
         _stop(proc)
-    assert proc.returncode == 0
-    assert "stopped watching" in "\n".join(seen + [ln for ln in iter(lambda: lines.get(
-        timeout=10), None)])
+    out = "\n".join(seen + [ln for ln in iter(lambda: lines.get(timeout=10), None)])
+    assert proc.returncode == 0, out
+    assert "stopped watching" in out
