@@ -377,3 +377,28 @@ def test_salvage_keeps_simulations_with_their_dimension_scales(tmp_path):
         q = f["problems/lim-2031/simulations/main-RK45/q"]
         assert q.dims[0][0].name.endswith("/coordinate") and q.dims[1][0].name.endswith("/t")
         assert list(q.dims[0][0].asstr()[()]) == ["x", "y"]
+
+
+def test_salvage_keeps_text_whose_bytes_damage_made_invalid_utf8(tmp_path):
+    """Fuzz case 2844 (store kind, seed 1): a flipped byte inside a stored title left a
+    string that is not UTF-8, which the readers read (with surrogate escapes) but the
+    rebuild could not write back, so a readable record was lost when another one was
+    damaged. Its bytes now go back as they came."""
+    from test_store import make_record
+
+    path = tmp_path / "s.h5"
+    store.write([make_record(tmp_path, "2031"), make_record(tmp_path, "2032")], path)
+    data = bytearray(path.read_bytes())
+    title = store.read("lim-2031", path)["attrs"]["title"].encode("utf-8")
+    at = data.find(title)
+    assert at > 0
+    data[at + 1] = 0xE1  # a lead byte with no continuation: not UTF-8
+    with h5py.File(path, "r") as f:
+        addr = h5py.h5o.get_info(f["problems/lim-2032"].id).addr
+    data[addr:addr + 64] = b"\xff" * 64  # and another record damaged: the store is rebuilt
+    path.write_bytes(bytes(data))
+    before = store.read("lim-2031", path)["attrs"]["title"]
+    assert "\udce1" in before
+    store.write([make_record(tmp_path, "2033")], path)
+    assert store.problems(path) == ["lim-2031", "lim-2033"]
+    assert store.read("lim-2031", path)["attrs"]["title"] == before

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import h5py
+import numpy as np
 
 from mechbook.app.store_bounds import _SCALE_ATTRS, attribute, dataset, member, new_budget, walk
 from mechbook.app.store_check import (
@@ -106,23 +107,17 @@ def _salvage_problem(src: h5py.File, out: h5py.File, pid: str, budget: list[int]
             lost.append(at)
 
 
-def _tracked(group: h5py.Group) -> bool:
-    """Whether `group` lists its members in the order they were made (else by name)."""
-    return bool(group.id.get_create_plist().get_link_creation_order())
-
-
 def _copy_group(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = ()) -> None:
     """Copy a subtree between files as plain data (object references, which dimension
     scales are made of, do not survive a copy between files: the scales are re-attached by
-    their paths inside the subtree); the members named in `skip` are left out. A group keeps
-    its order of members (made, or by name)."""
-    dst.attrs.update(_raw_attrs(src))
+    their paths inside the subtree); the members named in `skip` are left out."""
+    _copy_attrs(src, dst)
     scales, links = [], []
     for name, obj in walk(src):
         if name.split("/", 1)[0] in skip:
             continue
         if isinstance(obj, h5py.Group):
-            dst.create_group(name, track_order=_tracked(obj)).attrs.update(_raw_attrs(obj))
+            _copy_attrs(obj, dst.create_group(name, track_order=True))
             continue
         _copy_dataset(obj, dst, name)
         if obj.is_scale:
@@ -138,10 +133,24 @@ def _copy_group(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = ()) ->
 
 
 def _copy_dataset(obj: h5py.Dataset, dst: h5py.Group, name: str) -> None:
-    d = dst.create_dataset(name, data=dataset(obj), dtype=obj.dtype,
+    d = dst.create_dataset(name, data=_as_read(dataset(obj)), dtype=obj.dtype,
                            compression=obj.compression)
-    d.attrs.update(_raw_attrs(obj))
+    _copy_attrs(obj, d)
 
 
-def _raw_attrs(obj) -> dict:
-    return {k: attribute(obj, k) for k in obj.attrs if k not in _SCALE_ATTRS}
+def _copy_attrs(src, dst) -> None:
+    """Every attribute of `src` but the scales' bookkeeping, with its type."""
+    for key in src.attrs:
+        if key not in _SCALE_ATTRS:
+            dst.attrs.create(key, _as_read(attribute(src, key)), dtype=src.attrs.get_id(key).dtype)
+
+
+def _as_read(value):
+    """Text as its bytes were: the readers decode what is not UTF-8 (damage flips bytes of
+    a string too) with surrogate escapes, which HDF5 cannot encode; the bytes go back as
+    they came (a string type takes bytes unchanged)."""
+    if isinstance(value, str):
+        return value.encode("utf-8", "surrogateescape")
+    if isinstance(value, np.ndarray) and value.dtype == object:
+        return np.array([_as_read(v) for v in value.flat], dtype=object).reshape(value.shape)
+    return value
