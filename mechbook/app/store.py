@@ -68,12 +68,14 @@ from mechbook.app.outputs import OutputError, output_file, remove_stale, replace
 from mechbook.app.store_bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
 from mechbook.app.store_cache import Cached, cached, durations  # noqa: F401 - re-exported
 from mechbook.app.store_compact import compact
+from mechbook.app.store_guard import ChildEnded, in_child, is_sound, mark_sound
 from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's readers
     FORMAT,
     StoreError,
     _opened,
     _reason,
     damage,
+    hang_reason,
     problems,
     read,
     read_simulation,
@@ -181,7 +183,7 @@ def _atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File
                     yield f
                 if compacted:
                     compact(image, fh)  # the edit's freed space left behind
-            _SOUND[str(real)] = _signature(real)
+            mark_sound(real)  # written by this process: its readers need no child
     except StoreError:
         raise
     except Exception as exc:  # noqa: BLE001 - every way a write fails is reported as one
@@ -191,14 +193,6 @@ def _atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File
 
 
 # ---- a damaged store: detected before an edit, moved aside, rebuilt --------------------------
-_SOUND: dict[str, tuple] = {}  # path -> signature of the file last found (or made) sound
-
-
-def _signature(path: Path) -> tuple:
-    st = os.stat(path)
-    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
-
-
 def _foreign(path: Path) -> str | None:
     """Why the file at `path` is not a store this mechbook may write (HDF5 made by
     something else, a newer store format), or None (a store of ours, or not HDF5 at all:
@@ -213,29 +207,48 @@ def _foreign(path: Path) -> str | None:
 
 def _ensure_sound(path: Path, shown: Path) -> None:
     """Before an edit: a damaged store is moved aside and rebuilt from what still reads; a
-    file that is not a store of this mechbook's format is refused (StoreError), whole."""
-    if _SOUND.get(str(path)) == _signature(path):
+    file that is not a store of this mechbook's format is refused (StoreError), whole. The
+    file is read in a child under a CPU limit (mechbook.app.store_guard): HDF5 loops for
+    ever on some damage, and a file it does not come back from is moved aside unread."""
+    if is_sound(path):
         return
-    foreign = _foreign(path)
+    try:
+        foreign = in_child(path, _foreign, path)
+        why = None if foreign is not None else in_child(path, damage, path)
+    except ChildEnded as end:
+        foreign, why = None, hang_reason(end.seconds)
     if foreign is not None:
         raise StoreError(shown, foreign)
-    why = damage(path)
     if why is None:
-        _SOUND[str(path)] = _signature(path)
+        mark_sound(path)
         return
     stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S.%fZ")
     aside = path.with_name(f"{path.name}{DAMAGED}{stamp}")
-    kept, lost = [], []
     with replaced(path) as fh:  # the rebuilt store
-        with h5py.File(fh, "w") as out:
-            out.attrs["format"] = FORMAT
-            kept, lost = _salvage(path, out)
+        try:
+            kept, lost = in_child(path, _rebuilt_into, path, fh)
+        except ChildEnded:
+            kept, lost = [], ["everything (HDF5 did not come back from reading it)"]
+            fh.seek(0)
+            fh.truncate()
+            with h5py.File(fh, "w") as out:
+                out.attrs["format"] = FORMAT
         os.link(path, aside)  # the damaged file stays whole beside the new one
-    _SOUND[str(path)] = _signature(path)
+    mark_sound(path)
     lost_text = f"; could not read (lost here, kept in the damaged file): {', '.join(lost)}" \
         if lost else ""
     log.warning("the store %s was damaged (%s): moved aside to %s and rebuilt with the %d "
                 "entries that could still be read%s", shown, why, aside, len(kept), lost_text)
+
+
+def _rebuilt_into(path: Path, fh) -> tuple[list[str], list[str]]:
+    """In the child: the store rebuilt from what of `path` still reads, written into `fh`
+    (the parent's new file, shared across the fork); ([kept], [lost])."""
+    with h5py.File(fh, "w") as out:
+        out.attrs["format"] = FORMAT
+        kept, lost = _salvage(path, out)
+    fh.flush()
+    return kept, lost
 
 
 def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:

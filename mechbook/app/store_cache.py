@@ -14,7 +14,7 @@ import h5py
 from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.store_bounds import attribute, attributes, member
 from mechbook.app.store_check import _crosschecks, _member, _plain, _reason, refusal
-from mechbook.app.store_read import DEFAULT_PATH
+from mechbook.app.store_read import DEFAULT_PATH, StoreError, guarded
 from mechbook.records import CrossCheck, Outcome
 
 log = logging.getLogger("mechbook.store")
@@ -33,14 +33,23 @@ def cached(wanted: dict[str, tuple[str, str]], path: str | Path = DEFAULT_PATH,
            crosschecks: bool = True) -> dict[str, Cached]:
     """The stored results of the problems in `wanted` ({id: (problem sha256, answers
     sha256)}) whose problem file, answer key and engine are unchanged since they were
-    stored (and, with `crosschecks`, that were cross-checked). One read of the file. A
-    record that cannot be read is not a hit (the problem is checked again); a store that
-    cannot be read gives no hits (its first write moves it aside and rebuilds it)."""
-    path = Path(path)
+    stored (and, with `crosschecks`, that were cross-checked). One read of the file (in a
+    child while the file is not known sound: mechbook.app.store_guard). A record that
+    cannot be read is not a hit (the problem is checked again); a store that cannot be
+    read gives no hits (its first write moves it aside and rebuilds it)."""
+    try:
+        return _cached(wanted, Path(path), crosschecks, engine_sha256())
+    except StoreError as exc:  # HDF5 did not come back: no hits
+        log.debug("store %s unreadable: %s", path, exc)
+        return {}
+
+
+@guarded
+def _cached(wanted: dict[str, tuple[str, str]], path: Path, crosschecks: bool,
+            engine: str) -> dict[str, Cached]:
     out: dict[str, Cached] = {}
     if not path.is_file():
         return out
-    engine = engine_sha256()
     try:
         with h5py.File(path, "r") as f:
             if refusal(f) is not None:  # not a store of ours: no hits (its write is refused)
@@ -80,7 +89,14 @@ def _cached_one(root, pid: str, shas: tuple[str, str], engine: str,
 def durations(path: str | Path = DEFAULT_PATH) -> dict[str, float]:
     """Each stored problem's last cold duration (seconds): a batch starts the longest first
     (an unreadable store or record just gives no duration)."""
-    path = Path(path)
+    try:
+        return _durations(Path(path))
+    except StoreError:  # HDF5 did not come back: no durations
+        return {}
+
+
+@guarded
+def _durations(path: Path) -> dict[str, float]:
     if not path.is_file():
         return {}
     out = {}

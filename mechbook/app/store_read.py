@@ -33,6 +33,7 @@ from mechbook.app.store_check import (  # noqa: F401 - re-exported: the store's 
     damage,
     refusal,
 )
+from mechbook.app.store_guard import sheltered
 from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE
 from mechbook.model.hints import MAX_LISTED, did_you_mean
@@ -46,6 +47,33 @@ class StoreError(MechbookError):
     def __init__(self, path: str | Path, reason: str, action: str = "write"):
         self.path, self.reason = Path(path), reason
         super().__init__(f"cannot {action} the store {path}: {reason}")
+
+    def __reduce__(self):  # whole across a pipe (a read in a child: mechbook.app.store_guard)
+        return (_rebuilt, (type(self), str(self.path), self.reason, str(self)))
+
+
+def _rebuilt(cls: type, path: str, reason: str, message: str) -> StoreError:
+    err = cls.__new__(cls)
+    Exception.__init__(err, message)
+    err.path, err.reason = Path(path), reason
+    return err
+
+
+class StoreHang(StoreError):
+    """Reading the store did not end within the CPU limit: HDF5 loops on some damaged
+    files (mechbook.app.store_guard)."""
+
+    def __init__(self, path: str | Path, seconds: float, action: str = "read"):
+        super().__init__(path, f"{hang_reason(seconds)}: the file is damaged; the next "
+                         "`mechbook check` into it moves it aside", action)
+
+
+def hang_reason(seconds: float) -> str:
+    return (f"reading it did not end within {seconds:.0f} s of CPU time (HDF5 loops on "
+            "some damaged files)")
+
+
+guarded = sheltered(StoreHang)  # a reader of a store not yet found sound runs in a child
 
 
 @contextmanager
@@ -86,6 +114,7 @@ def there(name: str, names: list[str], what: str) -> str:
     return f"{len(names)} {what}s stored" + (f"; {close}" if close else "")
 
 
+@guarded
 def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
     """One problem's record as plain Python data (NotFoundError, also a KeyError, naming
     those stored if it is absent; FileNotFoundError if there is no store; StoreError naming
@@ -108,6 +137,7 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
             raise _damaged(path, f"the stored record of {pid}", exc) from None
 
 
+@guarded
 def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dict:
     """{"attrs": {...}, "arrays": {key: array}, "array_attrs": {key: {...}}} of one run
     (NotFoundError, also a KeyError, naming the problem's stored runs if it is absent)."""
@@ -126,6 +156,7 @@ def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dic
             raise _damaged(path, f"the simulation {name} of {pid}", exc) from None
 
 
+@guarded
 def problems(path: str | Path = DEFAULT_PATH) -> list[str]:
     """The ids stored (StoreError if the store cannot be read)."""
     with _opened(path) as f:
