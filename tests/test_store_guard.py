@@ -85,3 +85,18 @@ def test_a_sound_store_is_read_in_this_process_once_found_sound(tmp_path, quick,
     store.write([], path)  # written by this process: still known sound
     store.read("lim-2101", path)
     assert len(forks) == 1
+
+
+def test_vet_reads_the_whole_store_once_for_a_reader_of_many_records(tmp_path, quick):
+    base = pendulum_tree(tmp_path, nums=("2101", "2102"))
+    assert check(base).exit_code == 0
+    path = base / "results" / "mechbook.h5"
+    guard._SOUND.clear()
+    assert not guard.is_sound(path)
+    store.vet(path)
+    assert guard.is_sound(path)
+    _looping(path)  # a new version of the file: not known sound, and HDF5 loops on it
+    store.vet(path)
+    assert not guard.is_sound(path)
+    with pytest.raises(store.StoreError, match="did not end"):
+        store.read("lim-2102", path)

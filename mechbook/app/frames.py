@@ -48,11 +48,12 @@ def results(store: str | Path = DEFAULT_STORE) -> Frames:
     from mechbook.core.optional import require
 
     pd = require("pandas", "data", "mechbook.results()")
-    from mechbook.app.store import problems, read
+    from mechbook.app.store import problems, read, vet
 
     path = Path(store)
     if not path.exists():
         raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
+    vet(path)  # once for the whole file, not a child per record
     checks, cross, timings = [], [], []
     for pid in problems(path):
         rows = _rows(pid, read(pid, path))

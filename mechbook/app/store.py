@@ -80,6 +80,7 @@ from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's r
     read,
     read_simulation,
     refusal,
+    vet,
 )
 from mechbook.app.store_repair import _salvage
 from mechbook.app.text import storable

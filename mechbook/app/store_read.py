@@ -33,7 +33,14 @@ from mechbook.app.store_check import (  # noqa: F401 - re-exported: the store's 
     damage,
     refusal,
 )
-from mechbook.app.store_guard import sheltered
+from mechbook.app.store_guard import (
+    ChildEnded,
+    in_child,
+    is_sound,
+    mark_sound,
+    sheltered,
+    signature,
+)
 from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE
 from mechbook.model.hints import MAX_LISTED, did_you_mean
@@ -112,6 +119,20 @@ def there(name: str, names: list[str], what: str) -> str:
         return f"{what}s stored: {', '.join(names)}"
     close = did_you_mean(name, names)
     return f"{len(names)} {what}s stored" + (f"; {close}" if close else "")
+
+
+def vet(path: str | Path = DEFAULT_PATH) -> None:
+    """Read the whole store once in a child (`damage`) and, if it is sound, mark it so:
+    a reader of many records (the report, a DataFrame of every problem) then reads them in
+    this process, not one child each. A store that is not sound is left to each read to
+    describe."""
+    if is_sound(path) or signature(path) is None:
+        return
+    try:
+        if in_child(path, damage, path) is None:
+            mark_sound(path)
+    except ChildEnded:
+        pass  # each read now says so at once
 
 
 @guarded

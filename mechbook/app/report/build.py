@@ -194,10 +194,11 @@ def _read_one(pid: str, store: Path) -> tuple[dict | None, str | None]:
 def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str, str]]:
     """The stored records of `ids`, and {id: why} for those the store has but cannot give
     back (damaged): the report says so and shows them as not checked."""
-    from mechbook.app.store import StoreError, problems, read
+    from mechbook.app.store import StoreError, problems, read, vet
 
     if not store.exists():
         return {}, {}
+    vet(store)  # once for the whole file, not a child per record
     try:
         in_store = set(problems(store))
     except StoreError as exc:
