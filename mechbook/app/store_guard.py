@@ -19,7 +19,9 @@ import inspect
 import os
 import pickle
 import resource
+import select
 import signal
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -97,9 +99,21 @@ def in_child(path: str | Path, fn: Callable[..., Any], *args, **kwargs) -> Any:
             os._exit(code)
     os.close(wr)
     chunks = []
+    deadline = time.monotonic() + 4 * seconds + 30  # a child stuck without using CPU too
     try:
-        while chunk := os.read(rd, 1 << 20):
+        while True:
+            ready, _, _ = select.select([rd], [], [], max(0.0, deadline - time.monotonic()))
+            if not ready:
+                os.kill(pid, signal.SIGKILL)
+                chunks = []
+                break
+            chunk = os.read(rd, 1 << 20)
+            if not chunk:
+                break
             chunks.append(chunk)
+    except BaseException:  # Ctrl-C here: the child is not left to finish
+        os.kill(pid, signal.SIGKILL)
+        raise
     finally:
         os.close(rd)
         _, status = os.waitpid(pid, 0)
