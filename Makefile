@@ -19,13 +19,13 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 	-$(BIN)/mechbook check  # a failing part is shown in the report, not an end to it
 	$(BIN)/mechbook report
 
-test: $(STAMP)   ## the test suite, the mutation tests on a sample of six answer keys (~3 min on two cores)
+test: $(STAMP)   ## the test suite, the mutation tests on a sample of six answer keys (~10 min on two cores)
 	$(BIN)/python -m pytest -q -n auto -m 'not mutation'
 
 test-mutation: $(STAMP)  ## the mutation tests on every other answer key (~6 min on two cores; CI runs it)
 	$(BIN)/python -m pytest -q -n auto -m mutation
 
-test-quick: $(STAMP)  ## the suite without the slow tests, for every change (~30 s, 1520 of 1939 tests, on two cores)
+test-quick: $(STAMP)  ## the suite without the slow tests, for every change (1950 of 2409 tests, on two cores)
 	$(BIN)/python -m pytest -q -n auto -m 'not slow'
 
 # The oldest versions pyproject.toml's ranges allow (.ci/min_versions.py), mechbook itself
