@@ -26,6 +26,7 @@ tests/test_power.py).
 from __future__ import annotations
 
 import ast
+import itertools
 
 import sympy as sp
 
@@ -78,6 +79,40 @@ def _functionally_dependent(a: sp.Expr, b: sp.Expr, ctx: Context) -> bool:
     gb = [sp.diff(b, x) for x in xs]
     return all(vanishes(ga[i] * gb[j] - ga[j] * gb[i], ctx.sampler, symbolic=False).ok
                for i in range(len(xs)) for j in range(i + 1, len(xs)))
+
+
+def _function_of(b: sp.Expr, stated: list[sp.Expr], ctx: Context) -> bool:
+    """b is locally a function of the `stated` first integrals: its gradient in the motion
+    variables lies in the span of theirs (every (k+1)-minor of the gradients vanishes at
+    the sampled states), with more motion variables than integrals (else any b would do).
+    Then b is conserved with them, whatever its form (Symon 11-6: |ω|² with wz's exponent
+    moved, given wz conserved)."""
+    xs = [x for x in _motion(ctx) if b.has(x) or any(a.has(x) for a in stated)]
+    k = len(stated)
+    if len(xs) <= k:
+        return False
+    grads = sp.Matrix([[sp.diff(e, x) for x in xs] for e in [b, *stated]])
+    return all(vanishes(grads[:, list(cols)].det(method="berkowitz"), ctx.sampler,
+                        symbolic=False).ok
+               for cols in itertools.combinations(range(len(xs)), k + 1))
+
+
+def _stated_integrals(ctx: Context, path: tuple, parse) -> list[sp.Expr]:
+    """The other first integrals the part states beside the one at `path` (unnamed ones,
+    as the book gives them: they passed with it)."""
+    if not path or not isinstance(path[-1], int):  # a list of integrals only
+        return []
+    out = []
+    for i, text in enumerate(_siblings(ctx, path)):
+        if i == path[-1] or not isinstance(text, str) or "=" in text:
+            continue
+        name, value = split_named(text)
+        if name is None:
+            try:
+                out.append(parse(value))
+            except Exception:  # noqa: BLE001 - one that does not parse: not used
+                continue
+    return out
 
 
 def _identifiers(text: str) -> list[str]:
@@ -204,6 +239,9 @@ def same_meaning(ctx: Context, path: tuple, old, new, token: str = "") -> str:
     if "function" in declared and name is None and new_name is None:
         if _functionally_dependent(b, a, ctx):
             return "a function of the same conserved quantity"
+        stated = [a, *_stated_integrals(ctx, path, parse)]
+        if len(stated) > 1 and _function_of(b, stated, ctx):
+            return "a function of the conserved quantities the part states"
         if _proved_first_integral(ctx, b):
             return "another first integral (its time derivative proved zero)"
     if "direction" in declared and _only_component(ctx, path):
