@@ -19,6 +19,10 @@ from typing import BinaryIO
 import h5py
 
 _REFERENCES = ("DIMENSION_LIST", "REFERENCE_LIST")
+# HDF5 1.14.2 (h5py 3.10's wheels) crashes copying a group that tracks its members' order
+# and holds more than eight attributes (dense attribute storage): every stored problem.
+# 2.0.0 (h5py 3.16) copies it; the versions between are untested, so they copy in Python.
+NATIVE_COPY_SINCE = (2, 0, 0)
 
 
 def compact(image: BinaryIO, out: BinaryIO) -> None:
@@ -30,6 +34,12 @@ def compact(image: BinaryIO, out: BinaryIO) -> None:
 
     Example: ``with open(old, "rb") as a, open(new, "w+b") as b: compact(a, b)``.
     """
+    if h5py.version.hdf5_version_tuple < NATIVE_COPY_SINCE:
+        from mechbook.app.store_repair import _copy_group
+
+        with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
+            _copy_group(src, dst)  # member by member in Python: slower, and safe there
+        return
     with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
         for key in src.attrs:
             dst.attrs.create(key, src.attrs[key], dtype=src.attrs.get_id(key).dtype)
@@ -49,7 +59,7 @@ def _scale_links(src: h5py.File) -> list[tuple[str, int, str]]:
     found: list[str] = []
 
     def visit(name: bytes, info) -> None:
-        if info.type == h5py.h5o.TYPE_DATASET and info.num_attrs:
+        if info.type == h5py.h5o.TYPE_DATASET:  # (ObjInfo.num_attrs: h5py >= 3.11 only)
             if h5py.h5a.exists(h5py.h5o.open(src.id, name), b"DIMENSION_LIST"):
                 found.append(name.decode("utf-8"))
 
