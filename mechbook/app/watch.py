@@ -22,9 +22,7 @@ from __future__ import annotations
 import hashlib
 import os
 import resource
-import signal
 import stat
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -50,19 +48,6 @@ class WatchOptions:
     memory_mb: float = DEFAULT_MEMORY_MB  # resident memory per check (0: no bound)
     poll: float = POLL_SECONDS
     runs: int = 0  # stop after this many checks (0: until interrupted; for tests)
-
-
-def _deferring_ctrl_c(fn, *args):
-    """fn(*args) with Ctrl-C held until it returns: a KeyboardInterrupt raised inside the
-    bounded reader's open (mechbook.app.bounded) printed a traceback and skipped "stopped
-    watching" (seen once in make test-min); held, it arrives at the next statement."""
-    if threading.current_thread() is not threading.main_thread():
-        return fn(*args)
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        return fn(*args)
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _signature(paths: list[Path]) -> tuple:
@@ -153,7 +138,7 @@ def watch(pid: str, base: Path, say: Callable[[str], None],
     try:
         with Batch(base, limits, task=check_in_worker, failed=check_stopped) as batch:
             while True:
-                now = _deferring_ctrl_c(_signature, paths)
+                now = _signature(paths)
                 if not _changed(last, now):
                     time.sleep(options.poll)
                     continue
