@@ -79,7 +79,7 @@ def _number(model, name: str, given) -> float:
     if isinstance(given, Real) and not isinstance(given, bool):
         value = float(given)
     elif isinstance(given, str | sp.Basic):
-        expr = model.parse(given, ()) if isinstance(given, str) else sp.sympify(given)
+        expr = model.parse(given, ()) if isinstance(given, str) else given  # a SymPy object
         try:
             value = float(expr.subs(model.values()))
         except (TypeError, ValueError):
