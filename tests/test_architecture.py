@@ -232,18 +232,18 @@ def _outside_registry() -> list[str]:
 
 @pytest.mark.parametrize("module", _outside_registry())
 def test_no_quantity_is_named_outside_the_registry(module):
-    from mechbook.verify.registry import quantities
+    from mechbook.verify.registry import default_quantities
 
     source = modules()[module].read_text(encoding="utf-8")
-    found = quantity_names_used(source, set(quantities()))
+    found = quantity_names_used(source, set(default_quantities()))
     assert not found, (f"{module} names quantities: {found}; declare it in the quantity's "
                        "registration (crosschecks=, display=, sweeps=) and read it from there")
 
 
 def test_the_quantity_name_test_can_fail():
-    from mechbook.verify.registry import quantities
+    from mechbook.verify.registry import default_quantities
 
-    assert set(HOMONYMS) <= set(quantities()), "a homonym that is no quantity any more"
+    assert set(HOMONYMS) <= set(default_quantities()), "a homonym that is no quantity any more"
     registered = {"eom", "frequencies"}
     assert quantity_names_used('X = ("eom",)', registered)
     assert quantity_names_used('if part.quantity == "frequencies": pass', registered)
@@ -259,9 +259,9 @@ def test_every_declared_use_of_a_quantity_is_known():
     from mechbook.app.report.values import DISPLAYS
     from mechbook.app.sweep import QUANTITIES as SWEEPS
     from mechbook.crosscheck.vouch import CROSSCHECKS
-    from mechbook.verify.registry import quantities
+    from mechbook.verify.registry import default_quantities
 
-    table = quantities().values()
+    table = default_quantities().values()
     for q in table:
         assert set(q.crosschecks) <= set(CROSSCHECKS), (q.name, q.crosschecks)
         assert q.display is None or q.display in DISPLAYS, (q.name, q.display)

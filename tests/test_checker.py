@@ -32,7 +32,6 @@ from mechbook.model.tensorexpr import kind
 from mechbook.verify.answers import AnswerKey, Part, load_answers
 from mechbook.verify.checker import check_problem
 from mechbook.verify.context import Context, split_named
-from mechbook.verify.registry import quantities
 
 ROOT = Path(__file__).resolve().parents[1]
 ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
@@ -497,11 +496,11 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
             return name == new_name and (_zero(a - b) or (
                 name in ("E", "h", "energy", "jacobi") and _free_of(b - a, motion)))
         return _free_of(b - a, motion) or _zero(a - b) or (a != 0 and _free_of(b / a, motion))
-    extra = quantities()[ctx.part.quantity].names
+    extra = ctx.quantity.names
     if extra is not None:  # the quantity's own names (a polynomial's variable, W0(j), ...)
         names = extra(ctx)
-        a = ctx.part.parse(old, slot.path, names)
-        b = ctx.part.parse(new, slot.path, names)
+        a = ctx.parse(old, slot.path, names=names)
+        b = ctx.parse(new, slot.path, names=names)
         return _zero(b - a)
     sys = ctx.system
     motion = set(sys.q + sys.qd + sys.qdd) | {sys.t}

@@ -84,16 +84,18 @@ def test_part_details_carry_a_message_and_check_v_prints_the_traceback(tmp_path,
     """An unexpected error inside a part (here injected into the quantity's check): the
     detail is its type and message, the traceback travels with the run and `check -v`
     prints it on stderr, never in the table."""
-    from mechbook.verify import checker
+    from mechbook.verify import answers
+    from mechbook.verify.registration import QuantityTable
 
     base = pendulum_tree(tmp_path)
-    real = checker.quantities
+    real = answers.default_quantities
 
     def boom(ctx, value):
         return 1 / 0
 
-    monkeypatch.setattr(checker, "quantities", lambda: {k: replace(q, check=boom)
-                                                        for k, q in real().items()})
+    # every key is read against (and checked with) a table whose checks raise
+    monkeypatch.setattr(answers, "default_quantities",
+                        lambda: QuantityTable(replace(q, check=boom) for q in real().values()))
     got = run_problem("lim-2101", base)
     (outcome,) = got.outcomes
     assert outcome.status == "error"

@@ -122,7 +122,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
     from mechbook.engine.derive import computed
     from mechbook.model.problem import load_problem
     from mechbook.verify.answers import load_answers
-    from mechbook.verify.checker import check_part
+    from mechbook.verify.checker import check_problem, require_same_problem
 
     try:
         stage("loading")
@@ -131,9 +131,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
         if not apath.exists():
             raise MechbookError(f"{apath}: no answer key for {pid}")
         key = load_answers(apath)
-        if key.problem_id != problem.id:
-            raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem "
-                                f"file is {problem.id!r}")
+        require_same_problem(key, problem.id)  # before its parts are read in the problem
         analysis = Analysis(problem)
         stage("validating")  # a malformed file is refused whole: nothing is stored for it
         faults = validated_parts(problem, key, analysis, apath)  # under validate's limit
@@ -144,9 +142,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
             run.notes.append("the answer key is malformed: its other parts were not checked "
                              "and nothing was stored")
             return
-        for part in key.parts:
-            stage(f"part {part.name} ({part.quantity})")
-            run.outcomes.append(check_part(analysis, part, options.policy))
+        run.outcomes = check_problem(analysis, key, options.policy, stage)
         if options.crosscheck:
             stage("cross-checks")
             run.crosschecks = crosscheck_problem(analysis, key, stage)

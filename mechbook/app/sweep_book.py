@@ -17,7 +17,7 @@ import sympy as sp
 from mechbook.core.compile import compile_batch
 from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED, relations, truth
 from mechbook.errors import MechbookError, UnsupportedError
-from mechbook.verify.registry import quantities
+from mechbook.verify.registry import default_quantities
 
 
 def book_overlay(sweeper, result) -> dict:
@@ -29,7 +29,7 @@ def book_overlay(sweeper, result) -> dict:
         return out
     from mechbook.verify.context import Context
 
-    table = quantities()
+    table = default_quantities()
     for part in key.parts:
         entry = table.get(part.quantity)  # the registration names the sweeps that draw it
         if entry is None or sweeper.spec.quantity not in entry.sweeps or "limit" in part.data:

@@ -1,5 +1,6 @@
 """`mechbook validate`: a file is checked against its schema and every expression parsed,
-without deriving anything.
+without deriving anything. This module orchestrates (which file, its problem, the time
+limit); whether a key is well formed is decided by mechbook.verify.wellformed.
 
 A problem file needs only the model (YAML, schema, the safe parser, the systems built from
 their declarations), so the engine and the answer quantities are imported only for an answer
@@ -25,6 +26,8 @@ from mechbook.model.yamlio import load
 
 if TYPE_CHECKING:
     from mechbook.engine.analysis import Analysis
+    from mechbook.model.problem import Problem
+    from mechbook.verify.answers import AnswerKey
 
 BUILD_SECONDS = 15.0  # CPU; `validate` runs in the caller's process, so it bounds itself
 
@@ -45,8 +48,10 @@ def validate_file(path: str | Path) -> str:
 
 
 def _validate_answers(path: Path) -> str:
+    # the engine and the quantities: imported only for an answer key (start-up of validate)
     from mechbook.engine.analysis import Analysis
     from mechbook.verify.answers import load_answers
+    from mechbook.verify.wellformed import validate_key
 
     key = load_answers(path)
     try:
@@ -60,7 +65,9 @@ def _validate_answers(path: Path) -> str:
     try:
         problem = load_problem(ppath)
         with build_limit(ppath, path):  # its problem's systems are built on the way
-            check_expressions(key, Analysis(problem))
+            faults = validate_key(Analysis(problem), key)
+            if faults:  # the first malformed part, at its file:line
+                raise next(iter(faults.values()))
     except SpecError as exc:
         if exc.file is None or Path(exc.file).resolve() != ppath.resolve():
             raise
@@ -92,17 +99,21 @@ def _too_slow(path: str | Path, key: str | Path | None) -> SpecError:
                      "engine", str(key))
 
 
-def validated_parts(problem, key, analysis: Analysis, key_path: str | Path) -> dict[str, str]:
+def validated_parts(problem: Problem, key: AnswerKey, analysis: Analysis,
+                    key_path: str | Path) -> dict[str, str]:
     """What `mechbook check` validates before any part (every system built, every part's
-    expressions parsed: `part_faults`), under the limit `validate` has for the same work:
+    names and expressions: mechbook.verify.wellformed.validate_key, {part name: its fault}),
+    under the limit `validate` has for the same work:
     a problem that `validate` refuses in BUILD_SECONDS is refused by the check as soon, not
     after its whole --timeout. SpecError (naming the file it was in) past the limit."""
+    from mechbook.verify.wellformed import validate_key  # the quantities: only for a key
+
     blame: list = [problem.doc.file, None]
     try:
         with hard_time_limit(BUILD_SECONDS):
             build_systems(problem)
             blame[1] = key_path
-            return part_faults(key, analysis)
+            return {name: str(fault) for name, fault in validate_key(analysis, key).items()}
     except Timeout:
         raise _too_slow(*blame) from None
 
@@ -113,63 +124,3 @@ def build_systems(problem) -> None:
     the first fault."""
     for name in problem.systems:
         check_physical(system_of(problem, name))
-
-
-def check_expressions(key, analysis: Analysis) -> None:
-    """Parse every expression of an answer key in its part's context; SpecError on the
-    first fault (file:line), before any part is checked."""
-    for part in key.parts:
-        check_part_expressions(part, analysis)
-
-
-def part_faults(key, analysis: Analysis) -> dict[str, str]:
-    """{part name: what is malformed} for every part whose expressions do not parse."""
-    faults = {}
-    for part in key.parts:
-        try:
-            check_part_expressions(part, analysis)
-        except SpecError as exc:
-            faults[part.name] = str(exc)
-    return faults
-
-
-def check_part_expressions(part, analysis: Analysis) -> None:
-    """Every name the part uses resolved (mechbook.verify.keynames) and every expression of
-    it parsed in its context; SpecError (file:line) on the first fault."""
-    from mechbook.verify.context import Context
-    from mechbook.verify.keynames import check_part_names
-    from mechbook.verify.quantities.tensors import validate_part
-    from mechbook.verify.registry import quantities
-
-    check_part_names(part, analysis.problem)
-    ctx = Context(analysis, part)
-    if ctx.tensor_mode:  # vectors, tensors, bodies: built once, nothing judged
-        validate_part(ctx)
-        return
-    q = quantities()[part.quantity]
-    names = q.names(ctx) if q.names else ctx.names  # a book value's extra names
-    for field in ("book", "about", "initial", "released", "region", "time", "hold", "signal",
-                  "event", "period"):
-        if field == "book" and part.data.get("book") in q.literals:
-            continue  # a word such as "stable", not an expression
-        if field in part.data:
-            _walk(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
-    if "erratum" in part.data:
-        _walk(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
-
-
-def _walk(ctx, value, sub: tuple, names: dict) -> None:
-    from mechbook.verify.context import strip_const
-
-    if isinstance(value, dict):
-        for k, v in value.items():
-            _walk(ctx, v, sub + (k,), names)
-    elif isinstance(value, list):
-        for i, v in enumerate(value):
-            _walk(ctx, v, sub + (i,), names)
-    elif isinstance(value, str):
-        value = strip_const(value)  # a first integral may be written "... = constant"
-        if "<" in value or ">" in value:
-            ctx.part.parse(value, sub, names, relation=True)
-        else:
-            ctx.part.parse(value, sub, names, equation=True)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mechbook.verify.registry import quantities
+from mechbook.verify.registry import default_quantities
 
 # the names a registration's `crosschecks=` may hold, and what each runs
 CROSSCHECKS = {
@@ -20,5 +20,5 @@ CROSSCHECKS = {
 
 def crosschecks_of(quantity: str) -> tuple[str, ...]:
     """The cross-checks the registration of `quantity` declares (none for an unknown one)."""
-    entry = quantities().get(quantity)
+    entry = default_quantities().get(quantity)
     return entry.crosschecks if entry is not None else ()

@@ -1,4 +1,6 @@
-"""Running an answer key against the engine: one outcome per part.
+"""Running an answer key against the engine: one outcome per part (the one check loop: the
+command line, the Python API and the tests all call `check_problem`, after `validate_key`,
+mechbook.verify.wellformed).
 
 Outcomes: pass · fail · erratum (the book's value fails, the key's corrected value passes and
 the key carries the derivation) · unsupported (the engine cannot compute it yet; never a pass)
@@ -8,6 +10,7 @@ the key carries the derivation) · unsupported (the engine cannot compute it yet
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import (
@@ -21,10 +24,15 @@ from mechbook.records import Outcome, Status
 from mechbook.verify.answers import AnswerKey, Part
 from mechbook.verify.compare import NUMERIC, ProofPolicy
 from mechbook.verify.context import Context
-from mechbook.verify.registry import quantities
+from mechbook.verify.registration import QuantityTable
+
+Stage = Callable[[str], None]  # told the stage a check is in, e.g. "part a (frequencies)"
 
 
-def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) -> Outcome:
+def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC,
+               quantities: QuantityTable | None = None) -> Outcome:
+    """The part's outcome (never raises for the part's own faults: they are its outcome).
+    `quantities`: the table to check with (default: the one its key was read against)."""
     start = time.perf_counter()
     out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], Status.ERROR,
                   origin=part.data.get("origin", "book"))
@@ -32,8 +40,8 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC) ->
         if "unsupported" in part.data:
             out.status, out.detail = Status.UNSUPPORTED, part.data["unsupported"]
             return out
-        ctx = Context(analysis, part, policy)
-        fn = quantities()[part.quantity].check
+        ctx = Context(analysis, part, policy, quantities=quantities)
+        fn = ctx.quantity.check
         verdict = fn(ctx, part.data.get("book"))
         if "erratum" in part.data:
             corrected = fn(ctx, part.data["erratum"]["corrected"])
@@ -77,9 +85,24 @@ def _power(part: Part, verdict) -> str:
     return power
 
 
-def check_problem(analysis: Analysis, key: AnswerKey,
-                  policy: ProofPolicy = NUMERIC) -> list[Outcome]:
-    if key.problem_id != analysis.problem.id:
+def require_same_problem(key: AnswerKey, problem_id: str) -> None:
+    """SpecError at the key's `problem:` unless the key is for the problem `problem_id`."""
+    if key.problem_id != problem_id:
         raise key.doc.error(("problem",), f"answer key is for {key.problem_id!r}, problem file "
-                            f"is {analysis.problem.id!r}")
-    return [check_part(analysis, part, policy) for part in key.parts]
+                            f"is {problem_id!r}")
+
+
+def check_problem(analysis: Analysis, key: AnswerKey, policy: ProofPolicy = NUMERIC,
+                  stage: Stage | None = None,
+                  quantities: QuantityTable | None = None) -> list[Outcome]:
+    """One outcome per part of `key`, in order (the key must be for the analysed problem);
+    `stage` is told "part NAME (QUANTITY)" before each part is checked, so a check stopped
+    from outside says where it was. Validate the key first (`validate_key`): a malformed
+    part comes out here as an error, but `mechbook check` refuses such a key whole."""
+    require_same_problem(key, analysis.problem.id)
+    outcomes = []
+    for part in key.parts:
+        if stage is not None:
+            stage(f"part {part.name} ({part.quantity})")
+        outcomes.append(check_part(analysis, part, policy, quantities))
+    return outcomes

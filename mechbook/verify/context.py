@@ -19,47 +19,75 @@ from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
 from mechbook.model.declared import declared
+from mechbook.model.hints import did_you_mean
 from mechbook.model.manifold import manifold_of
 from mechbook.records import NUMERIC, ProofPolicy
 from mechbook.verify.compare import Sampler, value, vanishes
 from mechbook.verify.part import Part
-from mechbook.verify.registration import registered
+from mechbook.verify.registration import Quantity, QuantityTable
 
 
 @dataclass
 class Context:
+    """What one part is checked in, built in named steps: the quantity's entry (from
+    `quantities`, by default the table its key was read against), the system and the names
+    the part may use, its `define:` forms, and the sampler of admissible points."""
+
     analysis: Analysis
     part: Part
     policy: ProofPolicy = NUMERIC
     validate_only: bool = False  # tensor parts: build the statement once, judge nothing
+    quantities: QuantityTable | None = None  # None: the table the part's key was read with
 
     def __post_init__(self):
+        self.quantity: Quantity = self._entry()
+        self.tensor_mode = not self.quantity.needs_system
+        self.system, self.names, self.unavailable = self._system_and_names()
+        self._add_defines()
+        self.sampler = self._sampler()
+
+    def _entry(self) -> Quantity:
+        """The part's quantity in the table; SpecError at `quantity:` if it is not there."""
+        table = self.part.key.quantities if self.quantities is None else self.quantities
+        entry = table.get(self.part.quantity)
+        if entry is None:
+            hint = did_you_mean(self.part.quantity, list(table))
+            raise self.part.error(("quantity",), f"{self.part.quantity!r} is not a quantity "
+                                  f"of the table this check uses ({len(table)} quantities"
+                                  + (f"; {hint})" if hint else ")"))
+        return entry
+
+    def _system_and_names(self) -> tuple:
+        """(the part's system or None, the names it may use, {abbreviation: why it does not
+        parse here}): a system's names with the momenta p_<q> and the multipliers
+        lambda_<constraint>, or the problem's declared ones for a tensor or body quantity."""
         problem = self.analysis.problem
-        self.tensor_mode = not registered(self.part.quantity).needs_system
         if self.part.system is None and (self.tensor_mode or not problem.systems):
-            self.system = None  # a tensor or body quantity, or a problem without a system
+            decl = declared(problem)  # a tensor or body quantity, or a problem without a system
+            return (None, *self.part.names(decl.names, tensor=True, bodies=decl.bodies))
+        try:
+            system = self.analysis.system(self.part.system)
+        except KeyError as exc:  # no `system:` in a multi-system problem, or a wrong one
+            raise self.part.error(("system",) if self.part.system else (),
+                                  str(exc.args[0]) + "; name it with `system:`") from None
+        names = dict(system.names)
+        bodies = None
+        if self.tensor_mode:
             decl = declared(problem)
-            self.names = self.part.names(decl.names, tensor=True, bodies=decl.bodies)
-        else:
-            try:
-                self.system = self.analysis.system(self.part.system)
-            except KeyError as exc:  # no `system:` in a multi-system problem, or a wrong one
-                raise self.part.error(("system",) if self.part.system else (),
-                                      str(exc.args[0]) + "; name it with `system:`") from None
-            names = dict(self.system.names)
-            bodies = None
-            if self.tensor_mode:
-                decl = declared(problem)
-                _merge_declared(names, decl.names, self.part)
-                bodies = decl.bodies
-            self.names = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
-            for c in self.system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
-                self.names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
-            for c, _ in list(self.system.constraints) + list(self.system.velocity_constraints):
-                name = "lambda_" + c  # a constraint's multiplier, as the engine names it
-                self.names.setdefault(name, sp.Symbol(name, real=True))
+            _merge_declared(names, decl.names, self.part)
+            bodies = decl.bodies
+        names, unavailable = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
+        for c in system.coord_names:  # momenta, for Hamiltonians: p_<coordinate>
+            names.setdefault("p_" + c, sp.Symbol("p_" + c, real=True))
+        for c, _ in list(system.constraints) + list(system.velocity_constraints):
+            name = "lambda_" + c  # a constraint's multiplier, as the engine names it
+            names.setdefault(name, sp.Symbol(name, real=True))
+        return system, names, unavailable
+
+    def _add_defines(self) -> None:
+        """The part's `define:` forms (e.g. alpha = theta - pi) and their rates, as names."""
         if self.system is not None and not self.tensor_mode:
-            for k, v in (self.part.data.get("define") or {}).items():  # e.g. alpha = theta - pi
+            for k, v in (self.part.data.get("define") or {}).items():
                 if k in self.names:
                     raise self.part.error(("define", k), f"{k!r} is already a name")
                 f = self.parse(v, ("define", k))
@@ -69,11 +97,38 @@ class Context:
         elif self.part.data.get("define") and not self.tensor_mode:
             raise self.part.error(("define",), "`define` needs a system (it names "
                                   "combinations of coordinates)")
-        conds = list(problem.conditions)
+
+    def _sampler(self) -> Sampler:
+        """The admissible points: the problem's conditions and the part's `assume:`, its
+        `restrict:` (symbols given by the others), a constrained system's manifold, and an
+        `estimate:`'s one point and tolerance."""
+        conds = list(self.analysis.problem.conditions)
         conds += [self.parse(c, ("assume", i), relation=True)
                   for i, c in enumerate(self.part.data.get("assume", []))]
         base = dict(self.analysis.problem.values())
         base.update(self.part.key.symbol_values)
+        derived = self._restrictions(base)
+        # a constrained system's states are drawn on its constraint manifold
+        manifold = (manifold_of(self.system) if self.system is not None and
+                    not self.tensor_mode else None)
+        if "estimate" not in self.part.data:
+            return Sampler(base, conds, policy=self.policy, derived=derived,
+                           manifold=manifold)
+        est = self.part.data["estimate"]  # a number the book computed: one point, its rtol
+        for k, v in (est.get("values") or {}).items():
+            sym = self.names.get(k)
+            if not isinstance(sym, sp.Symbol) or sym not in base:
+                raise self.part.error(("estimate", "values", k), f"{k!r} is not a "
+                                      "parameter or answer symbol")
+            val = self.parse(v, ("estimate", "values", k))
+            if not val.is_number:
+                raise self.part.error(("estimate", "values", k), "a number is expected")
+            base[sym] = float(val)
+        return Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
+                       fixed=list(base), derived=derived, manifold=manifold)
+
+    def _restrictions(self, base: dict) -> dict:
+        """The part's `restrict:`: {symbol: its expression in the other symbols}."""
         derived = {}
         for k, v in (self.part.data.get("restrict") or {}).items():
             sym = self.names.get(k)
@@ -84,25 +139,7 @@ class Context:
                 raise self.part.error(("restrict", k), "a restricted symbol is given by the "
                                       "others, not by itself or another restricted one")
             derived[sym] = expr
-        # a constrained system's states are drawn on its constraint manifold
-        manifold = (manifold_of(self.system) if self.system is not None and
-                    not self.tensor_mode else None)
-        if "estimate" in self.part.data:  # a number the book computed: one point, its rtol
-            est = self.part.data["estimate"]
-            for k, v in (est.get("values") or {}).items():
-                sym = self.names.get(k)
-                if not isinstance(sym, sp.Symbol) or sym not in base:
-                    raise self.part.error(("estimate", "values", k), f"{k!r} is not a "
-                                          "parameter or answer symbol")
-                val = self.parse(v, ("estimate", "values", k))
-                if not val.is_number:
-                    raise self.part.error(("estimate", "values", k), "a number is expected")
-                base[sym] = float(val)
-            self.sampler = Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
-                                   fixed=list(base), derived=derived, manifold=manifold)
-        else:
-            self.sampler = Sampler(base, conds, policy=self.policy, derived=derived,
-                                   manifold=manifold)
+        return derived
 
     @property
     def dyn(self):
@@ -116,8 +153,12 @@ class Context:
         """The problem's declared bodies (for the body functions of tensor expressions)."""
         return declared(self.analysis.problem).bodies
 
-    def parse(self, text, sub, equation=False, relation=False):
-        return self.part.parse(text, sub, self.names, equation, relation)
+    def parse(self, text, sub: tuple, equation: bool = False, relation: bool = False,
+              names: dict | None = None) -> sp.Basic:
+        """`text` parsed with the part's names (or `names`, e.g. with a quantity's extra
+        ones); SpecError at `sub` if it does not parse."""
+        return self.part.parse(text, sub, self.names if names is None else names, equation,
+                               relation, self.quantity.complex_values, self.unavailable)
 
     def point(self) -> dict:
         about = self.part.data.get("about")

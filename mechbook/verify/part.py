@@ -1,31 +1,56 @@
-"""One part of an answer key, as plain data: a module of its own so that the checks'
-context imports it without the key loader (which imports every check)."""
+"""An answer key and its parts, as records: a module of its own so that the checks' context
+imports them without the key loader (mechbook.verify.answers, which builds the schema from
+the table of quantities)."""
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
 import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import parse, parse_equation
 from mechbook.model.tensorexpr import parse_tensor
-from mechbook.verify.registration import QUANTITIES
-
-if TYPE_CHECKING:
-    from mechbook.verify.answers import AnswerKey
+from mechbook.model.yamlio import Document
+from mechbook.verify.registration import QuantityTable
 
 
-@dataclass
+class AnswerKey:
+    """An answer key: its document, its own symbols (`symbols:`, e.g. integration constants,
+    with the values they are sampled at), its parts, and the table of quantities it was read
+    against (its parts are checked with that table unless a caller gives another)."""
+
+    def __init__(self, doc: Document, quantities: QuantityTable):
+        self.doc = doc
+        self.file = doc.file
+        self.quantities = quantities
+        data = doc.data
+        self.problem_id: str = data["problem"]
+        self.symbols: dict[str, sp.Symbol] = {}
+        self.symbol_values: dict[sp.Symbol, float] = {}
+        for name, spec in (data.get("symbols") or {}).items():
+            spec = spec or {}
+            positive = spec.get("positive", True)
+            sym = sp.Symbol(name, positive=True) if positive else sp.Symbol(name, real=True)
+            self.symbols[name] = sym
+            self.symbol_values[sym] = float(spec.get("value", 1.0))
+        self.parts = [Part(self, i, p) for i, p in enumerate(data["parts"])]
+        seen = set()
+        for p in self.parts:
+            if p.name in seen:
+                raise p.error(("part",), f"part {p.name!r} appears twice")
+            seen.add(p.name)
+
+
+@dataclass(frozen=True)
 class Part:
-    """One part of an answer key: its data, names and parsing (plain data, under the checks)."""
+    """One part of an answer key: its data, names and parsing (a record: what a check learns
+    about it, such as the names available to it, stays with the check's context)."""
 
     key: AnswerKey
     index: int
     data: dict
-    _unavailable: dict = field(default_factory=dict, repr=False)  # abbreviation -> why
 
     @property
     def name(self) -> str:
@@ -47,11 +72,13 @@ class Part:
         return self.key.doc.error(self.path + sub, message)
 
     def names(self, base: dict, tensor: bool = False,
-              bodies: dict | None = None) -> dict[str, sp.Basic]:
+              bodies: dict | None = None) -> tuple[dict[str, sp.Basic], dict[str, str]]:
         """The names this part may use: `base` (a system's, or the problem's declared
         ones), the key's symbols and its abbreviations (tensor expressions, which may name
-        the problem's `bodies`, if `tensor`)."""
+        the problem's `bodies`, if `tensor`); and {abbreviation: why it does not parse here}
+        for those left out (`parse` says why when a part uses one)."""
         names = dict(base)
+        unavailable: dict[str, str] = {}
         for sym in self.key.symbols:
             if sym in names:
                 raise self.key.doc.error(("symbols", sym), f"{sym!r} is already a name of the "
@@ -69,21 +96,22 @@ class Part:
                 # part that uses it here is told why (the first abbreviation of a chain that
                 # failed, with its own reason).
                 used = re.search(r"unknown name '(\w+)'", str(exc))
-                self._unavailable[abbr] = self._unavailable.get(used.group(1) if used else "",
-                                                                str(exc))
-        return names
+                unavailable[abbr] = unavailable.get(used.group(1) if used else "", str(exc))
+        return names, unavailable
 
     def parse(self, text, sub: tuple, names: dict, equation: bool = False,
-              relation: bool = False) -> sp.Basic:
-        known = QUANTITIES.get(self.quantity)
-        complex_ok = bool(known and known.complex_values)  # exponents, complex modes
+              relation: bool = False, complex_ok: bool = False,
+              unavailable: dict[str, str] | None = None) -> sp.Basic:
+        """`text` parsed with `names` (an equation, or a relation, if asked); SpecError at
+        `sub` if it does not parse, saying why an abbreviation it uses is `unavailable`.
+        `complex_ok`: complex constants allowed (a quantity whose values are complex)."""
         try:
             if equation:
                 return parse_equation(text, names, complex_ok)
             return parse(text, names, relation, complex_ok)
         except ExpressionError as exc:
             message = str(exc)
-            for abbr, why in self._unavailable.items():
+            for abbr, why in (unavailable or {}).items():
                 if f"unknown name {abbr!r}" in message:
                     message += f" (abbreviation {abbr!r} does not parse here: {why})"
             raise self.error(sub, message) from None

@@ -36,7 +36,6 @@ from mechbook.model.expr import _split_single_equals
 from mechbook.verify import boundary
 from mechbook.verify.compare import equal, vanishes
 from mechbook.verify.context import Context, split_named, strip_const
-from mechbook.verify.registry import quantities
 
 PROOF_SECONDS = 10.0  # a symbolic proof that a mutant is itself a first integral
 TEXT_KEYS = {"part", "cite", "quantity", "note", "origin", "system", "derivation",
@@ -190,7 +189,7 @@ def _reparametrized(ctx: Context, old: sp.Expr | None, new: sp.Expr | None,
 def same_meaning(ctx: Context, path: tuple, old, new, token: str = "") -> str:
     """Why the value `new` at `path` means the same as `old` ('' if it does not, or if that
     cannot be shown). `token`: the name a scaling mutant multiplied ('' otherwise)."""
-    declared = quantities()[ctx.part.quantity].equivalent
+    declared = ctx.quantity.equivalent
     if callable(declared):
         declared = declared(ctx.part.data)
     if isinstance(new, bool) or not isinstance(new, str):
@@ -199,11 +198,11 @@ def same_meaning(ctx: Context, path: tuple, old, new, token: str = "") -> str:
         if "direction" in declared and _only_component(ctx, path, parse=False):
             return "the only nonzero component of a direction scaled (its direction is kept)"
         return _tensor_same(ctx, str(old), new)
-    q = quantities()[ctx.part.quantity]
+    q = ctx.quantity
     names = q.names(ctx) if q.names else ctx.names
 
     def parse(text, **kw):
-        return ctx.part.parse(text, path, names, **kw)
+        return ctx.parse(text, path, names=names, **kw)
 
     old_text = str(old)
     kind = _kind(old_text)

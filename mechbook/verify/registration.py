@@ -1,9 +1,10 @@
-"""How a quantity registers: its entry, the decorator and shared key schemas (a leaf the
-quantity modules import; mechbook.verify.registry, above them, holds the whole table)."""
+"""How a quantity is declared: its entry, the families that collect a module's entries, the
+table a check uses, and shared key schemas (a leaf the quantity modules import;
+mechbook.verify.registry, above them, builds the default table from the modules it names)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 # schema fragments shared by several quantities' keys
@@ -46,36 +47,75 @@ class Quantity:
     sweeps: tuple[str, ...] = ()
 
 
-QUANTITIES: dict[str, Quantity] = {}
+class Family:
+    """The quantities one module defines, in order: `@family.quantity(...)` makes the decorated
+    function the check of a quantity and records its entry here (nothing global: the table a
+    check uses is built from families by `QuantityTable.of`)."""
+
+    def __init__(self) -> None:
+        self._entries: dict[str, Quantity] = {}
+
+    @property
+    def entries(self) -> tuple[Quantity, ...]:
+        return tuple(self._entries.values())
+
+    def quantity(self, name: str, *, book: str, how: str, keys: dict | None = None,
+                 names: Callable | None = None, literals: tuple = (),
+                 needs_system: bool = True, complex_values: bool = False,
+                 equivalent: tuple | Callable = (), crosschecks: tuple[str, ...] = (),
+                 display: str | None = None,
+                 sweeps: tuple[str, ...] = ()) -> Callable[[Callable], Callable]:
+        """Make the decorated function the check of quantity `name` (`names`: a function of
+        the part's context giving the names its book value may use beyond the usual ones,
+        e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`:
+        words the book value may be instead, e.g. "stable"; `needs_system`: False for
+        quantities of declared tensors and bodies, which a problem without a system can
+        have; `complex_values`: its values are complex on purpose, so its expressions may
+        hold constants such as sqrt(-1), which are refused elsewhere; `crosschecks`,
+        `display`, `sweeps`: names of the cross-checks that vouch for it, of how the report
+        shows the engine's value, of the sweeps that draw its book value — see
+        `Quantity`)."""
+        def declare(fn: Callable) -> Callable:
+            if name in self._entries:
+                raise ValueError(f"quantity {name!r} declared twice")
+            self._entries[name] = Quantity(
+                name, fn, book, how, dict(keys or {}), names, tuple(literals), needs_system,
+                complex_values, equivalent if callable(equivalent) else tuple(equivalent),
+                tuple(crosschecks), display, tuple(sweeps))
+            return fn
+
+        return declare
 
 
-def quantity(name: str, *, book: str, how: str, keys: dict | None = None,
-             names: Callable | None = None, literals: tuple = (), needs_system: bool = True,
-             complex_values: bool = False, equivalent: tuple | Callable = (),
-             crosschecks: tuple[str, ...] = (), display: str | None = None,
-             sweeps: tuple[str, ...] = ()) -> Callable[[Callable], Callable]:
-    """Register the decorated function as the check of quantity `name` (`names`: a function
-    of the part's context giving the names its book value may use beyond the usual ones,
-    e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`: words
-    the book value may be instead, e.g. "stable"; `needs_system`: False for quantities of
-    declared tensors and bodies, which a problem without a system can have;
-    `complex_values`: its values are complex on purpose, so its expressions may hold
-    constants such as sqrt(-1), which are refused elsewhere; `crosschecks`, `display`,
-    `sweeps`: names of the cross-checks that vouch for it, of how the report shows the
-    engine's value, of the sweeps that draw its book value — see `Quantity`)."""
-    def register(fn):
-        if name in QUANTITIES and QUANTITIES[name].check is not fn:
-            raise ValueError(f"quantity {name!r} registered twice")
-        QUANTITIES[name] = Quantity(name, fn, book, how, dict(keys or {}), names,
-                                    tuple(literals), needs_system, complex_values,
-                                    equivalent if callable(equivalent) else tuple(equivalent),
-                                    tuple(crosschecks), display, tuple(sweeps))
-        return fn
+class QuantityTable(Mapping[str, Quantity]):
+    """The quantities a check knows, name -> entry: what an answer key may name (its schema
+    is built from the table) and how each part is checked. Immutable; compared and hashed
+    by identity, so that what is derived from a table (its schema) is cached per table."""
 
-    return register
+    def __init__(self, entries: Iterable[Quantity]) -> None:
+        table: dict[str, Quantity] = {}
+        for q in entries:
+            if q.name in table and table[q.name] is not q:
+                raise ValueError(f"quantity {q.name!r} is in the table twice")
+            table[q.name] = q
+        self._table = table
 
+    @classmethod
+    def of(cls, *families: Family) -> QuantityTable:
+        """The table of the quantities of `families` (a name in two of them is an error)."""
+        return cls(q for family in families for q in family.entries)
 
-def registered(name: str) -> Quantity:
-    """The entry of a registered quantity (all are registered once mechbook.verify.registry,
-    which imports every quantity module, is imported: answers.py imports it)."""
-    return QUANTITIES[name]
+    def __getitem__(self, name: str) -> Quantity:
+        return self._table[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._table)
+
+    def __len__(self) -> int:
+        return len(self._table)
+
+    __eq__ = object.__eq__
+    __hash__ = object.__hash__
+
+    def __repr__(self) -> str:
+        return f"QuantityTable({len(self)} quantities)"

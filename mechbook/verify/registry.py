@@ -1,14 +1,16 @@
-"""Every answer quantity, registered in one place: name → check, schema fragment, doc line.
+"""The built-in answer quantities: the table built from the modules listed here, the answer
+key schema of a table, and the table of quantities in docs/answers.md.
 
 A quantity is one function `check(ctx, value) -> Verdict` in a module of
-mechbook.verify.quantities, registered with `@quantity(name, book=..., how=..., keys=...)`
-(mechbook.verify.registration; this module imports every quantity module, so it sits above them):
-`book` says what the part's `book:` value holds, `how` how it is checked (both become the
-row of the table in docs/answers.md, which a test keeps equal to this registry), and `keys`
-maps the part keys this quantity reads, beyond the common ones, to their JSON-Schema
-fragments. The answer-key schema is assembled from the bundled base schema and these
-registrations, so a key that does not apply to a part's quantity is an error with its line.
-Adding a quantity is one new function (or module) and its registration.
+mechbook.verify.quantities, declared with `@quantity(name, book=..., how=..., keys=...)`, the
+decorator of that module's `FAMILY` (mechbook.verify.registration): `book` says what the
+part's `book:` value holds, `how` how it is checked (both become the row of the table in
+docs/answers.md, which a test keeps equal to this table), and `keys` maps the part keys this
+quantity reads, beyond the common ones, to their JSON-Schema fragments. The answer-key schema
+is assembled from the bundled base schema and a table's entries, so a key that does not
+apply to a part's quantity is an error with its line. Adding a quantity is one new function
+in a family's module; a new family is a new module and its line in `MODULES`. A caller may
+check with a table of its own (`QuantityTable.of(...)`, passed to `load_answers`).
 """
 
 from __future__ import annotations
@@ -16,9 +18,33 @@ from __future__ import annotations
 import copy
 from functools import cache
 
-import mechbook.verify.quantities  # noqa: F401 - every quantity module registers its checks
 from mechbook.model.schema import bundled
-from mechbook.verify.registration import QUANTITIES, Quantity
+from mechbook.verify.quantities import (
+    access,
+    adiabatic,
+    equations,
+    equilibria,
+    expressions,
+    extremum,
+    motion,
+    oscillations,
+    parts,
+    perturbation,
+    phase,
+    response,
+    rotation,
+    stability,
+    steady,
+    tensors,
+    trajectory,
+    words,
+)
+from mechbook.verify.registration import QuantityTable
+
+# the modules whose families make up the built-in table, one per family of quantities
+MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, motion,
+           oscillations, parts, perturbation, phase, response, rotation, stability, steady,
+           tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
@@ -26,18 +52,20 @@ COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", 
                "origin")
 
 
-def quantities() -> dict[str, Quantity]:
-    """All registered quantities (this module imports the modules that register them)."""
-    return QUANTITIES
+@cache
+def default_quantities() -> QuantityTable:
+    """The built-in table: every quantity of the modules in `MODULES`."""
+    return QuantityTable.of(*(module.FAMILY for module in MODULES))
 
 
 @cache
-def answers_schema() -> dict:
-    """The answer-key schema: the bundled base, with the quantity names, their extra keys'
-    schemas, and for each quantity the keys a part of it may carry."""
+def answers_schema(table: QuantityTable | None = None) -> dict:
+    """The answer-key schema for `table` (default: the built-in one): the bundled base, with
+    the quantity names, their extra keys' schemas, and for each quantity the keys a part of
+    it may carry."""
+    table = default_quantities() if table is None else table
     schema = copy.deepcopy(bundled("answers"))
     part = schema["$defs"]["part"]
-    table = quantities()
     part["properties"]["quantity"] = {"enum": sorted(table)}
     rules = []
     for q in table.values():
@@ -54,11 +82,12 @@ def answers_schema() -> dict:
     return schema
 
 
-def markdown_table() -> str:
-    """The table of quantities in docs/answers.md."""
+def markdown_table(table: QuantityTable | None = None) -> str:
+    """The table of quantities in docs/answers.md (of the built-in table by default)."""
+    table = default_quantities() if table is None else table
     rows = ["| quantity | `book` | check |", "| --- | --- | --- |"]
-    for name in sorted(quantities()):
-        q = QUANTITIES[name]
+    for name in sorted(table):
+        q = table[name]
         keys = ", ".join(f"`{k}`" for k in q.keys)
         extra = f" (keys: {keys})" if keys else ""
         rows.append(f"| `{name}`{extra} | {q.book} | {q.how} |")

@@ -28,7 +28,7 @@ from mechbook.app.report.syntax import syntax_math
 from mechbook.engine.periodic import time_dependent
 from mechbook.errors import MechbookError
 from mechbook.verify.context import Context, numbers, strip_const
-from mechbook.verify.registry import quantities
+from mechbook.verify.registry import default_quantities
 
 # the names a registration's `display=` may hold: what the page shows beside the book's value
 DISPLAYS = {
@@ -236,7 +236,7 @@ def _numeric_pair(ctx: Context, view: StoredSystem | None, values: dict, pt: dic
 
 def display_of(quantity: str) -> str | None:
     """How the registration of `quantity` says its engine value is shown (DISPLAYS)."""
-    entry = quantities().get(quantity)
+    entry = default_quantities().get(quantity)
     return entry.display if entry is not None else None
 
 

@@ -27,7 +27,10 @@ from mechbook.engine.access import Access
 from mechbook.verify import boundary
 from mechbook.verify.compare import Sampler, Verdict, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registration import POINT, quantity
+from mechbook.verify.registration import POINT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 INTEGRALS = {"type": "object", "minProperties": 1,
              "propertyNames": {"pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
@@ -88,13 +91,13 @@ def _integrals(ctx: Context) -> tuple[dict, dict, dict]:
 def check_accessible(ctx: Context, val) -> Verdict:
     names, what, base = _integrals(ctx)
     sys = ctx.system
-    cond = ctx.part.parse(val, ("book",), names, relation=True)
+    cond = ctx.parse(val, ("book",), relation=True, names=names)
     at = ctx.as_map(ctx.part.data.get("at") or {}, ("at",))
     config = {}
     for k, v in at.items():
         if k not in sys.coord_names:
             raise ctx.part.error(("at", k), f"{k!r} is not a coordinate")
-        config[sys.q[sys.coord_names.index(k)]] = ctx.part.parse(v, ("at", k), names)
+        config[sys.q[sys.coord_names.index(k)]] = ctx.parse(v, ("at", k), names=names)
     for q in sys.q:
         if q not in config and q not in ctx.dyn.cyclic:
             raise ctx.part.error(("at",), f"the configuration leaves {q} open (only cyclic "

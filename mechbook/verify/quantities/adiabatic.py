@@ -27,7 +27,10 @@ from mechbook.engine.adiabatic import frozen, simulate
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, value_and_scale
 from mechbook.verify.context import Context
-from mechbook.verify.registration import EXPR, quantity
+from mechbook.verify.registration import EXPR, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 POINTS = 6
 RTOL = 1e-20

@@ -8,7 +8,10 @@ import sympy as sp
 from mechbook.engine.lagrange import lagrange_expressions
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, linear_accelerations, split_named
-from mechbook.verify.registration import quantity
+from mechbook.verify.registration import Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 
 @quantity('lagrangian',

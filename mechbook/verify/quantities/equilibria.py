@@ -8,7 +8,10 @@ from mechbook.verify import boundary, boundary_limit
 from mechbook.verify.compare import Verdict, all_vanish, combine, vanishes
 from mechbook.verify.context import Context
 from mechbook.verify.periodic import FloquetVerdicts, time_dependent
-from mechbook.verify.registration import EXPR, LIMIT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 
 def _engine_points(ctx: Context) -> list[dict]:

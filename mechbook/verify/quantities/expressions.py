@@ -9,7 +9,10 @@ import sympy as sp
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registration import POINT, quantity
+from mechbook.verify.registration import POINT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 OF = ["potential", "kinetic", "quadratic_potential", "quadratic_kinetic", "energy_function",
       "hamiltonian", "momenta"]

@@ -38,7 +38,10 @@ from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.parts import energy_at, linear_motion, part_energy_expr
-from mechbook.verify.registration import EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, POINT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 POINTS = 3
 DPS = 60

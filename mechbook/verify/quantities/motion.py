@@ -12,7 +12,10 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registration import POINT, quantity
+from mechbook.verify.registration import POINT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 
 def _time_functions(ctx: Context, val, sub) -> dict[sp.Symbol, sp.Expr]:

@@ -15,7 +15,10 @@ from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registration import EXPR, LIMIT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 
 def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:

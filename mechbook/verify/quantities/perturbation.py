@@ -50,7 +50,10 @@ from mechbook.errors import UnsupportedError
 from mechbook.model.expr import Operator
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.context import Context
-from mechbook.verify.registration import EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import EXPR, LIMIT, POINT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 KINDS = ("squared_frequency", "component", "exponent", "damped_component", "equilibrium",
          "stiffness", "group")
@@ -254,7 +257,7 @@ def check_perturbation(ctx: Context, val):
         if key not in ctx.part.data:
             raise ctx.part.error((), f"a perturbation part needs `{key}:`")
     names, _ = _names(ctx)
-    book = ctx.part.parse(val, ("book",), names)
+    book = ctx.parse(val, ("book",), names=names)
     spec = ctx.part.data
     kind = spec["approximates"]
     f = len(ctx.system.q)
@@ -374,8 +377,8 @@ def _error(ctx, kind, book, T: _Tables, names, f, mode):
         for a, ga in enumerate(group):
             for c, gc in enumerate(group):
                 Mx[a, c] = mpmath.re(T.evaluate(book.subs({j: ga + 1, r: gc + 1})))
-        ref = T.evaluate(ctx.part.parse(ctx.part.data.get("reference", 0), ("reference",),
-                                        names))
+        ref = T.evaluate(ctx.parse(ctx.part.data.get("reference", 0), ("reference",),
+                                   names=names))
         approx = sorted(mpmath.re(ref) + x for x in mpmath.eig(Mx, left=False, right=False))
         w, _ = pert.exact_eigen(s)
         exact = sorted(w[g] for g in group)

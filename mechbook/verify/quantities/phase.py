@@ -10,7 +10,10 @@ from mechbook.core.compile import compile_batch
 from mechbook.errors import UndecidedError, UnsupportedError
 from mechbook.verify.compare import Sampler, Verdict, value
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registration import EXPR, REGION, quantity
+from mechbook.verify.registration import EXPR, REGION, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 PHASE_RTOL = 1e-8  # agreement required of a phase area
 PHASE_POINTS = 3  # parameter points per phase-space check

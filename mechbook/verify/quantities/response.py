@@ -17,7 +17,10 @@ from mechbook.engine import response
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
 from mechbook.verify.context import Context
-from mechbook.verify.registration import EXPR, quantity
+from mechbook.verify.registration import EXPR, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 POINTS = 5
 RTOL = 1e-8  # eigenvalue problems: relative to the largest exponent
@@ -98,7 +101,7 @@ def _exponent_map(ctx: Context):
     var = sp.Symbol(name)
     names = dict(ctx.names)
     names[name] = var
-    exponent = ctx.part.parse(ctx.part.data.get("exponent", name), ("exponent",), names)
+    exponent = ctx.parse(ctx.part.data.get("exponent", name), ("exponent",), names=names)
     return var, names, exponent
 
 
@@ -116,7 +119,7 @@ def _exponent_map(ctx: Context):
           crosschecks=("modes",))
 def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
     var, names, exponent = _exponent_map(ctx)
-    poly_expr = ctx.part.parse(val, ("book",), names)
+    poly_expr = ctx.parse(val, ("book",), names=names)
     if not poly_expr.has(var):
         raise ctx.part.error(("book",), f"the polynomial does not contain {var}")
     lin = ctx.linear()

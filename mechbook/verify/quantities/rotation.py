@@ -14,7 +14,10 @@ import sympy as sp
 from mechbook.model.attitude import rotation_matrix
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal
 from mechbook.verify.context import Context
-from mechbook.verify.registration import ESTIMATE, quantity
+from mechbook.verify.registration import ESTIMATE, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 BODY = {"type": "string"}
 VECTOR = {"oneOf": [{"enum": ["omega", "L", "e1", "e2", "e3", "x", "y", "z"]},

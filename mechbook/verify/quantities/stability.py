@@ -15,7 +15,10 @@ from mechbook.verify.context import Context
 from mechbook.verify.periodic import FloquetVerdicts, time_dependent
 from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.quantities.steady import coordinate_map
-from mechbook.verify.registration import EXPR, LIMIT, POINT, REGION, quantity
+from mechbook.verify.registration import EXPR, LIMIT, POINT, REGION, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 
 @quantity('stability',

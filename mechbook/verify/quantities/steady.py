@@ -23,7 +23,10 @@ from mechbook.verify import boundary
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, quantity
+from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 HOLD = {"type": "array", "items": {"type": "string"}}
 ROOT_RTOL = 1e-9

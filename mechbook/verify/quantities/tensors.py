@@ -27,7 +27,10 @@ from mechbook.verify.instances import (
     generic_symbols,
     rational_point,
 )
-from mechbook.verify.registration import ESTIMATE, NAME, quantity, registered
+from mechbook.verify.registration import ESTIMATE, NAME, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 TENSOR = {"type": "string"}
 FOR_ALL = {"type": "object", "minProperties": 1,
@@ -460,14 +463,3 @@ def check_inertia_ellipsoid(ctx: Context, val) -> Verdict:
 
     return check(ctx, build)
 
-
-def validate_part(ctx: Context) -> None:
-    """Parse every expression of a tensor part (for `mechbook validate`): the statement is
-    built once, at a random instance, and not judged."""
-    ctx.validate_only = True
-    try:
-        registered(ctx.part.quantity).check(ctx, ctx.part.data.get("book"))
-        if "erratum" in ctx.part.data:
-            registered(ctx.part.quantity).check(ctx, ctx.part.data["erratum"]["corrected"])
-    finally:
-        ctx.validate_only = False

@@ -28,7 +28,10 @@ from mechbook.numerics.model import build_model
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers
-from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, quantity
+from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
 
 LEVEL_RTOL = 1e-10
 LEVEL_DPS = 50  # the level set's working precision
