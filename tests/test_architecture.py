@@ -443,3 +443,10 @@ def test_the_unused_module_test_can_fail(tmp_path):
     orphan.write_text('"""Nobody imports me."""\n', encoding="utf-8")
     known["mechbook.app.orphan"] = orphan
     assert "mechbook.app.orphan" in unused_modules(known, [])
+
+
+def test_an_answer_key_record_and_its_loader_do_not_import_each_other():
+    """verify.part (the key and part records) is below verify.answers (the loader, which
+    needs the table of quantities): not even a TYPE_CHECKING import goes back up."""
+    assert "mechbook.verify.answers" not in imports(modules()["mechbook.verify.part"])
+    assert "mechbook.verify.part" in imports(modules()["mechbook.verify.answers"])
