@@ -79,7 +79,7 @@ import cProfile, json, pstats, time
 from pathlib import Path
 tree = Path(sys.argv[1]); sys.path.insert(0, str(tree))
 from mechbook.app.run import RunOptions, run_problem
-import mechbook.verify.checker, mechbook.verify.quantities, mechbook.crosscheck  # noqa
+import mechbook.verify.checker, mechbook.verify.registry, mechbook.crosscheck  # noqa
 pr = cProfile.Profile()
 start = time.process_time()
 pr.enable(); run_problem(sys.argv[2], tree, RunOptions()); pr.disable()

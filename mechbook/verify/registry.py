@@ -58,12 +58,15 @@ def default_quantities() -> QuantityTable:
     return QuantityTable.of(*(module.FAMILY for module in MODULES))
 
 
-@cache
 def answers_schema(table: QuantityTable | None = None) -> dict:
     """The answer-key schema for `table` (default: the built-in one): the bundled base, with
     the quantity names, their extra keys' schemas, and for each quantity the keys a part of
     it may carry."""
-    table = default_quantities() if table is None else table
+    return _schema(default_quantities() if table is None else table)
+
+
+@cache
+def _schema(table: QuantityTable) -> dict:
     schema = copy.deepcopy(bundled("answers"))
     part = schema["$defs"]["part"]
     part["properties"]["quantity"] = {"enum": sorted(table)}
