@@ -66,9 +66,11 @@ def test_a_problem_checks_with_a_table_of_its_own(tmp_path, book, status):
     key = load_answers(path, TABLE)
     assert key.quantities is TABLE
     assert validate_key(analysis, key) == {}
-    (outcome,) = check_problem(analysis, key)
+    stages: list[str] = []
+    (outcome,) = check_problem(analysis, key, stage=stages.append)
     assert outcome.status == status, outcome.detail
     assert outcome.quantity == "stiffness_ratio"
+    assert stages == ["part a (stiffness_ratio)"]
 
 
 def test_the_built_in_table_does_not_know_the_tests_quantity(tmp_path):
@@ -145,3 +147,41 @@ def test_a_part_is_a_frozen_record_and_its_context_keeps_what_is_learned(tmp_pat
     assert "w" not in ctx.names and isinstance(ctx.names["theta"], sp.Basic)
     with pytest.raises(SpecError, match="abbreviation 'w' does not parse here"):
         ctx.parse("w*theta", ("book", 0))
+
+
+def test_the_command_line_and_the_api_run_verifys_pipeline(tmp_path, monkeypatch):
+    """`mechbook check` and `Problem.check()` validate with verify's validate_key and check
+    with verify's check_problem (told the stage of each part), not a loop of their own."""
+    from hostile import check
+
+    import mechbook
+    from mechbook.verify import checker, wellformed
+
+    calls: list[tuple[str, list[str]]] = []
+    real_check, real_validate = checker.check_problem, wellformed.validate_key
+
+    def check_problem_spy(analysis, key, policy, stage=None, quantities=None):
+        seen: list[str] = []
+
+        def staged(text: str) -> None:
+            seen.append(text)
+            stage(text)
+
+        out = real_check(analysis, key, policy, staged, quantities)
+        calls.append(("check", seen))
+        return out
+
+    def validate_spy(analysis, key, quantities=None):
+        calls.append(("validate", []))
+        return real_validate(analysis, key, quantities)
+
+    monkeypatch.setattr(checker, "check_problem", check_problem_spy)
+    monkeypatch.setattr(wellformed, "validate_key", validate_spy)
+    base = pendulum_tree(tmp_path)
+    result = check(base, "--no-store")
+    assert result.exit_code == 0, result.output
+    assert calls == [("validate", []), ("check", ["part a (eom)"])]
+    calls.clear()
+    got = mechbook.load("lim-2101", base).check(crosscheck=False)
+    assert got.ok and [o.status for o in got.outcomes] == [Status.PASS]
+    assert calls == [("validate", []), ("check", ["part a (eom)"])]
