@@ -10,6 +10,8 @@ Nothing else is modelled.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
@@ -20,7 +22,7 @@ from mechbook.core.secalc import total_derivative
 from mechbook.errors import NotFoundError, UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
-from mechbook.model.declared import declared
+from mechbook.model.declared import Declared, declared
 from mechbook.model.domains import Domain, assumptions, domain_of
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
@@ -46,8 +48,13 @@ class System(SystemLike):
     """Symbols and the Lagrangian of one system of a problem (the full system: nothing
     reduced, no momenta held; mechbook.model.protocol)."""
 
-    def __init__(self, problem: Problem, spec: SystemSpec):
+    def __init__(self, problem: Problem, spec: SystemSpec,
+                 declarations: Callable[[], Declared] | None = None):
+        """`declarations`: the problem's declared vectors, tensors and bodies, for a rigid
+        body made of parts (model.built.Built passes the one it keeps; without it, the
+        system builds them when a body needs them)."""
         self.problem = problem
+        self._declarations = declarations
         self.name = spec.name
         self.spec = spec.data
         self.path = spec.path
@@ -298,7 +305,10 @@ class System(SystemLike):
 
     def _composite(self, body: str, sub: tuple):
         """A body declared under the problem's `bodies:` (made of parts)."""
-        bodies = declared(self.problem).bodies
+        if self._declarations is None:  # built once for all of this system's bodies
+            decl = declared(self.problem)
+            self._declarations = lambda: decl
+        bodies = self._declarations().bodies
         if body not in bodies:
             known = ", ".join(sorted(bodies)) or "none declared"
             raise self._error(sub, f"no body {body!r} under 'bodies:' ({known})")
@@ -479,22 +489,26 @@ class System(SystemLike):
         return {}
 
 
-def system_of(problem: Problem, name: str | None = None) -> System:
-    """The built (symbolic) system `name` of a problem, or its only one (of several, the one
-    named `main`); built once and kept on the problem. NotFoundError (a KeyError too)
-    names the systems there are."""
+def system_name(problem: Problem, name: str | None = None) -> str:
+    """`name`, checked, or the problem's only system (of several, the one named `main`).
+    NotFoundError (a KeyError too) names the systems there are."""
     if name is None:
         if len(problem.systems) == 1:
-            name = next(iter(problem.systems))
-        elif "main" in problem.systems:
-            name = "main"
-        else:
-            raise NotFoundError(f"{problem.id} has several systems: "
-                                f"{', '.join(problem.systems)}")
+            return next(iter(problem.systems))
+        if "main" in problem.systems:
+            return "main"
+        raise NotFoundError(f"{problem.id} has several systems: "
+                            f"{', '.join(problem.systems)}")
     if name not in problem.systems:
         raise NotFoundError(f"{problem.id} has no system {name!r} (has "
                             f"{', '.join(problem.systems)})")
-    if name not in problem._cache:
-        problem._cache[name] = System(problem, problem.systems[name])
-    return problem._cache[name]
+    return name
 
+
+def system_of(problem: Problem, name: str | None = None,
+              declarations: Callable[[], Declared] | None = None) -> System:
+    """The system `name` of a problem, or its only one (of several, the one named `main`),
+    built anew: what is built once and kept is kept by its builder (model.built.Built, which
+    an engine Analysis owns). NotFoundError (a KeyError too) names the systems there are."""
+    name = system_name(problem, name)
+    return System(problem, problem.systems[name], declarations)

@@ -18,7 +18,6 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
-from mechbook.model.declared import declared
 from mechbook.model.manifold import manifold_of
 from mechbook.records import NUMERIC, ProofPolicy
 from mechbook.verify.compare import Sampler, value, vanishes
@@ -38,7 +37,7 @@ class Context:
         self.tensor_mode = not registered(self.part.quantity).needs_system
         if self.part.system is None and (self.tensor_mode or not problem.systems):
             self.system = None  # a tensor or body quantity, or a problem without a system
-            decl = declared(problem)
+            decl = self.analysis.declared()
             self.names = self.part.names(decl.names, tensor=True, bodies=decl.bodies)
         else:
             try:
@@ -49,7 +48,7 @@ class Context:
             names = dict(self.system.names)
             bodies = None
             if self.tensor_mode:
-                decl = declared(problem)
+                decl = self.analysis.declared()
                 _merge_declared(names, decl.names, self.part)
                 bodies = decl.bodies
             self.names = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
@@ -114,7 +113,7 @@ class Context:
     @property
     def bodies(self) -> dict:
         """The problem's declared bodies (for the body functions of tensor expressions)."""
-        return declared(self.analysis.problem).bodies
+        return self.analysis.declared().bodies
 
     def parse(self, text, sub, equation=False, relation=False):
         return self.part.parse(text, sub, self.names, equation, relation)
