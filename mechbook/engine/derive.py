@@ -125,13 +125,8 @@ def _ranges(sys, search: dict | None) -> dict | None:
     if not search:
         return None
     vals = sys.problem.values()
-
-    def number(text, path: tuple) -> float:
-        return float(sys.problem.parse(text, sys.path + path, sys.names).subs(vals))
-
-    return {sys.q[sys.coord_names.index(k)]: tuple(number(x, ("equilibria", "search", k, i))
-                                                   for i, x in enumerate(v))
-            for k, v in search.items()}
+    return {sys.q[sys.coord_names.index(k)]: tuple(float(sys.parse(x, ("equilibria", "search",
+            k, i)).subs(vals)) for i, x in enumerate(v)) for k, v in search.items()}
 
 
 def _oscillations(res: Results, lin, tag: str, values: dict) -> None:
