@@ -258,7 +258,7 @@ def test_every_declared_use_of_a_quantity_is_known():
     each of those is declared by some quantity."""
     from mechbook.app.report.values import DISPLAYS
     from mechbook.app.sweep import QUANTITIES as SWEEPS
-    from mechbook.crosscheck.vouch import CROSSCHECKS
+    from mechbook.crosscheck.problem import CROSSCHECKS
     from mechbook.verify.registry import default_quantities
 
     table = default_quantities().values()

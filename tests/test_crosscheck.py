@@ -288,3 +288,42 @@ def test_box_integrals_term_by_term_equal_sympys_multiple_integral():
             assert {key[1] for key in known} == {u, v, w}
     tri = ((u, 0, v), (v, 0, a))  # a limit depending on the other variable
     assert sp.simplify(_box_integral(u * v, tri, {}) - a**4 / 8) == 0
+
+
+def test_each_crosscheck_name_is_one_entry_of_the_table(monkeypatch):
+    """crosscheck.problem.CROSSCHECKS is the one table of the cross-checks a part's
+    registration may name (issue 35, item 4): each entry runs its check, or names the
+    check whose measurement it changes; two names of one check run it once; and a new
+    entry is all a new check needs to run for the parts that name it, in table order."""
+    import re
+
+    from mechbook.crosscheck import problem as problem_mod
+    from mechbook.crosscheck.problem import CROSSCHECKS, PartCheck, _each_part
+
+    for name, entry in CROSSCHECKS.items():
+        if entry.run is None:
+            other = re.match(r"with `(\w+)`: ", entry.doc)
+            assert other and CROSSCHECKS[other.group(1)].run is not None, name
+    assert CROSSCHECKS["first_integrals"].run is CROSSCHECKS["energy_integral"].run
+
+    calls = []
+
+    def probe(analysis, part, models):
+        calls.append(part.name)
+        return CrossCheck(f"probe:{part.name}", "probe", "main", parts=[part.name])
+
+    run_probe = _each_part(probe, "probe")
+    table = {"probe": PartCheck("a probe", run_probe),
+             "again": PartCheck("Newton's, by another name", CROSSCHECKS["newton"].run),
+             "probe_too": PartCheck("the probe by another name", run_probe)}
+    monkeypatch.setattr(problem_mod, "CROSSCHECKS", table)
+    monkeypatch.setattr(problem_mod, "crosschecks_of", lambda q: ("probe_too", "again"))
+    an, key = real("lim-2031")
+    stages = []
+    out = crosscheck_problem(an, key, stages.append)
+    parts = [p.name for p in key.parts if "unsupported" not in p.data]
+    assert calls == parts  # each part once, though it names the probe twice
+    assert [x.name for x in out if x.kind == "probe"] == [f"probe:{p}" for p in parts]
+    assert f"cross-check probe:{parts[0]}" in stages
+    (newton,) = [x for x in out if x.kind == "newton"]
+    assert newton.parts == parts  # the Newton entry, under another name, ran too

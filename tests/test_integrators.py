@@ -165,3 +165,32 @@ def test_cli_refuses_an_option_the_method_does_not_take():
     assert res.exit_code != 0
     assert "--rtol does not apply to the fixed method leapfrog" in res.output  # said by the CLI
     assert "Traceback" not in res.output
+
+
+def test_each_method_is_one_entry_of_the_table_naming_its_class(pendulum):
+    """numerics.methods.METHODS is the one table of methods (issue 35, item 4): each
+    name's entry names a module of mechbook.numerics and an Integrator subclass there,
+    which make_integrator builds under the name its results carry (an alias's, the
+    method's own); the lists the command line offers are read from it."""
+    import importlib
+
+    from mechbook.numerics.integrator_base import Integrator
+    from mechbook.numerics.integrators import make_integrator
+    from mechbook.numerics.methods import ALIASES, CHOICES, METHODS, OPTIONS, kind
+
+    assert CHOICES == ("RK45", "DOP853", "Radau", "LSODA", "RK4", "leapfrog", "yoshida4",
+                       "midpoint", "taylor")
+    assert ALIASES == {"verlet": "leapfrog", "forest-ruth": "yoshida4"}
+    for name, entry in METHODS.items():
+        assert entry.module.startswith("mechbook.numerics.") and entry.family in OPTIONS
+        cls = getattr(importlib.import_module(entry.module), entry.cls)
+        assert issubclass(cls, Integrator)
+        made = make_integrator(name)
+        assert type(made) is cls and made.name == ALIASES.get(name, name)
+        assert kind(name) == entry.family
+    assert kind("nosuch") is None
+    with pytest.raises(IntegratorError, match=r"unknown method 'nosuch'; known: RK45, "
+                                              r"DOP853, .*, forest-ruth, midpoint, taylor$"):
+        make_integrator("nosuch")
+    run = integrate(pendulum, (0.0, 0.1), [0.5], [0.0], "verlet", step=0.01)
+    assert run.success and run.method == "leapfrog" and run.settings["order"] == 2

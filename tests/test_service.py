@@ -96,7 +96,7 @@ def _must_not_run(*args, **kwargs):
 def test_option_choices_are_read_from_their_owners():
     from mechbook.app.cli import main
     from mechbook.core.compile import BACKENDS
-    from mechbook.numerics.integrators import FIXED, METHODS, SCIPY_METHODS
+    from mechbook.numerics.integrators import FIXED_METHODS, METHODS, SCIPY_METHODS
     from mechbook.numerics.methods import ALIASES, CHOICES
 
     def choices(command: str, option: str) -> tuple:
@@ -105,6 +105,6 @@ def test_option_choices_are_read_from_their_owners():
 
     assert choices("simulate", "--method") == CHOICES
     assert set(CHOICES) | set(ALIASES) == set(METHODS) == \
-        set(SCIPY_METHODS) | set(FIXED) | {"taylor"}
+        set(SCIPY_METHODS) | set(FIXED_METHODS) | {"taylor"}
     assert choices("simulate", "--backend") == choices("sweep", "--backend") == BACKENDS
     assert choices("sweep", "--quantity") == sweep.QUANTITIES

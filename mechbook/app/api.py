@@ -91,7 +91,8 @@ class Problem:
     def __init__(self, model: Model, base: Path, simplify: bool = True):
         self.model, self.base, self.simplify = model, Path(base), simplify
         self.analysis = Analysis(model, simplify=simplify)
-        self.fast = Analysis(model) if simplify else self.analysis  # checks, simulations
+        # checks, simulations: unsimplified, on the same systems (each built once)
+        self.fast = Analysis(model, built=self.analysis.built) if simplify else self.analysis
         self._views: dict[str, SystemView] = {}
 
     id = property(lambda self: self.model.id)

@@ -17,7 +17,7 @@ import logging
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -65,10 +65,8 @@ class RunOptions:
 def run_problem(pid: str, base: Path, options: RunOptions = RunOptions(),
                 stage: Stage = _quiet, problem: Problem | None = None) -> ProblemRun:
     """Check one problem against its answer key (and cross-check it), from scratch.
-    `problem`: the problem file already loaded (the Python API's), checked on a fresh
-    cache of its own, so what the run stores is what this check derived."""
-    if problem is not None:
-        problem = replace(problem, _cache={})
+    `problem`: the problem file already loaded (the Python API's), checked by an Analysis
+    of its own, so what the run stores is what this check derived."""
     start = time.perf_counter()
     run = ProblemRun(pid)
     reached = [""]

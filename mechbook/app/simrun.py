@@ -72,8 +72,8 @@ def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -
         report.problem_id = problem.id
         stage("validating")
         with build_limit(problem.doc.file):  # validate's limit, and its message
-            build_systems(problem)  # a system that is not physical is refused with the reason
-        analysis = Analysis(problem)
+            built = build_systems(problem)  # one not physical is refused with the reason
+        analysis = Analysis(problem, built=built)
         stage("deriving and integrating")
         sim = simulate(analysis, request.system, init=parse_assignments(request.init),
                        t_span=(0.0, request.t_end), method=request.method,

@@ -17,16 +17,14 @@ from typing import TYPE_CHECKING
 
 from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.errors import MechbookError, SpecError
+from mechbook.model.built import Built
 from mechbook.model.catalog import problem_path, root
-from mechbook.model.declared import declared
 from mechbook.model.physical import check_physical
-from mechbook.model.problem import load_problem
-from mechbook.model.system import system_of
+from mechbook.model.problem import Problem, load_problem
 from mechbook.model.yamlio import load
 
 if TYPE_CHECKING:
     from mechbook.engine.analysis import Analysis
-    from mechbook.model.problem import Problem
     from mechbook.verify.answers import AnswerKey
 
 BUILD_SECONDS = 15.0  # CPU; `validate` runs in the caller's process, so it bounds itself
@@ -40,8 +38,8 @@ def validate_file(path: str | Path) -> str:
         return _validate_answers(path)
     problem = load_problem(path)
     with build_limit(path):
-        build_systems(problem)
-    decl = declared(problem)
+        built = build_systems(problem)
+    decl = built.declared()
     return (f"{path}: problem {problem.id} is valid ({len(problem.systems)} system(s), "
             f"{len(decl.vectors)} vector(s), {len(decl.tensors)} tensor(s), "
             f"{len(decl.bodies)} body(ies))")
@@ -111,16 +109,19 @@ def validated_parts(problem: Problem, key: AnswerKey, analysis: Analysis,
     blame: list = [problem.doc.file, None]
     try:
         with hard_time_limit(BUILD_SECONDS):
-            build_systems(problem)
+            build_systems(problem, analysis.built)  # kept for the check's parts
             blame[1] = key_path
             return {name: str(fault) for name, fault in validate_key(analysis, key).items()}
     except Timeout:
         raise _too_slow(*blame) from None
 
 
-def build_systems(problem) -> None:
+def build_systems(problem: Problem, built: Built | None = None) -> Built:
     """Build every system of a problem (each expression parsed) and refuse one that is not
     physical (a mass not positive, a kinetic energy not positive definite); SpecError on
-    the first fault."""
+    the first fault. The systems are kept by `built` (an Analysis's, for its check), or by
+    a new Built, returned."""
+    built = built if built is not None else Built(problem)
     for name in problem.systems:
-        check_physical(system_of(problem, name))
+        check_physical(built.system(name))
+    return built

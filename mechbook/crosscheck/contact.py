@@ -121,7 +121,7 @@ def on_manifold(analysis: Analysis, sys, newton: list, frames: dict,
     lam = list(dyn.multipliers)
     names = list(sys.spec.get("particles") or {}) + list(sys.spec.get("rigid_bodies") or {})
     positions = {name: sys.positions[name] for name in names}
-    forces, rows = _constraint_forces(sys, sys.spec, positions, frames, sys._parse, lam)
+    forces, rows = _constraint_forces(sys, sys.spec, positions, frames, sys.parse, lam)
     engine_rows = [c for _, c in sys.velocity_constraints][
         len(sys.spec.get("velocity_constraints") or []):]
     params = [p.symbol for p in sys.params.values()]

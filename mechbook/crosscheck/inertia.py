@@ -15,7 +15,6 @@ import numpy as np
 from mechbook.crosscheck.assembly import composite_inertia
 from mechbook.crosscheck.guard import guarded
 from mechbook.engine.analysis import Analysis
-from mechbook.model.declared import declared
 from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import AnswerKey
 from mechbook.verify.compare import Sampler, value
@@ -61,7 +60,7 @@ def inertia_crosschecks(analysis: Analysis, key: AnswerKey | None) -> list[Cross
 
 def _compare(analysis: Analysis, name: str, x: CrossCheck) -> None:
     problem = analysis.problem
-    body = declared(problem).bodies[name]
+    body = analysis.declared().bodies[name]
     engine = [body.mass, *body.center_of_mass, *body.inertia()]
     m, com, inertia = composite_inertia(problem, name)
     own = [m, *com, *inertia]

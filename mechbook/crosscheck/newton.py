@@ -65,7 +65,7 @@ def _newton_residual(sys, symengine: bool = True) -> list:
     if not particles and not bodies:
         raise UnsupportedError("Newton cross-check: no particle or body positions (T and V "
                                "are given directly)")
-    parse = sys._parse  # the system's own safe parser, at the file's paths
+    parse = sys.parse  # the system's own safe parser, at the file's paths
     n = len(sys.q)
     positions = {name: sys.positions[name] for name in list(particles) + list(bodies)}
     masses = {name: sys.masses[name] for name in positions}
@@ -363,7 +363,7 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     out.status = Status.PASS if worst < NEWTON_TOL else Status.FAIL
     out.detail = _what_was_compared(sys.spec, used, worst)
     if sys.constraints or sys.velocity_constraints:
-        frames = {k: _body_frame(sys, k, b, sys.masses[k], sys._parse)
+        frames = {k: _body_frame(sys, k, b, sys.masses[k], sys.parse)
                   for k, b in (sys.spec.get("rigid_bodies") or {}).items()}
         rows, force, states = on_manifold(analysis, sys, newton, frames, samples)
         out.error = max(worst, rows, force)

@@ -1,16 +1,22 @@
 """Every cross-check of one problem: which run, for which answer parts, in what order.
 
 Newton per system; per answer part, the checks its quantity's registration declares
-(vouch.py): a first integral along a run, steady motions and trajectories measured, the
-driven response, and the frequencies at the part's point (points.py: one simulation per
-distinct point); then the frequencies about the engine's own stable equilibria, and the
-declared bodies' inertia. Each check runs under the one guard (guard.py): a fault in one
-never hides the others.
+(vouch.py), each the entry of its name in CROSSCHECKS: a first integral along a run, steady
+motions and trajectories measured, the driven response, and the frequencies at the part's
+point (points.py: one simulation per distinct point); then the frequencies about the
+engine's own stable equilibria, and the declared bodies' inertia. Each check runs under the
+one guard (guard.py): a fault in one never hides the others.
+
+Adding a cross-check of a part: a module of mechbook/crosscheck with its function
+`check(analysis, part, models) -> CrossCheck | None`, and one entry in CROSSCHECKS,
+`"name": PartCheck("what it checks", _each_part(check, "name"))`; a quantity's
+registration then names it in `crosschecks=`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from mechbook.crosscheck.conserved import conserved_part
 from mechbook.crosscheck.frequencies import frequency_crosscheck
@@ -37,6 +43,93 @@ def _modes_check(analysis: Analysis, lin, values: dict, name: str, models: dict)
     with guarded(out):
         state_frequency_crosscheck(analysis, lin, values, out, models)
     return out
+
+
+Runner = Callable[["_ProblemChecks", Part, "str | None", tuple[str, ...]], None]
+
+
+@dataclass(frozen=True)
+class PartCheck:
+    """A cross-check an answer part's registration may name (`crosschecks=`): what it
+    checks, and what runs it for a part, given the problem's checks so far, the part, its
+    system and every name its registration declares (None: a name that changes what
+    another check measures, which that check reads)."""
+
+    doc: str
+    run: Runner | None = None
+
+
+def _each_part(check: Callable[[Analysis, Part, dict], CrossCheck | None], what: str) -> Runner:
+    """Run `check(analysis, part, models)` for each part that names it; list its result
+    (None: nothing to check)."""
+    def run(checks: _ProblemChecks, part: Part, system: str | None,
+            vouch: tuple[str, ...]) -> None:
+        checks.stage(f"cross-check {what}:{part.name}")
+        x = check(checks.analysis, part, checks.models)
+        if x is not None:
+            checks.out.append(x)
+
+    return run
+
+
+def _shared_by(question: Callable[[Part, str | None], tuple], what: str,
+               check: Callable[[Analysis, Part], CrossCheck]) -> Runner:
+    """A simulation that parts asking the same `question(part, system)` share."""
+    def run(checks: _ProblemChecks, part: Part, system: str | None,
+            vouch: tuple[str, ...]) -> None:
+        checks.shared(question(part, system), part, what, check)
+
+    return run
+
+
+def _newton(checks: _ProblemChecks, part: Part, system: str | None,
+            vouch: tuple[str, ...]) -> None:
+    """The part listed under its system's Newton check (run once per system, first)."""
+    if system in checks.newton:
+        checks.newton[system].parts.append(part.name)
+
+
+def _modes(checks: _ProblemChecks, part: Part, system: str | None,
+           vouch: tuple[str, ...]) -> None:
+    checks.modes(part, system, vouch)
+
+
+def _steady_question(part: Part, system: str | None) -> tuple:
+    data = part.data
+    return (system, "steady", repr(data.get("about")), data.get("unknown"),
+            repr(data.get("hold")), repr(data.get("assume")), repr(data.get("estimate")))
+
+
+def _trajectory_question(part: Part, system: str | None) -> tuple:
+    data = part.data
+    return (system, part.quantity, repr(data.get("initial")), data.get("coordinate"),
+            data.get("rate"))
+
+
+_conserved = _each_part(conserved_part, "conserved")
+
+# every name a registration's `crosschecks=` may hold, run for a part in this order (a check
+# two names lead to, once)
+CROSSCHECKS: dict[str, PartCheck] = {
+    "newton": PartCheck("the system's equations against Newton's and Euler's laws "
+                        "(newton.py)", _newton),
+    "first_integrals": PartCheck("the named first integrals constant along a run "
+                                 "(conserved.py)", _conserved),
+    "energy_integral": PartCheck("the part's energy function or Hamiltonian constant along "
+                                 "a run", _conserved),
+    "steady": PartCheck("each steady rate kept by a simulation of the full equations "
+                        "(motion.py)", _shared_by(_steady_question, "steady", steady_crosscheck)),
+    "trajectory": PartCheck("the turning points of the level set measured by integration "
+                            "(motion.py)",
+                            _shared_by(_trajectory_question, "measured", trajectory_crosscheck)),
+    "trajectory_period": PartCheck("with `trajectory`: the period measured too"),
+    "trajectory_advance": PartCheck("with `trajectory`: a coordinate's advance per period "
+                                    "measured too"),
+    "modes": PartCheck("the frequencies at the part's point measured by simulation "
+                       "(frequencies.py)", _modes),
+    "response": PartCheck("with `modes`: the steady amplitude measured from the driven "
+                          "motion (response.py)"),
+}
 
 
 def crosscheck_problem(analysis: Analysis, key: AnswerKey | None = None,
@@ -81,30 +174,17 @@ class _ProblemChecks:
             self.newton[name] = x
 
     def part(self, part: Part) -> None:
-        """The checks that vouch for one answer part."""
-        sname = part.system or self.only
+        """The checks that vouch for one answer part: those its registration names."""
+        system = part.system or self.only
         vouch = crosschecks_of(part.quantity)  # the names its registration declares
-        if "newton" in vouch and sname in self.newton:
-            self.newton[sname].parts.append(part.name)
-        if "first_integrals" in vouch or "energy_integral" in vouch:
-            self.stage(f"cross-check conserved:{part.name}")
-            x = conserved_part(self.analysis, part, self.models)
-            if x is not None:
-                self.out.append(x)
-        if "steady" in vouch:
-            tag = (sname, "steady", repr(part.data.get("about")), part.data.get("unknown"),
-                   repr(part.data.get("hold")), repr(part.data.get("assume")),
-                   repr(part.data.get("estimate")))
-            self._shared(tag, part, "steady", steady_crosscheck)
-        if "trajectory" in vouch:
-            tag = (sname, part.quantity, repr(part.data.get("initial")),
-                   part.data.get("coordinate"), part.data.get("rate"))
-            self._shared(tag, part, "measured", trajectory_crosscheck)
-        if "modes" in vouch:
-            self._modes(part, sname, vouch)
+        ran: list[Runner] = []
+        for name, check in CROSSCHECKS.items():
+            if name in vouch and check.run is not None and check.run not in ran:
+                ran.append(check.run)
+                check.run(self, part, system, vouch)
 
-    def _shared(self, tag: tuple, part: Part, what: str,
-                check: Callable[[Analysis, Part], CrossCheck]) -> None:
+    def shared(self, tag: tuple, part: Part, what: str,
+               check: Callable[[Analysis, Part], CrossCheck]) -> None:
         """A simulation that parts asking the same question share."""
         if tag in self.measured:
             self.measured[tag].parts.append(part.name)
@@ -113,7 +193,7 @@ class _ProblemChecks:
         self.measured[tag] = check(self.analysis, part)
         self.out.append(self.measured[tag])
 
-    def _modes(self, part: Part, sname: str | None, vouch: tuple[str, ...]) -> None:
+    def modes(self, part: Part, sname: str | None, vouch: tuple[str, ...]) -> None:
         """The frequencies at the part's point (and the driven response there)."""
         x = CrossCheck(f"modes:{sname}", "frequencies", sname or "", parts=[part.name])
         values = None

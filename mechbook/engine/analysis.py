@@ -1,12 +1,16 @@
 """One problem's derived results, computed lazily and cached per system and per point.
 
 The checker and the CLI both ask this object for what they need; nothing is derived that is
-not asked for ("the engine computes only what the problem asks for").
+not asked for ("the engine computes only what the problem asks for"). It keeps everything
+derived from its problem: the systems and declared objects (through its model.built.Built),
+their dynamics, equilibria and linearizations, and what `reuse` was asked to keep; what a
+check derived is what its Analysis holds (`derived`, which engine.derive stores).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TypeVar
 
 import sympy as sp
@@ -17,23 +21,49 @@ from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
 from mechbook.engine.routh import ReducedSystem
 from mechbook.errors import UnsupportedError
+from mechbook.model.built import Built
+from mechbook.model.declared import Declared
 from mechbook.model.problem import Problem
-from mechbook.model.system import System, system_of
+from mechbook.model.system import System
 
 T = TypeVar("T")
 
 
+@dataclass(frozen=True)
+class Derived:
+    """What an analysis derived for one system so far (engine.derive stores it)."""
+
+    system: System
+    dynamics: Dynamics | None
+    equilibria: Equilibria | None
+    linear: list[LinearSystem]  # in the order they were asked for
+
+
 class Analysis:
-    def __init__(self, problem: Problem, simplify: bool = False):
+    def __init__(self, problem: Problem, simplify: bool = False, built: Built | None = None):
+        """`built`: the systems and declared objects to start from (another analysis's
+        `built`, shared: the API's simplified and plain analyses build each system once);
+        by default, a new one."""
         self.problem = problem
         self.simplify = simplify
+        self.built = built if built is not None else Built(problem)
         self._dyn: dict[str, Dynamics] = {}
         self._eq: dict[str, Equilibria] = {}
         self._lin: dict[tuple, LinearSystem] = {}
         self._reused: dict[tuple, object] = {}
 
     def system(self, name: str | None = None) -> System:
-        return system_of(self.problem, name)
+        return self.built.system(name)
+
+    def declared(self) -> Declared:
+        """The problem's declared vectors, tensors and bodies (built once)."""
+        return self.built.declared()
+
+    def derived(self) -> list[Derived]:
+        """For each system built so far (in the problem's order), what was derived for it."""
+        return [Derived(sys, self._dyn.get(sys.name), self._eq.get(sys.name),
+                        [lin for key, lin in self._lin.items() if key[0] == sys.name])
+                for sys in self.built.systems_built()]
 
     def dynamics(self, name: str | None = None) -> Dynamics:
         sys = self.system(name)

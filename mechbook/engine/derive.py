@@ -13,7 +13,6 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.domains import existing
 from mechbook.engine.growth import growth_rates
 from mechbook.errors import MechbookError, UnsupportedError
-from mechbook.model.declared import CACHE_KEY
 from mechbook.records import Results
 
 DEFAULT_COMPUTE = ["lagrangian", "eom", "momenta", "cyclic", "energy", "equilibria",
@@ -126,7 +125,7 @@ def _ranges(sys, search: dict | None) -> dict | None:
     if not search:
         return None
     vals = sys.problem.values()
-    return {sys.q[sys.coord_names.index(k)]: tuple(float(sys._parse(x, ("equilibria", "search",
+    return {sys.q[sys.coord_names.index(k)]: tuple(float(sys.parse(x, ("equilibria", "search",
             k, i)).subs(vals)) for i, x in enumerate(v)) for k, v in search.items()}
 
 
@@ -181,12 +180,11 @@ DECLARED = "_declared"  # the store's name for a problem's declared vectors, ten
 def declared_results(analysis: Analysis) -> Results | None:
     """A problem's declared vectors and tensors, and each body's mass, centre of mass and
     inertia about it, if a check touched them (None otherwise)."""
-    problem = analysis.problem
-    decl = problem._cache.get(CACHE_KEY)
+    decl = analysis.built.declared_built()
     if decl is None:
         return None
     res = Results(DECLARED)
-    values = problem.values()
+    values = analysis.problem.values()
     for name in decl.vectors + decl.tensors:
         obj = decl.names[name]
         res.text[name] = show(list(obj) if obj.shape == (3, 1) else obj.tolist())
@@ -217,27 +215,22 @@ def computed(analysis: Analysis) -> list[Results]:
     extra = declared_results(analysis)
     if extra is not None:
         out.append(extra)
-    for name in problem.systems:
-        sys = problem._cache.get(name)
-        if sys is None:  # no part touched this system
-            continue
-        res = Results(name)
+    for derived in analysis.derived():  # the systems built (validation builds them all)
+        sys, dyn, eq = derived.system, derived.dynamics, derived.equilibria
+        res = Results(sys.name)
         res.text["lagrangian"] = _stored(sys.lagrangian)
         res.text["kinetic"] = _stored(sys.kinetic)  # built with the system: nothing derived
         res.text["potential"] = _stored(sys.potential)
-        dyn = analysis._dyn.get(name)
         if dyn is not None:
             for key in _DYNAMICS_TEXT:
-                if key in dyn.__dict__:  # a cached_property that was evaluated
-                    val = dyn.__dict__[key]
+                if key in vars(dyn):  # a cached_property that was evaluated
+                    val = vars(dyn)[key]
                     if key == "momenta":
                         val = dict(zip(sys.q, val, strict=True))
                     res.text[key] = _stored(val.tolist() if hasattr(val, "tolist") else val)
-        eq = analysis._eq.get(name)
-        if eq is not None and eq._solved is not None:
-            res.text["equilibria"] = _stored(eq._solved)
-        linears = [lin for key, lin in analysis._lin.items() if key[0] == name]
-        for i, lin in enumerate(linears):
+        if eq is not None and eq.solved is not None:
+            res.text["equilibria"] = _stored(eq.solved)
+        for i, lin in enumerate(derived.linear):
             tag = f"linear_{i}"
             res.text[f"{tag}/point"] = _stored(lin.point)
             if lin.dyn.sys.reduced:

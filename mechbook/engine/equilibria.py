@@ -37,6 +37,29 @@ class Equilibria:
         self.sys = dyn.sys
         self._solved: list[dict] | None = None
         self._gave_up_at: float | None = None
+        self._jacobians: dict[tuple, list[sp.Matrix]] = {}
+
+    @property
+    def solved(self) -> list[dict] | None:
+        """The closed-form equilibria if a search for them has ended, else None (nothing
+        is searched for here: for what a check derived, engine.derive)."""
+        return self._solved
+
+    def steady_jacobians(self, rates: dict) -> list[sp.Matrix]:
+        """∂E/∂q̈, ∂E/∂q̇, ∂E/∂q of the equations of motion E (a reduced system's momenta
+        put back) with the coordinates turning at `rates` ({q: rate}), the other rates,
+        the accelerations and the small parameters zero: the M, C, K of a steady motion as
+        functions of the coordinates, taken symbolically once per `rates`."""
+        key = tuple(sorted((str(q), sp.srepr(v)) for q, v in rates.items()))
+        if key not in self._jacobians:
+            dyn = self.dyn
+            sub = {v: sp.S(rates.get(q, 0)) for q, v in zip(dyn.q, dyn.qd, strict=True)}
+            sub.update({a: sp.S.Zero for a in dyn.qdd})
+            sub.update({s: sp.S.Zero for s in dyn.sys.small_params})
+            res = [e.xreplace(dyn.sys.held) for e in dyn.residuals]
+            self._jacobians[key] = [sp.Matrix([[sp.diff(e, v) for v in vs] for e in res])
+                                    .xreplace(sub) for vs in (dyn.qdd, dyn.qd, dyn.q)]
+        return self._jacobians[key]
 
     @cached_property
     def conditions(self) -> list[sp.Expr]:

@@ -24,22 +24,10 @@ def classify_at(eq: Equilibria, root: dict, values: dict, rates: dict | None = N
     fixed `rates` of the turning coordinates (or at rest in a reduced system): M, C, K are
     the derivatives of the equations of motion there, taken symbolically once and
     evaluated at the numbers (a numeric root is no exact equilibrium for `linearize`)."""
-    dyn = eq.dyn
-    held = dyn.sys.held
-    rates = rates or {}
-    sub = {v: sp.S(rates.get(q, 0)) for q, v in zip(dyn.q, dyn.qd, strict=True)}
-    sub.update({a: sp.S.Zero for a in dyn.qdd})
-    sub.update({s: sp.S.Zero for s in dyn.sys.small_params})
-    key = ("jacobians", tuple(sorted(map(str, rates))))
-    cache = eq.__dict__.setdefault("_jacobians", {})
-    if key not in cache:
-        res = [e.xreplace(held) for e in dyn.residuals]
-        cache[key] = [sp.Matrix([[sp.diff(e, v) for v in vs] for e in res]).xreplace(sub)
-                      for vs in (dyn.qdd, dyn.qd, dyn.q)]
     at = dict(values)
     at.update({q: sp.Float(x, 30) for q, x in root.items()})
     M, C, K = (np.array([[_at(x, at) for x in row] for row in A.tolist()], dtype=float)
-               for A in cache[key])
+               for A in eq.steady_jacobians(rates or {}))
     return classify_matrices(M, C, K)
 
 

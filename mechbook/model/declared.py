@@ -23,7 +23,6 @@ from mechbook.model.problem import RESERVED, Problem
 from mechbook.model.tensorexpr import kind, parse_tensor
 
 TAKEN = RESERVED
-CACHE_KEY = "_declared"  # never a system name (those start with a letter)
 
 
 @dataclass
@@ -37,13 +36,8 @@ class Declared:
 
 
 def declared(problem: Problem) -> Declared:
-    """The problem's declared vectors, bodies and tensors (built once, kept on it)."""
-    if CACHE_KEY not in problem._cache:
-        problem._cache[CACHE_KEY] = _build(problem)
-    return problem._cache[CACHE_KEY]
-
-
-def _build(problem: Problem) -> Declared:
+    """The problem's declared vectors, bodies and tensors, built anew (model.built.Built
+    builds them once and keeps them)."""
     data = problem.doc.data
     out = Declared(dict(problem.names()))
     taken = set(out.names) | TAKEN

@@ -45,10 +45,10 @@ class Contact:
 def point_velocity(sys, body: str, point: sp.Matrix, sub: tuple) -> sp.Matrix:
     """The velocity of the body's material point now at `point`."""
     if body not in sys.positions:
-        raise sys._error(sub + ("body",), f"no particle or rigid body {body!r}")
+        raise sys.error(sub + ("body",), f"no particle or rigid body {body!r}")
     r = sys.positions[body]
     if point.rows != r.rows:
-        raise sys._error(sub + ("point",), f"the point has {point.rows} components, the "
+        raise sys.error(sub + ("point",), f"the point has {point.rows} components, the "
                          f"body's position {r.rows}")
     v = sys.dt(r)
     bodies = sys.spec.get("rigid_bodies") or {}
@@ -57,15 +57,15 @@ def point_velocity(sys, body: str, point: sp.Matrix, sub: tuple) -> sp.Matrix:
     d = point - r
     if r.rows == 3:
         if sys.body_rates.get(body) is None:
-            raise sys._error(sub + ("body",), f"{body!r} has no angular velocity")
+            raise sys.error(sub + ("body",), f"{body!r} has no angular velocity")
         omega = sys.body_rates[body]
         if body in sys.attitudes:
             omega = rotation_matrix(sys.attitudes[body]) * omega  # space components
         return v + omega.cross(d)
     spec = bodies[body]
     if "angular_velocity" not in spec:
-        raise sys._error(sub + ("body",), f"planar body {body!r} has no angular_velocity")
-    w = sys._parse(spec["angular_velocity"], ("rigid_bodies", body, "angular_velocity"))
+        raise sys.error(sub + ("body",), f"planar body {body!r} has no angular_velocity")
+    w = sys.parse(spec["angular_velocity"], ("rigid_bodies", body, "angular_velocity"))
     return v + sp.Matrix([-w * d[1], w * d[0]])
 
 
@@ -75,23 +75,23 @@ def contacts(sys, specs: list) -> list[Contact]:
     qdd = list(sys.qdd)
     for i, spec in enumerate(specs):
         sub = ("friction", i)
-        point = sp.Matrix([sys._parse(x, sub + ("point", j)) for j, x in
+        point = sp.Matrix([sys.parse(x, sub + ("point", j)) for j, x in
                            enumerate(spec["point"])])
         v = point_velocity(sys, spec["body"], point, sub)
         if "normal" in spec:
-            n = sp.Matrix([sys._parse(x, sub + ("normal", j))
+            n = sp.Matrix([sys.parse(x, sub + ("normal", j))
                            for j, x in enumerate(spec["normal"])])
         else:
             n = sp.Matrix([0] * (v.rows - 1) + [1])
         if n.rows != v.rows or any(x.free_symbols & set(sys.q + sys.qd) for x in n):
-            raise sys._error(sub + ("normal",), "the normal is a constant vector with as many "
+            raise sys.error(sub + ("normal",), "the normal is a constant vector with as many "
                              "components as the position")
         n = n / sp.sqrt(n.dot(n))
         vt = (v - v.dot(n) * n).applyfunc(lambda e: trig_canonical(e, list(sys.qd)))
-        mu = sys._parse(spec["mu"], sub + ("mu",))
-        N = sys._parse(spec["normal_force"], sub + ("normal_force",))
+        mu = sys.parse(spec["mu"], sub + ("mu",))
+        N = sys.parse(spec["normal_force"], sub + ("normal_force",))
         if N.has(*qdd) or mu.has(*qdd):
-            raise sys._error(sub + ("normal_force",), "the normal force is a function of the "
+            raise sys.error(sub + ("normal_force",), "the normal force is a function of the "
                              "state (no accelerations)")
         J = vt.jacobian(sys.qd)
         acc = sys.dt(vt)

@@ -30,14 +30,14 @@ def torque_forces(sys, torques: list) -> list[sp.Expr]:
         sub = ("torques", i)
         body = spec["body"]
         if body not in sys.body_rates or sys.body_rates[body] is None:
-            raise sys._error(sub + ("body",), f"no 3-D rigid body {body!r} with an attitude or "
+            raise sys.error(sub + ("body",), f"no 3-D rigid body {body!r} with an attitude or "
                              "an angular velocity vector")
-        N = sp.Matrix([sys._parse(x, sub + ("components", j))
+        N = sp.Matrix([sys.parse(x, sub + ("components", j))
                        for j, x in enumerate(spec["components"])])
         omega = sys.body_rates[body]
         if spec.get("axes", "body") == "space":
             if body not in sys.attitudes:
-                raise sys._error(sub + ("axes",), "space-axis torque components need the "
+                raise sys.error(sub + ("axes",), "space-axis torque components need the "
                                  "body's attitude (`euler_angles` or `rotation`)")
             omega = rotation_matrix(sys.attitudes[body]) * omega
         for k, v in enumerate(sys.qd):
@@ -51,21 +51,21 @@ def attractor_potential(sys, attractors: dict) -> sp.Expr:
     bodies = set(sys.spec.get("rigid_bodies") or {})
     for name, spec in attractors.items():
         sub = ("attractors", name)
-        M = sys._parse(spec["mass"], sub + ("mass",))
+        M = sys.parse(spec["mass"], sub + ("mass",))
         if "G" in spec:
-            G = sys._parse(spec["G"], sub + ("G",))
+            G = sys.parse(spec["G"], sub + ("G",))
         elif "G" in sys.params:
             G = sys.params["G"].symbol
         else:
-            raise sys._error(sub, "an attractor needs the gravitational constant: a parameter "
+            raise sys.error(sub, "an attractor needs the gravitational constant: a parameter "
                              "'G' or the attractor's own 'G'")
-        at = sp.Matrix([sys._parse(x, sub + ("position", i))
+        at = sp.Matrix([sys.parse(x, sub + ("position", i))
                         for i, x in enumerate(spec.get("position", [0, 0, 0]))])
         if not sys.positions:
-            raise sys._error(sub, "an attractor acts on particles or rigid bodies; none given")
+            raise sys.error(sub, "an attractor acts on particles or rigid bodies; none given")
         for obj, r in sys.positions.items():
             if r.rows != at.rows:
-                raise sys._error(sub + ("position",), f"{obj}'s position has {r.rows} "
+                raise sys.error(sub + ("position",), f"{obj}'s position has {r.rows} "
                                  f"components, the attractor's {at.rows}")
             d = r - at
             dist = sp.sqrt(d.dot(d))
@@ -73,7 +73,7 @@ def attractor_potential(sys, attractors: dict) -> sp.Expr:
             if obj not in bodies or obj not in sys.inertias:
                 continue
             if obj not in sys.attitudes:
-                raise sys._error(sub, f"the attraction on body {obj!r} depends on its "
+                raise sys.error(sub, f"the attraction on body {obj!r} depends on its "
                                  "orientation: give the body `euler_angles` or `rotation`")
             R = rotation_matrix(sys.attitudes[obj])
             inertia = R * sys.inertias[obj] * R.T
@@ -90,12 +90,12 @@ def average_over(sys, expr: sp.Expr, spec: dict) -> sp.Expr:
     for name, bounds in spec.items():
         sub = ("average", name)
         if name not in sys.params:
-            raise sys._error(sub, "averaging is over a declared parameter (an angle)")
+            raise sys.error(sub, "averaging is over a declared parameter (an angle)")
         x = sys.params[name].symbol
-        lo, hi = (sys._parse(b, sub + (i,)) for i, b in enumerate(bounds))
+        lo, hi = (sys.parse(b, sub + (i,)) for i, b in enumerate(bounds))
         expr = _average(expr, x, lo, hi)
         if expr is None:
-            raise sys._error(sub, f"could not average over {name} (not a trigonometric "
+            raise sys.error(sub, f"could not average over {name} (not a trigonometric "
                              "polynomial, and SymPy's integral found no closed form within "
                              f"its time limit of {INTEGRAL_SECONDS:g} s of CPU)")
     return expr

@@ -308,7 +308,7 @@ def check_constraint_set(system, starts: int = 8) -> None:
     ranks = [manifold.freedoms(pt) for pt in states]
     if holonomic and all(n - f.configuration < holonomic for f in ranks):
         r = max(n - f.configuration for f in ranks)
-        raise system._error(("constraints",), f"the constraints are dependent: their Jacobian "
+        raise system.error(("constraints",), f"the constraints are dependent: their Jacobian "
                             f"has rank {r} for {holonomic} constraints at every state tried "
                             "(one repeats what the others say, and its multiplier is not "
                             "determined): remove the redundant one")
@@ -316,7 +316,7 @@ def check_constraint_set(system, starts: int = 8) -> None:
     if len(manifold.velocity) and all(n - f.velocity < rows for f in ranks):
         r = max(n - f.velocity for f in ranks)
         key = "rolling" if system.spec.get("rolling") else "velocity_constraints"
-        raise system._error((key,), f"the velocity constraints are dependent: with the "
+        raise system.error((key,), f"the velocity constraints are dependent: with the "
                             f"holonomic ones their rows have rank {r} for {rows} constraints "
                             "at every state tried (one repeats what the others say): remove "
                             "the redundant one")
@@ -338,7 +338,7 @@ def _contacts_stay_on(system, states: list[dict]) -> None:
             speed = max(float(abs(pt[x])) for x in system.qd) if system.qd else 1.0
             worst = max(worst, abs(value) / max(scale, speed, 1e-300))
         if worst > 1e-12:
-            raise system._error(("rolling", i), f"rolling contact {spec['name']!r}: the "
+            raise system.error(("rolling", i), f"rolling contact {spec['name']!r}: the "
                                 f"contact point leaves the surface (its velocity along the "
                                 f"normal, {sp.sstr(normal)[:100]}, is not zero): choose "
                                 "coordinates that keep the body on the surface (its height a "

@@ -57,6 +57,9 @@ class SystemSpec:
 
 @dataclass
 class Problem:
+    """A problem file's declarations, as data: nothing built from it is kept here (its
+    systems and declared objects are kept by model.built.Built, which an Analysis owns)."""
+
     id: str
     title: str
     source: str
@@ -68,7 +71,6 @@ class Problem:
     description: str = ""
     conditions: list = field(default_factory=list)
     functions: dict = field(default_factory=dict)  # name -> Operator (arbitrary functions)
-    _cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def book(self) -> str:

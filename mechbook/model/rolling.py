@@ -51,7 +51,7 @@ def velocity_constraints(sys) -> list[tuple[str, sp.Expr]]:
     out: list[tuple[str, sp.Expr, tuple]] = []
     for i, spec in enumerate(sys.spec.get("velocity_constraints") or []):
         sub = ("velocity_constraints", i)
-        out.append((spec["name"], sys._parse(spec["expr"], sub + ("expr",)), sub + ("expr",)))
+        out.append((spec["name"], sys.parse(spec["expr"], sub + ("expr",)), sub + ("expr",)))
     for i, spec in enumerate(sys.spec.get("rolling") or []):
         sub = ("rolling", i)
         out += [(name, c, sub) for name, c in _rolling(sys, spec, sub)]
@@ -59,27 +59,27 @@ def velocity_constraints(sys) -> list[tuple[str, sp.Expr]]:
     for name, c, sub in out:
         _linear_in_velocities(sys, name, c, sub)
         if name in taken:
-            raise sys._error(sub, f"a constraint named {name!r} is already declared: each "
+            raise sys.error(sub, f"a constraint named {name!r} is already declared: each "
                              "constraint (and its multiplier lambda_<name>) needs its own name")
         taken.add(name)
         if f"lambda_{name}" in sys.names:
-            raise sys._error(sub, f"constraint {name!r} has the multiplier lambda_{name}, which "
+            raise sys.error(sub, f"constraint {name!r} has the multiplier lambda_{name}, which "
                              f"is already a name here: rename the constraint or lambda_{name}")
     return [(name, c) for name, c, _ in out]
 
 
 def _linear_in_velocities(sys, name: str, c: sp.Expr, sub: tuple) -> None:
     if c.free_symbols & set(sys.qdd):
-        raise sys._error(sub, f"velocity constraint {name!r} holds an acceleration: it is "
+        raise sys.error(sub, f"velocity constraint {name!r} holds an acceleration: it is "
                          "A(q, t)·q̇ + b(q, t) = 0")
     if not c.free_symbols & set(sys.qd):
-        raise sys._error(sub, f"velocity constraint {name!r} holds no velocity: a relation "
+        raise sys.error(sub, f"velocity constraint {name!r} holds no velocity: a relation "
                          "among the coordinates is a holonomic constraint (`constraints:`)")
     for v in sys.qd:
         for w in sys.qd:
             second = sp.diff(c, v, w)
             if second != 0 and not _vanishes(second):
-                raise sys._error(sub, f"velocity constraint {name!r} is not linear in the "
+                raise sys.error(sub, f"velocity constraint {name!r} is not linear in the "
                                  f"velocities (its second derivative in {v} and {w} is "
                                  f"{sp.sstr(second)[:80]}): it must read A(q, t)·q̇ + b(q, t) "
                                  "= 0")
@@ -95,7 +95,7 @@ def _vanishes(expr: sp.Expr) -> bool:
 
 
 def _vector(sys, texts: list, sub: tuple) -> sp.Matrix:
-    return sp.Matrix([sys._parse(x, sub + (j,)) for j, x in enumerate(texts)])
+    return sp.Matrix([sys.parse(x, sub + (j,)) for j, x in enumerate(texts)])
 
 
 def _rolling(sys, spec: dict, sub: tuple) -> list[tuple[str, sp.Expr]]:
@@ -115,9 +115,9 @@ def relative_velocity(sys, spec: dict, sub: tuple) -> tuple[sp.Matrix, sp.Matrix
     body = spec["body"]
     bodies = sys.spec.get("rigid_bodies") or {}
     if body not in sys.positions:
-        raise sys._error(sub + ("body",), f"no rigid body {body!r} to roll")
+        raise sys.error(sub + ("body",), f"no rigid body {body!r} to roll")
     if body not in bodies:
-        raise sys._error(sub + ("body",), f"{body!r} is a particle: a particle has no surface "
+        raise sys.error(sub + ("body",), f"{body!r} is a particle: a particle has no surface "
                          "to roll on (rolling needs a rigid body; a particle that does not "
                          "slide is a velocity constraint on its own)")
     dim = sys.positions[body].rows
@@ -127,22 +127,22 @@ def relative_velocity(sys, spec: dict, sub: tuple) -> tuple[sp.Matrix, sp.Matrix
     else:
         n = sp.Matrix([0] * (dim - 1) + [1])
     if n.rows != dim or any(x.free_symbols & set(sys.q + sys.qd + [sys.t]) for x in n):
-        raise sys._error(sub + ("surface", "normal"), f"the surface's normal is a constant "
+        raise sys.error(sub + ("surface", "normal"), f"the surface's normal is a constant "
                          f"vector with {dim} components (as many as the body's position)")
     size = sp.sqrt(n.dot(n))
     if size == 0:
-        raise sys._error(sub + ("surface", "normal"), "the surface's normal is zero")
+        raise sys.error(sub + ("surface", "normal"), "the surface's normal is zero")
     n = n / size
     point = (_vector(sys, spec["point"], sub + ("point",)) if "point" in spec
              else _contact_from_shape(sys, body, bodies[body], n, sub))
     if point.rows != dim:
-        raise sys._error(sub + ("point",), f"the contact point has {point.rows} components, "
+        raise sys.error(sub + ("point",), f"the contact point has {point.rows} components, "
                          f"the body's position {dim}")
     v = point_velocity(sys, body, point, sub)
     if "velocity" in surface:
         moving = _vector(sys, surface["velocity"], sub + ("surface", "velocity"))
         if moving.rows != dim:
-            raise sys._error(sub + ("surface", "velocity"), f"the surface's velocity has "
+            raise sys.error(sub + ("surface", "velocity"), f"the surface's velocity has "
                              f"{moving.rows} components, the body's position {dim}")
         v = v - moving
     return v, n
@@ -172,14 +172,14 @@ def _contact_from_shape(sys, body: str, spec: dict, n: sp.Matrix, sub: tuple) ->
            "spherical_shell, radius: ...})")
     if shape not in ROUND + RIMMED or "radius" not in inertia:
         what = f"a {shape}" if shape else "its inertia as numbers"
-        raise sys._error(sub + ("body",), f"rolling body {body!r} declares no surface to roll "
+        raise sys.error(sub + ("body",), f"rolling body {body!r} declares no surface to roll "
                          f"on ({what}): {fix}")
-    radius = sys._parse(inertia["radius"], ("rigid_bodies", body, "inertia", "radius"))
+    radius = sys.parse(inertia["radius"], ("rigid_bodies", body, "inertia", "radius"))
     r = sys.positions[body]
     if shape in ROUND or r.rows == 2:
         return r - radius * n
     if body not in sys.attitudes:
-        raise sys._error(sub + ("body",), f"rolling body {body!r} has no attitude (euler_angles "
+        raise sys.error(sub + ("body",), f"rolling body {body!r} has no attitude (euler_angles "
                          f"or rotation) to find its rim by: {fix}")
     e = rotation_matrix(sys.attitudes[body]) * sp.Matrix([0, 0, 1])
     w = n - n.dot(e) * e

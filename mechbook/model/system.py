@@ -10,6 +10,8 @@ Nothing else is modelled.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import sympy as sp
 
 from mechbook.core.expansion import expand_lagrangian
@@ -17,10 +19,10 @@ from mechbook.core.integrals import box_integral
 from mechbook.core.numeval import is_zero, without_absent
 from mechbook.core.secalc import Unsupported as SymEngineCannot
 from mechbook.core.secalc import total_derivative
-from mechbook.errors import NotFoundError, UnsupportedError
+from mechbook.errors import NotFoundError, SpecError, UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
-from mechbook.model.declared import declared
+from mechbook.model.declared import Declared, declared
 from mechbook.model.domains import Domain, assumptions, domain_of
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
@@ -46,8 +48,13 @@ class System(SystemLike):
     """Symbols and the Lagrangian of one system of a problem (the full system: nothing
     reduced, no momenta held; mechbook.model.protocol)."""
 
-    def __init__(self, problem: Problem, spec: SystemSpec):
+    def __init__(self, problem: Problem, spec: SystemSpec,
+                 declarations: Callable[[], Declared] | None = None):
+        """`declarations`: the problem's declared vectors, tensors and bodies, for a rigid
+        body made of parts (model.built.Built passes the one it keeps; without it, the
+        system builds them when a body needs them)."""
         self.problem = problem
+        self._declarations = declarations
         self.name = spec.name
         self.spec = spec.data
         self.path = spec.path
@@ -58,10 +65,13 @@ class System(SystemLike):
         self._build_energies()
 
     # ---- symbols -------------------------------------------------------------------------
-    def _error(self, sub: tuple, message: str):
+    def error(self, sub: tuple, message: str) -> SpecError:
+        """A SpecError at `sub` of this system's declarations (file and line)."""
         return self.problem.doc.error(self.path + sub, message)
 
-    def _parse(self, text, sub: tuple, relation: bool = False):
+    def parse(self, text, sub: tuple, relation: bool = False):
+        """An expression at `sub` of this system's declarations, in its names; SpecError
+        (file and line) if it does not parse."""
         return self.problem.parse(text, self.path + sub, self.names, relation)
 
     def _build_symbols(self) -> None:
@@ -76,7 +86,7 @@ class System(SystemLike):
         for c, q, qd, qdd in zip(coords, self.q, self.qd, self.qdd, strict=True):
             for sym in (q, qd, qdd):
                 if sym.name in taken:
-                    raise self._error(("coordinates", c), f"name {sym.name!r} is already taken "
+                    raise self.error(("coordinates", c), f"name {sym.name!r} is already taken "
                                       "(parameter, reserved word, or another coordinate)")
                 taken.add(sym.name)
                 names[sym.name] = sym
@@ -91,7 +101,7 @@ class System(SystemLike):
         self.free_driven: list[tuple[sp.Symbol, sp.Symbol, sp.Symbol]] = []
         for name, text in (self.spec.get("driven") or {}).items():
             if name in taken or name + "dot" in taken or name + "ddot" in taken:
-                raise self._error(("driven", name), f"name {name!r} is already taken")
+                raise self.error(("driven", name), f"name {name!r} is already taken")
             if isinstance(text, dict):  # {free: true}: an arbitrary prescribed function of t
                 syms = tuple(sp.Symbol(name + s, real=True) for s in ("", "dot", "ddot"))
                 self.free_driven.append(syms)
@@ -100,7 +110,7 @@ class System(SystemLike):
                 continue
             expr = self._parse_with(text, ("driven", name), names)
             if any(s in expr.free_symbols for s in self.q + self.qd + self.qdd):
-                raise self._error(("driven", name), "a driven coordinate is a function of t and "
+                raise self.error(("driven", name), "a driven coordinate is a function of t and "
                                   "parameters only")
             self.driven[name] = expr
             names[name] = expr
@@ -116,9 +126,9 @@ class System(SystemLike):
     def _build_energies(self) -> None:
         s = self.spec
         if "lagrangian" in s and ("kinetic" in s or "potential" in s):
-            raise self._error(("lagrangian",), "give either 'lagrangian' or 'kinetic'/'potential'")
-        kinetic = self._parse(s["kinetic"], ("kinetic",)) if "kinetic" in s else sp.S.Zero
-        potential = self._parse(s["potential"], ("potential",)) if "potential" in s else sp.S.Zero
+            raise self.error(("lagrangian",), "give either 'lagrangian' or 'kinetic'/'potential'")
+        kinetic = self.parse(s["kinetic"], ("kinetic",)) if "kinetic" in s else sp.S.Zero
+        potential = self.parse(s["potential"], ("potential",)) if "potential" in s else sp.S.Zero
         self.positions: dict[str, sp.Matrix] = {}
         self.masses: dict[str, sp.Expr] = {}
         self.attitudes: dict[str, list] = {}  # body -> chain of rotations (3-D bodies)
@@ -129,8 +139,8 @@ class System(SystemLike):
         self.part_kinetic: dict[str, sp.Expr] = {}
         self.part_potential: dict[str, sp.Expr] = {}
         for name, p in (s.get("particles") or {}).items():
-            m = self._parse(p["mass"], ("particles", name, "mass"))
-            r = sp.Matrix([self._parse(x, ("particles", name, "position", i))
+            m = self.parse(p["mass"], ("particles", name, "mass"))
+            r = sp.Matrix([self.parse(x, ("particles", name, "position", i))
                            for i, x in enumerate(p["position"])])
             self.positions[name], self.masses[name] = r, m
             v = self.dt(r)
@@ -147,15 +157,15 @@ class System(SystemLike):
         if s.get("attractors"):
             potential += attractor_potential(self, s["attractors"])
         if "lagrangian" in s:
-            lag = self._parse(s["lagrangian"], ("lagrangian",))
+            lag = self.parse(s["lagrangian"], ("lagrangian",))
             if self.positions or s.get("rigid_bodies"):
                 lag += kinetic - potential
         else:
             lag = kinetic - potential
         if "velocity_potential" in s:
-            lag -= self._parse(s["velocity_potential"], ("velocity_potential",))
+            lag -= self.parse(s["velocity_potential"], ("velocity_potential",))
         if lag == 0:
-            raise self._error(("coordinates",), "the system has no kinetic or potential energy")
+            raise self.error(("coordinates",), "the system has no kinetic or potential energy")
         if "average" in s:  # averaged over a fast angle, e.g. a planet's orbital position
             rest = lag - (kinetic - potential)  # the average is linear: T and V once each
             kinetic, potential, rest = (average_over(self, e, s["average"])
@@ -182,14 +192,14 @@ class System(SystemLike):
             self.contacts = contacts(self, s["friction"])
             self.forces = [f + sp.Add(*(c.force[k] for c in self.contacts))
                            for k, f in enumerate(self.forces)]
-        self.constraints = [(c["name"], self._parse(c["expr"], ("constraints", i, "expr")))
+        self.constraints = [(c["name"], self.parse(c["expr"], ("constraints", i, "expr")))
                             for i, c in enumerate(s.get("constraints") or [])]
         for i, (cname, f) in enumerate(self.constraints):
             if f.free_symbols & set(self.qd + self.qdd):
-                raise self._error(("constraints", i, "expr"),
+                raise self.error(("constraints", i, "expr"),
                                   f"constraint {cname!r} must be holonomic: f(q, t) = 0")
             if f"lambda_{cname}" in self.names:  # the engine's name for its multiplier
-                raise self._error(("constraints", i, "name"),
+                raise self.error(("constraints", i, "name"),
                                   f"constraint {cname!r} has the multiplier lambda_{cname}, "
                                   f"which is already a name here: rename the constraint or "
                                   f"lambda_{cname}")
@@ -207,54 +217,54 @@ class System(SystemLike):
         if isinstance(inertia, dict) and "body" in inertia:
             composite = self._composite(inertia["body"], sub + ("inertia", "body"))
         if "mass" in b:
-            m = self._parse(b["mass"], sub + ("mass",))
+            m = self.parse(b["mass"], sub + ("mass",))
             if composite is not None and not is_zero(m - composite.mass):
-                raise self._error(sub + ("mass",), f"the mass differs from body "
+                raise self.error(sub + ("mass",), f"the mass differs from body "
                                   f"{inertia['body']!r}'s ({composite.mass}); leave it out")
         elif composite is not None:
             m = composite.mass
         else:
-            raise self._error(sub, "a rigid body needs 'mass' (unless its inertia names a body)")
-        r = sp.Matrix([self._parse(x, sub + ("position", i)) for i, x in enumerate(b["position"])])
+            raise self.error(sub, "a rigid body needs 'mass' (unless its inertia names a body)")
+        r = sp.Matrix([self.parse(x, sub + ("position", i)) for i, x in enumerate(b["position"])])
         self.positions[name], self.masses[name] = r, m
         if composite is not None:
             if r.rows != 3:
-                raise self._error(sub + ("position",), "a body made of parts moves in 3-D")
+                raise self.error(sub + ("position",), "a body made of parts moves in 3-D")
             tensor = composite.inertia()  # about its centre of mass, in its own axes
         elif isinstance(inertia, dict):
-            dims = {k: self._parse(v, sub + ("inertia", k)) for k, v in inertia.items()
+            dims = {k: self.parse(v, sub + ("inertia", k)) for k, v in inertia.items()
                     if k in ("radius", "length", "height")}
             for key in ("sides", "semi_axes"):
                 if key in inertia:
-                    dims[key] = [self._parse(v, sub + ("inertia", key, i))
+                    dims[key] = [self.parse(v, sub + ("inertia", key, i))
                                  for i, v in enumerate(inertia[key])]
             try:
                 tensor = shape_inertia(inertia["shape"], m, dims)
             except ValueError as exc:
-                raise self._error(sub + ("inertia",), str(exc)) from None
+                raise self.error(sub + ("inertia",), str(exc)) from None
             if r.rows == 2 and tensor[2, 2] == 0 and inertia["shape"] != "point":  # own z
-                raise self._error(sub + ("inertia",), f"a planar body uses the moment about "
+                raise self.error(sub + ("inertia",), f"a planar body uses the moment about "
                                   f"its own z axis (normal to the plane), and a "
                                   f"{inertia['shape']}'s is 0 (its length is along its own "
                                   "z): give the moment as a number, e.g. m*l**2/12 for a rod")
         elif isinstance(inertia, list):
-            tensor = sp.Matrix([[self._parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]
+            tensor = sp.Matrix([[self.parse(x, sub + ("inertia", i, j)) for j, x in enumerate(row)]
                                 for i, row in enumerate(inertia)])
             if tensor != tensor.T:
-                raise self._error(sub + ("inertia",), "inertia tensor must be symmetric")
+                raise self.error(sub + ("inertia",), "inertia tensor must be symmetric")
         else:
-            tensor = self._parse(inertia, sub + ("inertia",))  # planar: scalar moment
+            tensor = self.parse(inertia, sub + ("inertia",))  # planar: scalar moment
         omega = None
         if "angular_velocity" in b:
             w = b["angular_velocity"]
-            omega = (sp.Matrix([self._parse(x, sub + ("angular_velocity", i))
+            omega = (sp.Matrix([self.parse(x, sub + ("angular_velocity", i))
                                 for i, x in enumerate(w)]) if isinstance(w, list)
-                     else self._parse(w, sub + ("angular_velocity",)))
+                     else self.parse(w, sub + ("angular_velocity",)))
         chain = self._attitude(sub, b)
         try:
             kinetic = body_kinetic(m, self.dt(r), tensor, omega, chain, self.dt)
         except ValueError as exc:
-            raise self._error(sub, str(exc)) from None
+            raise self.error(sub, str(exc)) from None
         if isinstance(tensor, sp.MatrixBase) and r.rows == 3:
             self.inertias[name] = tensor
             self.body_rates[name] = body_rates(chain, self.dt) if chain is not None else omega
@@ -266,12 +276,12 @@ class System(SystemLike):
     def _attitude(self, sub: tuple, b: dict) -> list | None:
         """The body's chain of rotations: `euler_angles` (z-x-z) or `rotation`."""
         if "euler_angles" in b and "rotation" in b:
-            raise self._error(sub + ("rotation",), "give either 'euler_angles' or 'rotation'")
+            raise self.error(sub + ("rotation",), "give either 'euler_angles' or 'rotation'")
         if "euler_angles" in b:
-            return euler_chain([self._parse(x, sub + ("euler_angles", i))
+            return euler_chain([self.parse(x, sub + ("euler_angles", i))
                                 for i, x in enumerate(b["euler_angles"])])
         if "rotation" in b:
-            return [(axis, self._parse(angle, sub + ("rotation", i, 1)))
+            return [(axis, self.parse(angle, sub + ("rotation", i, 1)))
                     for i, (axis, angle) in enumerate(b["rotation"])]
         return None
 
@@ -284,7 +294,7 @@ class System(SystemLike):
                 continue
             omega = self.body_rates.get(name)
             if omega is None or (key == "space_rates" and name not in self.attitudes):
-                raise self._error(sub + (key,), f"'{key}' names the angular velocity of a 3-D "
+                raise self.error(sub + (key,), f"'{key}' names the angular velocity of a 3-D "
                                   "body with an attitude (or, for 'rates', a vector "
                                   "angular_velocity)")
             if key == "space_rates":
@@ -292,16 +302,19 @@ class System(SystemLike):
             for i, rname in enumerate(b[key]):
                 for n in (rname, rname + "dot"):
                     if n in self.names or n in RESERVED:
-                        raise self._error(sub + (key, i), f"name {n!r} is already taken")
+                        raise self.error(sub + (key, i), f"name {n!r} is already taken")
                 self.names[rname] = omega[i]
                 self.names[rname + "dot"] = self.dt(omega[i])
 
     def _composite(self, body: str, sub: tuple):
         """A body declared under the problem's `bodies:` (made of parts)."""
-        bodies = declared(self.problem).bodies
+        if self._declarations is None:  # built once for all of this system's bodies
+            decl = declared(self.problem)
+            self._declarations = lambda: decl
+        bodies = self._declarations().bodies
         if body not in bodies:
             known = ", ".join(sorted(bodies)) or "none declared"
-            raise self._error(sub, f"no body {body!r} under 'bodies:' ({known})")
+            raise self.error(sub, f"no body {body!r} under 'bodies:' ({known})")
         return bodies[body]
 
     def _gravity(self) -> sp.Expr:
@@ -309,21 +322,21 @@ class System(SystemLike):
             return sp.S.Zero
         grav = self.spec["gravity"] or {}
         if "g" in grav:
-            g = self._parse(grav["g"], ("gravity", "g"))
+            g = self.parse(grav["g"], ("gravity", "g"))
         elif "g" in self.params:
             g = self.params["g"].symbol
         else:
-            raise self._error(("gravity",), "gravity needs a parameter 'g' (declare it; default "
+            raise self.error(("gravity",), "gravity needs a parameter 'g' (declare it; default "
                               "value 9.81) or gravity.g")
         if not self.positions:
-            raise self._error(("gravity",), "gravity acts on particles or rigid bodies; none given")
+            raise self.error(("gravity",), "gravity acts on particles or rigid bodies; none given")
         total = sp.S.Zero
         for name, r in self.positions.items():
             if "up" in grav:
-                up = sp.Matrix([self._parse(x, ("gravity", "up", i))
+                up = sp.Matrix([self.parse(x, ("gravity", "up", i))
                                 for i, x in enumerate(grav["up"])])
                 if up.shape != r.shape:
-                    raise self._error(("gravity", "up"), f"'up' has {up.rows} components, "
+                    raise self.error(("gravity", "up"), f"'up' has {up.rows} components, "
                                       f"{name}'s position has {r.rows}")
             else:
                 up = sp.Matrix([0] * (r.rows - 1) + [1])  # default: last axis points up
@@ -335,24 +348,24 @@ class System(SystemLike):
         total = sp.S.Zero
         for i, spring in enumerate(self.spec.get("springs") or []):
             sub = ("springs", i)
-            k = self._parse(spring["k"], sub + ("k",))
+            k = self.parse(spring["k"], sub + ("k",))
             if "length" in spring:
-                length = self._parse(spring["length"], sub + ("length",))
+                length = self.parse(spring["length"], sub + ("length",))
             else:
                 ends = []
                 for j, end in enumerate(spring["between"]):
                     if isinstance(end, str):
                         if end not in self.positions:
-                            raise self._error(sub + ("between", j), f"no particle or body {end!r}")
+                            raise self.error(sub + ("between", j), f"no particle or body {end!r}")
                         ends.append(self.positions[end])
                     else:
-                        ends.append(sp.Matrix([self._parse(x, sub + ("between", j, n))
+                        ends.append(sp.Matrix([self.parse(x, sub + ("between", j, n))
                                                for n, x in enumerate(end)]))
                 if ends[0].shape != ends[1].shape:
-                    raise self._error(sub + ("between",), "spring ends differ in dimension")
+                    raise self.error(sub + ("between",), "spring ends differ in dimension")
                 d = ends[0] - ends[1]
                 length = sp.sqrt(d.dot(d))
-            natural = (self._parse(spring["natural_length"], sub + ("natural_length",))
+            natural = (self.parse(spring["natural_length"], sub + ("natural_length",))
                        if "natural_length" in spring else sp.S.Zero)
             total += k * (length - natural) ** 2 / 2
         return total
@@ -372,17 +385,17 @@ class System(SystemLike):
         x = sp.Symbol("x", real=True)
         names = dict(self.names)
         if "x" in names:
-            raise self._error(sub, "the string's coordinate along it is x: the name is taken")
+            raise self.error(sub, "the string's coordinate along it is x: the name is taken")
         names["x"] = x
         length = self._parse_with(spec["length"], sub + ("length",), names)
         tension = self._parse_with(spec["tension"], sub + ("tension",), names)
         density = self._parse_with(spec["density"], sub + ("density",), names)
         if tension.has(x) or length.has(x):
-            raise self._error(sub, "the length and the tension do not depend on x")
+            raise self.error(sub, "the length and the tension do not depend on x")
         amps = []
         for i, name in enumerate(spec["amplitudes"]):
             if name not in self.coord_names:
-                raise self._error(sub + ("amplitudes", i), f"{name!r} is not a coordinate")
+                raise self.error(sub + ("amplitudes", i), f"{name!r} is not a coordinate")
             amps.append(self.coord_names.index(name))
         modes = [sp.sin((k + 1) * sp.pi * x / length) for k in range(len(amps))]
         kinetic = potential = sp.S.Zero
@@ -396,9 +409,9 @@ class System(SystemLike):
                     mass = box_integral(sp.expand(TR8(density * modes[a] * modes[b])),
                                         ((x, 0, length),), known)
                 except Exception as exc:  # noqa: BLE001 - SymPy's many failure modes
-                    raise self._error(sub + ("density",), f"cannot integrate: {exc}") from None
+                    raise self.error(sub + ("density",), f"cannot integrate: {exc}") from None
                 if mass.has(sp.Integral) or mass.has(x):
-                    raise self._error(sub + ("density",), "the mass integrals have no closed "
+                    raise self.error(sub + ("density",), "the mass integrals have no closed "
                                       "form")
                 kinetic += mult * mass * self.qd[ia] * self.qd[ib] / 2
             k = a + 1
@@ -410,7 +423,7 @@ class System(SystemLike):
                                 [self.qd[i] for i in amps])
             for n in named:
                 if n in self.names or n in RESERVED:
-                    raise self._error(sub + ("field",), f"name {n!r} is already taken")
+                    raise self.error(sub + ("field",), f"name {n!r} is already taken")
             self.names.update(named)
         return kinetic, potential
 
@@ -418,13 +431,13 @@ class System(SystemLike):
         forces = self.spec.get("forces") or {}
         out = []
         for c in self.coord_names:
-            out.append(self._parse(forces[c], ("forces", c)) if c in forces else sp.S.Zero)
+            out.append(self.parse(forces[c], ("forces", c)) if c in forces else sp.S.Zero)
         unknown = set(forces) - set(self.coord_names)
         if unknown:
-            raise self._error(("forces", sorted(unknown)[0]), "generalized forces are keyed by "
+            raise self.error(("forces", sorted(unknown)[0]), "generalized forces are keyed by "
                               "coordinate; no coordinate of that name")
         if "dissipation" in self.spec:  # Rayleigh's function R(q, q̇): Q_k = −∂R/∂q̇_k
-            rayleigh = self._parse(self.spec["dissipation"], ("dissipation",))
+            rayleigh = self.parse(self.spec["dissipation"], ("dissipation",))
             out = [f - sp.diff(rayleigh, v) for f, v in zip(out, self.qd, strict=True)]
         return out
 
@@ -454,8 +467,8 @@ class System(SystemLike):
         out = {}
         for name, text in mapping.items():
             if name not in self.coord_names:
-                raise self._error(sub + (name,), f"{name!r} is not a coordinate of this system")
-            out[self.q[self.coord_names.index(name)]] = self._parse(text, sub + (name,))
+                raise self.error(sub + (name,), f"{name!r} is not a coordinate of this system")
+            out[self.q[self.coord_names.index(name)]] = self.parse(text, sub + (name,))
         return out
 
     def numeric_values(self) -> dict[sp.Symbol, float]:
@@ -479,22 +492,26 @@ class System(SystemLike):
         return {}
 
 
-def system_of(problem: Problem, name: str | None = None) -> System:
-    """The built (symbolic) system `name` of a problem, or its only one (of several, the one
-    named `main`); built once and kept on the problem. NotFoundError (a KeyError too)
-    names the systems there are."""
+def system_name(problem: Problem, name: str | None = None) -> str:
+    """`name`, checked, or the problem's only system (of several, the one named `main`).
+    NotFoundError (a KeyError too) names the systems there are."""
     if name is None:
         if len(problem.systems) == 1:
-            name = next(iter(problem.systems))
-        elif "main" in problem.systems:
-            name = "main"
-        else:
-            raise NotFoundError(f"{problem.id} has several systems: "
-                                f"{', '.join(problem.systems)}")
+            return next(iter(problem.systems))
+        if "main" in problem.systems:
+            return "main"
+        raise NotFoundError(f"{problem.id} has several systems: "
+                            f"{', '.join(problem.systems)}")
     if name not in problem.systems:
         raise NotFoundError(f"{problem.id} has no system {name!r} (has "
                             f"{', '.join(problem.systems)})")
-    if name not in problem._cache:
-        problem._cache[name] = System(problem, problem.systems[name])
-    return problem._cache[name]
+    return name
 
+
+def system_of(problem: Problem, name: str | None = None,
+              declarations: Callable[[], Declared] | None = None) -> System:
+    """The system `name` of a problem, or its only one (of several, the one named `main`),
+    built anew: what is built once and kept is kept by its builder (model.built.Built, which
+    an engine Analysis owns). NotFoundError (a KeyError too) names the systems there are."""
+    name = system_name(problem, name)
+    return System(problem, problem.systems[name], declarations)

@@ -1,13 +1,15 @@
 """Numerical integration of the full nonlinear equations of motion.
 
     model        the equations compiled once per problem (the compile layer's scalar entry)
-    methods      the integration methods' names and the options each kind takes
-    integrators  SciPy's solve_ivp methods, fixed-step RK4 / symplectic methods and the
-                 Taylor method, one interface
+    methods      the integration methods' table: name -> the options it takes and its class
+    integrators  `integrate` and `make_integrator`: any method by name, one interface
+    integrator_base  that interface (Integrator), the Trajectory it returns, IntegratorError
+    scipy_methods    SciPy's solve_ivp methods (RK45, DOP853, Radau, LSODA)
+    fixed_step   fixed-step RK4 and the symplectic methods (leapfrog, yoshida4, midpoint)
     native       loops.c built once per machine, called through ctypes (Model.rhs too)
     compiled     the compiled loops run once per integration (fixed steps, DOP853, RK45)
     events       DOP853 with solve_ivp's events in the compiled loop (event steps in SciPy)
-    taylor       heyoka's Taylor method: integration, events, batch mode, float128
+    taylor       heyoka's Taylor method: integration (TaylorMethod), events, batch mode, float128
     hyexpr       SymPy -> heyoka expressions by walking the tree; LDLᵀ solve
     monitors     drift of the conserved quantities the engine found
     measure      turning points, periods, mean rates and event times measured along a run

@@ -1,13 +1,47 @@
-"""The integration methods by name (mechbook.numerics.integrators holds the classes). A
-module of its own, importing nothing, so that the command line offers them as choices
-without loading NumPy or SciPy."""
+"""The integration methods by name: one entry each in METHODS, like scipy.integrate's
+`METHODS` (name → class), saying which options the method takes (its family's, OPTIONS)
+and where its class is. A module of its own, importing nothing, so that the command line
+offers the names as choices and refuses an option a method does not take without loading
+NumPy or SciPy; numerics.integrators.make_integrator imports a method's module when the
+method is used.
 
-SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")  # solve_ivp's, adaptive
-FIXED_METHODS = ("RK4", "leapfrog", "verlet", "yoshida4", "forest-ruth", "midpoint")
-ALIASES = {"verlet": "leapfrog", "forest-ruth": "yoshida4"}  # other names of the same method
+Adding an integrator: a module of mechbook/numerics with a subclass of
+numerics.integrator_base.Integrator (its `solve`), and one entry here.
+"""
+
+from typing import NamedTuple
+
+
+class Method(NamedTuple):
+    """One entry of METHODS."""
+
+    family: str  # "scipy", "fixed", "midpoint" or "taylor": the options it takes, OPTIONS[family]
+    module: str  # the module that holds its class,
+    cls: str  # and the class, constructed as cls(name, **options)
+    alias_of: str = ""  # another name of that method (the one its results carry)
+
+
+SCIPY = "mechbook.numerics.scipy_methods"
+FIXED_STEP = "mechbook.numerics.fixed_step"
+
+METHODS: dict[str, Method] = {  # every name `integrate` takes
+    "RK45": Method("scipy", SCIPY, "SciPyMethod"),  # solve_ivp's, adaptive
+    "DOP853": Method("scipy", SCIPY, "SciPyMethod"),
+    "Radau": Method("scipy", SCIPY, "SciPyMethod"),
+    "LSODA": Method("scipy", SCIPY, "SciPyMethod"),
+    "RK4": Method("fixed", FIXED_STEP, "RK4"),
+    "leapfrog": Method("fixed", FIXED_STEP, "Leapfrog"),
+    "verlet": Method("fixed", FIXED_STEP, "Leapfrog", alias_of="leapfrog"),
+    "yoshida4": Method("fixed", FIXED_STEP, "Yoshida4"),
+    "forest-ruth": Method("fixed", FIXED_STEP, "Yoshida4", alias_of="yoshida4"),
+    "midpoint": Method("midpoint", FIXED_STEP, "ImplicitMidpoint"),
+    "taylor": Method("taylor", "mechbook.numerics.taylor", "TaylorMethod"),  # heyoka's
+}
+CHOICES = tuple(m for m, e in METHODS.items() if not e.alias_of)  # one name per method
+ALIASES = {m: e.alias_of for m, e in METHODS.items() if e.alias_of}  # other names of one
+SCIPY_METHODS = tuple(m for m, e in METHODS.items() if e.family == "scipy")
+FIXED_METHODS = tuple(m for m, e in METHODS.items() if e.family in ("fixed", "midpoint"))
 TAYLOR = "taylor"  # heyoka's Taylor method
-METHODS = SCIPY_METHODS + FIXED_METHODS + (TAYLOR,)  # every name `integrate` takes
-CHOICES = tuple(m for m in METHODS if m not in ALIASES)  # one name per method
 
 # which integrator options each kind of method takes (others do not apply to it); of the
 # fixed-step methods only the implicit midpoint rule iterates (`tol`, `max_iter`)
@@ -20,13 +54,8 @@ OPTIONS = {"scipy": ("rtol", "atol", "max_step", "first_step", "dense_output", "
 def kind(method: str) -> str | None:
     """'scipy', 'fixed', 'midpoint' or 'taylor': the key of the options `method` takes in
     OPTIONS (None: not a method)."""
-    if method in SCIPY_METHODS:
-        return "scipy"
-    if method == "midpoint":
-        return "midpoint"
-    if method in FIXED_METHODS:
-        return "fixed"
-    return "taylor" if method == TAYLOR else None
+    entry = METHODS.get(method)
+    return entry.family if entry is not None else None
 
 
 # why an option another kind of method takes has no effect on this kind

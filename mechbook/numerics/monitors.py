@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from mechbook.numerics.integrators import Trajectory
+from mechbook.numerics.integrator_base import Trajectory
 from mechbook.numerics.model import Model
 
 

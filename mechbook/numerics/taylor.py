@@ -23,6 +23,7 @@ import sympy as sp
 
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.hyexpr import Translator, solve_spd
+from mechbook.numerics.integrator_base import Integrator, IntegratorError, Trajectory
 from mechbook.numerics.model import Model
 
 DEFAULT_TOL = 2.0 ** -52  # heyoka's own default: machine epsilon
@@ -370,6 +371,32 @@ def crossings_batch(model: Model, weights: np.ndarray, offset: tuple[float, floa
     return [np.sort(np.array(x)) for x in out]
 
 
-__all__ = ["DEFAULT_TOL", "available", "compile_seconds", "crossings_batch", "first_crossing",
-           "integrator",
+class TaylorMethod(Integrator):
+    """heyoka's adaptive Taylor method behind the Integrator interface (`integrate(...,
+    method="taylor")`): options `tol` (default machine epsilon; `rtol` is taken for it
+    when `tol` is not given), `max_points`."""
+
+    adaptive = True
+
+    def solve(self, model, t_span, q0, qd0, t_eval=None, events=None) -> Trajectory:
+        if events:
+            raise IntegratorError("the taylor method takes no solve_ivp events (its own "
+                                  "events: taylor.turning_points, taylor.first_crossing)")
+        tol = float(self.options.get("tol") or self.options.get("rtol") or DEFAULT_TOL)
+        y0 = np.concatenate((q0, qd0)).astype(float)
+        before = compile_seconds(model)
+        start = time.perf_counter()
+        t, y, ok, message, steps = propagate(
+            model, t_span, y0, tol, t_eval, int(self.options.get("max_points") or 200_001))
+        compile_s = compile_seconds(model) - before
+        n = model.n
+        settings = {"method": self.name, "tol": tol, "steps": steps,
+                    "compile_s": compile_s,
+                    "integrate_s": time.perf_counter() - start - compile_s}
+        return Trajectory(t, y[:n], y[n:], self.name, settings, 0, ok, message)
+
+
+
+__all__ = ["DEFAULT_TOL", "TaylorMethod", "available", "compile_seconds", "crossings_batch",
+           "first_crossing", "integrator",
            "propagate", "propagate_batch", "system_of", "turning_points"]

@@ -18,7 +18,6 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
-from mechbook.model.declared import declared
 from mechbook.model.hints import did_you_mean
 from mechbook.model.manifold import manifold_of
 from mechbook.records import NUMERIC, ProofPolicy
@@ -63,7 +62,7 @@ class Context:
         lambda_<constraint>, or the problem's declared ones for a tensor or body quantity."""
         problem = self.analysis.problem
         if self.part.system is None and (self.tensor_mode or not problem.systems):
-            decl = declared(problem)  # a tensor or body quantity, or a problem without a system
+            decl = self.analysis.declared()  # a tensor or body quantity, or no system
             return (None, *self.part.names(decl.names, tensor=True, bodies=decl.bodies))
         try:
             system = self.analysis.system(self.part.system)
@@ -73,7 +72,7 @@ class Context:
         names = dict(system.names)
         bodies = None
         if self.tensor_mode:
-            decl = declared(problem)
+            decl = self.analysis.declared()
             _merge_declared(names, decl.names, self.part)
             bodies = decl.bodies
         names, unavailable = self.part.names(names, tensor=self.tensor_mode, bodies=bodies)
@@ -151,7 +150,7 @@ class Context:
     @property
     def bodies(self) -> dict:
         """The problem's declared bodies (for the body functions of tensor expressions)."""
-        return declared(self.analysis.problem).bodies
+        return self.analysis.declared().bodies
 
     def parse(self, text, sub: tuple, equation: bool = False, relation: bool = False,
               names: dict | None = None) -> sp.Basic:

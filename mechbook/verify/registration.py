@@ -39,8 +39,8 @@ class Quantity:
     # function), "direction" (a mode shape's length); stated in docs/answers.md
     equivalent: tuple | Callable = ()
     # how other stages use the quantity, as plain names they map to their own code (verify
-    # imports neither): the independent checks that vouch for it (mechbook.crosscheck's
-    # CROSSCHECKS), how the report shows the engine's value (mechbook.app.report.values'
+    # imports neither): the independent checks that vouch for it (mechbook.crosscheck.
+    # problem.CROSSCHECKS), how the report shows the engine's value (mechbook.app.report.values'
     # DISPLAYS), the `mechbook sweep --quantity` whose grid its book value is drawn on
     crosschecks: tuple[str, ...] = ()
     display: str | None = None

@@ -17,7 +17,6 @@ def command(ctx: click.Context, problem_id: str, system: str | None, no_simplify
     """Derive and print a problem's results (what its `compute:` asks for), simplified."""
     from mechbook.app.api import load
     from mechbook.engine.derive import declared_results, derive
-    from mechbook.model.declared import declared
 
     base = resolve_root(ctx)
     try:
@@ -38,7 +37,7 @@ def command(ctx: click.Context, problem_id: str, system: str | None, no_simplify
                 click.echo(f"{key}: {text}")
         if not names or any(k in problem.model.doc.data for k in ("vectors", "tensors",
                                                                  "bodies")):
-            declared(problem.model)  # a problem's own vectors, tensors and bodies
+            problem.analysis.declared()  # a problem's own vectors, tensors and bodies
             res = declared_results(problem.analysis)
             click.echo("\n== declared vectors, tensors and bodies")
             for key, text in res.text.items():

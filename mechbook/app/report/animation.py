@@ -119,7 +119,7 @@ def _fixed_points(sys, values: dict, dims: int) -> list[list[float]]:
         for end in (spring.get("between") or []) if isinstance(spring, dict) else []:
             if isinstance(end, list):
                 try:
-                    point = [float(sys._parse(c, ("springs",)).xreplace(values)) for c in end]
+                    point = [float(sys.parse(c, ("springs",)).xreplace(values)) for c in end]
                 except Exception:  # noqa: BLE001 - a fixed end that does not evaluate
                     continue
                 out.append(point + [0.0] * (dims - len(point)))
@@ -172,7 +172,7 @@ def _springs(sys, names: list[str], values: dict, dims: int, axes: list[int]) ->
                 out.append(("body", end))
             elif isinstance(end, list):
                 try:
-                    point = [float(sys._parse(c, ("springs",)).xreplace(values)) for c in end]
+                    point = [float(sys.parse(c, ("springs",)).xreplace(values)) for c in end]
                 except Exception:  # noqa: BLE001 - a fixed end that does not evaluate
                     out.append(("none", None))
                     continue

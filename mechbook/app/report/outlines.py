@@ -71,9 +71,9 @@ def _dims(sys, name: str, spec: dict, values: dict) -> tuple[str, dict] | None:
         dims = {}
         for key, v in inertia.items():
             if key in ("radius", "length", "height"):
-                dims[key] = float(sys._parse(v, sub + (key,)).xreplace(values))
+                dims[key] = float(sys.parse(v, sub + (key,)).xreplace(values))
             elif key in ("sides", "semi_axes"):
-                dims[key] = [float(sys._parse(x, sub + (key, i)).xreplace(values))
+                dims[key] = [float(sys.parse(x, sub + (key, i)).xreplace(values))
                              for i, x in enumerate(v)]
     except (TypeError, ValueError, AttributeError):
         return None  # a dimension that is no number at the default values

@@ -74,10 +74,8 @@ def family(ctx: Context) -> SteadyFamily:
             for i, h in enumerate(data.get("hold") or [])]
     key = ("steady-family", ctx.part.system, repr(sorted(data["about"].items())), name,
            tuple(data.get("hold") or []))
-    cache = ctx.analysis.__dict__.setdefault("_steady_families", {})
-    if key not in cache:
-        cache[key] = SteadyFamily.build(ctx.dyn, ctx.point(), unknown, hold)
-    return cache[key]
+    return ctx.analysis.reuse(key, lambda: SteadyFamily.build(ctx.dyn, ctx.point(), unknown,
+                                                               hold))
 
 
 def _rate_symbol(ctx: Context, fam: SteadyFamily) -> sp.Symbol:
@@ -218,11 +216,9 @@ def _vanishes_at_rates(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
 def check_steady_exists(ctx: Context, val) -> Verdict:
     fam = family(ctx)
     cond = ctx.parse(val, ("book",), relation=True)
-    key = ("steady-coefficients", id(fam))
-    cache = ctx.analysis.__dict__.setdefault("_steady_coefficients", {})
-    if key not in cache:
-        cache[key] = (fam, _coefficients(ctx, fam))
-    coefficients = cache[key][1]
+    # the family kept beside its coefficients: its id is not reused while the analysis lives
+    coefficients = ctx.analysis.reuse(("steady-coefficients", id(fam)),
+                                      lambda: (fam, _coefficients(ctx, fam)))[1]
     result = boundary.compare(cond, lambda pt, near: _common_real_root(coefficients, pt, near),
                               ctx.sampler, ("a steady motion", "none"))
     return boundary.verdict(result)

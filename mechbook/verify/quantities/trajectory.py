@@ -113,13 +113,12 @@ def _start(ctx: Context) -> dict:
 
 
 def _level(ctx: Context, coordinate) -> LevelSet:
-    cache = ctx.analysis.__dict__.setdefault("_level_sets", {})
-    key = (ctx.part.system, str(coordinate))
-    if key not in cache:
+    def build() -> LevelSet:
         level = LevelSet(ctx.dyn, coordinate)
         level.reduced  # noqa: B018 - derive now: an unsupported reduction falls back here
-        cache[key] = level
-    return cache[key]
+        return level
+
+    return ctx.analysis.reuse(("level-set", ctx.part.system, str(coordinate)), build)
 
 
 def _book_values(ctx: Context, val) -> list:
