@@ -2,7 +2,7 @@
 
 Why: one Python call per step (or per right-hand side inside solve_ivp) costs far more
 than the step's arithmetic; here the whole run is one C call, and the records come back as
-arrays. Each function mirrors its Python reference (`integrators.py`; scipy's solve_ivp for
+arrays. Each function mirrors its Python reference (`fixed_step.py`; scipy's solve_ivp for
 DOP853 and RK45) step for step, so the numbers agree to rounding (tests/test_native.py).
 """
 

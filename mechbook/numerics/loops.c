@@ -3,7 +3,7 @@
  * The equations come in as a kernel: a function compiled by SymEngine's LLVM backend from the
  * engine's M(q, t) q'' = f(q, q', t) (plus A q'' + b = 0 with constraints), called as
  * kernel(out, x, user) with x = (t, q, q') and out = (M row-major, f, A, b). Every loop below
- * mirrors the Python reference in mechbook/numerics/integrators.py (or scipy's solve_ivp for
+ * mirrors the Python reference in mechbook/numerics/fixed_step.py (or scipy's solve_ivp for
  * DOP853 and RK45) operation by operation, so the same steps give the same numbers up to the
  * rounding of the small linear solves; tests/test_native.py checks that.
  */

@@ -8,7 +8,7 @@ small mass-matrix solve is in C too. `loops.c` is generic (n, m at run time), so
 compiled once per machine with the system's C compiler (`cc`, or $CC) and cached by the
 hash of its source under $MECHBOOK_CACHE (default ~/.cache/mechbook). Without a compiler,
 or with MECHBOOK_NATIVE=0, everything falls back to the Python reference loops in
-`integrators.py`, which compute the same numbers.
+`fixed_step.py` (and scipy's solve_ivp), which compute the same numbers.
 """
 
 from __future__ import annotations
