@@ -238,7 +238,7 @@ def run_restore(where: Path, spec: dict) -> tuple[str, str]:
     """Write a side file (good and hostile lines), restore it as `mechbook restore` does
     from inside the tree; nothing outside may change; what it says it stored reads back."""
     from mechbook.app.restore import restore
-    from mechbook.app.store_read import read
+    from mechbook.app.store.reader import read
     from mechbook.errors import MechbookError
 
     rng = random.Random(spec["seed"])
@@ -609,7 +609,7 @@ def run_hdf5(where: Path, spec: dict) -> tuple[str, str]:
     from fuzz_faults import HOSTILE_STRINGS, _readable, _record
 
     import mechbook.app.store as store
-    from mechbook.app.sweep_io import stored_sweeps
+    from mechbook.app.sweep.storage import stored_sweeps
     from mechbook.app.unsaved import Saver
     from mechbook.errors import MechbookError
 

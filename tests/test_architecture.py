@@ -443,3 +443,25 @@ def test_the_unused_module_test_can_fail(tmp_path):
     orphan.write_text('"""Nobody imports me."""\n', encoding="utf-8")
     known["mechbook.app.orphan"] = orphan
     assert "mechbook.app.orphan" in unused_modules(known, [])
+
+
+# ---- the store and the sweeps: packages with a public __init__ -------------------------------
+def test_the_sweep_package_names_resolve_to_their_modules():
+    """mechbook.app.sweep loads its names on first use (the command line must not load NumPy
+    at start-up): each public name is in `__all__` and in the table, and is found there."""
+    import importlib
+
+    import mechbook.app.sweep as sweep
+
+    assert sorted(sweep.__all__) == sorted(sweep._HOME)
+    for name, home in sweep._HOME.items():
+        assert getattr(sweep, name) is getattr(importlib.import_module(home), name), name
+    with pytest.raises(AttributeError):
+        sweep.no_such_name  # noqa: B018
+
+
+def test_the_store_package_exports_what_it_lists():
+    import mechbook.app.store as store
+
+    missing = [n for n in store.__all__ if not hasattr(store, n)]
+    assert not missing, missing

@@ -15,7 +15,7 @@ pytest.importorskip("distributed")
 
 from dask.distributed import Client  # noqa: E402
 
-import mechbook.app.sweep as sweep_mod  # noqa: E402
+import mechbook.app.sweep.runner as sweep_mod  # noqa: E402
 from mechbook.app.cli import main  # noqa: E402
 from mechbook.app.distributed import ENV, limited, local_cluster  # noqa: E402
 from mechbook.app.sweep import make_spec, run_sweep  # noqa: E402

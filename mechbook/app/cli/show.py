@@ -41,7 +41,7 @@ def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
             f"{problem_id}` stores one)")
     for name in rec.get("simulations", []):
         say(f"simulation stored: /problems/{problem_id}/simulations/{name}")
-    from mechbook.app.sweep_io import stored_sweeps
+    from mechbook.app.sweep.storage import stored_sweeps
 
     for name, text in stored_sweeps(problem_id, path):  # a damaged entry is said so
         say(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")

@@ -27,7 +27,7 @@ from mechbook.app.cli.common import (
     system_option,
     timeout_option,
 )
-from mechbook.app.sweep_spec import QUANTITIES
+from mechbook.app.sweep.spec import QUANTITIES
 from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.errors import MechbookError, message
 
@@ -105,7 +105,7 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
     run_name = name or "-".join([quantity] + [a.name for a in axes])
     failed = not _write(result, base, path, run_name, out_path, stored=not no_store)
     if plot_path is not None:
-        from mechbook.app.sweep_plot import plot_sweep
+        from mechbook.app.sweep.plot import plot_sweep
 
         say(f"plot written to {plot_sweep(result, plot_path)}")
     if failed:
@@ -158,8 +158,8 @@ def _write(result, base: Path, store: Path, run_name: str, out_path: Path | None
     a sweep too large for the store goes to results/sweeps/ anyway. False if a write
     failed (the sweep is then kept where it can be)."""
     from mechbook.app.store import StoreError
-    from mechbook.app.sweep_io import STORE_POINTS, write_netcdf, write_store
-    from mechbook.app.sweep_text import summary
+    from mechbook.app.sweep.storage import STORE_POINTS, write_netcdf, write_store
+    from mechbook.app.sweep.text_summary import summary
 
     for line in summary(result):
         say(line)
@@ -187,7 +187,7 @@ def _keep_sweep(result, store: Path, label: str) -> str:
     place that takes it (beside the store, the temporary directory, home)."""
     import tempfile
 
-    from mechbook.app.sweep_io import write_netcdf
+    from mechbook.app.sweep.storage import write_netcdf
 
     tried = []
     for place in (store.parent, Path(tempfile.gettempdir()), Path.home()):

@@ -17,7 +17,7 @@ The float64 path is then checked against the 30-digit one at sampled points (ran
 and, for a stability map, ones beside the boundary) and the largest relative difference is
 reported; the book's answer at the same point (its stability condition, its frequencies),
 evaluated over the same grid, is kept beside the engine's for the plot and for a count of
-where they disagree (mechbook.app.sweep_book).
+where they disagree (mechbook.app.sweep.book_answer).
 """
 
 from __future__ import annotations
@@ -32,13 +32,10 @@ import numpy as np
 import sympy as sp
 
 from mechbook.app.options import SWEEP_SAMPLES
-from mechbook.app.sweep_spec import (  # noqa: F401 - re-exported: a sweep's definition
+from mechbook.app.sweep.spec import (
     AMPLITUDE,
-    MAX_POINTS,
-    QUANTITIES,
     SweepSpec,
     check_grid,
-    make_spec,
 )
 from mechbook.engine.sweep import UNDEFINED, Grid
 from mechbook.errors import InputError, MechbookError, NotFoundError
@@ -259,7 +256,7 @@ class SweepResult:
     arrays: dict[str, np.ndarray]
     dims: dict[str, tuple[str, ...]]
     attrs: dict = field(default_factory=dict)
-    book: dict = field(default_factory=dict)  # mechbook.app.sweep_book.BookOverlay fields
+    book: dict = field(default_factory=dict)  # mechbook.app.sweep.book_answer.BookOverlay fields
 
 
 def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None = None,
@@ -289,7 +286,7 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         where = "this process"
     seconds = time.perf_counter() - t1
     arrays, dims = _assemble(sweeper, [parts[a] for a, _ in ranges])
-    from mechbook.app.sweep_accuracy import sample_accuracy
+    from mechbook.app.sweep.accuracy import sample_accuracy
 
     t2 = time.perf_counter()
     accuracy = sample_accuracy(sweeper, arrays, samples)
@@ -306,7 +303,7 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
     if spec.part:
         attrs["part"] = spec.part
     result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
-    from mechbook.app.sweep_book import book_overlay
+    from mechbook.app.sweep.book_answer import book_overlay
 
     result.book = book_overlay(sweeper, result)
     return result

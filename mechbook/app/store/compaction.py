@@ -35,10 +35,10 @@ def compact(image: BinaryIO, out: BinaryIO) -> None:
     Example: ``with open(old, "rb") as a, open(new, "w+b") as b: compact(a, b)``.
     """
     if h5py.version.hdf5_version_tuple < NATIVE_COPY_SINCE:
-        from mechbook.app.store_repair import _copy_group
+        from mechbook.app.store.repair import copy_group
 
         with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
-            _copy_group(src, dst)  # member by member in Python: slower, and safe there
+            copy_group(src, dst)  # member by member in Python: slower, and safe there
         return
     with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
         for key in src.attrs:

@@ -39,7 +39,7 @@ MAX_OBJECTS = 200_000  # groups, datasets and attributes walked in one store (a 
 # of the book stores about 14,000)
 MAX_MEMBERS = 10_000  # members of one group inside a record (a check writes a few hundred)
 MAX_DEPTH = 24  # nesting of groups (mechbook's deepest is about 9)
-_SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
+SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
 _NUMERIC = "fiub"  # float, signed and unsigned integers, booleans (an HDF5 enum)
 
 
@@ -141,7 +141,7 @@ def attributes(obj, budget: list[int] | None = None) -> dict[str, Any]:
     for name in attrs:
         if budget is not None:
             spend(budget, obj)
-        if name not in _SCALE_ATTRS:
+        if name not in SCALE_ATTRS:
             out[name] = attribute(obj, name, attrs)
     return out
 

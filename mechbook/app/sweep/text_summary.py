@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechbook.app.sweep import AMPLITUDE, SweepResult
+from mechbook.app.sweep.runner import SweepResult
+from mechbook.app.sweep.spec import AMPLITUDE
 from mechbook.engine.sweep import STABILITY_NAMES, UNDEFINED
 
 
