@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import html
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import sympy as sp
 
@@ -19,6 +19,8 @@ from mechbook.core.compile import as_expr
 from mechbook.errors import NotFoundError
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from mechbook.app.api import Problem
 
 SIMULATE_OPTIONS = ("init", "params", "method", "accuracy", "rtol", "atol", "max_step",
@@ -203,7 +205,7 @@ class SystemView:
         return MathList(out)
 
     def modes(self, about: Mapping | None = None,
-              params: Mapping | None = None) -> tuple[Any, Any]:
+              params: Mapping | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The normal modes of small oscillations about an equilibrium, numerically.
 
         Parameters

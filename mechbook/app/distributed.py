@@ -204,9 +204,9 @@ class Sidecar:
         self._conn: Connection | None = None
 
     def _start(self) -> None:
-        from mechbook.app.batch import _context, start_server
+        from mechbook.app.batch import pool_context, start_server
 
-        ctx = _context()
+        ctx = pool_context()
         start_server()
         parent, child = ctx.Pipe()
         self._proc = ctx.Process(target=_sidecar_loop, args=(child,), daemon=True)
@@ -222,7 +222,7 @@ class Sidecar:
         self._proc = self._conn = None
 
     def call(self, fn, args: tuple, timeout: float, memory_mb: float):
-        from mechbook.app.batch import POLL, _rss_mb
+        from mechbook.app.batch import POLL, rss_mb
 
         if self._proc is None or not self._proc.is_alive():
             self._start()
@@ -245,7 +245,7 @@ class Sidecar:
                 why = f"the child process died (exit code {self._proc.exitcode})"
             elif time.monotonic() - start > timeout:
                 why = f"exceeded the time limit of {timeout:g} s"
-            elif memory_mb and _rss_mb(self._proc.pid) > memory_mb:
+            elif memory_mb and rss_mb(self._proc.pid) > memory_mb:
                 why = f"exceeded the memory bound of {memory_mb:g} MB"
             if why:
                 self.stop()

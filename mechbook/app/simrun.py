@@ -12,11 +12,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.run import Stage
 from mechbook.errors import MechbookError, describe, message
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 @dataclass(frozen=True)
@@ -49,14 +52,14 @@ class SimReport:
     system: str = ""
     method: str = ""
     success: bool = False
-    arrays: dict[str, Any] = field(default_factory=dict)
-    settings: dict[str, Any] = field(default_factory=dict)
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)  # t, q, qdot, monitors/<name>
+    settings: dict[str, object] = field(default_factory=dict)  # stored as HDF5 attributes
     array_attrs: dict[str, dict] = field(default_factory=dict)
     plot: str | None = None
     stage: str = ""
 
 
-def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -> SimReport:
+def simulate_task(request: SimRequest, base: Path, options: None, stage: Stage) -> SimReport:
     """The batch task: load, derive, integrate, (plot); errors become report.error."""
     from mechbook.app.validate import build_limit, build_systems
     from mechbook.core.compile import DEFAULT_BACKEND

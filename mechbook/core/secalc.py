@@ -102,7 +102,7 @@ def expand(expr: sp.Basic) -> sp.Basic:
         return sp.expand(expr)
 
 
-def same(e: Any) -> Any:
+def same(e: T) -> T:
     """The identity: SymPy's algebra for a computation written for either (`either`)."""
     return e
 

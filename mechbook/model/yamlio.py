@@ -29,6 +29,8 @@ from mechbook.model.limits import (
 )
 
 Path_ = tuple[str | int, ...]
+# a YAML file's plain data: mappings, lists and scalars (what `Document.data` holds)
+Data = dict[str, "Data"] | list["Data"] | str | int | float | bool | None
 
 
 class Document:
@@ -37,14 +39,14 @@ class Document:
     A file read by libyaml (mechbook.model.fastyaml) has no line numbers of its own: the
     round-trip parser reads it again the first time an error needs a line."""
 
-    def __init__(self, raw: Any, file: str, data: Any = None, text: str | None = None):
+    def __init__(self, raw: object, file: str, data: Data = None, text: str | None = None):
         self._raw = raw
         self._text = text
         self.file = file
         self.data = self._plain(raw if text is None else data, ())
 
     @property
-    def raw(self) -> Any:
+    def raw(self) -> object:
         """The round-trip parser's nodes (with their lines), read on first use."""
         if self._raw is None and self._text is not None:
             try:

@@ -13,7 +13,6 @@ damaged is what the next write moves aside, and nothing else.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import h5py
 import numpy as np
@@ -282,7 +281,8 @@ def _collect(target: dict, name: str, obj) -> None:
             np.array(data) if obj.dtype.kind == "f" else plain_value(data))
 
 
-def plain_value(v) -> Any:
+def plain_value(v: object) -> object:
+    """A value read from HDF5 as plain Python (bytes decoded, NumPy scalars as numbers)."""
     if isinstance(v, bytes):
         return v.decode()
     if isinstance(v, np.generic):

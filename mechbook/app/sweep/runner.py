@@ -331,11 +331,11 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import util
 
-    from mechbook.app.batch import _context, deferred_interrupt, kill_pool, start_server
+    from mechbook.app.batch import deferred_interrupt, kill_pool, pool_context, start_server
     from mechbook.app.distributed import use_scratch
 
     parts: dict[int, dict] = {}
-    context = _context()
+    context = pool_context()
     start_server()
     with deferred_interrupt():  # its workers are started as the blocks are submitted
         pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=use_scratch,
