@@ -364,7 +364,7 @@ def run_options(spec: dict) -> tuple[str, str]:
 
 def _axis(text: str) -> tuple[str, str]:
     from mechbook.app.sweep import MAX_POINTS, check_grid
-    from mechbook.engine.sweep import parse_axis
+    from mechbook.engine.linear_grid import parse_axis
     from mechbook.errors import MechbookError
 
     try:

@@ -18,8 +18,8 @@ from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError
 from mechbook.model.problem import load_problem
 from mechbook.model.system import system_of
-from mechbook.numerics.model import BACKENDS, build_model, structure
 from mechbook.numerics.monitors import conserved_quantities
+from mechbook.numerics.rhs import BACKENDS, build_model, structure
 from mechbook.numerics.simulate import simulate
 
 ROOT = Path(__file__).resolve().parents[1]

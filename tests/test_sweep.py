@@ -16,7 +16,7 @@ from mechbook.app.cli import main
 from mechbook.app.sweep import Sweeper, make_spec, run_sweep
 from mechbook.app.sweep.storage import read_netcdf, read_store, write_netcdf, write_store
 from mechbook.engine.analysis import Analysis
-from mechbook.engine.sweep import (
+from mechbook.engine.linear_grid import (
     MARGINAL,
     STABLE,
     UNDEFINED,

@@ -54,7 +54,7 @@ def test_an_answer_part_naming_no_such_system_is_an_error_at_its_line(tmp_path):
 
 
 def test_a_particle_or_body_that_is_not_there_names_those_that_are():
-    from mechbook.engine.parts import part_energy
+    from mechbook.engine.part_energy import part_energy
     from mechbook.model.problem import load_problem
     from mechbook.model.system import system_of
 
@@ -80,7 +80,7 @@ def test_a_declared_body_that_is_not_there_names_those_that_are():
     ("omega=0:2:3:log", "a log axis needs LO, HI > 0"),
 ])
 def test_a_sweep_axis_that_does_not_read_is_an_input_error(text, message):
-    from mechbook.engine.sweep import parse_axis
+    from mechbook.engine.linear_grid import parse_axis
 
     with pytest.raises(InputError, match=message) as info:
         parse_axis(text)

@@ -98,9 +98,9 @@ class SystemView:
     @property
     def equilibria(self) -> list[dict]:
         """The equilibria SymPy finds in closed form that exist at the default values (real,
-        inside the coordinates' domains: mechbook.engine.domains), each a dict from
+        inside the coordinates' domains: mechbook.engine.existence), each a dict from
         coordinate to value; index it by the coordinate's symbol or its name."""
-        from mechbook.engine.domains import existing
+        from mechbook.engine.existence import existing
 
         points, _ = existing(self._an.equilibria(self.name).symbolic, self._sys,
                              self.problem.model.values())
@@ -304,7 +304,7 @@ class SystemView:
         >>> f = mechbook.load("lim-2031").ode_function()                   # doctest: +SKIP
         >>> sol = solve_ivp(f, (0, 5), f.initial({"theta": 1.0}), rtol=1e-10)  # doctest: +SKIP
         """
-        from mechbook.numerics.model import build_model
+        from mechbook.numerics.rhs import build_model
 
         values = parameter_values(self.problem.model, params)
         an = self.problem.fast

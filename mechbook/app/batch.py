@@ -35,8 +35,10 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Generic, TypeVar
 
-from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
-from mechbook.app.run import ProblemRun, RunOptions, Stage
+from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.lifeline import die_with, sweep_stale_folders
+from mechbook.app.quiet import install
+from mechbook.app.run import ProblemRun, RunOptions, Stage, run_problem
 from mechbook.errors import MechbookError, describe
 
 ItemT = TypeVar("ItemT", bound=Hashable)  # what one task is given: a problem id, a request
@@ -72,8 +74,6 @@ class BatchOptions(Generic[OptionsT]):
 
 def check_problem(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
     """The default task: check one problem (mechbook.app.run)."""
-    from mechbook.app.run import run_problem
-
     return run_problem(pid, base, options, stage=stage)
 
 
@@ -85,9 +85,6 @@ def problem_failed(pid: str, why: str, seconds: float, stage: str) -> ProblemRun
 def _worker(conn: Connection, base: Path, options: object, task: Task, run_pid: int) -> None:
     """A worker's loop: receive an item, run the task on it, send stages and the result.
     It dies with the run (mechbook.app.lifeline), even one killed with -9."""
-    from mechbook.app.lifeline import die_with
-    from mechbook.app.quiet import install
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
     for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
         signal.signal(ends, signal.SIG_DFL)
@@ -132,8 +129,7 @@ GC_THRESHOLDS = (10_000, 20, 100)  # young collections ~14 times rarer than Pyth
 
 
 def pool_context():
-    from mechbook.app.lifeline import sweep_stale_folders
-
+    """The workers' context: a fork server that imported the engine once and settled."""
     sweep_stale_folders()  # what runs killed with their fork server left
     ctx = mp.get_context("forkserver")
     # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap;

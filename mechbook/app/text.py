@@ -1,6 +1,6 @@
 """Strings made safe for each output: HDF5, JSON, XML and a terminal.
 
-Text from problem files is validated when it is read (mechbook.model.limits.check_text: no
+Text from problem files is validated when it is read (mechbook.model.input_limits.check_text: no
 NUL, no lone surrogate, no control character but tab and newline), so these functions change
 nothing a valid file holds. They are the second line: a store written by an older version,
 an exception's message, or a value that reached an output by another road can still never

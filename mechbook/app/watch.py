@@ -28,8 +28,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.console import STATUS_ORDER
-from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.errors import MechbookError
 from mechbook.records import Status
 
@@ -54,7 +54,7 @@ def _signature(paths: list[Path]) -> tuple:
     """What a change is: a file's kind, size, time and content (a touch alone is not one).
     Only a regular file of at most the size a problem file may have is read."""
     from mechbook.app.bounded import Unreadable, read_regular
-    from mechbook.model.limits import MAX_FILE_BYTES
+    from mechbook.model.input_limits import MAX_FILE_BYTES
 
     out = []
     for path in paths:

@@ -21,7 +21,7 @@ import sympy as sp
 T = TypeVar("T")
 
 
-class Unsupported(Exception):
+class SymEngineCannot(Exception):
     """SymEngine cannot do this one (an unknown function, a derivative left unevaluated)."""
 
 
@@ -29,7 +29,7 @@ def to_sympy(e, symbols: Iterable[sp.Symbol]) -> sp.Basic:
     """A SymEngine result as SymPy, its symbols replaced by those of `symbols` (by name)."""
     out = e._sympy_()
     if out.has(sp.Derivative, sp.Subs):
-        raise Unsupported("a derivative left unevaluated")
+        raise SymEngineCannot("a derivative left unevaluated")
     by_name = {s.name: s for s in symbols}
     back = {s: by_name[s.name] for s in out.free_symbols
             if s.name in by_name and by_name[s.name] is not s}
@@ -48,7 +48,7 @@ def euler_lagrange(L: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
                    chains: Sequence[tuple[sp.Symbol, sp.Symbol]], t: sp.Symbol,
                    forces: Sequence[sp.Expr], stop: Sequence[sp.Symbol] = ()) -> list[sp.Expr]:
     """expand(d/dt(∂L/∂q̇_i) − ∂L/∂q_i − Q_i) for each i, with d/dt = ∂/∂t + Σ ẋ ∂/∂x over
-    `chains` [(x, ẋ), ...]. Raises Unsupported where SymEngine cannot do it all, or where
+    `chains` [(x, ẋ), ...]. Raises SymEngineCannot where SymEngine cannot do it all, or where
     ∂L/∂q̇_i holds a symbol of `stop` (one whose time derivative is not defined)."""
     names = set(L.free_symbols).union(*(f.free_symbols for f in forces))
     names |= set(q) | set(qd) | {t} | {s for pair in chains for s in pair}
@@ -61,23 +61,23 @@ def euler_lagrange(L: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
         for qi, vi, force in zip(q, qd, forces, strict=True):
             p = Ls.diff(se.sympify(vi))
             if stops & p.free_symbols:
-                raise Unsupported("a symbol without a time derivative")
+                raise SymEngineCannot("a symbol without a time derivative")
             d = p.diff(ts)
             for x, v in pairs:
                 d += p.diff(x) * v
             e = d - Ls.diff(se.sympify(qi)) - se.sympify(force)
             out.append(to_sympy(se.expand(e), names))
         return out
-    except Unsupported:
+    except SymEngineCannot:
         raise
     except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
-        raise Unsupported(str(exc)) from None
+        raise SymEngineCannot(str(exc)) from None
 
 
 def total_derivative(expr: sp.Basic, t: sp.Symbol,
                      chains: Sequence[tuple[sp.Symbol, sp.Symbol]]) -> sp.Basic:
     """∂expr/∂t + Σ ẋ·∂expr/∂x over `chains` [(x, ẋ), ...], not expanded. Raises
-    Unsupported where SymEngine cannot do it (then the caller differentiates with SymPy)."""
+    SymEngineCannot where SymEngine cannot do it (then the caller differentiates with SymPy)."""
     names = set(expr.free_symbols) | {t} | {s for pair in chains for s in pair}
     try:
         e = se.sympify(expr)
@@ -88,10 +88,10 @@ def total_derivative(expr: sp.Basic, t: sp.Symbol,
             if sx in present:
                 out += e.diff(sx) * se.sympify(v)
         return to_sympy(out, names)
-    except Unsupported:
+    except SymEngineCannot:
         raise
     except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
-        raise Unsupported(str(exc)) from None
+        raise SymEngineCannot(str(exc)) from None
 
 
 def expand(expr: sp.Basic) -> sp.Basic:

@@ -20,7 +20,7 @@ import sympy as sp
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import ZERO_CLUSTER, LinearSystem
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.model import Model, build_model
+from mechbook.numerics.rhs import Model, build_model
 
 
 @dataclass

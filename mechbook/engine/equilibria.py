@@ -21,7 +21,7 @@ from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import without_absent
 from mechbook.core.secalc import either, same, to_sympy
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
-from mechbook.engine.domains import clip_ranges, inside
+from mechbook.engine.existence import clip_ranges, inside
 from mechbook.engine.flat_roots import FlatRoots, jacobian_scale
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem

@@ -1,5 +1,5 @@
 """A first-order linearization over a grid of parameter values (a rolling coin's stability
-map), compiled once and batched as mechbook.engine.sweep does for M, C, K.
+map), compiled once and batched as mechbook.engine.linear_grid does for M, C, K.
 
 E(p) and Â(p) of E·ż = Â·z (mechbook.engine.state_space) are compiled with the parameters as
 arguments (the compile layer's batch entry); at each block of points A = E⁻¹Â is solved in
@@ -20,12 +20,7 @@ import sympy as sp
 
 from mechbook.core.compile import DEFAULT_BACKEND, compile_batch
 from mechbook.engine.linear import ZERO_CLUSTER
-from mechbook.engine.state_space import (
-    StateSpaceSystem,
-    ambiguous_exponents,
-    frequencies_of_exponents,
-)
-from mechbook.engine.sweep import (
+from mechbook.engine.linear_grid import (
     GROWTH_TOL,
     PRECISE_LIMIT,
     STABLE,
@@ -33,6 +28,11 @@ from mechbook.engine.sweep import (
     UNSTABLE,
     Block,
     sweepable,
+)
+from mechbook.engine.state_space import (
+    StateSpaceSystem,
+    ambiguous_exponents,
+    frequencies_of_exponents,
 )
 
 

@@ -53,7 +53,7 @@ class _Unsure(Exception):
 def fast_data(text: str, file: str, check_events) -> Data:
     """The plain data of `text`, or None where only the round-trip parser can say (an
     error, a limit, a scalar the two parsers might read differently). `check_events`
-    (mechbook.model.limits) runs on the event stream first; a refusal there also gives
+    (mechbook.model.input_limits) runs on the event stream first; a refusal there also gives
     None, so that the message is the round-trip parser's."""
     if yaml is None or _ODD.search(text):
         return None

@@ -4,7 +4,7 @@ PyYAML silently keeps the last of two equal keys; ruamel.yaml's round-trip loade
 them and records where every node sits, so errors can name the file and the line. Before
 anything is built, the file's size, its event stream (no anchors, aliases or tags; bounded
 depth and node count) and then every scalar (plain JSON-like values, finite numbers) are
-checked against mechbook.model.limits.
+checked against mechbook.model.input_limits.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from ruamel.yaml.error import MarkedYAMLError, YAMLError
 from mechbook.errors import SpecError
 from mechbook.model.fastyaml import fast_data
 from mechbook.model.hints import yaml_hint
-from mechbook.model.limits import (
+from mechbook.model.input_limits import (
     MAX_FILE_BYTES,
     check_events,
     check_scalar,
@@ -107,7 +107,7 @@ def _node_line(node: Any) -> int | None:
 
 def load(path: str | Path) -> Document:
     """Load a YAML file; syntax errors, duplicate keys and anything past the limits
-    (mechbook.model.limits) become SpecError with a line."""
+    (mechbook.model.input_limits) become SpecError with a line."""
     return loads(read_text(path), str(path))
 
 

@@ -44,7 +44,7 @@ from mechbook.numerics.methods import (  # noqa: F401 - the names, re-exported
     kind,
     why_not,
 )
-from mechbook.numerics.model import Model, structure
+from mechbook.numerics.rhs import Model, structure
 
 MAX_STEPS = 10**10  # steps of one fixed-step run: far more than any run's time limit allows
 
@@ -125,7 +125,7 @@ class SciPyMethod(Integrator):
         nat = model.native if compiled and self.name in ("DOP853", "RK45") else None
         if nat is not None and not events and not opts.get("dense_output") \
                 and not opts.get("vectorized"):
-            from mechbook.numerics import compiled as loops
+            from mechbook.numerics import c_stepping as loops
 
             run = loops.adaptive(
                 nat, model.stats, self.name, t_span, y0, opts["rtol"], opts["atol"],
@@ -180,7 +180,7 @@ class FixedStep(Integrator):
 
     def _run_native(self, nat, model, t_span, start, t_eval, **kw) -> Trajectory:
         """The same run as `_run`, as one call into loops.c (`compiled.fixed`)."""
-        from mechbook.numerics import compiled as loops
+        from mechbook.numerics import c_stepping as loops
 
         steps, h = self._grid(t_span)
         t0 = float(t_span[0])

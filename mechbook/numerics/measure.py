@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 MEASURE_RTOL = 1e-7
 TOLERANCE = 1e-12

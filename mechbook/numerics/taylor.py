@@ -23,7 +23,7 @@ import sympy as sp
 
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.hyexpr import Translator, solve_spd
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 DEFAULT_TOL = 2.0 ** -52  # heyoka's own default: machine epsilon
 COMPACT_OPS = 2000  # above this many SymPy operations, heyoka's compact mode (faster compile)

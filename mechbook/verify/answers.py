@@ -11,7 +11,7 @@ from pathlib import Path
 
 import sympy as sp
 
-from mechbook.model.limits import check_answer_counts
+from mechbook.model.input_limits import check_answer_counts
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, load
 from mechbook.verify.part import Part

@@ -116,7 +116,7 @@ def _axes(params: tuple[str, ...], memory_mb: float, name: str | None) -> list:
     """The swept axes, the grid's size and the run's name checked before any work."""
     from mechbook.app.store import check_run_name
     from mechbook.app.sweep import check_grid
-    from mechbook.engine.sweep import parse_axis
+    from mechbook.engine.linear_grid import parse_axis
 
     try:
         axes = [parse_axis(p) for p in params]

@@ -163,7 +163,7 @@ def _short(text: str) -> str:
 def build_page(pid: str, base: Path, stored: dict | None,
                options: PageOptions = PageOptions()) -> dict:
     """Everything the problem's page shows, as plain data (HTML fragments, numbers)."""
-    from mechbook.app.report.parts import parts
+    from mechbook.app.report.answer_parts import parts
     from mechbook.app.report.systems import system_section
     from mechbook.app.report.values import point_math
 

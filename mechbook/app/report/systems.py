@@ -3,7 +3,7 @@
 The Lagrangian, T and V come with the system as it is built from its declarations;
 Lagrange's equations, the momenta and the energy function are the stored ones where the
 check derived them, else derived here under the step limit (they are cheap). The
-equilibria are those the check found or linearized about (mechbook.app.report.equilibria);
+equilibria are those the check found or linearized about (mechbook.app.report.equilibria_table);
 the simulation starts from the problem's `initial:` or near a stable one of them.
 """
 
@@ -16,7 +16,7 @@ import sympy as sp
 
 from mechbook.app.report import svg
 from mechbook.app.report.derivation import StoredSystem
-from mechbook.app.report.equilibria import equilibria_rows
+from mechbook.app.report.equilibria_table import equilibria_rows
 from mechbook.app.report.stored import names_for
 
 

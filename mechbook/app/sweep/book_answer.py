@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
-from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED, relations, truth
+from mechbook.engine.linear_grid import MARGINAL, STABLE, UNDEFINED, relations, truth
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.verify.registry import quantities
 

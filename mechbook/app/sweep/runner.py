@@ -2,7 +2,7 @@
 
 The problem is derived once and its linear system (about `--about`, a steady motion
 `--steady`, an answer part's point `--part`, or the stable equilibrium) compiled once with
-the parameters as arguments (mechbook.engine.sweep); the grid is cut into blocks, evaluated
+the parameters as arguments (mechbook.engine.linear_grid); the grid is cut into blocks, evaluated
 in this process, on a local process pool (`-j`), or on a Dask cluster (`--scheduler`,
 mechbook.app.distributed), and put back together in grid order. Quantities:
 
@@ -37,7 +37,7 @@ from mechbook.app.sweep.spec import (
     SweepSpec,
     check_grid,
 )
-from mechbook.engine.sweep import UNDEFINED, Grid
+from mechbook.engine.linear_grid import UNDEFINED, Grid
 from mechbook.errors import InputError, MechbookError, NotFoundError
 
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
@@ -49,8 +49,8 @@ class Sweeper:
 
     def __init__(self, spec: SweepSpec, base: Path):
         from mechbook.engine.analysis import Analysis
+        from mechbook.engine.linear_grid import LinearSweep
         from mechbook.engine.state_sweep import StateSweep
-        from mechbook.engine.sweep import LinearSweep
         from mechbook.model.catalog import answer_path, problem_path
         from mechbook.model.problem import load_problem
         from mechbook.verify.answers import load_answers
@@ -199,7 +199,7 @@ class Sweeper:
 
     def admissible(self, X: np.ndarray) -> np.ndarray:
         """Where the conditions hold, at rows of X (columns: `lin_symbols`)."""
-        from mechbook.engine.sweep import condition_mask
+        from mechbook.engine.linear_grid import condition_mask
 
         return condition_mask(self.conditions, self.lin_symbols, X, self.spec.backend)
 

@@ -14,7 +14,7 @@ from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.errors import MechbookError
 
 if TYPE_CHECKING:
-    from mechbook.engine.sweep import Axis
+    from mechbook.engine.linear_grid import Axis
 
 QUANTITIES = ("frequencies", "stability", "drift")
 AMPLITUDE = "amplitude"

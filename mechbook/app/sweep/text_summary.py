@@ -6,7 +6,7 @@ import numpy as np
 
 from mechbook.app.sweep.runner import SweepResult
 from mechbook.app.sweep.spec import AMPLITUDE
-from mechbook.engine.sweep import STABILITY_NAMES, UNDEFINED
+from mechbook.engine.linear_grid import STABILITY_NAMES, UNDEFINED
 
 
 def summary(result: SweepResult) -> list[str]:

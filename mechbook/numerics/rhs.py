@@ -96,26 +96,26 @@ class Model:
 
     @cached_property
     def native(self):
-        """The compiled loops' view of this model (`native.NativeModel`), or None where the
+        """The compiled loops' view of this model (`c_library.NativeModel`), or None where the
         loop library or the LLVM kernel is unavailable (then the Python paths run)."""
-        from mechbook.numerics import native
+        from mechbook.numerics import c_library
 
-        kernel = native.kernel_pointer(self._mf)
-        lib = native.library() if kernel else None
+        kernel = c_library.kernel_pointer(self._mf)
+        lib = c_library.library() if kernel else None
         if lib is None:
             return None
-        return native.NativeModel(lib, kernel, self.n, self.constraints, keep=(self._mf,))
+        return c_library.NativeModel(lib, kernel, self.n, self.constraints, keep=(self._mf,))
 
     @cached_property
     def native_canonical(self):
         """Like `native`, with the canonical kernel too (the implicit midpoint loop)."""
-        from mechbook.numerics import native
+        from mechbook.numerics import c_library
 
-        kernel, canon = native.kernel_pointer(self._mf), native.kernel_pointer(self.canonical)
-        lib = native.library() if kernel and canon else None
+        kernel, canon = c_library.kernel_pointer(self._mf), c_library.kernel_pointer(self.canonical)
+        lib = c_library.library() if kernel and canon else None
         if lib is None:
             return None
-        return native.NativeModel(lib, kernel, self.n, self.constraints, canonical=canon,
+        return c_library.NativeModel(lib, kernel, self.n, self.constraints, canonical=canon,
                                   keep=(self._mf, self.canonical))
 
     def accelerations(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
