@@ -72,7 +72,7 @@ class BatchOptions(Generic[OptionsT]):
         return self.jobs if self.jobs > 0 else (os.cpu_count() or 1)
 
 
-def check_problem(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
+def problem_task(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
     """The default task: check one problem (mechbook.app.run)."""
     return run_problem(pid, base, options, stage=stage)
 
@@ -235,7 +235,7 @@ class Batch(Generic[ItemT, OptionsT, ResultT]):
     def __init__(self, base: Path, options: BatchOptions[OptionsT] = BatchOptions(),
                  on_done: Callable[[ResultT], None] | None = None,
                  on_start: Callable[[ItemT], None] | None = None,
-                 task: Task[ItemT, OptionsT, ResultT] = check_problem,
+                 task: Task[ItemT, OptionsT, ResultT] = problem_task,
                  failed: Failed[ItemT, ResultT] = problem_failed):
         self.base = base
         self.options = options
