@@ -16,7 +16,11 @@ from mechbook.app.display import MathDict, MathList
 from mechbook.app.linearization import Linearization, linearization
 from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
+from mechbook.core.timeout import try_simplify
+from mechbook.engine.existence import existing
 from mechbook.errors import NotFoundError
+from mechbook.numerics.rhs import build_model
+from mechbook.numerics.simulate import simulate
 
 if TYPE_CHECKING:
     import numpy as np
@@ -100,8 +104,6 @@ class SystemView:
         """The equilibria SymPy finds in closed form that exist at the default values (real,
         inside the coordinates' domains: mechbook.engine.existence), each a dict from
         coordinate to value; index it by the coordinate's symbol or its name."""
-        from mechbook.engine.existence import existing
-
         points, _ = existing(self._an.equilibria(self.name).symbolic, self._sys,
                              self.problem.model.values())
         return MathList(MathDict(p) for p in points)
@@ -271,8 +273,6 @@ class SystemView:
         >>> run.drifts                                                       # doctest: +SKIP
         {'energy_function': 1.2e-10}
         """
-        from mechbook.numerics.simulate import simulate
-
         refuse_unknown("simulate", options, SIMULATE_OPTIONS)
         options["init"] = texts(options.get("init"))
         options["parameters"] = texts(options.pop("params", None))
@@ -304,8 +304,6 @@ class SystemView:
         >>> f = mechbook.load("lim-2031").ode_function()                   # doctest: +SKIP
         >>> sol = solve_ivp(f, (0, 5), f.initial({"theta": 1.0}), rtol=1e-10)  # doctest: +SKIP
         """
-        from mechbook.numerics.rhs import build_model
-
         values = parameter_values(self.problem.model, params)
         an = self.problem.fast
         sys, dyn = an.system(self.name), an.dynamics(self.name)
@@ -315,7 +313,6 @@ class SystemView:
     def _readable(self, expr):
         if not self.problem.simplify:
             return expr
-        from mechbook.core.timeout import try_simplify
 
         return try_simplify(expr, self.problem.simplify_seconds)
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
+from mechbook.app.store import problems, read, vet
+from mechbook.core.optional import require
 from mechbook.model.catalog import DEFAULT_STORE
 
 if TYPE_CHECKING:  # pandas is imported only when `results` is called
@@ -48,10 +50,7 @@ def results(store: str | Path = DEFAULT_STORE) -> Frames:
     >>> checks, crosschecks, timings = mechbook.results("results/mechbook.h5")  # doctest: +SKIP
     >>> checks.groupby("status").size()                                         # doctest: +SKIP
     """
-    from mechbook.core.optional import require
-
     pd = require("pandas", "data", "mechbook.results()")
-    from mechbook.app.store import problems, read, vet
 
     path = Path(store)
     if not path.exists():

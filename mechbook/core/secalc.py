@@ -18,6 +18,8 @@ from typing import Any, TypeVar
 import symengine as se
 import sympy as sp
 
+from mechbook.errors import MechbookError
+
 T = TypeVar("T")
 
 
@@ -115,8 +117,6 @@ def either(build: Callable[[Callable], T]) -> T:
     SymPy, build(same). A MechbookError (the problem's own fault, or a capability the
     engine lacks), running out of memory or of recursion depth are not reasons to try
     again."""
-    from mechbook.errors import MechbookError
-
     try:
         out = build(se.sympify)
     except (MechbookError, MemoryError, RecursionError):

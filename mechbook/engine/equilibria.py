@@ -21,6 +21,7 @@ from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import without_absent
 from mechbook.core.secalc import either, same, to_sympy
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
+from mechbook.engine.constrained import equilibrium_conditions, linearize_on_manifold, residual_at
 from mechbook.engine.existence import clip_ranges, inside
 from mechbook.engine.flat_roots import FlatRoots, jacobian_scale
 from mechbook.engine.lagrange import Dynamics
@@ -44,8 +45,6 @@ class Equilibria:
         parameters switched off; with multiplier constraints, E(q, 0, 0) − A(q)ᵀλ and the
         constraints g(q) (mechbook.engine.constrained)."""
         if self.dyn.constrained:
-            from mechbook.engine.constrained import equilibrium_conditions
-
             return equilibrium_conditions(self)[0]
         return self.rest_residuals()
 
@@ -202,8 +201,6 @@ class Equilibria:
         """What must vanish if `point` is an equilibrium (with constraints: each constraint
         and the force along the constraint manifold)."""
         if self.dyn.constrained:
-            from mechbook.engine.constrained import residual_at
-
             return residual_at(self, point)
         return [c.subs(point) for c in self.conditions]
 
@@ -257,8 +254,6 @@ class Equilibria:
         there; M, C, K and F stay in the original parameters. A system with multiplier
         constraints is linearized on its constraint manifold (mechbook.engine.constrained)."""
         if self.dyn.constrained:
-            from mechbook.engine.constrained import linearize_on_manifold
-
             return linearize_on_manifold(self, point, velocity, given)
         if not velocity and not given and self._conservative():
             return self._linearize_lagrangian(point)

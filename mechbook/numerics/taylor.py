@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-from mechbook.errors import UnsupportedError
+from mechbook.core.optional import require
+from mechbook.errors import MissingDependencyError, UnsupportedError
 from mechbook.numerics.hyexpr import Translator, solve_spd
 from mechbook.numerics.rhs import Model
 
@@ -37,9 +38,6 @@ def available() -> bool:
 
 
 def _hy():
-    from mechbook.core.optional import require
-    from mechbook.errors import MissingDependencyError
-
     try:
         return require("heyoka", "taylor", "the Taylor method")
     except MissingDependencyError as exc:  # unsupported here: callers may go another way

@@ -28,7 +28,7 @@ from mechbook.app.store.bounds import (
     new_budget,
     walk,
 )
-from mechbook.records import Status
+from mechbook.records import CrossCheck, Status
 
 FORMAT = 1  # the store format this mechbook reads and writes (the root's `format` attribute)
 
@@ -151,8 +151,6 @@ def read_problem_entry(g, budget: list[int] | None = None) -> dict:
 
 
 def read_crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dict]:
-    from mechbook.records import CrossCheck
-
     out = []
     group = subgroup(g, "crosschecks")
     if group:

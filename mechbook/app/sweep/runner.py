@@ -31,14 +31,26 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from mechbook.app.batch import deferred_interrupt, kill_pool, pool_context, start_server
+from mechbook.app.distributed import connect, dask_distributed, limited, materialize, use_scratch
 from mechbook.app.options import SWEEP_SAMPLES
+from mechbook.app.sweep.accuracy import sample_accuracy
+from mechbook.app.sweep.book_answer import book_overlay
 from mechbook.app.sweep.spec import (
     AMPLITUDE,
     SweepSpec,
     check_grid,
 )
-from mechbook.engine.linear_grid import UNDEFINED, Grid
+from mechbook.crosscheck.amplitude import amplitude_response
+from mechbook.engine.analysis import Analysis
+from mechbook.engine.linear_grid import UNDEFINED, Grid, LinearSweep, condition_mask
+from mechbook.engine.state_sweep import StateSweep
 from mechbook.errors import InputError, MechbookError, NotFoundError
+from mechbook.model.catalog import answer_path, problem_path
+from mechbook.model.expr import parse
+from mechbook.model.problem import load_problem
+from mechbook.verify.answers import load_answers
+from mechbook.verify.context import Context
 
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
 DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
@@ -48,13 +60,6 @@ class Sweeper:
     """A sweep's derived and compiled state, built once per process."""
 
     def __init__(self, spec: SweepSpec, base: Path):
-        from mechbook.engine.analysis import Analysis
-        from mechbook.engine.linear_grid import LinearSweep
-        from mechbook.engine.state_sweep import StateSweep
-        from mechbook.model.catalog import answer_path, problem_path
-        from mechbook.model.problem import load_problem
-        from mechbook.verify.answers import load_answers
-
         self.spec = spec
         self.problem = load_problem(problem_path(spec.pid, base))
         self.analysis = Analysis(self.problem)
@@ -88,8 +93,6 @@ class Sweeper:
 
     def _linearize_at_part(self, fixed: dict, symbols: list) -> None:
         """--part: the part's system, point and values (its own symbols join the grid's)."""
-        from mechbook.verify.context import Context
-
         self.context = Context(self.analysis, self._part(self.spec.part))
         self.system = self.context.system
         self.lin = self.context.linear()
@@ -114,8 +117,6 @@ class Sweeper:
 
     def _point(self, pairs, what: str) -> dict:
         """{coordinate: value} from the option's NAME=EXPR pairs (the safe parser)."""
-        from mechbook.model.expr import parse
-
         names = dict(self.system.names)
         out = {}
         for name, text in pairs:
@@ -199,13 +200,9 @@ class Sweeper:
 
     def admissible(self, X: np.ndarray) -> np.ndarray:
         """Where the conditions hold, at rows of X (columns: `lin_symbols`)."""
-        from mechbook.engine.linear_grid import condition_mask
-
         return condition_mask(self.conditions, self.lin_symbols, X, self.spec.backend)
 
     def _drift(self, X: np.ndarray) -> dict[str, np.ndarray]:
-        from mechbook.crosscheck.amplitude import amplitude_response
-
         k, n = X.shape[0], self.modes
         linear = np.full((k, n), np.nan)
         measured = np.full((k, n), np.nan)
@@ -234,8 +231,6 @@ _SWEEPERS: dict[str, Sweeper] = {}  # per process: one sweeper per sweep (compil
 
 def block_of(spec: SweepSpec, start: int, stop: int) -> dict[str, np.ndarray]:
     """One block on whatever process runs it: derived and compiled on first use there."""
-    from mechbook.app.distributed import materialize
-
     if spec.key not in _SWEEPERS:
         _SWEEPERS[spec.key] = Sweeper(spec, materialize(dict(spec.files)))
     return _SWEEPERS[spec.key].block(start, stop)
@@ -244,8 +239,6 @@ def block_of(spec: SweepSpec, start: int, stop: int) -> dict[str, np.ndarray]:
 def cluster_block(spec: SweepSpec, start: int, stop: int, timeout: float,
                   memory_mb: float) -> dict[str, np.ndarray]:
     """A block on a Dask worker, inside that worker's limited child process."""
-    from mechbook.app.distributed import limited
-
     return limited(block_of, (spec, start, stop), timeout, memory_mb)
 
 
@@ -286,7 +279,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         where = "this process"
     seconds = time.perf_counter() - t1
     arrays, dims = _assemble(sweeper, [parts[a] for a, _ in ranges])
-    from mechbook.app.sweep.accuracy import sample_accuracy
 
     t2 = time.perf_counter()
     accuracy = sample_accuracy(sweeper, arrays, samples)
@@ -303,7 +295,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
     if spec.part:
         attrs["part"] = spec.part
     result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
-    from mechbook.app.sweep.book_answer import book_overlay
 
     result.book = book_overlay(sweeper, result)
     return result
@@ -312,8 +303,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
 def _on_cluster(spec: SweepSpec, ranges: list[tuple[int, int]], scheduler: str,
                 timeout: float, memory_mb: float, progress: Callable[[int, int], None]) -> dict:
     """Every block on the Dask cluster, each under the limits on its worker."""
-    from mechbook.app.distributed import connect, dask_distributed
-
     as_completed = dask_distributed().as_completed
     parts: dict[int, dict] = {}
     with connect(scheduler) as client:
@@ -330,9 +319,6 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
     """Every block on a pool of `jobs` local processes (that die with this one)."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import util
-
-    from mechbook.app.batch import deferred_interrupt, kill_pool, pool_context, start_server
-    from mechbook.app.distributed import use_scratch
 
     parts: dict[int, dict] = {}
     context = pool_context()

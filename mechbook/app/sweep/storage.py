@@ -21,6 +21,21 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from mechbook.app.outputs import OutputError, output_file, replaced
+from mechbook.app.store import (
+    StoreError,
+    atomic_edit,
+    attributes,
+    bounded_text,
+    check_run_name,
+    member,
+    names_in,
+    opened,
+    read_sweep_entry,
+    reason_of,
+    refusal,
+    there,
+)
 from mechbook.errors import NotFoundError
 from mechbook.version import __version__
 
@@ -55,20 +70,15 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        from mechbook.app.store import bounded_text
-
         return bounded_text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    from mechbook.app.store import bounded_text
 
     return bounded_text(json.dumps(v, default=float), cut=False)
 
 
 def write_store(result, name: str, path: str | Path) -> Path:
     """Add (or replace) the sweep at /sweeps/<id>/<name> of the store, atomically."""
-    from mechbook.app.store import atomic_edit
-
     _check_name(name)
     coords, vars_, attrs = variables(result)
     with atomic_edit(path) as f:
@@ -95,8 +105,6 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
     """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; NotFoundError
     (also a KeyError) naming the problem's stored sweeps if it is absent, StoreError naming
     what is damaged."""
-    from mechbook.app.store import StoreError, names_in, opened, read_sweep_entry, reason_of, there
-
     with opened(path) as f:
         try:
             g = f["sweeps"][pid][name]
@@ -116,8 +124,6 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
     """(name, one-line description) of a problem's stored sweeps (a damaged entry is one
     line that says so)."""
-    from mechbook.app.store import attributes, member, reason_of, refusal
-
     out = []
     try:
         with h5py.File(path, "r") as f:
@@ -144,8 +150,6 @@ def write_netcdf(result, path: str | Path) -> Path:
     """The sweep as a netCDF-4 file, replacing a regular file (or nothing) at `path` whole
     (mechbook.app.outputs); OutputError with the path and the reason if it cannot be."""
     import h5netcdf
-
-    from mechbook.app.outputs import OutputError, output_file, replaced
 
     path = Path(path)
     real = output_file(path, "netCDF file")
@@ -177,6 +181,4 @@ def read_netcdf(path: str | Path) -> dict:
 
 
 def _check_name(name: str) -> None:
-    from mechbook.app.store import check_run_name
-
     check_run_name(name, "sweep")
