@@ -55,7 +55,7 @@ class WatchOptions:
     runs: int = 0  # stop after this many checks (0: until interrupted; for tests)
 
 
-def _signature(paths: list[Path]) -> tuple:
+def files_signature(paths: list[Path]) -> tuple:
     """What a change is: a file's kind, size, time and content (a touch alone is not one).
     Only a regular file of at most the size a problem file may have is read."""
     out = []
@@ -132,7 +132,7 @@ def watch(pid: str, base: Path, say: Callable[[str], None],
     try:
         with Batch(base, limits, task=check_in_worker, failed=check_stopped) as batch:
             while True:
-                now = _signature(paths)
+                now = files_signature(paths)
                 if not _changed(last, now):
                     time.sleep(options.poll)
                     continue

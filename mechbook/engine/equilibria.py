@@ -226,7 +226,7 @@ class Equilibria:
                                                  (*at.values(), *held.values())))
 
         def build(conv):  # in SymEngine, its entries brought back to SymPy once; or SymPy
-            parts = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, conv)
+            parts = second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, conv)
             return parts if conv is same else [[to_sympy(x, names) for x in p] for p in parts]
 
         force, A, B, C = either(build)
@@ -335,7 +335,7 @@ class Equilibria:
         return zeroth, M, C, K, F
 
 
-def _second_derivatives(L, q, qd, at: dict, rest: dict, held: dict, conv) -> tuple:
+def second_derivatives(L, q, qd, at: dict, rest: dict, held: dict, conv) -> tuple:
     """(∂L/∂q at the point, A, B, C row by row) of `_linearize_lagrangian`, in the algebra
     `conv` converts to (SymEngine's or SymPy's: both have diff and xreplace). Each second
     derivative from the smallest expression that still holds it: A from L at the point (a

@@ -76,7 +76,7 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
     declared = books(base)
     rows, problems_index = [], []
     for pid in ids:
-        entry = _index_entry(pid, (pages.get(pid) or {}).get("index") or {}, stored.get(pid),
+        entry = index_entry(pid, (pages.get(pid) or {}).get("index") or {}, stored.get(pid),
                              declared)
         problems_index.append(entry)
         rows.extend(entry["rows"])
@@ -156,7 +156,7 @@ def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
              "parts": [{"part": p["part"], "quantity": p.get("quantity", ""),
                         "origin": p.get("origin", ""), "cite": p.get("cite", "")}
                        for p in page.get("parts", [])]}
-    entry = _index_entry(pid, index, stored, declared)
+    entry = index_entry(pid, index, stored, declared)
     render("problem.html", task.out / "problems" / f"{pid}.html", tree=base, page=page,
            stored=stored, entry=entry, version=__version__)
     return {"pid": pid, "index": index, "seconds": time.monotonic() - start}
@@ -173,7 +173,7 @@ def _write_failed(base: Path, out: Path, pid: str, stored: dict | None, why: str
             "conditions": [], "defaults": "", "systems": [], "parts": [],
             "crosscheck_figures": {},
             "page_notes": [f"this page could not be built: {why}"]}
-    entry = _index_entry(pid, {"title": page["title"]}, stored, books(base))
+    entry = index_entry(pid, {"title": page["title"]}, stored, books(base))
     render("problem.html", out / "problems" / f"{pid}.html", tree=base, page=page,
            stored=stored, entry=entry, version=__version__)
 
@@ -212,7 +212,7 @@ def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str
     return stored, damaged
 
 
-def _index_entry(pid: str, index: dict, stored: dict | None, declared: dict) -> dict:
+def index_entry(pid: str, index: dict, stored: dict | None, declared: dict) -> dict:
     book = split_id(pid)[0]
     attrs = (stored or {}).get("attrs", {})
     title = index.get("title") or attrs.get("title", "")
