@@ -7,8 +7,8 @@
     simrun       `mechbook simulate` in a worker, under the same limits
     distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
     sweep/       `mechbook sweep`: a result over a grid of parameters (runner: the grid
-                 evaluated in blocks; accuracy: float64 against 30 digits; book_answer: the
-                 book's answer on the grid; storage: store and netCDF; plot; text_summary:
+                 evaluated in blocks; precision: float64 against 30 digits; book_answer: the
+                 book's answer on the grid; storage: store and netCDF; figures; text_summary:
                  what it prints; spec: a sweep's definition, without NumPy)
     store/       the HDF5 store (writer: written atomically under a lock; reader: reading;
                  warm_cache: the warm-run cache; repair: a damaged store rebuilt; entries,

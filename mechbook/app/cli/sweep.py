@@ -107,7 +107,7 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
     failed = not _write(result, base, path, run_name, out_path, stored=not no_store)
     if plot_path is not None:
         # at call time, not at the top: `mechbook --help` and `list` start without it
-        from mechbook.app.sweep.plot import plot_sweep
+        from mechbook.app.sweep.figures import plot_sweep
 
         say(f"plot written to {plot_sweep(result, plot_path)}")
     if failed:

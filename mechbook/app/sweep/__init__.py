@@ -4,10 +4,10 @@ parts:
 
     spec          a sweep's definition as plain data, the grid's size checked (no NumPy)
     runner        the problem derived and compiled once, the grid evaluated in blocks
-    accuracy      the float64 results against the 30-digit path at sampled points
+    precision     the float64 results against the 30-digit path at sampled points
     book_answer   the book's answer over the same grid
     storage       a sweep's result in the HDF5 store or a netCDF-4 file
-    plot          its plots (matplotlib)
+    figures       its plots (matplotlib)
     text_summary  what the command prints
 
 The names below load their module on first use (PEP 562): the command line reads `spec`'s
@@ -21,7 +21,7 @@ import importlib
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # what the names are, for a reader and a type checker
-    from mechbook.app.sweep.plot import plot_sweep
+    from mechbook.app.sweep.figures import plot_sweep
     from mechbook.app.sweep.runner import BLOCK_ENTRIES, Sweeper, SweepResult, block_of, run_sweep
     from mechbook.app.sweep.spec import (
         AMPLITUDE,
@@ -48,7 +48,7 @@ _HOME = {
                     "mechbook.app.sweep.runner"),
     **dict.fromkeys(("STORE_POINTS", "read_netcdf", "read_store", "stored_sweeps",
                      "write_netcdf", "write_store"), "mechbook.app.sweep.storage"),
-    "plot_sweep": "mechbook.app.sweep.plot",
+    "plot_sweep": "mechbook.app.sweep.figures",
     "summary": "mechbook.app.sweep.text_summary",
 }
 __all__ = [  # the same names as _HOME (a test keeps them equal)

@@ -34,8 +34,8 @@ import sympy as sp
 from mechbook.app.batch import deferred_interrupt, kill_pool, pool_context, start_server
 from mechbook.app.distributed import connect, dask_distributed, limited, materialize, use_scratch
 from mechbook.app.options import SWEEP_SAMPLES
-from mechbook.app.sweep.accuracy import sample_accuracy
 from mechbook.app.sweep.book_answer import book_overlay
+from mechbook.app.sweep.precision import sample_accuracy
 from mechbook.app.sweep.spec import (
     AMPLITUDE,
     SweepSpec,
