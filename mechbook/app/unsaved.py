@@ -20,7 +20,6 @@ import tempfile
 from dataclasses import asdict
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -32,7 +31,8 @@ log = logging.getLogger("mechbook.store")
 FORMAT = 1
 
 
-def json_default(value: Any) -> Any:
+def json_default(value: object) -> list | float | int | bool:
+    """`json.dump`'s `default=`: NumPy arrays and scalars as JSON data; TypeError otherwise."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
