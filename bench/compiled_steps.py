@@ -49,10 +49,10 @@ from rhs_backends import chain_problem, equations  # noqa: E402
 from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.model.catalog import problem_path  # noqa: E402
 from mechbook.model.problem import load_problem  # noqa: E402
-from mechbook.numerics import native  # noqa: E402
+from mechbook.numerics import c_library  # noqa: E402
 from mechbook.numerics.integrators import integrate  # noqa: E402
-from mechbook.numerics.model import build_model  # noqa: E402
 from mechbook.numerics.monitors import conserved_quantities, drifts  # noqa: E402
+from mechbook.numerics.rhs import build_model  # noqa: E402
 from mechbook.numerics.simulate import initial_state  # noqa: E402
 from mechbook.numerics.stiffness import linear_rates  # noqa: E402
 
@@ -97,7 +97,7 @@ class Reference:
     def rhs(self, t, y):
         """The compiled right-hand side as a Python callable (for Fortran's dop853)."""
         self._y[:] = y
-        self.so.ref_rhs(t, native.address(self._y), native.address(self._dy))
+        self.so.ref_rhs(t, c_library.address(self._y), c_library.address(self._dy))
         return self._dy.copy()
 
 
@@ -142,10 +142,10 @@ def rhs_calls(repeat: int, sizes=(1, 2, 4, 8)) -> list[dict]:
         calls_py = 20_000
 
         def ours_loop(nat=nat, ya=ya, dya=dya, reps=reps):
-            nat.lib.mb_rhs_repeat(nat.ptr, 0.0, native.address(ya), native.address(dya), reps)
+            nat.lib.mb_rhs_repeat(nat.ptr, 0.0, c_library.address(ya), c_library.address(dya), reps)
 
         def ref_loop(ref=ref, yb=yb, dyb=dyb, reps=reps):
-            ref.so.ref_rhs_repeat(0.0, native.address(yb), native.address(dyb), reps)
+            ref.so.ref_rhs_repeat(0.0, c_library.address(yb), c_library.address(dyb), reps)
 
         def ours_python(model=model, y=y, calls=calls_py):
             for _ in range(calls):
@@ -192,7 +192,7 @@ def long_runs(repeat: int, quick: bool) -> tuple[list[dict], dict]:
     steps = int(round(t_end / h))
     rows = []
     info = {"period": T, "periods": periods, "reference_compile_s": ref.compile_seconds,
-            "loops_build_s": native.build_seconds()}
+            "loops_build_s": c_library.build_seconds()}
 
     def run(method, **opts):
         return integrate(model, (0.0, t_end), q0, qd0, method, t_eval=grid, **opts)
@@ -208,10 +208,10 @@ def long_runs(repeat: int, quick: bool) -> tuple[list[dict], dict]:
             q, v = q0.copy(), qd0.copy()
             if method == "RK4":
                 y = np.concatenate((q, v))
-                ref.so.ref_rk4(0.0, h, steps, native.address(y))
+                ref.so.ref_rk4(0.0, h, steps, c_library.address(y))
             else:
-                ref.so.ref_leapfrog(0.0, h, steps, native.address(w), len(w),
-                                    native.address(q), native.address(v))
+                ref.so.ref_leapfrog(0.0, h, steps, c_library.address(w), len(w),
+                                    c_library.address(q), c_library.address(v))
 
         def python_run(method=method, short=short):
             integrate(model, (0.0, short * h), q0, qd0, method, step=h, compiled=False,
@@ -375,8 +375,8 @@ def main() -> None:
     opts = ap.parse_args()
     import pandas as pd
 
-    if native.library() is None:
-        sys.exit(f"no compiled loops: {native.why()}")
+    if c_library.library() is None:
+        sys.exit(f"no compiled loops: {c_library.why()}")
     began = time.perf_counter()
     calls = pd.DataFrame(rhs_calls(opts.repeat, (1, 4) if opts.quick else (1, 2, 4, 8)))
     rows, info = long_runs(opts.repeat, opts.quick)

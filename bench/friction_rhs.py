@@ -51,7 +51,7 @@ def main(argv=None) -> int:
     from mechbook.model.problem import load_problem
     from mechbook.numerics.friction import Phases
     from mechbook.numerics.measure import TOLERANCE, first_event, signal_functions
-    from mechbook.numerics.model import build_model
+    from mechbook.numerics.rhs import build_model
 
     print(f"mechbook from {Path(mechbook.__file__).parent.parent}")
     a = Analysis(load_problem(problem_path("symon-11-15", args.tree.resolve())))

@@ -47,7 +47,7 @@ from mechbook.engine.analysis import Analysis  # noqa: E402
 from mechbook.errors import MechbookError  # noqa: E402
 from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
 from mechbook.model.problem import load_problem  # noqa: E402
-from mechbook.numerics.model import Model, timed_calls  # noqa: E402
+from mechbook.numerics.rhs import Model, timed_calls  # noqa: E402
 
 BACKENDS = ("sympy-math", "sympy-numpy", "symengine", "llvm", "gcc")
 SPAN = 5.0  # time units integrated

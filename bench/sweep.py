@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mechbook.app.sweep import make_spec, run_sweep  # noqa: E402
-from mechbook.engine.sweep import parse_axis  # noqa: E402
+from mechbook.engine.linear_grid import parse_axis  # noqa: E402
 
 CASES = [
     # (label, problem, quantity, axes (lo, hi per name), --about, backend)

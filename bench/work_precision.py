@@ -66,8 +66,8 @@ from mechbook.model.catalog import all_ids, problem_path  # noqa: E402
 from mechbook.model.problem import load_problem  # noqa: E402
 from mechbook.numerics import accuracy  # noqa: E402
 from mechbook.numerics.integrators import IntegratorError, integrate, make_integrator  # noqa: E402
-from mechbook.numerics.model import build_model  # noqa: E402
 from mechbook.numerics.monitors import conserved_quantities, drifts  # noqa: E402
+from mechbook.numerics.rhs import build_model  # noqa: E402
 from mechbook.numerics.simulate import initial_state  # noqa: E402
 from mechbook.numerics.stiffness import IMPLICIT, assess, linear_rates  # noqa: E402
 

@@ -19,8 +19,10 @@ _LAZY = {"load": "mechbook.app.api", "Problem": "mechbook.app.api",
 def __getattr__(name: str):
     if name in _LAZY:
         if _LAZY[name] == "mechbook.app.api":
+            # on first use (PEP 562): `import mechbook` stays light
             from mechbook.app import api as module
         else:
+            # on first use (PEP 562): `import mechbook` stays light
             from mechbook.app import frames as module
         return getattr(module, name)
     raise AttributeError(f"module 'mechbook' has no attribute {name!r}")

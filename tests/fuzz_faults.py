@@ -113,14 +113,15 @@ def _damage(path: Path, fault: str, rng: random.Random, where: Path) -> None:
 def _injected(fault: str):
     """Fault injection at one step of the store's write (never in the side file's)."""
     import mechbook.app.outputs as outputs
-    import mechbook.app.store as store
+    import mechbook.app.store.repair as store_repair
+    import mechbook.app.store.writer as store_writer
 
     if fault == "none":
         yield
         return
     code = {"readonly": errno.EROFS, "full": errno.ENOSPC}.get(fault, errno.EIO)
     error = OSError(code, os.strerror(code))
-    real_replaced = store.replaced
+    real_replaced = store_writer.replaced
 
     @contextmanager
     def replaced(path, copy=False):
@@ -132,11 +133,13 @@ def _injected(fault: str):
                 raise error  # the disk filled while it was written
 
     patches = {
-        "readonly": [mock.patch.object(store, "replaced", replaced)],
-        "full": [mock.patch.object(store, "replaced", replaced)],
+        "readonly": [mock.patch.object(store_writer, "replaced", replaced),
+                     mock.patch.object(store_repair, "replaced", replaced)],
+        "full": [mock.patch.object(store_writer, "replaced", replaced),
+                 mock.patch.object(store_repair, "replaced", replaced)],
         "copy": [mock.patch.object(outputs.shutil, "copyfileobj",
                                    side_effect=OSError(errno.EIO, "I/O error"))],
-        "write": [mock.patch.object(store, "_write_problem", side_effect=error)],
+        "write": [mock.patch.object(store_writer, "_write_problem", side_effect=error)],
         "sync": [mock.patch.object(outputs, "_sync_directory", side_effect=error)],
         "name": [mock.patch.object(outputs, "_link_anonymous", side_effect=error)],
         "rename": [mock.patch.object(outputs.os, "replace", side_effect=error)],
@@ -361,7 +364,7 @@ def run_options(spec: dict) -> tuple[str, str]:
 
 def _axis(text: str) -> tuple[str, str]:
     from mechbook.app.sweep import MAX_POINTS, check_grid
-    from mechbook.engine.sweep import parse_axis
+    from mechbook.engine.linear_grid import parse_axis
     from mechbook.errors import MechbookError
 
     try:

@@ -190,11 +190,11 @@ def _side_line(rng: random.Random, pid: str, store: object, spec: dict) -> str:
     from fuzz_faults import HOSTILE_STRINGS, _record
 
     from mechbook.app.text import json_safe
-    from mechbook.app.unsaved import _plain
+    from mechbook.app.unsaved import json_default
 
     record = json.loads(json.dumps(json_safe(asdict(_record(pid, rng.sample(HOSTILE_STRINGS,
                                                                             4), rng))),
-                                   default=_plain))
+                                   default=json_default))
     entry = {"format": 1, "kind": "problem", "store": store, "record": record}
     mutate = spec["mutate"] if rng.random() < 0.6 else "none"
     if mutate == "id":
@@ -238,7 +238,7 @@ def run_restore(where: Path, spec: dict) -> tuple[str, str]:
     """Write a side file (good and hostile lines), restore it as `mechbook restore` does
     from inside the tree; nothing outside may change; what it says it stored reads back."""
     from mechbook.app.restore import restore
-    from mechbook.app.store_read import read
+    from mechbook.app.store.reader import read
     from mechbook.errors import MechbookError
 
     rng = random.Random(spec["seed"])
@@ -386,7 +386,7 @@ def run_watch(where: Path, spec: dict) -> tuple[str, str]:
     problem (the task its worker runs), with one of them replaced by what an editor or a
     user can leave behind. Neither may block, read without bound, or end in a traceback."""
     from mechbook.app.run import RunOptions
-    from mechbook.app.watch import _signature, check_in_worker, report_lines
+    from mechbook.app.watch import check_in_worker, files_signature, report_lines
 
     tree = _tree(where)
     guard = Guard(where)
@@ -401,14 +401,14 @@ def run_watch(where: Path, spec: dict) -> tuple[str, str]:
         path.write_bytes(bytes(rng.randrange(256) for _ in range(rng.randint(1, 3000))))
     elif kind != "good":
         _special(path, kind, guard)
-    before = _signature(list(paths.values()))
+    before = files_signature(list(paths.values()))
     try:
         run, cpu = check_in_worker("lim-2101", tree, RunOptions(crosscheck=False),
                                    lambda text: None)
         lines = report_lines(run, run.seconds, cpu)
     except Exception as exc:  # noqa: BLE001 - the worker reports a task that raises as its
         return _crash(exc)  # failure; the fuzzer wants to see it
-    after = _signature(list(paths.values()))
+    after = files_signature(list(paths.values()))
     text = "\n".join(lines)
     if "Traceback" in text or any("Traceback" in d for d in run.debug):
         return "crash", text[:2000] + "\n".join(run.debug)[:2000]
@@ -437,7 +437,7 @@ def run_pagelist(where: Path, spec: dict) -> tuple[str, str]:
     import fuzz
 
     from mechbook.app.report import cache
-    from mechbook.app.report.build import _index_entry
+    from mechbook.app.report.build import index_entry
 
     rng = random.Random(spec["seed"])
     tree = _tree(where)
@@ -473,7 +473,7 @@ def run_pagelist(where: Path, spec: dict) -> tuple[str, str]:
     try:
         pages = cache.load(out)
         for pid in pages:
-            _index_entry(pid, (pages.get(pid) or {}).get("index") or {}, None, {})
+            index_entry(pid, (pages.get(pid) or {}).get("index") or {}, None, {})
         pages["lim-2101"] = {"key": "1" * 64, "index": {"title": "t", "parts": []},
                              "seconds": 0.5}
         cache.save(out, pages)
@@ -609,7 +609,7 @@ def run_hdf5(where: Path, spec: dict) -> tuple[str, str]:
     from fuzz_faults import HOSTILE_STRINGS, _readable, _record
 
     import mechbook.app.store as store
-    from mechbook.app.sweep_io import stored_sweeps
+    from mechbook.app.sweep.storage import stored_sweeps
     from mechbook.app.unsaved import Saver
     from mechbook.errors import MechbookError
 

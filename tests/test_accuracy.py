@@ -195,8 +195,8 @@ def test_not_stiff_when_the_fast_mode_is_excited_or_the_springs_are_alike(two_ma
 
 
 def test_assess_directly(two_masses):
-    from mechbook.numerics.model import build_model
     from mechbook.numerics.monitors import conserved_quantities
+    from mechbook.numerics.rhs import build_model
     from mechbook.numerics.simulate import parameter_values
 
     system, dyn = two_masses.system(), two_masses.dynamics()

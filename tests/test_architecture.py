@@ -450,3 +450,25 @@ def test_an_answer_key_record_and_its_loader_do_not_import_each_other():
     needs the table of quantities): not even a TYPE_CHECKING import goes back up."""
     assert "mechbook.verify.answers" not in imports(modules()["mechbook.verify.part"])
     assert "mechbook.verify.part" in imports(modules()["mechbook.verify.answers"])
+
+
+# ---- the store and the sweeps: packages with a public __init__ -------------------------------
+def test_the_sweep_package_names_resolve_to_their_modules():
+    """mechbook.app.sweep loads its names on first use (the command line must not load NumPy
+    at start-up): each public name is in `__all__` and in the table, and is found there."""
+    import importlib
+
+    import mechbook.app.sweep as sweep
+
+    assert sorted(sweep.__all__) == sorted(sweep._HOME)
+    for name, home in sweep._HOME.items():
+        assert getattr(sweep, name) is getattr(importlib.import_module(home), name), name
+    with pytest.raises(AttributeError):
+        sweep.no_such_name  # noqa: B018
+
+
+def test_the_store_package_exports_what_it_lists():
+    import mechbook.app.store as store
+
+    missing = [n for n in store.__all__ if not hasattr(store, n)]
+    assert not missing, missing

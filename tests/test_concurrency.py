@@ -17,6 +17,7 @@ from click.testing import CliRunner
 
 from mechbook.app import store
 from mechbook.app.cli import main
+from mechbook.app.store import writer as store_writer
 from mechbook.records import Outcome
 
 pytestmark = pytest.mark.slow  # concurrent check processes and writers
@@ -123,7 +124,7 @@ def test_without_the_lock_writers_lose_records(tmp_path, monkeypatch):
     def no_lock(directory):
         yield
 
-    monkeypatch.setattr(store, "_locked", no_lock)
+    monkeypatch.setattr(store_writer, "_locked", no_lock)
     h5 = tmp_path / "m.h5"
     ctx = mp.get_context("fork")
     procs = [ctx.Process(target=_writer, args=(str(h5), w, 15)) for w in range(4)]

@@ -148,11 +148,11 @@ def test_newton_residual_is_the_same_in_symengine_and_sympy(pid, name):
     unknown function): the two algebras give the same residual at random states."""
     import symengine as se
 
-    from mechbook.crosscheck.newton import _newton_residual
+    from mechbook.crosscheck.newton import newton_residual
 
     an, _ = real(pid)
     sys = an.system(name)
-    fast, slow = _newton_residual(sys), _newton_residual(sys, symengine=False)
+    fast, slow = newton_residual(sys), newton_residual(sys, symengine=False)
     assert all(isinstance(e, se.Basic) for e in fast)
     assert all(isinstance(e, sp.Basic) for e in slow)
     rng = np.random.default_rng(5)
@@ -259,14 +259,14 @@ def test_a_double_exponent_with_one_mode_is_not_measured():
     import numpy as np
     import scipy.linalg
 
-    from mechbook.crosscheck.frequencies import _defective
+    from mechbook.crosscheck.modal import defective
 
     critical = np.array([[0.0, 1.0], [-1.0, -2.0]])
     lam, V = scipy.linalg.eig(critical)
-    assert _defective(lam, V, 0, float(np.max(np.abs(lam))))
+    assert defective(lam, V, 0, float(np.max(np.abs(lam))))
     pair = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.eye(2), np.zeros((2, 2))]])
     lam, V = scipy.linalg.eig(pair)
-    assert not any(_defective(lam, V, j, 1.0) for j in range(4))
+    assert not any(defective(lam, V, j, 1.0) for j in range(4))
 
 
 def test_box_integrals_term_by_term_equal_sympys_multiple_integral():

@@ -15,11 +15,11 @@ pytest.importorskip("distributed")
 
 from dask.distributed import Client  # noqa: E402
 
-import mechbook.app.sweep as sweep_mod  # noqa: E402
+import mechbook.app.sweep.runner as sweep_mod  # noqa: E402
 from mechbook.app.cli import main  # noqa: E402
 from mechbook.app.distributed import ENV, limited, local_cluster  # noqa: E402
 from mechbook.app.sweep import make_spec, run_sweep  # noqa: E402
-from mechbook.engine.sweep import parse_axis  # noqa: E402
+from mechbook.engine.linear_grid import parse_axis  # noqa: E402
 from mechbook.errors import MechbookError  # noqa: E402
 
 pytestmark = pytest.mark.slow  # a Dask cluster

@@ -16,7 +16,7 @@ from click.testing import CliRunner
 
 from mechbook.app.cli import main
 from mechbook.engine.analysis import Analysis
-from mechbook.engine.domains import existing
+from mechbook.engine.existence import existing
 from mechbook.errors import MechbookError
 from mechbook.model.problem import load_problem
 

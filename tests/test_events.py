@@ -12,9 +12,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from systems import DOUBLE, DRIVEN, OSCILLATOR, load_analysis, pendulum
 
-from mechbook.numerics import compiled, events, native
+from mechbook.numerics import c_library, c_stepping, events
 from mechbook.numerics.events import solve_with_events
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9312\nsource: test\ntitle: simple pendulum\n")
@@ -33,8 +33,8 @@ SYSTEMS = {"oscillator": (OSCILLATOR, "9311"), "pendulum": (PENDULUM, "9312"),
            "double": (DOUBLE, "9313"), "driven": (DRIVEN, "9314"),
            "runaway": (RUNAWAY, "9315")}
 
-pytestmark = pytest.mark.skipif(native.library() is None,
-                                reason=f"no compiled loops here: {native.why()}")
+pytestmark = pytest.mark.skipif(c_library.library() is None,
+                                reason=f"no compiled loops here: {c_library.why()}")
 
 
 def model_of(tmp_path: Path, name: str):
@@ -188,7 +188,7 @@ def test_vector_atol_is_solve_ivps(tmp_path):
     y0 = np.array([0.4, 0.3])
     evals = {}
     for atol in ([1e-10, 1e-7], [1e-7, 1e-10]):
-        run = compiled.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8, atol)
+        run = c_stepping.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8, atol)
         ref = solve_ivp(model.rhs_python, (0, 3), y0, method="DOP853", rtol=1e-8, atol=atol)
         assert run.status == 0 and len(run.t) == len(ref.t)
         assert run.evaluations == ref.nfev
@@ -196,11 +196,11 @@ def test_vector_atol_is_solve_ivps(tmp_path):
         assert np.max(np.abs(run.y[:, -1] - ref.y[:, -1])) < 1e-11
         evals[tuple(atol)] = run.evaluations
     for atol in (1e-10, 1e-7):
-        scalar = compiled.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8, atol)
+        scalar = c_stepping.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8, atol)
         assert scalar.evaluations not in evals.values()
-        both = compiled.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8,
+        both = c_stepping.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8,
                                  [atol, atol])
         assert np.array_equal(both.t, scalar.t) and np.array_equal(both.y, scalar.y)
     with pytest.raises(ValueError, match="atol"):
-        compiled.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8,
+        c_stepping.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8,
                           [1e-8, 1e-8, 1e-8])

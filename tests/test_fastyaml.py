@@ -15,7 +15,7 @@ import pytest
 from mechbook.errors import SpecError
 from mechbook.model import yamlio
 from mechbook.model.fastyaml import fast_data
-from mechbook.model.limits import check_events
+from mechbook.model.input_limits import check_events
 
 ROOT = Path(__file__).resolve().parents[1]
 

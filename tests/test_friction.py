@@ -17,7 +17,7 @@ from mechbook.errors import SpecError
 from mechbook.model.problem import load_problem
 from mechbook.numerics.friction import Phases
 from mechbook.numerics.measure import first_event, signal_functions
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 
 G = 9.81
 

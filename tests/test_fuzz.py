@@ -216,7 +216,8 @@ def test_the_hdf5_kind_reports_a_leak_through_an_external_link(tmp_path, monkeyp
     """A store whose links are followed (as on 0834a76) reads a file outside it: 'leak'."""
     import fuzz_surfaces as surfaces
 
-    from mechbook.app import store_bounds, store_read
+    from mechbook.app.store import bounds as store_bounds
+    from mechbook.app.store import reader as store_read
 
     spec = {"fault": "external", "records": 1, "seed": 4}
     (tmp_path / "case-1").mkdir()

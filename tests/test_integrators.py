@@ -10,8 +10,8 @@ import pytest
 from systems import DOUBLE, OSCILLATOR, load_analysis, pendulum
 
 from mechbook.numerics.integrators import IntegratorError, integrate
-from mechbook.numerics.model import build_model, structure
 from mechbook.numerics.monitors import conserved_quantities, drifts
+from mechbook.numerics.rhs import build_model, structure
 
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9101\nsource: test\ntitle: simple pendulum\n")

@@ -17,7 +17,7 @@ from click.testing import CliRunner
 import mechbook.app.validate  # noqa: F401 - imported here, so the timings below are the refusals
 from mechbook.app.cli import main
 from mechbook.errors import MechbookError, SpecError
-from mechbook.model import limits
+from mechbook.model import input_limits
 from mechbook.model.catalog import answer_path, check_id, problem_path
 from mechbook.model.expr import MAX_SUBSTITUTED, parse, tree_size
 from mechbook.model.problem import load_problem
@@ -214,7 +214,7 @@ def test_nesting_past_the_limit(tmp_path, n):
 
 
 def test_nesting_at_the_limit_is_fine():
-    depth = limits.MAX_YAML_DEPTH
+    depth = input_limits.MAX_YAML_DEPTH
     doc = loads("a: " + "[" * (depth - 1) + "x" + "]" * (depth - 1) + "\n")
     assert doc.data["a"]
 
@@ -241,7 +241,7 @@ def test_special_files_are_refused_without_reading(tmp_path, kind):
 
 
 def test_too_many_coordinates_and_the_limit_itself(tmp_path):
-    most = limits.SYSTEM_COUNTS["coordinates"]
+    most = input_limits.SYSTEM_COUNTS["coordinates"]
 
     def chain(n: int) -> str:
         qs = [f"q{i}" for i in range(n)]
@@ -258,7 +258,7 @@ def test_too_many_coordinates_and_the_limit_itself(tmp_path):
 
 def test_too_many_parts(tmp_path):
     parts = "".join(f"  - {{part: p{i}, cite: t, quantity: frequencies, book: [1]}}\n"
-                    for i in range(limits.ANSWER_COUNTS["parts"] + 1))
+                    for i in range(input_limits.ANSWER_COUNTS["parts"] + 1))
     tree(tmp_path, key="problem: lim-2099\nsource: t\nparts:\n" + parts)
     path = tmp_path / "answers" / "lim" / "2099.yaml"
     refused_fast(tmp_path, path, "parts", "too many entries")

@@ -14,7 +14,7 @@ import sympy as sp
 
 from mechbook.core.secalc import to_sympy
 from mechbook.engine.analysis import Analysis
-from mechbook.engine.equilibria import _second_derivatives
+from mechbook.engine.equilibria import second_derivatives
 from mechbook.model.problem import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -32,8 +32,8 @@ def test_second_derivatives_agree_in_both_algebras(pid, name):
     rest = {v: sp.S.Zero for v in dyn.qd}
     names = set(dyn.L.free_symbols)
     fast = [[to_sympy(x, names) for x in part] for part in
-            _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, sys.held, se.sympify)]
-    slow = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, sys.held, lambda e: e)
+            second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, sys.held, se.sympify)]
+    slow = second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, sys.held, lambda e: e)
     symbols = sorted(set().union(*(e.free_symbols for part in slow for e in part)), key=str)
     point = {s: sp.Float(rng.uniform(0.5, 1.5)) for s in symbols}
     for part_fast, part_slow in zip(fast, slow, strict=True):

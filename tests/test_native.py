@@ -10,9 +10,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from systems import DOUBLE, DRIVEN, OSCILLATOR, load_analysis, pendulum
 
-from mechbook.numerics import native
+from mechbook.numerics import c_library
 from mechbook.numerics.integrators import integrate
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 
 PENDULUM = pendulum(m=1.0, l=1.0, g=1.0,
                     header="id: lim-9301\nsource: test\ntitle: simple pendulum\n")
@@ -34,8 +34,8 @@ constraints:
   - {name: rod, expr: x**2 + y**2 - l**2}
 """
 
-pytestmark = pytest.mark.skipif(native.library() is None,
-                                reason=f"no compiled loops here: {native.why()}")
+pytestmark = pytest.mark.skipif(c_library.library() is None,
+                                reason=f"no compiled loops here: {c_library.why()}")
 
 
 def model_of(tmp_path: Path, text: str, num: str):
@@ -112,7 +112,7 @@ def test_blow_up_is_reported_like_the_python_loop(tmp_path):
 
 
 def test_without_the_library_the_python_paths_run(tmp_path, monkeypatch):
-    monkeypatch.setattr(native, "_state", {"lib": None, "tried": True, "why": "test",
+    monkeypatch.setattr(c_library, "_state", {"lib": None, "tried": True, "why": "test",
                                            "build_seconds": 0.0})
     model = model_of(tmp_path, PENDULUM, "9301")
     assert model.native is None

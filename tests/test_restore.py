@@ -17,6 +17,7 @@ import pytest
 from hostile import check, mechbook, pendulum_tree
 
 import mechbook.app.store as store
+import mechbook.app.store.writer as store_writer
 from mechbook.app.unsaved import FORMAT
 
 
@@ -156,7 +157,7 @@ def test_what_check_kept_is_restored_into_the_tree_store(tree, monkeypatch):
     fault is gone, into the tree's store by the path the side file holds."""
     import errno
 
-    monkeypatch.setattr(store, "_write_problem",
+    monkeypatch.setattr(store_writer, "_write_problem",
                         lambda *a: (_ for _ in ()).throw(OSError(errno.EIO, "I/O error")))
     res = check(tree)
     monkeypatch.undo()

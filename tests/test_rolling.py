@@ -353,8 +353,8 @@ def test_simulated_wobble_confirms_the_first_order_linearization(tmp_path, monke
 def test_stability_map_of_the_rolling_disc(tmp_path):
     """`mechbook sweep` of a first-order linearization: the stacked state matrices' verdict
     against Ω² > g/(3r) over a grid (points within 1e-9 of the boundary left out)."""
+    from mechbook.engine.linear_grid import STABLE, UNSTABLE
     from mechbook.engine.state_sweep import StateSweep
-    from mechbook.engine.sweep import STABLE, UNSTABLE
 
     an = _analysis(tmp_path, "9520", SYMPY_DISC)
     q1, q2, q3, q4, q5 = an.system().q

@@ -12,13 +12,14 @@ import pytest
 from click.testing import CliRunner
 
 import mechbook.app.store as store
+import mechbook.app.store.writer as store_writer
 from mechbook.app.cli import main
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError
 from mechbook.model.problem import load_problem
 from mechbook.model.system import system_of
-from mechbook.numerics.model import BACKENDS, build_model, structure
 from mechbook.numerics.monitors import conserved_quantities
+from mechbook.numerics.rhs import BACKENDS, build_model, structure
 from mechbook.numerics.simulate import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -163,7 +164,7 @@ def test_interrupted_simulation_write_keeps_previous_file(tmp_path, monkeypatch)
     def broken(*a, **k):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(store.os, "replace", broken)
+    monkeypatch.setattr(store_writer.os, "replace", broken)
     with pytest.raises(KeyboardInterrupt):
         store.write_simulation("lim-1", "b", {"t": np.arange(4.0)}, {}, path=h5)
     assert h5.read_bytes() == before

@@ -11,6 +11,7 @@ import sympy as sp
 from click.testing import CliRunner
 
 import mechbook.app.store as store
+import mechbook.app.store.writer as store_writer
 from mechbook.app.cli import main
 from mechbook.model.problem import load_problem
 from mechbook.records import Outcome, Results
@@ -131,7 +132,7 @@ def test_interrupted_write_keeps_previous_file(tmp_path, monkeypatch, exc):
     path = d / "store.h5"
     store.write([make_record(tmp_path, "2031")], path)
     before = path.read_bytes()
-    real = store._write_problem
+    real = store_writer._write_problem
     calls = []
 
     def half_then_fail(root, rec):
@@ -140,7 +141,7 @@ def test_interrupted_write_keeps_previous_file(tmp_path, monkeypatch, exc):
         root[rec.problem_id].attrs["title"] = "half written"
         raise exc  # ... and then the run dies
 
-    monkeypatch.setattr(store, "_write_problem", half_then_fail)
+    monkeypatch.setattr(store_writer, "_write_problem", half_then_fail)
     # a failure of the write is a StoreError (path and reason); an interrupt stays one
     with pytest.raises(store.StoreError if isinstance(exc, Exception) else type(exc)):
         store.write([make_record(tmp_path, "2032"), make_record(tmp_path, "2031", "x")], path)
@@ -162,7 +163,7 @@ def test_failure_at_rename_leaves_no_temp_file(tmp_path, monkeypatch):
     def broken_replace(src, dst):
         raise OSError("rename failed")
 
-    monkeypatch.setattr(store.os, "replace", broken_replace)
+    monkeypatch.setattr(store_writer.os, "replace", broken_replace)
     with pytest.raises(store.StoreError, match=f"cannot write the store {path}: rename failed"):
         store.write([make_record(tmp_path, "2032")], path)
     assert path.read_bytes() == before
@@ -176,7 +177,7 @@ def test_interrupted_first_write_creates_nothing(tmp_path, monkeypatch):
     def fail(root, rec):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(store, "_write_problem", fail)
+    monkeypatch.setattr(store_writer, "_write_problem", fail)
     with pytest.raises(store.StoreError, match="boom"):
         store.write([make_record(tmp_path, "2031")], path)
     assert not path.exists()

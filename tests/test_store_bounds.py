@@ -77,7 +77,7 @@ def test_the_bounds_are_checked_on_the_declared_size():
     """A dataset never written reads as its whole shape of fill values: refused at once."""
     import tempfile
 
-    from mechbook.app.store_bounds import MAX_DATASET_BYTES, Oversized, dataset
+    from mechbook.app.store.bounds import MAX_DATASET_BYTES, Oversized, dataset
 
     with tempfile.TemporaryFile() as fh, h5py.File(fh, "w") as f:
         d = f.create_dataset("x", shape=(10**10,), dtype="f8", chunks=(1 << 16,))

@@ -23,6 +23,8 @@ from hostile import ROOT, can_mount, check, pendulum_tree, run, tmpfs
 
 import mechbook.app.outputs as outputs
 import mechbook.app.store as store
+import mechbook.app.store.repair as store_repair
+import mechbook.app.store.writer as store_writer
 import mechbook.app.unsaved as unsaved
 from mechbook.app.restore import restore
 from mechbook.app.selection import lastfailed_path
@@ -105,7 +107,7 @@ def test_a_full_disk_exits_nonzero_and_keeps_the_problem(tmp_path, side_dir):
 def _fail_store_writes(monkeypatch, fault: int) -> None:
     """Fault injection: every write of the store fails with `fault` once its new version is
     written, just before it would be renamed into place (the side file is not touched)."""
-    real = store.replaced
+    real = store_writer.replaced
 
     @contextmanager
     def failing(path, copy=False):
@@ -113,7 +115,8 @@ def _fail_store_writes(monkeypatch, fault: int) -> None:
             yield fh
             raise OSError(fault, os.strerror(fault))
 
-    monkeypatch.setattr(store, "replaced", failing)
+    monkeypatch.setattr(store_writer, "replaced", failing)
+    monkeypatch.setattr(store_repair, "replaced", failing)
 
 
 @pytest.mark.parametrize("fault", [errno.EROFS, errno.ENOSPC, errno.EIO])
@@ -276,15 +279,16 @@ KILLED_WRITER = textwrap.dedent("""\
     import sys, time
     from pathlib import Path
     import mechbook.app.store as store
+    import mechbook.app.store.writer as store_writer
     sys.path.insert(0, {tests!r})
     from test_store import make_record
     path = Path({path!r})
-    real = store._write_problem
+    real = store_writer._write_problem
     def slow(root, rec):
         real(root, rec)
         print("writing", flush=True)
         time.sleep(60)
-    store._write_problem = slow
+    store_writer._write_problem = slow
     store.write([make_record(Path({tmp!r}), "2032")], path)
 """)
 
@@ -333,7 +337,7 @@ def test_named_temporaries_where_there_is_no_anonymous_file(tmp_path, monkeypatc
     def fail(root, rec):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(store, "_write_problem", fail)
+    monkeypatch.setattr(store_writer, "_write_problem", fail)
     with pytest.raises(store.StoreError):
         store.write([make_record(tmp_path, "2032")], path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["problems", "store.h5"]

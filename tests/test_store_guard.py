@@ -2,7 +2,7 @@
 of a string in an HDF5 global heap collection) made libhdf5 spin for ever inside
 `H5Aread` (HDFGroup/hdf5#1707), and with it every reader: the warm-run cache of `check`,
 `show`, the damage check before a write. A store not yet found sound is now read in a
-child under a CPU limit (mechbook.app.store_guard); a file HDF5 does not come back from is
+child under a CPU limit (mechbook.app.store.child_read); a file HDF5 does not come back from is
 a StoreError, gives no cache hits, and is moved aside unread by the next write."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pytest
 from hostile import check, pendulum_tree
 
 import mechbook.app.store as store
-import mechbook.app.store_guard as guard
+import mechbook.app.store.child_read as guard
 
 
 def _looping(path) -> None:

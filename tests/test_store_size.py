@@ -12,7 +12,7 @@ import numpy as np
 from hostile import check, pendulum_tree, run
 
 import mechbook.app.store as store
-from mechbook.app.store_compact import compact
+from mechbook.app.store.compaction import compact
 
 
 def _size(path) -> int:

@@ -14,9 +14,9 @@ from scipy.special import ellipk
 
 from mechbook.app.cli import main
 from mechbook.app.sweep import Sweeper, make_spec, run_sweep
-from mechbook.app.sweep_io import read_netcdf, read_store, write_netcdf, write_store
+from mechbook.app.sweep.storage import read_netcdf, read_store, write_netcdf, write_store
 from mechbook.engine.analysis import Analysis
-from mechbook.engine.sweep import (
+from mechbook.engine.linear_grid import (
     MARGINAL,
     STABLE,
     UNDEFINED,
@@ -322,7 +322,7 @@ def test_ill_conditioned_points_are_recomputed_with_50_digits(tmp_path):
 
 
 def test_a_local_process_pool_gives_the_same_result(monkeypatch):
-    import mechbook.app.sweep as sweep_mod
+    import mechbook.app.sweep.runner as sweep_mod
 
     monkeypatch.setattr(sweep_mod, "BLOCK_ENTRIES", 2000)
     spec = make_spec("lim-9001", TREE, "frequencies",

@@ -17,8 +17,8 @@ from systems import pendulum
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.numerics.integrators import integrate
 from mechbook.numerics.measure import first_event, measure, signal_functions
-from mechbook.numerics.model import build_model
 from mechbook.numerics.monitors import conserved_quantities, drifts
+from mechbook.numerics.rhs import build_model
 
 pytest.importorskip("heyoka")
 

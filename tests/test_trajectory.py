@@ -18,7 +18,7 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.levelset import LevelSet
 from mechbook.model.problem import load_problem
 from mechbook.numerics.measure import measure, signal_functions
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 from mechbook.verify.answers import load_answers
 from mechbook.verify.checker import check_problem
 

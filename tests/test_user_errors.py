@@ -54,7 +54,7 @@ def test_an_answer_part_naming_no_such_system_is_an_error_at_its_line(tmp_path):
 
 
 def test_a_particle_or_body_that_is_not_there_names_those_that_are():
-    from mechbook.engine.parts import part_energy
+    from mechbook.engine.part_energy import part_energy
     from mechbook.model.problem import load_problem
     from mechbook.model.system import system_of
 
@@ -80,7 +80,7 @@ def test_a_declared_body_that_is_not_there_names_those_that_are():
     ("omega=0:2:3:log", "a log axis needs LO, HI > 0"),
 ])
 def test_a_sweep_axis_that_does_not_read_is_an_input_error(text, message):
-    from mechbook.engine.sweep import parse_axis
+    from mechbook.engine.linear_grid import parse_axis
 
     with pytest.raises(InputError, match=message) as info:
         parse_axis(text)
@@ -121,7 +121,7 @@ def test_a_problem_not_in_the_store_names_those_that_are(tmp_path):
 
 def test_a_simulation_or_sweep_not_in_the_store_names_those_that_are(tmp_path):
     from mechbook.app.store import read_simulation
-    from mechbook.app.sweep_io import read_store
+    from mechbook.app.sweep.storage import read_store
 
     path = _store(tmp_path, "problems/lim-2031/simulations/main-RK45", "sweeps/lim-2031/map")
     with pytest.raises(NotFoundError, match=r"^no simulation 'main-DOP853' of lim-2031 in .*"
@@ -137,7 +137,7 @@ def test_a_simulation_or_sweep_not_in_the_store_names_those_that_are(tmp_path):
 
 
 def test_many_stored_names_are_counted_and_the_nearest_named():
-    from mechbook.app.store_read import there
+    from mechbook.app.store.reader import there
 
     names = [f"lim-20{n}" for n in range(28, 68)]
     assert there("lim-2063x", names, "problem") == "40 problems stored; did you mean 'lim-2063'?"

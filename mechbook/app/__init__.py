@@ -6,12 +6,13 @@
     batch        a pool of worker processes with time and memory limits (any task)
     simrun       `mechbook simulate` in a worker, under the same limits
     distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
-    sweep        `mechbook sweep`: a result over a grid of parameters (sweep_accuracy:
-                 float64 against 30 digits; sweep_book: the book's answer on the grid;
-                 sweep_io: store and netCDF; sweep_plot; sweep_text: what it prints;
-                 sweep_spec: a sweep's definition, without NumPy)
-    store        the HDF5 store, written atomically under a lock (store_read: reading;
-                 store_cache: the warm-run cache; store_repair: a damaged store rebuilt)
+    sweep/       `mechbook sweep`: a result over a grid of parameters (runner: the grid
+                 evaluated in blocks; precision: float64 against 30 digits; book_answer: the
+                 book's answer on the grid; storage: store and netCDF; figures; text_summary:
+                 what it prints; spec: a sweep's definition, without NumPy)
+    store/       the HDF5 store (writer: written atomically under a lock; reader: reading;
+                 warm_cache: the warm-run cache; repair: a damaged store rebuilt; entries,
+                 bounds, compaction, child_read)
     fingerprint  content hashes for the warm-run cache
     validate     `mechbook validate`
     limits       the batch's default limits (light: the command line's --help shows them)

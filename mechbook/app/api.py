@@ -31,6 +31,8 @@ from mechbook.app.api_params import Parameters
 from mechbook.app.api_results import CheckResult, Simulation
 from mechbook.app.api_system import SystemView
 from mechbook.app.mathml import math
+from mechbook.app.run import RunOptions
+from mechbook.app.service import check_loaded
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import NotFoundError
 from mechbook.model.books import Book, book_of
@@ -182,9 +184,6 @@ class Problem:
         >>> mechbook.load("lim-2031").check().ok       # doctest: +SKIP
         True
         """
-        from mechbook.app.run import RunOptions
-        from mechbook.app.service import check_loaded
-
         run = check_loaded(self.model, self.base, RunOptions(crosscheck=crosscheck), store)
         return CheckResult(self.id, run.outcomes, run.crosschecks, run.error, run.seconds)
 

@@ -18,6 +18,7 @@ import sympy as sp
 
 from mechbook.errors import InputError, NotFoundError
 from mechbook.model.hints import did_you_mean
+from mechbook.numerics.simulate import initial_state
 
 # keyword arguments people reach for, and what mechbook calls them
 ALIASES = {"initial": "init", "initial_conditions": "init", "initial_state": "init",
@@ -138,8 +139,6 @@ class OdeFunction:
         """The state `simulate` starts from with the same `init` ({coordinate or
         coordinate + 'dot': number or text}; the problem's `initial:` and then zeros for
         what it leaves out)."""
-        from mechbook.numerics.simulate import initial_state
-
         q0, qd0, _ = initial_state(self._analysis, self._system, texts(init), self._values)
         return np.concatenate((q0, qd0))
 

@@ -7,6 +7,9 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from mechbook.app.store import write_simulation
+from mechbook.core.optional import require
+from mechbook.numerics.plot import plot_simulation
 from mechbook.records import FAILING, CrossCheck, Outcome
 
 
@@ -59,8 +62,6 @@ class CheckResult:
         >>> result = mechbook.load("lim-2031").check()      # doctest: +SKIP
         >>> result.to_frame()[["part", "status"]]            # doctest: +SKIP
         """
-        from mechbook.core.optional import require
-
         pd = require("pandas", "data", "CheckResult.to_frame()")
         return pd.DataFrame([o.as_dict() for o in self.outcomes])
 
@@ -126,8 +127,6 @@ class Simulation:
         >>> ds = mechbook.load("lim-2031").simulate(t_end=5).to_xarray()   # doctest: +SKIP
         >>> ds.q.sel(coordinate="theta").plot()                            # doctest: +SKIP
         """
-        from mechbook.core.optional import require
-
         xr = require("xarray", "xarray", "Simulation.to_xarray()")
         run = self.run
         data = {"q": (("coordinate", "t"), self.q), "qdot": (("coordinate", "t"), self.qdot)}
@@ -154,8 +153,6 @@ class Simulation:
         --------
         >>> mechbook.load("lim-2031").simulate(t_end=5).plot("run.png")   # doctest: +SKIP
         """
-        from mechbook.numerics.plot import plot_simulation
-
         return plot_simulation(self.run, path)
 
     def store(self, path: str | Path, name: str | None = None) -> str:
@@ -179,8 +176,6 @@ class Simulation:
         >>> run.store("results/mechbook.h5")                     # doctest: +SKIP
         '/problems/lim-2031/simulations/main-DOP853'
         """
-        from mechbook.app.store import write_simulation
-
         run = self.run
         name = name or f"{run.system}-{run.trajectory.method}"
         write_simulation(run.problem_id, name, run.arrays(), run.settings(),

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import html
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import sympy as sp
 
@@ -16,9 +16,15 @@ from mechbook.app.display import MathDict, MathList
 from mechbook.app.linearization import Linearization, linearization
 from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
+from mechbook.core.timeout import try_simplify
+from mechbook.engine.existence import existing
 from mechbook.errors import NotFoundError
+from mechbook.numerics.rhs import build_model
+from mechbook.numerics.simulate import simulate
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from mechbook.app.api import Problem
 
 SIMULATE_OPTIONS = ("init", "params", "method", "accuracy", "rtol", "atol", "max_step",
@@ -96,10 +102,8 @@ class SystemView:
     @property
     def equilibria(self) -> list[dict]:
         """The equilibria SymPy finds in closed form that exist at the default values (real,
-        inside the coordinates' domains: mechbook.engine.domains), each a dict from
+        inside the coordinates' domains: mechbook.engine.existence), each a dict from
         coordinate to value; index it by the coordinate's symbol or its name."""
-        from mechbook.engine.domains import existing
-
         points, _ = existing(self._an.equilibria(self.name).symbolic, self._sys,
                              self.problem.model.values())
         return MathList(MathDict(p) for p in points)
@@ -203,7 +207,7 @@ class SystemView:
         return MathList(out)
 
     def modes(self, about: Mapping | None = None,
-              params: Mapping | None = None) -> tuple[Any, Any]:
+              params: Mapping | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The normal modes of small oscillations about an equilibrium, numerically.
 
         Parameters
@@ -269,8 +273,6 @@ class SystemView:
         >>> run.drifts                                                       # doctest: +SKIP
         {'energy_function': 1.2e-10}
         """
-        from mechbook.numerics.simulate import simulate
-
         refuse_unknown("simulate", options, SIMULATE_OPTIONS)
         options["init"] = texts(options.get("init"))
         options["parameters"] = texts(options.pop("params", None))
@@ -302,8 +304,6 @@ class SystemView:
         >>> f = mechbook.load("lim-2031").ode_function()                   # doctest: +SKIP
         >>> sol = solve_ivp(f, (0, 5), f.initial({"theta": 1.0}), rtol=1e-10)  # doctest: +SKIP
         """
-        from mechbook.numerics.model import build_model
-
         values = parameter_values(self.problem.model, params)
         an = self.problem.fast
         sys, dyn = an.system(self.name), an.dynamics(self.name)
@@ -313,7 +313,6 @@ class SystemView:
     def _readable(self, expr):
         if not self.problem.simplify:
             return expr
-        from mechbook.core.timeout import try_simplify
 
         return try_simplify(expr, self.problem.simplify_seconds)
 

@@ -33,26 +33,31 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
-from typing import Any
+from typing import Generic, TypeVar
 
-from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
-from mechbook.app.run import ProblemRun, RunOptions, Stage
+from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.lifeline import die_with, sweep_stale_folders
+from mechbook.app.quiet import install
+from mechbook.app.run import ProblemRun, RunOptions, Stage, run_problem
 from mechbook.errors import MechbookError, describe
 
-Task = Callable[[Any, Path, Any, Stage], Any]  # (item, base, options, stage) -> result
-Failed = Callable[[Any, str, float, str], Any]  # (item, why, seconds, stage) -> result
+ItemT = TypeVar("ItemT", bound=Hashable)  # what one task is given: a problem id, a request
+OptionsT = TypeVar("OptionsT")  # what every task of a batch is handed (RunOptions: a check)
+ResultT = TypeVar("ResultT")  # what a task returns: plain data (it crosses processes)
+Task = Callable[[ItemT, Path, OptionsT, Stage], ResultT]  # (item, base, options, stage)
+Failed = Callable[[ItemT, str, float, str], ResultT]  # (item, why, seconds, stage)
 
 MAX_TASKS = 20  # problems per worker before it is replaced
 POLL = 0.25  # seconds between checks of the limits
 
 
 @dataclass(frozen=True)
-class BatchOptions:
+class BatchOptions(Generic[OptionsT]):
     jobs: int = 0  # 0: one per core
     timeout: float = DEFAULT_TIMEOUT
     memory_mb: float = DEFAULT_MEMORY_MB
     max_tasks: int = MAX_TASKS
-    run: Any = RunOptions()  # handed to the task (RunOptions for the problem check)
+    run: OptionsT = RunOptions()  # handed to the task (RunOptions: the default task's)
     serial: bool = False  # in the calling process, no limits (debugging)
 
     def __post_init__(self):
@@ -67,10 +72,8 @@ class BatchOptions:
         return self.jobs if self.jobs > 0 else (os.cpu_count() or 1)
 
 
-def check_problem(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
+def problem_task(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
     """The default task: check one problem (mechbook.app.run)."""
-    from mechbook.app.run import run_problem
-
     return run_problem(pid, base, options, stage=stage)
 
 
@@ -79,12 +82,9 @@ def problem_failed(pid: str, why: str, seconds: float, stage: str) -> ProblemRun
     return ProblemRun(pid, error=why, seconds=seconds, stage=stage)
 
 
-def _worker(conn: Connection, base: Path, options: Any, task: Task, run_pid: int) -> None:
+def _worker(conn: Connection, base: Path, options: object, task: Task, run_pid: int) -> None:
     """A worker's loop: receive an item, run the task on it, send stages and the result.
     It dies with the run (mechbook.app.lifeline), even one killed with -9."""
-    from mechbook.app.lifeline import die_with
-    from mechbook.app.quiet import install
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
     for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
         signal.signal(ends, signal.SIG_DFL)
@@ -128,9 +128,8 @@ PRELOAD = ("mechbook.app.run", "mechbook.verify.checker", "mechbook.verify.quant
 GC_THRESHOLDS = (10_000, 20, 100)  # young collections ~14 times rarer than Python's default
 
 
-def _context():
-    from mechbook.app.lifeline import sweep_stale_folders
-
+def pool_context():
+    """The workers' context: a fork server that imported the engine once and settled."""
     sweep_stale_folders()  # what runs killed with their fork server left
     ctx = mp.get_context("forkserver")
     # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap;
@@ -221,7 +220,7 @@ def _cannot_start(exc: OSError) -> str:
             "one, or use --serial")
 
 
-def _rss_mb(os_pid: int) -> float:
+def rss_mb(os_pid: int) -> float:
     """Resident memory of a process in MB (0 if it cannot be read)."""
     try:
         with open(f"/proc/{os_pid}/statm") as fh:
@@ -230,20 +229,21 @@ def _rss_mb(os_pid: int) -> float:
         return 0.0
 
 
-class Batch:
+class Batch(Generic[ItemT, OptionsT, ResultT]):
     """Check many problems on worker processes; see the module docstring."""
 
-    def __init__(self, base: Path, options: BatchOptions = BatchOptions(),
-                 on_done: Callable[[Any], None] | None = None,
-                 on_start: Callable[[Hashable], None] | None = None,
-                 task: Task = check_problem, failed: Failed = problem_failed):
+    def __init__(self, base: Path, options: BatchOptions[OptionsT] = BatchOptions(),
+                 on_done: Callable[[ResultT], None] | None = None,
+                 on_start: Callable[[ItemT], None] | None = None,
+                 task: Task[ItemT, OptionsT, ResultT] = problem_task,
+                 failed: Failed[ItemT, ResultT] = problem_failed):
         self.base = base
         self.options = options
         self.on_done = on_done or (lambda run: None)
         self.on_start = on_start or (lambda pid: None)
         self.task = task
         self.failed = failed
-        self._ctx = _context()
+        self._ctx = pool_context()
         self._slots: list[_Slot] = []
         self._kept = False  # inside `with`: idle workers stay for the next run
         self.stopped = False
@@ -298,13 +298,13 @@ class Batch:
             slot.process.join()
         slot.conn.close()
 
-    def run(self, ids: list[Hashable]) -> list[Any]:
+    def run(self, ids: list[ItemT]) -> list[ResultT]:
         """Run the task on `ids` (distinct; in the order given: put the longest first);
         results in that order (those finished, after `stop`)."""
         if self.options.serial:
             return self._serial(ids)
         todo = list(ids)
-        done: dict[Hashable, Any] = {}
+        done: dict[ItemT, ResultT] = {}
         finished = False
         try:
             want = min(self.options.workers, len(todo))
@@ -318,7 +318,7 @@ class Batch:
                 self._retire_all()
         return [done[pid] for pid in ids if pid in done]
 
-    def _serial(self, ids: list[Hashable]) -> list[Any]:
+    def _serial(self, ids: list[ItemT]) -> list[ResultT]:
         """In this process, one after another: no limits, but a debugger can follow."""
         out = []
         for pid in ids:
@@ -330,7 +330,7 @@ class Batch:
             out.append(run)
         return out
 
-    def _assign(self, todo: list[Hashable]) -> None:
+    def _assign(self, todo: list[ItemT]) -> None:
         for i, slot in enumerate(self._slots):
             if slot.pid is not None or not todo:
                 continue
@@ -342,7 +342,7 @@ class Batch:
             slot.conn.send(slot.pid)
             self.on_start(slot.pid)
 
-    def _collect(self, done: dict[Hashable, Any]) -> None:
+    def _collect(self, done: dict[ItemT, ResultT]) -> None:
         busy = [s for s in self._slots if s.pid is not None]
         ready = wait([s.conn for s in busy] + [s.process.sentinel for s in busy], POLL)
         for slot in busy:
@@ -355,12 +355,12 @@ class Batch:
             why = None
             if now - slot.started > self.options.timeout:
                 why = f"exceeded the time limit of {self.options.timeout:g} s"
-            elif self.options.memory_mb and _rss_mb(slot.process.pid) > self.options.memory_mb:
+            elif self.options.memory_mb and rss_mb(slot.process.pid) > self.options.memory_mb:
                 why = f"exceeded the memory bound of {self.options.memory_mb:g} MB"
             if why:
                 self._fail(slot, done, f"{why} while in stage: {slot.stage}")
 
-    def _read(self, slot: _Slot, done: dict[Hashable, Any]) -> None:
+    def _read(self, slot: _Slot, done: dict[ItemT, ResultT]) -> None:
         finished = None
         try:
             while slot.conn.poll():
@@ -388,7 +388,7 @@ class Batch:
             self._fail(slot, done, f"the worker process died ({how}) while in stage: "
                        f"{slot.stage}")
 
-    def _fail(self, slot: _Slot, done: dict[Hashable, Any], why: str) -> None:
+    def _fail(self, slot: _Slot, done: dict[ItemT, ResultT], why: str) -> None:
         pid = slot.pid
         run = self.failed(pid, why, time.monotonic() - slot.started, slot.stage)
         self._retire(slot, kill=True)

@@ -18,9 +18,12 @@ import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Any
+from typing import IO
 
 from mechbook.errors import MechbookError
+
+# a value JSON can hold (what `json.loads` gives)
+JSON = dict[str, "JSON"] | list["JSON"] | str | int | float | bool | None
 
 MAX_JSON_DEPTH = 32  # mechbook's own documents nest at most 6 levels
 
@@ -80,7 +83,7 @@ def read_regular(path: str | Path, max_bytes: int) -> bytes:
     return data
 
 
-def json_value(text: str | bytes, max_depth: int = MAX_JSON_DEPTH) -> Any:
+def json_value(text: str | bytes, max_depth: int = MAX_JSON_DEPTH) -> JSON:
     """`text` parsed as JSON, refused (ValueError) when it is not JSON or nests deeper than
     `max_depth` (Python's parser itself raises RecursionError at about a thousand)."""
     try:
@@ -92,7 +95,7 @@ def json_value(text: str | bytes, max_depth: int = MAX_JSON_DEPTH) -> Any:
     return value
 
 
-def depth(value: Any) -> int:
+def depth(value: object) -> int:
     """How deeply lists and dicts nest in `value` (a scalar: 0), without recursion."""
     most, todo = 0, [(value, 0)]
     while todo:

@@ -35,8 +35,10 @@ from dataclasses import replace
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
-from mechbook.app.batch import BatchOptions
+from mechbook.app.batch import POLL, Batch, BatchOptions, pool_context, rss_mb, start_server
+from mechbook.app.lifeline import die_with
 from mechbook.app.run import ProblemRun
+from mechbook.core.optional import require
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import answer_path, problem_path
 
@@ -68,8 +70,6 @@ SCRATCH: str | None = None
 
 def use_scratch(run_pid: int, folder: str) -> None:
     """A local pool worker's initializer: die with the run, keep scratch trees in `folder`."""
-    from mechbook.app.lifeline import die_with
-
     global SCRATCH
     die_with(run_pid)
     SCRATCH = folder
@@ -104,8 +104,6 @@ def check_task(pid: str, files: dict[str, bytes], options: BatchOptions,
                client_base: str) -> ProblemRun:
     """On a worker: check one problem in a one-worker local batch (its limits act from
     outside, as in `mechbook check`), paths in messages shown as the client's."""
-    from mechbook.app.batch import Batch
-
     _can_fork()
     base = materialize(files)
     run = Batch(base, replace(options, jobs=1, serial=False)).run([pid])[0]
@@ -124,8 +122,6 @@ def _relocated(run: ProblemRun, here: str, there: str) -> ProblemRun:
 def dask_distributed():
     """dask.distributed, or MissingDependencyError with the install line (before anything
     else of a run on the cluster imports it)."""
-    from mechbook.core.optional import require
-
     return require("dask.distributed", "cluster", "--scheduler (a Dask cluster)")
 
 
@@ -204,9 +200,7 @@ class Sidecar:
         self._conn: Connection | None = None
 
     def _start(self) -> None:
-        from mechbook.app.batch import _context, start_server
-
-        ctx = _context()
+        ctx = pool_context()
         start_server()
         parent, child = ctx.Pipe()
         self._proc = ctx.Process(target=_sidecar_loop, args=(child,), daemon=True)
@@ -222,8 +216,6 @@ class Sidecar:
         self._proc = self._conn = None
 
     def call(self, fn, args: tuple, timeout: float, memory_mb: float):
-        from mechbook.app.batch import POLL, _rss_mb
-
         if self._proc is None or not self._proc.is_alive():
             self._start()
         start = time.monotonic()
@@ -245,7 +237,7 @@ class Sidecar:
                 why = f"the child process died (exit code {self._proc.exitcode})"
             elif time.monotonic() - start > timeout:
                 why = f"exceeded the time limit of {timeout:g} s"
-            elif memory_mb and _rss_mb(self._proc.pid) > memory_mb:
+            elif memory_mb and rss_mb(self._proc.pid) > memory_mb:
                 why = f"exceeded the memory bound of {memory_mb:g} MB"
             if why:
                 self.stop()

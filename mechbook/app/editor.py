@@ -24,14 +24,17 @@ MODELINE = "# yaml-language-server: $schema="
 def schema(name: str) -> dict:
     """The JSON Schema `name` (one of NAMES)."""
     if name == "problem" or name == "books":
+        # at call time: `mechbook schema NAME` loads only the schema it prints (verify: SymPy)
         from mechbook.model.schema import bundled
 
         return bundled(name)
     if name == "answers":
+        # at call time: `mechbook schema NAME` loads only the schema it prints (verify: SymPy)
         from mechbook.verify.registry import answers_schema
 
         return answers_schema()
     if name == "check-result":
+        # at call time: `mechbook schema NAME` loads only the schema it prints (verify: SymPy)
         from mechbook.app.formats import schema as check_result
 
         return check_result()

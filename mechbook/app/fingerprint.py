@@ -6,7 +6,7 @@ import hashlib
 from functools import cache
 from pathlib import Path
 
-from mechbook.model.limits import read_bytes
+from mechbook.model.input_limits import read_bytes
 
 
 @cache

@@ -20,6 +20,8 @@ import atexit
 import os
 import signal
 
+from mechbook.app.lifeline import remove_if_abandoned
+
 _SERVER = os.getpid()  # the fork server; its workers inherit this module, and never end by
 # way of atexit (they leave with os._exit), but a removal is the server's alone all the same
 
@@ -28,8 +30,6 @@ def _remove_socket_folder() -> None:
     """The folder of this server's socket, if the run that started it is gone (a server
     that ends while its run lives, say by a SIGTERM of its own, leaves it to the run)."""
     from multiprocessing import forkserver
-
-    from mechbook.app.lifeline import remove_if_abandoned
 
     address = getattr(forkserver._forkserver, "_forkserver_address", None)
     if os.getpid() != _SERVER or not isinstance(address, str) or not address \

@@ -18,6 +18,7 @@ from collections import Counter
 from importlib import resources
 from pathlib import Path
 
+from mechbook.app.outputs import OutputError, output_file, replaced
 from mechbook.app.text import for_xml
 from mechbook.records import CROSSCHECK_STATUSES, FAILING, STATUSES, Status
 from mechbook.version import __version__
@@ -139,8 +140,6 @@ def junit_xml(runs: list) -> ET.ElementTree:
 def write_junit(runs: list, path: Path) -> Path:
     """Write the JUnit XML, replacing a regular file (or nothing) at `path` whole
     (mechbook.app.outputs); OutputError with the path and the reason if it cannot be."""
-    from mechbook.app.outputs import OutputError, output_file, replaced
-
     path = Path(path)
     real = output_file(path, "JUnit XML file")
     tree = junit_xml(runs)

@@ -7,18 +7,23 @@ need it, and importing this module does not import it until `results` is called.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
+from mechbook.app.store import problems, read, vet
+from mechbook.core.optional import require
 from mechbook.model.catalog import DEFAULT_STORE
+
+if TYPE_CHECKING:  # pandas is imported only when `results` is called
+    import pandas as pd
 
 
 class Frames(NamedTuple):
     """checks: one row per answer part; crosschecks: one row per cross-check; timings: one
     row per problem (duration and the versions that produced it)."""
 
-    checks: Any
-    crosschecks: Any
-    timings: Any
+    checks: pd.DataFrame
+    crosschecks: pd.DataFrame
+    timings: pd.DataFrame
 
 
 def results(store: str | Path = DEFAULT_STORE) -> Frames:
@@ -45,10 +50,7 @@ def results(store: str | Path = DEFAULT_STORE) -> Frames:
     >>> checks, crosschecks, timings = mechbook.results("results/mechbook.h5")  # doctest: +SKIP
     >>> checks.groupby("status").size()                                         # doctest: +SKIP
     """
-    from mechbook.core.optional import require
-
     pd = require("pandas", "data", "mechbook.results()")
-    from mechbook.app.store import problems, read, vet
 
     path = Path(store)
     if not path.exists():

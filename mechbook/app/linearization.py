@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from mechbook.engine.response import exponents
 from mechbook.errors import NotFoundError
 from mechbook.model.manifold import Freedoms, manifold_of
 
@@ -73,8 +74,6 @@ class Linearization:
         --------
         >>> lin.exponents(params={"W": 3})        # doctest: +SKIP
         """
-        from mechbook.engine.response import exponents
-
         return exponents(self.engine, self._at(params))
 
     def frequencies(self, params: dict | None = None) -> np.ndarray:

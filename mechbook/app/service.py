@@ -21,9 +21,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mechbook.app.batch import Batch, BatchOptions
+from mechbook.app.distributed import ClusterBatch, scheduler_address
+from mechbook.app.formats import failures
 from mechbook.app.outputs import OutputError, output_file, resolve_path
 from mechbook.app.run import ProblemRun, RunOptions, cached_runs, run_problem
 from mechbook.app.selection import select
+from mechbook.app.store import durations, write
+from mechbook.app.unsaved import Saver
 from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, problem_path
 
@@ -134,10 +138,6 @@ class CheckService:
         """Check `ids` (from `resolve`): answer what the store still holds, run the rest
         the longest first on the pool or the cluster, write each as it finishes; every run,
         cached or new, is handed to `on_done` as it is known."""
-        from mechbook.app.formats import failures
-        from mechbook.app.store import durations
-        from mechbook.app.unsaved import Saver
-
         opts = self.options
         good = [pid for pid in ids if pid not in self.refused]
         reuse = opts.write and not opts.fresh
@@ -176,8 +176,6 @@ class CheckService:
     def _batch(self, todo: list[str], finished: OnDone):
         """The cluster when a scheduler is named and there is work, else the local pool
         (the pool runs in this process with `serial`)."""
-        from mechbook.app.distributed import ClusterBatch, scheduler_address
-
         address = None if self.options.batch.serial else \
             scheduler_address(self.options.scheduler)
         if address and todo:
@@ -189,8 +187,6 @@ def check_loaded(problem: Problem, base: Path, options: RunOptions | None = None
                  store: str | Path | None = None) -> ProblemRun:
     """Check a problem already loaded (the Python API's), in this process, and write the
     run to `store` if given (StoreError if it cannot be: the caller asked for it)."""
-    from mechbook.app.store import write
-
     run = run_problem(problem.id, Path(base), options or RunOptions(), problem=problem)
     if store is not None and run.record is not None:
         write([run.record], store)

@@ -12,11 +12,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.run import Stage
+from mechbook.app.validate import build_limit, build_systems
+from mechbook.core.compile import DEFAULT_BACKEND
+from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, describe, message
+from mechbook.model.catalog import problem_path
+from mechbook.model.problem import load_problem
+from mechbook.numerics.plot import plot_simulation
+from mechbook.numerics.simulate import parse_assignments, simulate
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 @dataclass(frozen=True)
@@ -49,22 +59,15 @@ class SimReport:
     system: str = ""
     method: str = ""
     success: bool = False
-    arrays: dict[str, Any] = field(default_factory=dict)
-    settings: dict[str, Any] = field(default_factory=dict)
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)  # t, q, qdot, monitors/<name>
+    settings: dict[str, object] = field(default_factory=dict)  # stored as HDF5 attributes
     array_attrs: dict[str, dict] = field(default_factory=dict)
     plot: str | None = None
     stage: str = ""
 
 
-def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -> SimReport:
+def simulate_task(request: SimRequest, base: Path, options: None, stage: Stage) -> SimReport:
     """The batch task: load, derive, integrate, (plot); errors become report.error."""
-    from mechbook.app.validate import build_limit, build_systems
-    from mechbook.core.compile import DEFAULT_BACKEND
-    from mechbook.engine.analysis import Analysis
-    from mechbook.model.catalog import problem_path
-    from mechbook.model.problem import load_problem
-    from mechbook.numerics.simulate import parse_assignments, simulate
-
     report = SimReport(request.problem_id)
     try:
         stage("loading")
@@ -106,8 +109,6 @@ def simulate_task(request: SimRequest, base: Path, options: Any, stage: Stage) -
     report.arrays, report.settings = sim.arrays(), sim.settings()
     report.array_attrs = {f"monitors/{d.name}": d.attrs() for d in sim.drifts}
     if request.plot is not None:
-        from mechbook.numerics.plot import plot_simulation
-
         stage("plotting")
         report.plot = str(plot_simulation(sim, Path(request.plot)))
     return report

@@ -1,6 +1,6 @@
 """Strings made safe for each output: HDF5, JSON, XML and a terminal.
 
-Text from problem files is validated when it is read (mechbook.model.limits.check_text: no
+Text from problem files is validated when it is read (mechbook.model.input_limits.check_text: no
 NUL, no lone surrogate, no control character but tab and newline), so these functions change
 nothing a valid file holds. They are the second line: a store written by an older version,
 an exception's message, or a value that reached an output by another road can still never
@@ -11,7 +11,10 @@ or send escape sequences to a terminal.
 from __future__ import annotations
 
 import re
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from mechbook.app.bounded import JSON
 
 # C0 and C1 controls but tab and newline, DEL, and the bidirectional overrides and isolates
 # (they reorder what a terminal shows)
@@ -47,7 +50,7 @@ def for_xml(text: str) -> str:
     return _XML.sub(_escape, str(text))
 
 
-def json_safe(value: Any) -> Any:
+def json_safe(value: JSON) -> JSON:
     """A JSON-able value with every string made encodable (lone surrogates escaped)."""
     if isinstance(value, str):
         return unicode_safe(value)

@@ -20,7 +20,6 @@ import tempfile
 from dataclasses import asdict
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -32,7 +31,8 @@ log = logging.getLogger("mechbook.store")
 FORMAT = 1
 
 
-def _plain(value: Any) -> Any:
+def json_default(value: object) -> list | float | int | bool:
+    """`json.dump`'s `default=`: NumPy arrays and scalars as JSON data; TypeError otherwise."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
@@ -58,7 +58,7 @@ class SideFile:
         """Append one result; the side file's path, or None if no place would take it."""
         line = json.dumps(json_safe({"format": FORMAT, "kind": kind,
                                      "store": str(self.store.absolute()), **payload}),
-                          default=_plain) + "\n"
+                          default=json_default) + "\n"
         places = [self.path.parent] if self.path is not None else _places(self.store)
         for place in places:
             path = self.path or place / (f"{self.store.name}.unsaved-"

@@ -28,9 +28,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from mechbook.app.batch import Batch, BatchOptions
+from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.bounded import Unreadable, read_regular
 from mechbook.app.console import STATUS_ORDER
-from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.run import ProblemRun, RunOptions, run_problem
 from mechbook.errors import MechbookError
+from mechbook.model.ids import split_id
+from mechbook.model.input_limits import MAX_FILE_BYTES
 from mechbook.records import Status
 
 POLL_SECONDS = 0.1
@@ -50,12 +55,9 @@ class WatchOptions:
     runs: int = 0  # stop after this many checks (0: until interrupted; for tests)
 
 
-def _signature(paths: list[Path]) -> tuple:
+def files_signature(paths: list[Path]) -> tuple:
     """What a change is: a file's kind, size, time and content (a touch alone is not one).
     Only a regular file of at most the size a problem file may have is read."""
-    from mechbook.app.bounded import Unreadable, read_regular
-    from mechbook.model.limits import MAX_FILE_BYTES
-
     out = []
     for path in paths:
         try:
@@ -83,8 +85,6 @@ def _changed(old: tuple, new: tuple) -> bool:
 
 def check_in_worker(pid: str, base: Path, options, stage) -> tuple:
     """The batch task: one check (mechbook.app.run), and the CPU time it took here."""
-    from mechbook.app.run import run_problem
-
     cpu = _cpu()
     run = run_problem(pid, base, options, stage=stage)
     return run, _cpu() - cpu
@@ -92,8 +92,6 @@ def check_in_worker(pid: str, base: Path, options, stage) -> tuple:
 
 def check_stopped(pid: str, why: str, seconds: float, stage: str) -> tuple:
     """The batch's result for a check stopped from outside (a limit, a dead worker)."""
-    from mechbook.app.run import ProblemRun
-
     return ProblemRun(pid, error=why, seconds=seconds, stage=stage), None
 
 
@@ -122,10 +120,6 @@ def watch(pid: str, base: Path, say: Callable[[str], None],
           options: WatchOptions = WatchOptions()) -> int:
     """Check `pid` now and after every change of its files; returns the number of checks
     run (when `options.runs` stops it, or the user interrupts)."""
-    from mechbook.app.batch import Batch, BatchOptions
-    from mechbook.app.run import RunOptions
-    from mechbook.model.ids import split_id
-
     book, number = split_id(pid)
     paths = [base / "problems" / book / f"{number}.yaml",
              base / "answers" / book / f"{number}.yaml", base / "books.yaml"]
@@ -138,7 +132,7 @@ def watch(pid: str, base: Path, say: Callable[[str], None],
     try:
         with Batch(base, limits, task=check_in_worker, failed=check_stopped) as batch:
             while True:
-                now = _signature(paths)
+                now = files_signature(paths)
                 if not _changed(last, now):
                     time.sleep(options.poll)
                     continue

@@ -1,7 +1,7 @@
 """The compile layer: SymPy expressions turned into fast numeric functions, once.
 
 Every numeric evaluation of engine expressions at many points goes through here: the
-simulation's right-hand side (mechbook.numerics.model), the phase-space flow, the numeric
+simulation's right-hand side (mechbook.numerics.rhs), the phase-space flow, the numeric
 equilibrium search, the cross-checks and region checks. Two entries:
 
     compile_exprs(args, exprs)  f(x) for one point x (a flat vector of the args' values)
@@ -105,7 +105,7 @@ def _compile_symengine(args, exprs, backend: str) -> Compiled:
     def call(x: np.ndarray) -> np.ndarray:
         return np.asarray(fn(x), dtype=float).reshape(-1)
 
-    # the LLVM object itself: mechbook.numerics.native calls its machine code directly
+    # the LLVM object itself: mechbook.numerics.c_library calls its machine code directly
     call.lambdify = fn  # type: ignore[attr-defined]
     return call
 

@@ -18,10 +18,12 @@ from typing import Any, TypeVar
 import symengine as se
 import sympy as sp
 
+from mechbook.errors import MechbookError
+
 T = TypeVar("T")
 
 
-class Unsupported(Exception):
+class SymEngineCannot(Exception):
     """SymEngine cannot do this one (an unknown function, a derivative left unevaluated)."""
 
 
@@ -29,7 +31,7 @@ def to_sympy(e, symbols: Iterable[sp.Symbol]) -> sp.Basic:
     """A SymEngine result as SymPy, its symbols replaced by those of `symbols` (by name)."""
     out = e._sympy_()
     if out.has(sp.Derivative, sp.Subs):
-        raise Unsupported("a derivative left unevaluated")
+        raise SymEngineCannot("a derivative left unevaluated")
     by_name = {s.name: s for s in symbols}
     back = {s: by_name[s.name] for s in out.free_symbols
             if s.name in by_name and by_name[s.name] is not s}
@@ -48,7 +50,7 @@ def euler_lagrange(L: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
                    chains: Sequence[tuple[sp.Symbol, sp.Symbol]], t: sp.Symbol,
                    forces: Sequence[sp.Expr], stop: Sequence[sp.Symbol] = ()) -> list[sp.Expr]:
     """expand(d/dt(∂L/∂q̇_i) − ∂L/∂q_i − Q_i) for each i, with d/dt = ∂/∂t + Σ ẋ ∂/∂x over
-    `chains` [(x, ẋ), ...]. Raises Unsupported where SymEngine cannot do it all, or where
+    `chains` [(x, ẋ), ...]. Raises SymEngineCannot where SymEngine cannot do it all, or where
     ∂L/∂q̇_i holds a symbol of `stop` (one whose time derivative is not defined)."""
     names = set(L.free_symbols).union(*(f.free_symbols for f in forces))
     names |= set(q) | set(qd) | {t} | {s for pair in chains for s in pair}
@@ -61,23 +63,23 @@ def euler_lagrange(L: sp.Expr, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
         for qi, vi, force in zip(q, qd, forces, strict=True):
             p = Ls.diff(se.sympify(vi))
             if stops & p.free_symbols:
-                raise Unsupported("a symbol without a time derivative")
+                raise SymEngineCannot("a symbol without a time derivative")
             d = p.diff(ts)
             for x, v in pairs:
                 d += p.diff(x) * v
             e = d - Ls.diff(se.sympify(qi)) - se.sympify(force)
             out.append(to_sympy(se.expand(e), names))
         return out
-    except Unsupported:
+    except SymEngineCannot:
         raise
     except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
-        raise Unsupported(str(exc)) from None
+        raise SymEngineCannot(str(exc)) from None
 
 
 def total_derivative(expr: sp.Basic, t: sp.Symbol,
                      chains: Sequence[tuple[sp.Symbol, sp.Symbol]]) -> sp.Basic:
     """∂expr/∂t + Σ ẋ·∂expr/∂x over `chains` [(x, ẋ), ...], not expanded. Raises
-    Unsupported where SymEngine cannot do it (then the caller differentiates with SymPy)."""
+    SymEngineCannot where SymEngine cannot do it (then the caller differentiates with SymPy)."""
     names = set(expr.free_symbols) | {t} | {s for pair in chains for s in pair}
     try:
         e = se.sympify(expr)
@@ -88,10 +90,10 @@ def total_derivative(expr: sp.Basic, t: sp.Symbol,
             if sx in present:
                 out += e.diff(sx) * se.sympify(v)
         return to_sympy(out, names)
-    except Unsupported:
+    except SymEngineCannot:
         raise
     except Exception as exc:  # noqa: BLE001 - SymEngine's conversion or calculus failed
-        raise Unsupported(str(exc)) from None
+        raise SymEngineCannot(str(exc)) from None
 
 
 def expand(expr: sp.Basic) -> sp.Basic:
@@ -102,7 +104,7 @@ def expand(expr: sp.Basic) -> sp.Basic:
         return sp.expand(expr)
 
 
-def same(e: Any) -> Any:
+def same(e: T) -> T:
     """The identity: SymPy's algebra for a computation written for either (`either`)."""
     return e
 
@@ -115,8 +117,6 @@ def either(build: Callable[[Callable], T]) -> T:
     SymPy, build(same). A MechbookError (the problem's own fault, or a capability the
     engine lacks), running out of memory or of recursion depth are not reasons to try
     again."""
-    from mechbook.errors import MechbookError
-
     try:
         out = build(se.sympify)
     except (MechbookError, MemoryError, RecursionError):

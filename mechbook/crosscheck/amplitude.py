@@ -19,6 +19,7 @@ from mechbook.crosscheck.modal import modal_setup, mode_signal, normal_modes, st
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
+from mechbook.numerics import taylor
 from mechbook.numerics.events import solve_with_events
 
 PERIODS = 4
@@ -58,8 +59,6 @@ def amplitude_response(analysis: Analysis, lin: LinearSystem, values: dict,
 def _measure_batch(s, mode: dict, amplitudes: np.ndarray, period: float) -> np.ndarray:
     """The frequencies at every amplitude from one Taylor batch run (same fit as _measure:
     the first PERIODS + 1 upward crossings, within MAX_PERIODS linear periods)."""
-    from mechbook.numerics import taylor
-
     if not np.all(amplitudes > 0):
         raise UnsupportedError("a finite-amplitude frequency needs an amplitude > 0")
     n_full = len(s.q_star)

@@ -23,7 +23,7 @@ from mechbook.engine.screen import screen
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.manifold import manifold_of
 from mechbook.numerics.integrators import integrate
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 from mechbook.numerics.simulate import FALLBACK_OFFSET, initial_state
 from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import Part

@@ -29,7 +29,6 @@ from mechbook.crosscheck.modal import (
     start_state,
     unstable_modes,
 )
-from mechbook.crosscheck.modal import defective as _defective  # noqa: F401 - tests read it here
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import MechbookError, UnsupportedError

@@ -17,10 +17,12 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
+from mechbook.core.backends import FEW_CALLS_BACKEND
+from mechbook.core.compile import compile_exprs
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import ZERO_CLUSTER, LinearSystem
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.model import Model, build_model
+from mechbook.numerics.rhs import Model, build_model
 
 
 @dataclass
@@ -100,9 +102,6 @@ def _manifold(base, independent: list[int], values: dict):
     by Newton's method from where they are, their rates solved from the others'. A start
     displaced along a mode of the linear system is first order; on the constraints exactly,
     the simulated system is the one whose frequencies are compared."""
-    from mechbook.core.backends import FEW_CALLS_BACKEND
-    from mechbook.core.compile import compile_exprs
-
     cons = [f.subs(values) for _, f in base.constraints]
     A = sp.Matrix([[sp.diff(f, q) for q in base.q] for f in cons])
     g_num, _ = compile_exprs(base.q, cons, FEW_CALLS_BACKEND)  # a few Newton steps per start

@@ -52,7 +52,7 @@ def newton_crosscheck(analysis: Analysis, system_name: str | None = None,
     return out
 
 
-def _newton_residual(sys, symengine: bool = True) -> list:
+def newton_residual(sys, symengine: bool = True) -> list:
     """Σ J·(m r̈ − F) + rigid-body Euler terms + the Lagrange expressions of everything the
     file gives other than particles and bodies − Q: SymEngine expressions where SymEngine
     can do the calculus, SymPy's where it cannot or `symengine` is False."""
@@ -324,7 +324,7 @@ def _attractors(sys, spec, positions, masses, frames, parse) -> tuple[dict, list
 
 def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     dyn = analysis.dynamics(sys.name)
-    newton = _newton_residual(sys)
+    newton = newton_residual(sys)
     engine = list(dyn.residuals)
     params = [p.symbol for p in sys.params.values()]
     free = [s for trio in sys.free_driven for s in trio]

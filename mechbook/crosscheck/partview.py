@@ -10,7 +10,7 @@ quantity families; the rest of crosscheck/ asks a `PartView` and never sees thei
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import sympy as sp
 
@@ -19,10 +19,13 @@ from mechbook.verify.answers import Part
 from mechbook.verify.compare import value
 from mechbook.verify.context import Context
 from mechbook.verify.context import split_named as _split_named
+from mechbook.verify.quantities.steady import family
+from mechbook.verify.quantities.trajectory import Motion
 
 if TYPE_CHECKING:
     from mechbook.engine.lagrange import Dynamics
     from mechbook.engine.linear import LinearSystem
+    from mechbook.engine.steady import SteadyFamily
     from mechbook.model.protocol import SystemLike
 
 
@@ -43,7 +46,7 @@ class PartView:
         return self._ctx.dyn
 
     @property
-    def names(self) -> dict[str, Any]:
+    def names(self) -> dict[str, sp.Basic]:
         return self._ctx.names
 
     def linear(self) -> LinearSystem:
@@ -54,29 +57,26 @@ class PartView:
         """The parameter values the part is checked at by default."""
         return self._ctx.sampler.default()
 
-    def parse(self, text: Any, sub: tuple) -> sp.Expr:
-        """An expression of the part at `sub` of its key, through the safe parser."""
+    def parse(self, text: object, sub: tuple) -> sp.Expr:
+        """An expression of the part at `sub` of its key (`text`: a value of the key as YAML
+        read it), through the safe parser; SpecError if it is none."""
         return self._ctx.parse(text, sub)
 
     def number(self, key: str, values: dict) -> float:
         """The real value of the part's `key:` (a driving frequency) at `values`."""
         return value(self.parse(self.part.data[key], (key,)), values).real
 
-    def steady_family(self) -> Any:
+    def steady_family(self) -> SteadyFamily:
         """The steady motions a `steady_rates`/`steady_exists` part derives
         (mechbook.verify.quantities.steady: `real_rates(values)`, `point`, `rates`, `x`)."""
-        from mechbook.verify.quantities.steady import family
-
         return family(self._ctx)
 
-    def motion(self) -> Any:
+    def motion(self) -> Motion:
         """The trajectory a trajectory part derives (mechbook.verify.quantities.trajectory:
         `level`, `orbit(values)`, `measured(values)`)."""
-        from mechbook.verify.quantities.trajectory import Motion
-
         return Motion(self._ctx)
 
 
-def split_named(text: Any) -> tuple[str | None, object]:
+def split_named(text: object) -> tuple[str | None, object]:
     """(name, value) of a first integral written `name = value` (verify's reading)."""
     return _split_named(text)

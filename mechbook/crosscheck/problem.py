@@ -22,11 +22,11 @@ from mechbook.crosscheck.conserved import conserved_part
 from mechbook.crosscheck.frequencies import frequency_crosscheck
 from mechbook.crosscheck.guard import guarded
 from mechbook.crosscheck.inertia import inertia_crosschecks
-from mechbook.crosscheck.motion import steady_crosscheck, trajectory_crosscheck
 from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.crosscheck.partview import PartView
 from mechbook.crosscheck.points import engine_linear_systems, numeric_key, point_label
 from mechbook.crosscheck.response import response_part
+from mechbook.crosscheck.simulated_motion import steady_crosscheck, trajectory_crosscheck
 from mechbook.crosscheck.state_modes import state_frequency_crosscheck
 from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis

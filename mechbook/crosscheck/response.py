@@ -23,7 +23,7 @@ from mechbook.engine import response
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import MechbookError, UnsupportedError
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 from mechbook.records import CrossCheck, Status
 
 REL_TOL = 1e-4

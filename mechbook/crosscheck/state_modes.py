@@ -30,7 +30,7 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.state_space import StateSpaceSystem
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.manifold import manifold_of
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 from mechbook.records import CrossCheck, Status
 
 

@@ -30,6 +30,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from mechbook.core.compile import compile_exprs
+from mechbook.core.numeval import is_zero
 from mechbook.engine.lagrange import Dynamics
 from mechbook.errors import UnsupportedError
 
@@ -75,8 +76,6 @@ def frozen(dyn: Dynamics, coordinate: sp.Symbol, slow: sp.Symbol, point: dict) -
 
 
 def _vanishes(e: sp.Expr) -> bool:
-    from mechbook.core.numeval import is_zero
-
     return e == 0 or is_zero(e)
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.engine.analysis import Analysis
-from mechbook.engine.domains import existing
+from mechbook.engine.existence import existing
 from mechbook.engine.growth import growth_rates
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.records import Results

@@ -21,7 +21,8 @@ from mechbook.core.expansion import EPS, expand_lagrangian
 from mechbook.core.numeval import without_absent
 from mechbook.core.secalc import either, same, to_sympy
 from mechbook.core.timeout import Timeout, cpu_time, time_limit, try_simplify
-from mechbook.engine.domains import clip_ranges, inside
+from mechbook.engine.constrained import equilibrium_conditions, linearize_on_manifold, residual_at
+from mechbook.engine.existence import clip_ranges, inside
 from mechbook.engine.flat_roots import FlatRoots, jacobian_scale
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
@@ -67,8 +68,6 @@ class Equilibria:
         parameters switched off; with multiplier constraints, E(q, 0, 0) − A(q)ᵀλ and the
         constraints g(q) (mechbook.engine.constrained)."""
         if self.dyn.constrained:
-            from mechbook.engine.constrained import equilibrium_conditions
-
             return equilibrium_conditions(self)[0]
         return self.rest_residuals()
 
@@ -225,8 +224,6 @@ class Equilibria:
         """What must vanish if `point` is an equilibrium (with constraints: each constraint
         and the force along the constraint manifold)."""
         if self.dyn.constrained:
-            from mechbook.engine.constrained import residual_at
-
             return residual_at(self, point)
         return [c.subs(point) for c in self.conditions]
 
@@ -252,7 +249,7 @@ class Equilibria:
                                                  (*at.values(), *held.values())))
 
         def build(conv):  # in SymEngine, its entries brought back to SymPy once; or SymPy
-            parts = _second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, conv)
+            parts = second_derivatives(dyn.L, dyn.q, dyn.qd, at, rest, held, conv)
             return parts if conv is same else [[to_sympy(x, names) for x in p] for p in parts]
 
         force, A, B, C = either(build)
@@ -280,8 +277,6 @@ class Equilibria:
         there; M, C, K and F stay in the original parameters. A system with multiplier
         constraints is linearized on its constraint manifold (mechbook.engine.constrained)."""
         if self.dyn.constrained:
-            from mechbook.engine.constrained import linearize_on_manifold
-
             return linearize_on_manifold(self, point, velocity, given)
         if not velocity and not given and self._conservative():
             return self._linearize_lagrangian(point)
@@ -363,7 +358,7 @@ class Equilibria:
         return zeroth, M, C, K, F
 
 
-def _second_derivatives(L, q, qd, at: dict, rest: dict, held: dict, conv) -> tuple:
+def second_derivatives(L, q, qd, at: dict, rest: dict, held: dict, conv) -> tuple:
     """(∂L/∂q at the point, A, B, C row by row) of `_linearize_lagrangian`, in the algebra
     `conv` converts to (SymEngine's or SymPy's: both have diff and xreplace). Each second
     derivative from the smallest expression that still holds it: A from L at the point (a

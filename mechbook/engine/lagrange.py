@@ -14,8 +14,7 @@ from functools import cached_property
 import sympy as sp
 
 from mechbook.core.numeval import is_zero
-from mechbook.core.secalc import Unsupported as SymEngineCannot
-from mechbook.core.secalc import euler_lagrange
+from mechbook.core.secalc import SymEngineCannot, euler_lagrange
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.affine import solve_unknowns
 from mechbook.errors import MechbookError, UnsupportedError

@@ -196,9 +196,9 @@ class StateSpaceSystem:
         family, cyclic coordinates, conserved speeds) are not frequencies."""
         core = self.numeric_state_matrix(values, core=True)
         lam = np.linalg.eigvals(core) if core.size else np.zeros(0, complex)
-        if _ambiguous(lam):
+        if ambiguous_exponents(lam):
             lam = np.array([complex(x) for x in self.precise_exponents(values)[: core.shape[0]]])
-        return _frequencies(lam)
+        return frequencies_of_exponents(lam)
 
     def precise_frequencies(self, values: dict, dps: int = 50) -> list:
         """`numeric_frequencies` at `dps` digits."""
@@ -219,7 +219,7 @@ class StateSpaceSystem:
         if not np.all(np.isfinite(core)):
             raise MechbookError("the linearized system has no finite value at this point")
         lam = np.linalg.eigvals(core)
-        if _ambiguous(lam):
+        if ambiguous_exponents(lam):
             return self.precise_stability(values)
         return classify_exponents(lam)
 
@@ -258,7 +258,7 @@ def _eigenvalues(A) -> list:
     return list(mpmath.eig(A, left=False, right=False))
 
 
-def _ambiguous(lam: np.ndarray) -> bool:
+def ambiguous_exponents(lam: np.ndarray) -> bool:
     """Exponents double precision cannot place: small ones (below 1e-4 of the largest)
     that are several (a Jordan block's zero, which rounding splits into ±ε^(1/k)) or one
     above rounding (a slow mode, or a split zero). A single exponent at rounding level is a
@@ -269,7 +269,7 @@ def _ambiguous(lam: np.ndarray) -> bool:
     return len(small) >= 2 or bool(np.any(small > 1e-10 * top))
 
 
-def _frequencies(lam: np.ndarray) -> np.ndarray:
+def frequencies_of_exponents(lam: np.ndarray) -> np.ndarray:
     scale = max(1e-300, float(np.max(np.abs(lam)))) if len(lam) else 1.0
     tol = 1e-9 * scale
     out = [abs(x.imag) for x in lam if x.imag > tol]

@@ -1,5 +1,5 @@
 """A first-order linearization over a grid of parameter values (a rolling coin's stability
-map), compiled once and batched as mechbook.engine.sweep does for M, C, K.
+map), compiled once and batched as mechbook.engine.linear_grid does for M, C, K.
 
 E(p) and Â(p) of E·ż = Â·z (mechbook.engine.state_space) are compiled with the parameters as
 arguments (the compile layer's batch entry); at each block of points A = E⁻¹Â is solved in
@@ -20,8 +20,7 @@ import sympy as sp
 
 from mechbook.core.compile import DEFAULT_BACKEND, compile_batch
 from mechbook.engine.linear import ZERO_CLUSTER
-from mechbook.engine.state_space import StateSpaceSystem, _ambiguous, _frequencies
-from mechbook.engine.sweep import (
+from mechbook.engine.linear_grid import (
     GROWTH_TOL,
     PRECISE_LIMIT,
     STABLE,
@@ -29,6 +28,11 @@ from mechbook.engine.sweep import (
     UNSTABLE,
     Block,
     sweepable,
+)
+from mechbook.engine.state_space import (
+    StateSpaceSystem,
+    ambiguous_exponents,
+    frequencies_of_exponents,
 )
 
 
@@ -78,7 +82,7 @@ class StateSweep:
             np.zeros((len(idx), 0), complex)
         for row, i in enumerate(idx):
             self._one(lam[row], i, freq, stab, growth)
-            ill[i] = _ambiguous(lam[row])
+            ill[i] = ambiguous_exponents(lam[row])
         block = Block()
         block.ill = int(ill.sum())
         if precise and 0 < block.ill <= PRECISE_LIMIT:
@@ -96,7 +100,7 @@ class StateSweep:
 
     def _one(self, lam: np.ndarray, i: int, freq, stab, growth) -> None:
         """One point's frequencies, stability code and growth rate from its exponents."""
-        w = _frequencies(lam)[: self.n]
+        w = frequencies_of_exponents(lam)[: self.n]
         freq[i, : len(w)] = w
         scale = max(1.0, float(np.max(np.abs(lam)))) if len(lam) else 1.0
         live = lam[np.abs(lam) > ZERO_CLUSTER * scale]

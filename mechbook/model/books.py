@@ -105,6 +105,7 @@ def books(base: str | Path) -> dict[str, Book]:
 
 def load_books(path: str | Path) -> dict[str, Book]:
     """Read and check a books.yaml; a fault is a SpecError naming file and line."""
+    # at call time: `mechbook --help` reads no YAML (ruamel, jsonschema)
     from mechbook.model.schema import validate
     from mechbook.model.yamlio import load
 

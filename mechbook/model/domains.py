@@ -111,7 +111,7 @@ def outside(point: dict, domains: dict, values: dict) -> str | None:
         except (TypeError, ValueError, ZeroDivisionError, OverflowError):
             continue
         if abs(z.imag) > 1e-9 * max(1.0, abs(z.real)):
-            continue  # not real: another question (mechbook.engine.domains)
+            continue  # not real: another question (mechbook.engine.existence)
         if not dom.contains(z.real, values):
             return f"{sym} = {sp.sstr(point[sym])} is outside {dom.text}"
     return None

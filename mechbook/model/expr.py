@@ -130,7 +130,7 @@ def tree_size(expr: sp.Basic, memo: dict | None = None) -> int:
     return memo[expr]
 
 
-class _Builder:
+class ExprBuilder:
     def __init__(self, text: str, names: Mapping[str, sp.Basic], allow_relations: bool):
         self.text = text
         self.source = text.strip()
@@ -362,7 +362,7 @@ def parse(text: str | int | float, names: Mapping[str, sp.Basic] | None = None,
     allowed."""
     names = names or {}
     text, tree = syntax_tree(text)
-    builder = _Builder(text, names, allow_relations)
+    builder = ExprBuilder(text, names, allow_relations)
     builder.complex_ok = complex_ok
     try:
         result = builder.build(tree)
@@ -380,7 +380,7 @@ def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None,
     """Parse ``lhs = rhs`` (or a bare ``expr`` meaning ``expr = 0``) into ``lhs - rhs``."""
     if not isinstance(text, str):
         return parse(text, names, complex_ok=complex_ok)
-    pieces = _split_single_equals(text)
+    pieces = split_single_equals(text)
     if len(pieces) == 1:
         return parse(pieces[0], names, complex_ok=complex_ok)
     if len(pieces) == 2:
@@ -389,7 +389,7 @@ def parse_equation(text: str, names: Mapping[str, sp.Basic] | None = None,
     raise ExpressionError(f"more than one '=' in equation {text!r}", text)
 
 
-def _split_single_equals(text: str) -> list[str]:
+def split_single_equals(text: str) -> list[str]:
     out, start = [], 0
     for i, ch in enumerate(text):
         if ch == "=":

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import re
 from functools import cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 try:  # PyYAML is a dependency; libyaml is in its wheels, but a source build may lack it
     import yaml
@@ -27,6 +27,9 @@ except ImportError:  # pragma: no cover - then every file takes the round-trip p
     _Loader = None
 
 from mechbook.errors import SpecError
+
+if TYPE_CHECKING:
+    from mechbook.model.yamlio import Data
 
 # the scalars resolved here; ruamel.yaml's YAML 1.2 resolvers give the same values for them
 _INT = re.compile(r"[-+]?(?:0|[1-9][0-9]*)")
@@ -47,10 +50,10 @@ class _Unsure(Exception):
     """The fast reading cannot promise the round-trip parser's result."""
 
 
-def fast_data(text: str, file: str, check_events) -> Any:
+def fast_data(text: str, file: str, check_events) -> Data:
     """The plain data of `text`, or None where only the round-trip parser can say (an
     error, a limit, a scalar the two parsers might read differently). `check_events`
-    (mechbook.model.limits) runs on the event stream first; a refusal there also gives
+    (mechbook.model.input_limits) runs on the event stream first; a refusal there also gives
     None, so that the message is the round-trip parser's."""
     if yaml is None or _ODD.search(text):
         return None

@@ -27,6 +27,7 @@ import mpmath
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, program
+from mechbook.model.rolling import relative_velocity
 
 DIGITS = 30  # the checks' working precision: a projected state is kept to it
 WORK = 40  # digits of the iteration
@@ -324,8 +325,6 @@ def check_constraint_set(system, starts: int = 8) -> None:
 
 
 def _contacts_stay_on(system, states: list[dict]) -> None:
-    from mechbook.model.rolling import relative_velocity
-
     for i, spec in enumerate(system.spec.get("rolling") or []):
         v, n = relative_velocity(system, spec, ("rolling", i))
         normal = v.dot(n)

@@ -18,7 +18,7 @@ import sympy as sp
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
 from mechbook.model.expr import CONSTANTS, DECLARABLE, FUNCTIONS, Operator, parse
-from mechbook.model.limits import check_problem_counts, decode, read_bytes
+from mechbook.model.input_limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, loads
 

@@ -11,7 +11,7 @@ the reduced Lagrangian (both empty for a `System`).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from mechbook.model.domains import Domain
     from mechbook.model.problem import Problem
     from mechbook.model.system import System
+    from mechbook.model.yamlio import Data
 
 
 class SystemLike(Protocol):
@@ -26,13 +27,13 @@ class SystemLike(Protocol):
 
     problem: Problem
     name: str  # the system's name in its problem file (a reduced one keeps it)
-    spec: dict[str, Any]  # the file's declarations of the system
+    spec: dict[str, Data]  # the file's declarations of the system
     t: sp.Symbol
     q: list[sp.Symbol]  # coordinates, with their rates qd and accelerations qdd
     qd: list[sp.Symbol]
     qdd: list[sp.Symbol]
     coord_names: list[str]
-    names: dict[str, Any]  # every name an expression of the system may use
+    names: dict[str, sp.Basic]  # every name an expression of the system may use
     lagrangian: sp.Expr
     forces: list[sp.Expr]  # generalized forces not derived from a potential, per coordinate
     constraints: list[tuple[str, sp.Expr]]  # (name, g(q)) held by multipliers
@@ -63,7 +64,7 @@ class SystemLike(Protocol):
         full system)."""
         ...
 
-    def dt(self, expr: Any) -> Any:
+    def dt(self, expr: sp.Expr) -> sp.Expr:
         """The total time derivative along the motion."""
         ...
 

@@ -37,6 +37,7 @@ from __future__ import annotations
 import sympy as sp
 
 from mechbook.core.expansion import trig_canonical
+from mechbook.core.numeval import is_zero
 from mechbook.model.attitude import rotation_matrix
 from mechbook.model.friction import point_velocity
 
@@ -86,8 +87,6 @@ def _linear_in_velocities(sys, name: str, c: sp.Expr, sub: tuple) -> None:
 
 
 def _vanishes(expr: sp.Expr) -> bool:
-    from mechbook.core.numeval import is_zero
-
     try:
         return is_zero(expr)
     except Exception:  # noqa: BLE001 - an expression that does not evaluate is not zero

@@ -17,8 +17,7 @@ import sympy as sp
 from mechbook.core.expansion import expand_lagrangian
 from mechbook.core.integrals import box_integral
 from mechbook.core.numeval import is_zero, without_absent
-from mechbook.core.secalc import Unsupported as SymEngineCannot
-from mechbook.core.secalc import total_derivative
+from mechbook.core.secalc import SymEngineCannot, total_derivative
 from mechbook.errors import NotFoundError, SpecError, UnsupportedError
 from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
@@ -135,7 +134,7 @@ class System(SystemLike):
         self.inertias: dict[str, sp.Matrix] = {}  # body -> inertia tensor in body axes
         self.body_rates: dict[str, sp.Matrix] = {}  # body -> ω in body axes
         # each particle's and body's own kinetic energy and potential energy in gravity
-        # (mechbook.engine.parts: the energy of one part of the system)
+        # (mechbook.engine.part_energy: the energy of one part of the system)
         self.part_kinetic: dict[str, sp.Expr] = {}
         self.part_potential: dict[str, sp.Expr] = {}
         for name, p in (s.get("particles") or {}).items():

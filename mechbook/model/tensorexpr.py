@@ -18,21 +18,24 @@ import sympy as sp
 from sympy.matrices.utilities import dotprodsimp
 
 from mechbook.errors import ExpressionError
-from mechbook.model.expr import MAX_SUBSTITUTED_TENSOR, _Builder, syntax_tree
+from mechbook.model.expr import (
+    MAX_SUBSTITUTED_TENSOR,
+    ExprBuilder,
+    split_single_equals,
+    syntax_tree,
+)
 from mechbook.model.tensorfuncs import (  # noqa: F401 - `kind` is this module's API too
     BODY_FUNCTIONS,
     TENSOR_ARITY,
     TENSOR_FUNCTIONS,
-    _holds_matrix,
-    _im,
-    _kind,
-    _scalar,
-    _tensor,
+    holds_matrix,
+    is_scalar,
+    is_tensor,
     kind,
 )
 
 
-class _TensorBuilder(_Builder):
+class _TensorBuilder(ExprBuilder):
     complex_ok = True  # eigenvalues of rotations: i(), expi(theta)
     max_substituted = MAX_SUBSTITUTED_TENSOR
 
@@ -42,7 +45,7 @@ class _TensorBuilder(_Builder):
 
     def _List(self, node: ast.List, depth: int):
         items = [self.build(e, depth) for e in node.elts]
-        if len(items) == 3 and all(_scalar(x) for x in items):
+        if len(items) == 3 and all(is_scalar(x) for x in items):
             return sp.ImmutableMatrix(items)
         if len(items) == 3 and all(isinstance(x, sp.MatrixBase) and x.shape == (3, 1)
                                    for x in items):
@@ -53,12 +56,12 @@ class _TensorBuilder(_Builder):
         if isinstance(node.op, ast.Pow):
             base, exponent = self.build(node.left, depth), self.build(node.right, depth)
             if isinstance(base, sp.MatrixBase) or isinstance(exponent, sp.MatrixBase):
-                if not (_tensor(base) and _scalar(exponent) and exponent.is_Integer
+                if not (is_tensor(base) and is_scalar(exponent) and exponent.is_Integer
                         and abs(exponent) <= 16):
                     raise self.fail(node, "only a tensor has powers, with an integer exponent "
                                     "(at most 16 in size)")
                 try:
-                    return _im(base**int(exponent))
+                    return sp.ImmutableMatrix(base**int(exponent))
                 except (ValueError, ZeroDivisionError) as exc:
                     raise self.fail(node, f"cannot raise this tensor to {exponent} ({exc})") \
                         from None
@@ -67,18 +70,18 @@ class _TensorBuilder(_Builder):
         except (TypeError, ValueError, NotImplementedError, sp.ShapeError,
                 sp.NonSquareMatrixError) as exc:
             raise self.fail(node, f"cannot combine these operands ({exc})") from None
-        if not isinstance(out, sp.MatrixBase) and _holds_matrix(out):
+        if not isinstance(out, sp.MatrixBase) and holds_matrix(out):
             raise self.fail(node, "a vector or tensor cannot be an exponent or a base here")
         if isinstance(out, sp.MatrixBase):
             if out.shape not in ((3, 1), (3, 3)):
-                raise self.fail(node, f"the result is a {_kind(out)}: use dot(u, v) for the "
+                raise self.fail(node, f"the result is a {kind(out)}: use dot(u, v) for the "
                                 "scalar product of vectors")
-            return _im(out)
+            return sp.ImmutableMatrix(out)
         return out
 
     def _UnaryOp(self, node: ast.UnaryOp, depth: int):
         out = super()._UnaryOp(node, depth)
-        return _im(out) if isinstance(out, sp.MatrixBase) else out
+        return sp.ImmutableMatrix(out) if isinstance(out, sp.MatrixBase) else out
 
     def _Call(self, node: ast.Call, depth: int):
         if not isinstance(node.func, ast.Name):
@@ -88,7 +91,7 @@ class _TensorBuilder(_Builder):
             return self._body_call(node, depth)
         if name not in TENSOR_FUNCTIONS:
             out = super()._Call(node, depth)
-            if _holds_matrix(out):
+            if holds_matrix(out):
                 raise self.fail(node, f"{name}() takes scalars only")
             return out
         if node.keywords:
@@ -141,11 +144,9 @@ def parse_tensor_equation(text, names: Mapping[str, sp.Basic] | None = None,
                           objects: Mapping[str, object] | None = None):
     """`lhs = rhs` as the pair (lhs, rhs) of like objects; `= 0` stands for a zero vector or
     tensor too."""
-    from mechbook.model.expr import _split_single_equals
-
     if not isinstance(text, str):
         raise ExpressionError(f"expected an equation 'lhs = rhs', got {text!r}")
-    pieces = _split_single_equals(text)
+    pieces = split_single_equals(text)
     if len(pieces) != 2:
         raise ExpressionError(f"expected one '=' in equation {text!r}", text)
     lhs = parse_tensor(pieces[0], names, objects)
@@ -154,7 +155,7 @@ def parse_tensor_equation(text, names: Mapping[str, sp.Basic] | None = None,
         if isinstance(a, sp.MatrixBase) and not isinstance(b, sp.MatrixBase) and b == 0:
             return (lhs, sp.ImmutableMatrix.zeros(*a.shape)) if a is lhs else \
                 (sp.ImmutableMatrix.zeros(*a.shape), rhs)
-    if _kind(lhs) != _kind(rhs):
-        raise ExpressionError(f"the sides of {text!r} differ in kind: a {_kind(lhs)} and a "
-                              f"{_kind(rhs)}", text)
+    if kind(lhs) != kind(rhs):
+        raise ExpressionError(f"the sides of {text!r} differ in kind: a {kind(lhs)} and a "
+                              f"{kind(rhs)}", text)
     return lhs, rhs

@@ -13,7 +13,7 @@ import sympy as sp
 from mechbook.core.secalc import derivative
 
 
-def _holds_matrix(expr) -> bool:
+def holds_matrix(expr) -> bool:
     """A scalar expression with a matrix inside it (sin of a tensor, 2**T): refused."""
     return isinstance(expr, sp.Basic) and bool(expr.atoms(sp.MatrixBase))
 
@@ -22,23 +22,24 @@ def _vector(v) -> bool:
     return isinstance(v, sp.MatrixBase) and v.shape == (3, 1)
 
 
-def _tensor(v) -> bool:
+def is_tensor(v) -> bool:
     return isinstance(v, sp.MatrixBase) and v.shape == (3, 3)
 
 
-def _scalar(v) -> bool:
+def is_scalar(v) -> bool:
     return not isinstance(v, sp.MatrixBase)
 
 
-def _kind(v) -> str:
-    return "vector" if _vector(v) else "tensor" if _tensor(v) else "scalar" if _scalar(v) \
+def kind(v) -> str:
+    """'scalar', 'vector', 'tensor' or '<n>x<m> matrix'."""
+    return "vector" if _vector(v) else "tensor" if is_tensor(v) else "scalar" if is_scalar(v) \
         else f"{v.shape[0]}x{v.shape[1]} matrix"
 
 
 def _need(what: str, test: Callable, *args) -> None:
     for a in args:
         if not test(a):
-            raise TypeError(f"expected a {what}, got a {_kind(a)}")
+            raise TypeError(f"expected a {what}, got a {kind(a)}")
 
 
 def _im(m: sp.MatrixBase) -> sp.ImmutableMatrix:
@@ -53,53 +54,53 @@ def _dyad(a, b):
 def _dot(a, b):
     if _vector(a) and _vector(b):
         return a.dot(b)
-    if _vector(a) and _tensor(b):  # v·T
+    if _vector(a) and is_tensor(b):  # v·T
         return _im(b.T * a)
-    if _tensor(a) and (_tensor(b) or _vector(b)):
+    if is_tensor(a) and (is_tensor(b) or _vector(b)):
         return _im(a * b)
-    raise TypeError(f"dot of a {_kind(a)} and a {_kind(b)}")
+    raise TypeError(f"dot of a {kind(a)} and a {kind(b)}")
 
 
 def _ddot(a, b):
     """The double dot product A:B = Σ A_ij B_ij of two tensors."""
-    _need("tensor", _tensor, a, b)
+    _need("tensor", is_tensor, a, b)
     return sum((a[i, j] * b[i, j] for i in range(3) for j in range(3)), sp.S.Zero)
 
 
 def _cross(a, b):
     """u × v; with a tensor, the dyadic rule: w × (AB) = (w × A)B, (AB) × w = A(B × w)."""
-    if _vector(a) and _tensor(b):
+    if _vector(a) and is_tensor(b):
         return _im(_skew(a) * b)
-    if _tensor(a) and _vector(b):
+    if is_tensor(a) and _vector(b):
         return _im(a * _skew(b))
     _need("vector", _vector, a, b)
     return _im(a.cross(b))
 
 
 def _transpose(t):
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return _im(t.T)
 
 
 def _det(t):
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return t.det(method="berkowitz")
 
 
 def _trace(t):
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return t.trace()
 
 
 def _second_invariant(t):
     """Symon's M(T), Eq. (10-139): the sum of the three principal 2×2 minors."""
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return sum((t[i, i] * t[j, j] - t[i, j] * t[j, i] for i, j in ((0, 1), (1, 2), (0, 2))),
                sp.S.Zero)
 
 
 def _inverse(t):
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     d = _det(t)
     if d == 0:
         raise ValueError("the tensor is singular (determinant 0)")
@@ -113,7 +114,7 @@ def _unit():
 def _rotation(axis, angle):
     """The orthogonal tensor turning vectors through `angle` about `axis` (right hand)."""
     _need("vector", _vector, axis)
-    _need("scalar", _scalar, angle)
+    _need("scalar", is_scalar, angle)
     n2 = axis.dot(axis)
     if n2 == 0:
         raise ValueError("a rotation axis must not be the zero vector")
@@ -137,25 +138,25 @@ def _index(i) -> int:
 
 def _entry(t, i, j=None):
     """Component T_ij (1-based) of a tensor, or v_i of a vector."""
-    if j is None and _tensor(t):
+    if j is None and is_tensor(t):
         raise TypeError("a tensor's entry takes two indices: entry(T, i, j)")
     if j is not None and _vector(t):
         raise TypeError("a vector's entry takes one index: entry(v, i)")
     if j is None:
         _need("vector", _vector, t)
         return t[_index(i), 0]
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return t[_index(i), _index(j)]
 
 
 def _row(t, i):
     """Row i (1-based) of a tensor's matrix, as a vector (e'_i for a transformation a)."""
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return _im(t[_index(i), :].T)
 
 
 def _col(t, j):
-    _need("tensor", _tensor, t)
+    _need("tensor", is_tensor, t)
     return _im(t[:, _index(j)])
 
 
@@ -212,7 +213,7 @@ def _grad(x, r):
     """∇f (a vector) of a scalar field, or the dyad ∇v, (∇v)_ij = ∂v_j/∂x_i (Symon Eq.
     10-175), of a vector field; `r` = [x, y, z], Cartesian."""
     xs = _coordinates(r)
-    if _scalar(x):
+    if is_scalar(x):
         return _im(sp.Matrix([sp.diff(x, c) for c in xs]))
     _need("vector", _vector, x)
     return _im(sp.Matrix(3, 3, lambda i, j: sp.diff(x[j], xs[i])))
@@ -223,7 +224,7 @@ def _div(x, r):
     xs = _coordinates(r)
     if _vector(x):
         return sum((sp.diff(x[i], xs[i]) for i in range(3)), sp.S.Zero)
-    _need("tensor", _tensor, x)
+    _need("tensor", is_tensor, x)
     return _im(sp.Matrix([sum((sp.diff(x[i, j], xs[i]) for i in range(3)), sp.S.Zero)
                           for j in range(3)]))
 
@@ -232,7 +233,7 @@ def _subs(x, s, v):
     """x with the symbol s replaced by the scalar v (a boundary value, a change of
     variables)."""
     s = _calculus_symbol(s, "substitute for")
-    _need("scalar", _scalar, v)
+    _need("scalar", is_scalar, v)
     return _im(x.xreplace({s: v})) if isinstance(x, sp.MatrixBase) else x.xreplace({s: v})
 
 
@@ -240,7 +241,7 @@ def _integral(f, s, lo, hi):
     """The definite integral of a scalar over s from lo to hi (SymPy's integrate; an
     integral it cannot do in closed form is an error)."""
     s = _calculus_symbol(s, "integrate over")
-    _need("scalar", _scalar, f, lo, hi)
+    _need("scalar", is_scalar, f, lo, hi)
     out = sp.integrate(f, (s, lo, hi))
     if out.has(sp.Integral):
         raise ValueError("SymPy finds no closed form for this integral")
@@ -254,7 +255,7 @@ def _norm(v):
 
 def _scalar_fn(fn):
     def apply(x):
-        _need("scalar", _scalar, x)
+        _need("scalar", is_scalar, x)
         return fn(x)
     return apply
 
@@ -287,8 +288,3 @@ BODY_FUNCTIONS: dict[str, tuple[Callable, tuple[int, int]]] = {
     "inertia": (lambda b, p=None: _im(b.inertia(None if p is None else _point(b, p))), (0, 1)),
     "moment": (lambda b, p, n: b.moment(_point(b, p), _point(b, n)), (2, 2)),
 }
-
-
-def kind(value) -> str:
-    """'scalar', 'vector' or 'tensor'."""
-    return _kind(value)

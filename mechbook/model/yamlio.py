@@ -4,7 +4,7 @@ PyYAML silently keeps the last of two equal keys; ruamel.yaml's round-trip loade
 them and records where every node sits, so errors can name the file and the line. Before
 anything is built, the file's size, its event stream (no anchors, aliases or tags; bounded
 depth and node count) and then every scalar (plain JSON-like values, finite numbers) are
-checked against mechbook.model.limits.
+checked against mechbook.model.input_limits.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from ruamel.yaml.error import MarkedYAMLError, YAMLError
 from mechbook.errors import SpecError
 from mechbook.model.fastyaml import fast_data
 from mechbook.model.hints import yaml_hint
-from mechbook.model.limits import (
+from mechbook.model.input_limits import (
     MAX_FILE_BYTES,
     check_events,
     check_scalar,
@@ -29,6 +29,8 @@ from mechbook.model.limits import (
 )
 
 Path_ = tuple[str | int, ...]
+# a YAML file's plain data: mappings, lists and scalars (what `Document.data` holds)
+Data = dict[str, "Data"] | list["Data"] | str | int | float | bool | None
 
 
 class Document:
@@ -37,14 +39,14 @@ class Document:
     A file read by libyaml (mechbook.model.fastyaml) has no line numbers of its own: the
     round-trip parser reads it again the first time an error needs a line."""
 
-    def __init__(self, raw: Any, file: str, data: Any = None, text: str | None = None):
+    def __init__(self, raw: object, file: str, data: Data = None, text: str | None = None):
         self._raw = raw
         self._text = text
         self.file = file
         self.data = self._plain(raw if text is None else data, ())
 
     @property
-    def raw(self) -> Any:
+    def raw(self) -> object:
         """The round-trip parser's nodes (with their lines), read on first use."""
         if self._raw is None and self._text is not None:
             try:
@@ -105,7 +107,7 @@ def _node_line(node: Any) -> int | None:
 
 def load(path: str | Path) -> Document:
     """Load a YAML file; syntax errors, duplicate keys and anything past the limits
-    (mechbook.model.limits) become SpecError with a line."""
+    (mechbook.model.input_limits) become SpecError with a line."""
     return loads(read_text(path), str(path))
 
 

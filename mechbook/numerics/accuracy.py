@@ -42,6 +42,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechbook.errors import MechbookError
+from mechbook.numerics.stiffness import IMPLICIT
+from mechbook.numerics.taylor import available
 
 BENCH_PERIODS = 3  # the bench integrates this many periods of the slowest linear mode
 SCIPY = ("RK45", "DOP853", "Radau", "LSODA")
@@ -177,8 +179,6 @@ def choose(accuracy: float, *, method: str | None = None, stiff: bool = False,
     `stiff` picks the implicit method when none is forced; `periods` is the run's length
     in periods of the slowest linear mode; `taylor_available` (default: whether heyoka
     imports) lets the taylor column compete."""
-    from mechbook.numerics.stiffness import IMPLICIT
-
     if not accuracy > 0 or not math.isfinite(accuracy):
         raise MechbookError(f"--accuracy must be a positive number, got {accuracy}")
     if method is not None and method not in ADAPTIVE:
@@ -188,8 +188,6 @@ def choose(accuracy: float, *, method: str | None = None, stiff: bool = False,
     if not TABLE:
         raise MechbookError("no accuracy table (run bench/work_precision.py)")
     if taylor_available is None:
-        from mechbook.numerics.taylor import available
-
         taylor_available = available()
     wanted = accuracy
     if periods and periods > BENCH_PERIODS:

@@ -2,7 +2,7 @@
 
 Why: solve_ivp(fun, ..., method="DOP853", events=...) spends its time stepping in Python
 (~100 µs a step against a few µs of arithmetic), while the compiled loop
-(mechbook.numerics.compiled.adaptive) takes the very same steps in C but knows nothing of
+(mechbook.numerics.c_stepping.adaptive) takes the very same steps in C but knows nothing of
 events. Here the loop records every step; the events are evaluated at the recorded steps
 with solve_ivp's rule for a sign change (find_active_events), and only a step in which one
 changes sign is taken again, by SciPy on `fun`: from the same state, with the same length
@@ -25,8 +25,8 @@ from types import SimpleNamespace
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from mechbook.numerics.compiled import adaptive
-from mechbook.numerics.native import NativeModel
+from mechbook.numerics.c_library import NativeModel
+from mechbook.numerics.c_stepping import adaptive
 
 ROWS = 4096  # steps recorded per call of the compiled loop (at most)
 FIRST_ROWS = 64  # the first call's record when a terminal event may end the run early

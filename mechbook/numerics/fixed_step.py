@@ -12,7 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from mechbook.numerics.integrator_base import Integrator, IntegratorError, Trajectory
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 MAX_STEPS = 10**10  # steps of one fixed-step run: far more than any run's time limit allows
 
@@ -55,8 +55,8 @@ class FixedStep(Integrator):
         return model.native_canonical if canonical else model.native
 
     def _run_native(self, nat, model, t_span, start, t_eval, **kw) -> Trajectory:
-        """The same run as `_run`, as one call into loops.c (`compiled.fixed`)."""
-        from mechbook.numerics import compiled as loops
+        """The same run as `_run`, as one call into loops.c (`c_stepping.fixed`)."""
+        from mechbook.numerics import c_stepping as loops
 
         steps, h = self._grid(t_span)
         t0 = float(t_span[0])

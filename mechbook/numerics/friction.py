@@ -30,9 +30,9 @@ from scipy.integrate import solve_ivp as scipy_solve_ivp
 
 from mechbook.core.compile import as_expr, compile_exprs
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.c_library import kernel_pointer
 from mechbook.numerics.events import ROWS, solve_with_events
 from mechbook.numerics.lapack import solve_small as _gesv
-from mechbook.numerics.native import kernel_pointer
 
 EPS = 1e-9  # a sliding speed this small (relative to the velocity scale) is a stop
 
@@ -67,7 +67,7 @@ def _same(a: float, b: float) -> bool:
 
 def _kernel(fn, x: np.ndarray, out: np.ndarray):
     """fn(x) into `out`, as a function of nothing: the LLVM machine code behind a SymEngine
-    Lambdify (mechbook.numerics.native.kernel_pointer) called through ctypes with the two
+    Lambdify (mechbook.numerics.c_library.kernel_pointer) called through ctypes with the two
     buffers' addresses (~0.3 µs against ~2 µs through Lambdify's own wrapper: the same
     code, the same numbers), else Lambdify writing into `out`; None for a backend that can
     do neither (then `fn`'s result is copied)."""
@@ -110,7 +110,7 @@ def _tangent_basis(n: np.ndarray) -> np.ndarray:
 class Phases:
     """A system with frictional contacts at fixed parameter values, integrated in phases.
 
-    `smooth`, the system's own compiled model (mechbook.numerics.model.build_model: every
+    `smooth`, the system's own compiled model (mechbook.numerics.rhs.build_model: every
     contact sliding, −μN·v_t/|v_t| in its forces), lets a phase in which every contact
     slides run in the compiled DOP853 loop (`_sliding`); the other phases, and the step in
     which an event happens, run in SciPy's DOP853 on this class's right-hand side."""

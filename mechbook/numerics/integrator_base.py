@@ -12,7 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from mechbook.errors import MechbookError
-from mechbook.numerics.model import Model, structure
+from mechbook.numerics.rhs import Model, structure
 
 
 class IntegratorError(MechbookError):

@@ -48,7 +48,7 @@ from mechbook.numerics.methods import (  # noqa: F401 - the names, re-exported
     kind,
     why_not,
 )
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 
 def make_integrator(method: str, **options) -> Integrator:

@@ -1,4 +1,4 @@
-/* mechbook's compiled stepping loops (built once per machine by mechbook/numerics/native.py).
+/* mechbook's compiled stepping loops (built once per machine by mechbook/numerics/c_library.py).
  *
  * The equations come in as a kernel: a function compiled by SymEngine's LLVM backend from the
  * engine's M(q, t) q'' = f(q, q', t) (plus A q'' + b = 0 with constraints), called as

@@ -20,7 +20,8 @@ from scipy.integrate import solve_ivp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.model import Model
+from mechbook.numerics import taylor
+from mechbook.numerics.rhs import Model
 
 MEASURE_RTOL = 1e-7
 TOLERANCE = 1e-12
@@ -158,8 +159,6 @@ def measure(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: float
 
 
 def _measure_taylor(model, fn, q0, qd0, time_scale, extremes, max_chunks) -> Measured:
-    from mechbook.numerics import taylor
-
     y0 = np.concatenate((q0, qd0))
     hits = taylor.turning_points(model, fn.exprs[1], y0, time_scale, extremes, TOLERANCE,
                                  max_chunks)
@@ -188,8 +187,6 @@ def first_event(model: Model, fn, q0: np.ndarray, qd0: np.ndarray, time_scale: f
     sign, integrating chunk by chunk (each half as long again as the last); with `method`
     "taylor" as a terminal heyoka event."""
     if method == "taylor":
-        from mechbook.numerics import taylor
-
         return taylor.first_crossing(model, fn.exprs[0], np.concatenate((q0, qd0)),
                                      time_scale, TOLERANCE, max_chunks)
     def event(t, y):

@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.numerics.integrator_base import Trajectory
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 
 def conserved_quantities(system, dyn) -> dict[str, sp.Expr]:

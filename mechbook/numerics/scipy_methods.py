@@ -29,7 +29,7 @@ class SciPyMethod(Integrator):
         nat = model.native if compiled and self.name in ("DOP853", "RK45") else None
         if nat is not None and not events and not opts.get("dense_output") \
                 and not opts.get("vectorized"):
-            from mechbook.numerics import compiled as loops
+            from mechbook.numerics import c_stepping as loops
 
             run = loops.adaptive(
                 nat, model.stats, self.name, t_span, y0, opts["rtol"], opts["atol"],

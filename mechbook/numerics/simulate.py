@@ -31,8 +31,8 @@ from mechbook.model.manifold import manifold_of
 from mechbook.numerics.accuracy import choose
 from mechbook.numerics.domain import check_start, within_domains
 from mechbook.numerics.integrators import SCIPY_METHODS, Trajectory, integrate
-from mechbook.numerics.model import DEFAULT_BACKEND, Model, build_model
 from mechbook.numerics.monitors import Drift, conserved_quantities, drifts
+from mechbook.numerics.rhs import DEFAULT_BACKEND, Model, build_model
 from mechbook.numerics.stiffness import IMPLICIT, Stiffness, assess, fixed_step_warning
 from mechbook.version import __version__
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 STIFF_RATIO = 30.0  # ω_max / ω_min from which a run counts as stiff
 STIFF_RADIANS = 1.0e3  # ... when ω_max · span is at least this (≈ 300 explicit steps)

@@ -21,10 +21,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-from mechbook.errors import UnsupportedError
+from mechbook.core.optional import require
+from mechbook.errors import MissingDependencyError, UnsupportedError
 from mechbook.numerics.hyexpr import Translator, solve_spd
 from mechbook.numerics.integrator_base import Integrator, IntegratorError, Trajectory
-from mechbook.numerics.model import Model
+from mechbook.numerics.rhs import Model
 
 DEFAULT_TOL = 2.0 ** -52  # heyoka's own default: machine epsilon
 COMPACT_OPS = 2000  # above this many SymPy operations, heyoka's compact mode (faster compile)
@@ -38,9 +39,6 @@ def available() -> bool:
 
 
 def _hy():
-    from mechbook.core.optional import require
-    from mechbook.errors import MissingDependencyError
-
     try:
         return require("heyoka", "taylor", "the Taylor method")
     except MissingDependencyError as exc:  # unsupported here: callers may go another way

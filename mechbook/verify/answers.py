@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mechbook.model.limits import check_answer_counts
+from mechbook.model.input_limits import check_answer_counts
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import load
 from mechbook.verify.part import AnswerKey, Part

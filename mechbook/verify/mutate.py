@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 
-from mechbook.model.expr import _split_single_equals
+from mechbook.model.expr import split_single_equals as _split_single_equals
 
 WORDS = ("stable", "unstable", "marginal")
 COUNTS = ("equilibrium_count", "mode_count", "secular_growth")  # integers that are counts

@@ -32,7 +32,7 @@ import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_mp, holds
 from mechbook.core.timeout import Timeout, time_limit
-from mechbook.model.expr import _split_single_equals
+from mechbook.model.expr import split_single_equals as _split_single_equals
 from mechbook.verify import boundary
 from mechbook.verify.compare import equal, vanishes
 from mechbook.verify.context import Context, split_named, strip_const

@@ -33,6 +33,7 @@ from mechbook.app.cli import (
 )
 from mechbook.app.cli.common import say, set_logging
 from mechbook.app.text import for_terminal
+from mechbook.errors import MechbookError
 from mechbook.version import __version__
 
 INTERRUPTED = 130  # the shell's convention for a command ended by Ctrl-C (128 + SIGINT)
@@ -44,8 +45,6 @@ class _Group(click.Group):
     stops them, mechbook.app.batch); a MechbookError no command caught is its message."""
 
     def invoke(self, ctx: click.Context):
-        from mechbook.errors import MechbookError
-
         try:
             return super().invoke(ctx)
         except KeyboardInterrupt:
@@ -70,6 +69,7 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
     ctx.ensure_object(dict)
     ctx.obj["root_opt"] = root_dir
     set_logging()
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.quiet import install
 
     install(lambda text: say(text, err=True))  # warnings as one-line notes, no traceback

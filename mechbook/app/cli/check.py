@@ -24,6 +24,7 @@ from mechbook.app.cli.common import (
     store_option,
     timeout_option,
 )
+from mechbook.app.text import json_safe
 from mechbook.errors import MechbookError
 
 
@@ -80,6 +81,7 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     frequency part's linear system is confirmed by simulating the nonlinear equations along
     every mode, and each system's Lagrange equations against Newton's law
     (docs/numerics.md); a cross-check fail also exits 1."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.batch import BatchOptions, settle
     from mechbook.app.run import RunOptions
     from mechbook.app.service import CheckOptions, CheckService
@@ -110,6 +112,7 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
 
 def _last_failed(store: Path, ids: list[str]) -> list[str]:
     """Of `ids`, those that failed when last checked; all of them when none did."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.selection import last_failed
 
     failed = last_failed(store)
@@ -124,6 +127,7 @@ def _last_failed(store: Path, ids: list[str]) -> list[str]:
 
 def _remember(report) -> None:
     """Record which problems failed now, for `--lf` (a note if it cannot be written)."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.formats import failures
     from mechbook.app.selection import lastfailed_path, record
 
@@ -150,6 +154,7 @@ def _refuse_serial_limits(ctx: click.Context, serial: bool) -> None:
 def _run(service, ids: list[str], verbose: bool):
     """The service's run with the progress on stderr (and, with -v, each problem's debug
     lines); a batch that cannot run at all is the command's error."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.console import Progress
 
     progress = Progress(len(ids), 0)
@@ -173,9 +178,9 @@ def _print(report, base: Path, fmt: str, verbose: bool, junit_path: Path | None)
     the exit status (1 on a fail, an error, or results that could not be written)."""
     import json
 
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.console import print_table
     from mechbook.app.formats import failures, to_json, write_junit
-    from mechbook.app.text import json_safe
 
     ordered = report.runs
     if fmt == "json":

@@ -17,8 +17,9 @@ from typing import Any
 import click
 
 from mechbook.app import options as opt
-from mechbook.app.limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.text import for_terminal
+from mechbook.core.backends import BACKENDS
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, root
 
@@ -61,6 +62,7 @@ def resolve_root(ctx: click.Context) -> Path:
 
 def in_tree(ctx: click.Context, path: Path) -> Path:
     """A path option as given when absolute, else relative to the tree's root."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.outputs import resolve_path
 
     return resolve_path(resolve_root(ctx), path)
@@ -69,6 +71,7 @@ def in_tree(ctx: click.Context, path: Path) -> Path:
 def checked_output(path: Path | None, what: str) -> Path | None:
     """An output path checked before any work: a regular file or nothing (a link is
     followed to its file); a plot's suffix must name a format."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.outputs import OutputError, output_file
 
     if path is None:
@@ -87,6 +90,7 @@ def numeric_text(key: str, arr, arrays: dict) -> str:
     """An array of results as text; frequencies with each unstable mode's growth rate
     instead of NaN (mechbook.engine.growth)."""
     if key.endswith("/frequencies"):
+        # at call time, not at the top: `mechbook --help` and `list` start without it
         from mechbook.engine.growth import describe
 
         return describe(list(arr), arrays.get(key.replace("/frequencies", "/growth_rates")))
@@ -191,7 +195,5 @@ def name_option(help: str) -> Decorator:
 
 def backend_option(help: str, default: str | None) -> Decorator:
     """--backend: the compile layer's backends (mechbook.core.backends owns the list)."""
-    from mechbook.core.backends import BACKENDS
-
     return click.option("--backend", type=click.Choice(list(BACKENDS)), default=default,
                         show_default=default is not None, help=help)

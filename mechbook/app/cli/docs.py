@@ -15,6 +15,7 @@ from mechbook.errors import MechbookError
 def command(page: str | None, show_path: bool) -> None:
     """List the documentation pages, or print PAGE (schema, answers, numerics, ...; the
     docs/*.md that --help and error messages name) as Markdown."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app import docs
 
     if show_path:

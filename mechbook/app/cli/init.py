@@ -16,6 +16,7 @@ from mechbook.errors import MechbookError
 def command(directory: str) -> None:
     """Start a tree of your own in DIRECTORY: books.yaml, an example problem and its answer
     key (which `mechbook check` passes), and a Makefile. Nothing is overwritten."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.init import init_tree
 
     try:

@@ -8,6 +8,7 @@ import click
 
 from mechbook.app.cli.common import resolve_root, say
 from mechbook.errors import MechbookError
+from mechbook.model.books import file_id_error
 from mechbook.model.catalog import all_ids, answer_path, problem_path
 
 
@@ -33,7 +34,7 @@ def command(ctx: click.Context) -> None:
 
 def _title(pid: str, base) -> tuple[str, int]:
     """The problem's title, or INVALID and why; and 1 if it is invalid."""
-    from mechbook.model.books import file_id_error
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.model.schema import validate
     from mechbook.model.yamlio import load
 
@@ -50,6 +51,7 @@ def _title(pid: str, base) -> tuple[str, int]:
 
 def _parts(pid: str, base) -> tuple[str, int]:
     """How many parts the answer key has (or that it has none, or is invalid)."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.model.yamlio import load
 
     try:

@@ -48,6 +48,7 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     store (`mechbook check` first): nothing the check derived is derived again. Pages are
     written as they finish and kept by content hash: a rerun rebuilds only what changed.
     Works offline."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.report.build import ReportOptions, build_report
     from mechbook.app.report.page import PageOptions
     from mechbook.app.service import resolve_ids

@@ -9,6 +9,7 @@ import click
 from mechbook.app.cli.common import say, store_option
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
+from mechbook.model.catalog import root
 
 
 @click.command("restore")
@@ -21,9 +22,9 @@ def command(ctx: click.Context, files: tuple[Path, ...], store_path: Path | None
     read-only or full disk, a directory at the store's path), once the cause is fixed.
     Without --store, each result goes to the store it was meant for, and only if that lies
     inside the tree; the whole file is checked before anything is written."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.outputs import resolve_path
     from mechbook.app.restore import restore as restore_file
-    from mechbook.model.catalog import root
 
     given = ctx.obj.get("root_opt")
     try:

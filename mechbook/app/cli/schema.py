@@ -25,6 +25,7 @@ def command(name: str | None, directory: Path | None) -> None:
 
     on the first line of problems/<book>/<n>.yaml (answers.json for answer keys,
     books.json for books.yaml); `mechbook init` does both for a new tree."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app import editor
 
     if (name is None) == (directory is None):

@@ -24,6 +24,7 @@ from mechbook.model.catalog import check_id
 @click.pass_context
 def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     """Print a problem's stored results and checks, read back from the HDF5 store."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.store import read
 
     path = in_tree(ctx, store_path)
@@ -41,7 +42,8 @@ def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
             f"{problem_id}` stores one)")
     for name in rec.get("simulations", []):
         say(f"simulation stored: /problems/{problem_id}/simulations/{name}")
-    from mechbook.app.sweep_io import stored_sweeps
+    # at call time, not at the top: `mechbook --help` and `list` start without it
+    from mechbook.app.sweep.storage import stored_sweeps
 
     for name, text in stored_sweeps(problem_id, path):  # a damaged entry is said so
         say(f"sweep stored: /sweeps/{problem_id}/{name}: {text}")

@@ -29,6 +29,7 @@ from mechbook.app.cli.common import (
 )
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
+from mechbook.model.catalog import check_id
 
 # an integrator option given on the command line, by the keyword the integrator takes
 TOLERANCES = {"rtol": "--rtol", "atol": "--atol", "max_step": "--max-step", "step": "--step"}
@@ -90,9 +91,9 @@ def command(ctx: click.Context, problem_id: str, system: str | None, method: str
     conserved quantity the engine found; store the trajectory (and plot it). The run has a
     time limit and a memory bound (a worker process stopped from outside when it exceeds
     either); exceeding one is reported with the stage the run was in, exit status 1."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.simrun import SimRequest, run_simulation
     from mechbook.app.store import check_run_name
-    from mechbook.model.catalog import check_id
 
     _refuse_what_does_not_apply(ctx, method, accuracy, serial)
     base = resolve_root(ctx)
@@ -128,6 +129,7 @@ def _refuse_what_does_not_apply(ctx: click.Context, method: str | None,
     """An option the run would drop silently is refused, saying why: a tolerance or step
     the method does not take (mechbook.numerics.methods.OPTIONS; no --method: DOP853 or
     Radau, SciPy's), --points for a fixed-step method, limits with --serial."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.numerics.methods import OPTIONS, kind, why_not
 
     if method is not None or accuracy is None:  # with --accuracy alone the method is chosen
@@ -151,6 +153,7 @@ def _refuse_what_does_not_apply(ctx: click.Context, method: str | None,
 
 def _store(report, name: str | None, path: Path) -> bool:
     """Write the run to the store; on failure keep it in a side file and say where."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.store import StoreError, write_simulation
     from mechbook.app.unsaved import SideFile
 

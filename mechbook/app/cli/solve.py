@@ -15,6 +15,7 @@ from mechbook.errors import MechbookError
 @click.pass_context
 def command(ctx: click.Context, problem_id: str, system: str | None, no_simplify: bool) -> None:
     """Derive and print a problem's results (what its `compute:` asks for), simplified."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.api import load
     from mechbook.engine.derive import declared_results, derive
 

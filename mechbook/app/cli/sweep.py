@@ -27,7 +27,7 @@ from mechbook.app.cli.common import (
     system_option,
     timeout_option,
 )
-from mechbook.app.sweep_spec import QUANTITIES
+from mechbook.app.sweep.spec import QUANTITIES
 from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.errors import MechbookError, message
 
@@ -79,6 +79,7 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
     values: derived once, M(p), C(p), K(p) compiled once, every point's eigenproblem solved
     in stacked batches; the float64 result is checked against 30 digits at sampled points
     and the book's answer at the same point is drawn over (and compared)."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.distributed import scheduler_address
     from mechbook.app.sweep import make_spec, run_sweep
 
@@ -105,7 +106,8 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
     run_name = name or "-".join([quantity] + [a.name for a in axes])
     failed = not _write(result, base, path, run_name, out_path, stored=not no_store)
     if plot_path is not None:
-        from mechbook.app.sweep_plot import plot_sweep
+        # at call time, not at the top: `mechbook --help` and `list` start without it
+        from mechbook.app.sweep.figures import plot_sweep
 
         say(f"plot written to {plot_sweep(result, plot_path)}")
     if failed:
@@ -114,9 +116,10 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
 
 def _axes(params: tuple[str, ...], memory_mb: float, name: str | None) -> list:
     """The swept axes, the grid's size and the run's name checked before any work."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.store import check_run_name
     from mechbook.app.sweep import check_grid
-    from mechbook.engine.sweep import parse_axis
+    from mechbook.engine.linear_grid import parse_axis
 
     try:
         axes = [parse_axis(p) for p in params]
@@ -157,9 +160,10 @@ def _write(result, base: Path, store: Path, run_name: str, out_path: Path | None
     """The summary printed, the sweep written to the netCDF file and (`stored`) the store;
     a sweep too large for the store goes to results/sweeps/ anyway. False if a write
     failed (the sweep is then kept where it can be)."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.store import StoreError
-    from mechbook.app.sweep_io import STORE_POINTS, write_netcdf, write_store
-    from mechbook.app.sweep_text import summary
+    from mechbook.app.sweep.storage import STORE_POINTS, write_netcdf, write_store
+    from mechbook.app.sweep.text_summary import summary
 
     for line in summary(result):
         say(line)
@@ -187,7 +191,8 @@ def _keep_sweep(result, store: Path, label: str) -> str:
     place that takes it (beside the store, the temporary directory, home)."""
     import tempfile
 
-    from mechbook.app.sweep_io import write_netcdf
+    # at call time, not at the top: `mechbook --help` and `list` start without it
+    from mechbook.app.sweep.storage import write_netcdf
 
     tried = []
     for place in (store.parent, Path(tempfile.gettempdir()), Path.home()):

@@ -16,6 +16,7 @@ from mechbook.errors import MechbookError
                 type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def command(files: tuple[Path, ...]) -> None:
     """Validate problem or answer files (schema and every expression); nothing runs."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.validate import validate_file
 
     bad = 0

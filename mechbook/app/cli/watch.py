@@ -17,6 +17,7 @@ from mechbook.app.cli.common import (
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import problem_path
+from mechbook.model.ids import split_id
 
 
 @click.command("watch")
@@ -36,9 +37,9 @@ def command(ctx: click.Context, problem_id: str, no_crosscheck: bool, timeout: f
     with the engine kept loaded (a save is answered in the time the check takes, a few
     tenths of a second for a small problem). Each check runs in a worker process under the
     limits of `mechbook check` (--timeout, --memory). Ctrl-C stops; nothing is stored."""
+    # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.watch import WatchOptions
     from mechbook.app.watch import watch as watch_problem
-    from mechbook.model.ids import split_id
 
     base = resolve_root(ctx)
     try:

@@ -21,8 +21,14 @@ from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
 
+from mechbook.app.batch import Batch, BatchOptions
+from mechbook.app.outputs import replaced
+from mechbook.app.quiet import warnings_as_notes
 from mechbook.app.report import cache
-from mechbook.app.report.page import PageOptions
+from mechbook.app.report.page import PageOptions, build_page
+from mechbook.app.report.progress import Progress
+from mechbook.app.store import StoreError, problems, read, vet
+from mechbook.app.text import unicode_safe
 from mechbook.errors import MechbookError, describe
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
@@ -70,7 +76,7 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
     declared = books(base)
     rows, problems_index = [], []
     for pid in ids:
-        entry = _index_entry(pid, (pages.get(pid) or {}).get("index") or {}, stored.get(pid),
+        entry = index_entry(pid, (pages.get(pid) or {}).get("index") or {}, stored.get(pid),
                              declared)
         problems_index.append(entry)
         rows.extend(entry["rows"])
@@ -90,9 +96,6 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
 
 def _build_pages(base, store, out, todo, keys, pages, stored, options: ReportOptions,
                  log) -> None:
-    from mechbook.app.batch import Batch, BatchOptions
-    from mechbook.app.report.progress import Progress
-
     order = sorted(todo, key=lambda pid: -_expected(pid, pages, stored))
     progress = Progress(len(order), log)
 
@@ -125,9 +128,6 @@ def _expected(pid: str, pages: dict, stored: dict) -> float:
 
 def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
     """Build one page and write it (in a worker); its entry for the index comes back."""
-    from mechbook.app.quiet import warnings_as_notes
-    from mechbook.app.report.page import build_page
-
     start = time.monotonic()
     stored, why = _read_one(pid, task.store)
     notes: list[str] = []
@@ -156,7 +156,7 @@ def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
              "parts": [{"part": p["part"], "quantity": p.get("quantity", ""),
                         "origin": p.get("origin", ""), "cite": p.get("cite", "")}
                        for p in page.get("parts", [])]}
-    entry = _index_entry(pid, index, stored, declared)
+    entry = index_entry(pid, index, stored, declared)
     render("problem.html", task.out / "problems" / f"{pid}.html", tree=base, page=page,
            stored=stored, entry=entry, version=__version__)
     return {"pid": pid, "index": index, "seconds": time.monotonic() - start}
@@ -173,14 +173,12 @@ def _write_failed(base: Path, out: Path, pid: str, stored: dict | None, why: str
             "conditions": [], "defaults": "", "systems": [], "parts": [],
             "crosscheck_figures": {},
             "page_notes": [f"this page could not be built: {why}"]}
-    entry = _index_entry(pid, {"title": page["title"]}, stored, books(base))
+    entry = index_entry(pid, {"title": page["title"]}, stored, books(base))
     render("problem.html", out / "problems" / f"{pid}.html", tree=base, page=page,
            stored=stored, entry=entry, version=__version__)
 
 
 def _read_one(pid: str, store: Path) -> tuple[dict | None, str | None]:
-    from mechbook.app.store import StoreError, read
-
     if not store.exists():
         return None, None
     try:
@@ -194,8 +192,6 @@ def _read_one(pid: str, store: Path) -> tuple[dict | None, str | None]:
 def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str, str]]:
     """The stored records of `ids`, and {id: why} for those the store has but cannot give
     back (damaged): the report says so and shows them as not checked."""
-    from mechbook.app.store import StoreError, problems, read, vet
-
     if not store.exists():
         return {}, {}
     vet(store)  # once for the whole file, not a child per record
@@ -216,7 +212,7 @@ def _stored(ids: list[str], store: Path, log) -> tuple[dict[str, dict], dict[str
     return stored, damaged
 
 
-def _index_entry(pid: str, index: dict, stored: dict | None, declared: dict) -> dict:
+def index_entry(pid: str, index: dict, stored: dict | None, declared: dict) -> dict:
     book = split_id(pid)[0]
     attrs = (stored or {}).get("attrs", {})
     title = index.get("title") or attrs.get("title", "")
@@ -267,8 +263,6 @@ def _copy_assets(dest: Path) -> None:
 
 def _write_file(path: Path, data: bytes) -> None:
     """A file of the report replaced whole by a new one (never written through a link)."""
-    from mechbook.app.outputs import replaced
-
     with replaced(path) as fh:
         fh.write(data)
 
@@ -320,9 +314,6 @@ def render(template: str, path: Path, tree: Path, **context) -> None:
     """Write a page atomically, with the tree's own paths made relative (`_unleak`); a
     string that cannot be UTF-8 (a lone surrogate from an old store) is written as an
     escape instead of ending the report."""
-    from mechbook.app.outputs import replaced
-    from mechbook.app.text import unicode_safe
-
     text = _unleak(_environment().get_template(template).render(**context), tree)
     with replaced(path) as fh:  # a new file renamed into place: never written through a link
         fh.write(unicode_safe(text).encode("utf-8"))

@@ -25,6 +25,8 @@ from pathlib import Path
 
 from mechbook.app.bounded import Unreadable, json_value, read_regular
 from mechbook.app.fingerprint import engine_sha256, file_sha256
+from mechbook.app.outputs import replaced
+from mechbook.app.text import json_safe
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import answer_path, problem_path
 
@@ -110,9 +112,6 @@ def _sound(entry) -> bool:
 
 def save(out: Path, pages: dict[str, dict]) -> None:
     """Write the manifest atomically (a new file renamed over it)."""
-    from mechbook.app.outputs import replaced
-    from mechbook.app.text import json_safe
-
     try:
         with replaced(out / MANIFEST) as fh:
             fh.write(json.dumps(json_safe({"format": FORMAT, "pages": pages}),

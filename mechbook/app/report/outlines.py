@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from mechbook.model.attitude import rotation_matrix
+
 ROUND = ("disk", "ring", "solid_cylinder", "solid_sphere", "spherical_shell")
 N = 24  # points of a circle
 
@@ -83,8 +85,6 @@ def _dims(sys, name: str, spec: dict, values: dict) -> tuple[str, dict] | None:
 def outline_specs(sys, names: list[str], values: dict) -> list[dict]:
     """For each body that can be drawn with an outline: {body index, lines (its own axes),
     turns (R to be compiled per frame, or None), triad (axes instead of a shape)}."""
-    from mechbook.model.attitude import rotation_matrix
-
     out = []
     bodies = sys.spec.get("rigid_bodies") or {}
     for name, spec in bodies.items():

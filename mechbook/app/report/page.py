@@ -29,12 +29,16 @@ import sympy as sp
 
 from mechbook.app.mathml import math
 from mechbook.app.report import svg
+from mechbook.app.report.answer_parts import parts
 from mechbook.app.report.derivation import StoredSystem
+from mechbook.app.report.systems import system_section
+from mechbook.app.report.values import point_math
 from mechbook.core.timeout import Timeout, hard_time_limit, time_limit
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError, describe
 from mechbook.model.catalog import answer_path, problem_path
 from mechbook.model.problem import load_problem
+from mechbook.verify.answers import load_answers
 
 LONGEST = 6000  # characters of SymPy text beyond which an expression is not typeset
 MAX_POINTS = 8  # equilibria shown per system
@@ -163,10 +167,6 @@ def _short(text: str) -> str:
 def build_page(pid: str, base: Path, stored: dict | None,
                options: PageOptions = PageOptions()) -> dict:
     """Everything the problem's page shows, as plain data (HTML fragments, numbers)."""
-    from mechbook.app.report.parts import parts
-    from mechbook.app.report.systems import system_section
-    from mechbook.app.report.values import point_math
-
     start = time.monotonic()
     page = Page(options, budget=options.simplify_budget)
     problem = load_problem(problem_path(pid, base))
@@ -209,6 +209,4 @@ def _coefficient(problem, name: str) -> bool:
 
 
 def _answers(path: Path):
-    from mechbook.verify.answers import load_answers
-
     return load_answers(path)

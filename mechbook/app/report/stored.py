@@ -12,12 +12,14 @@ symbol: the text is only shown.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.expr import CONSTANTS, FUNCTIONS, parse
+
+# what stored text reads back as: an expression, or lists and dicts of them
+Stored = sp.Basic | list["Stored"] | dict[sp.Basic, "Stored"]
 
 MAX_TEXT = 20_000  # characters of one stored result read back (longer: not typeset)
 
@@ -36,12 +38,12 @@ class _Names(dict):
         return sym
 
 
-def names_for(known: Mapping[str, Any]) -> _Names:
+def names_for(known: Mapping[str, sp.Basic]) -> _Names:
     """A name table for reading stored text: `known` (a system's names) first."""
     return _Names(known)
 
 
-def read(text: str, names: Mapping[str, Any]) -> Any:
+def read(text: str, names: Mapping[str, sp.Basic]) -> Stored:
     """The stored `text` as SymPy objects: an expression, or lists and dicts of them (a
     matrix is a list of rows). ExpressionError when it cannot be read (too long, or not
     what a check writes)."""
@@ -51,7 +53,7 @@ def read(text: str, names: Mapping[str, Any]) -> Any:
     return _read(text.strip(), table)
 
 
-def _read(text: str, names: _Names) -> Any:
+def _read(text: str, names: _Names) -> Stored:
     if text.startswith("[") and text.endswith("]") and _closes_at_end(text):
         return [_read(item, names) for item in _split(text[1:-1], ",")]
     if text.startswith("{") and text.endswith("}") and _closes_at_end(text):
@@ -107,7 +109,7 @@ def _partition(item: str) -> tuple[str, str, str]:
     raise ExpressionError(f"expected 'name: value' in {item[:60]!r}")
 
 
-def matrix(value: Any) -> sp.Matrix:
+def matrix(value: Stored) -> sp.Matrix:
     """A stored matrix (a list of rows) as a SymPy Matrix."""
     if isinstance(value, list) and value and all(isinstance(r, list) for r in value):
         return sp.Matrix(value)

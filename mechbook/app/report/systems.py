@@ -3,7 +3,7 @@
 The Lagrangian, T and V come with the system as it is built from its declarations;
 Lagrange's equations, the momenta and the energy function are the stored ones where the
 check derived them, else derived here under the step limit (they are cheap). The
-equilibria are those the check found or linearized about (mechbook.app.report.equilibria);
+equilibria are those the check found or linearized about (mechbook.app.report.equilibria_table);
 the simulation starts from the problem's `initial:` or near a stable one of them.
 """
 
@@ -15,9 +15,11 @@ import numpy as np
 import sympy as sp
 
 from mechbook.app.report import svg
+from mechbook.app.report.animation import frames
 from mechbook.app.report.derivation import StoredSystem
-from mechbook.app.report.equilibria import equilibria_rows
+from mechbook.app.report.equilibria_table import equilibria_rows
 from mechbook.app.report.stored import names_for
+from mechbook.numerics.simulate import FALLBACK_OFFSET, simulate
 
 
 def system_section(page, analysis, name: str, entry: dict | None, key) -> tuple:
@@ -96,9 +98,6 @@ def _cyclic(view: StoredSystem, dyn) -> dict:
 def _simulation(page, analysis, name: str, sys_, rows: list[dict]) -> dict | None:
     """A run from the system's `initial:`, or else at rest a little away from the first
     stable equilibrium of the table; the page says which (or why there is none)."""
-    from mechbook.app.report.animation import frames
-    from mechbook.numerics.simulate import FALLBACK_OFFSET, simulate
-
     opts = page.options
     init, source, seconds = None, "the problem's initial conditions", opts.simulate_seconds
     if not sys_.spec.get("initial"):

@@ -13,7 +13,7 @@ or both). Subjects:
                        change of expr along the motion (or how far q has moved by then),
                        measured by integration; the variable may enter only the start
     energy_of: name    with `initial:` and `over: motion`: a part's energy along the
-                       linearized motion (mechbook.engine.parts); its supremum (infimum)
+                       linearized motion (mechbook.engine.part_energy); its supremum (infimum)
                        over all later times, the maximum over the torus of mode phases
 
 The engine's extremum is located by mechbook.engine.extremum (a grid over the interval for
@@ -158,7 +158,7 @@ class _Subject:
     # ---- a measured subject (an event along the full motion) ---------------------------------
     def prepare_measured(self, pt: dict) -> None:
         from mechbook.numerics.measure import signal_functions
-        from mechbook.numerics.model import build_model
+        from mechbook.numerics.rhs import build_model
         from mechbook.verify.quantities.trajectory import _start
 
         ctx, sys = self.ctx, self.ctx.system

@@ -1,6 +1,6 @@
 """The energy of one part of a system along a motion: `part_energy`.
 
-The engine's side is mechbook.engine.parts: the part's kinetic and gravitational energy to
+The engine's side is mechbook.engine.part_energy: the part's kinetic and gravitational energy to
 second order about the equilibrium (counted from its value there), along the linearized
 initial-value solution from `initial:`, all at 40 digits. The helpers here (the start, the
 motion, the energy at a state) serve `extremum` too, whose `over: motion` is the supremum
@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import evaluate_mp
-from mechbook.engine.parts import LinearMotion, quadratic_part_energy
+from mechbook.engine.part_energy import LinearMotion, quadratic_part_energy
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 from mechbook.verify.registration import POINT, Family

@@ -24,7 +24,7 @@ from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.levelset import LevelSet
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict, match_multiset
 from mechbook.verify.context import Context, numbers

@@ -1,25 +1,24 @@
 """A store's records read whole and checked to be what mechbook writes, within bounds.
 
-Everything here reads within the bounds of mechbook.app.store_bounds (a small file can
+Everything here reads within the bounds of mechbook.app.store.bounds (a small file can
 declare gigabytes) and refuses what a check never writes: a record without the attributes a
 check always writes, an outcome that is not one, cross-checks of JSON that does not parse or
 nests too deep, members a record never holds. A file that is HDF5 but not a mechbook store,
 or of a newer store format, is refused with the reason (`refusal`), never judged damaged.
-The readers (mechbook.app.store_read), `damage` and the rebuild of a damaged store
-(mechbook.app.store_repair) all judge an entry by `check_entry`, so what `show` calls
+The readers (mechbook.app.store.reader), `damage` and the rebuild of a damaged store
+(mechbook.app.store.repair) all judge an entry by `check_entry`, so what `show` calls
 damaged is what the next write moves aside, and nothing else.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import h5py
 import numpy as np
 
 from mechbook.app.bounded import json_value
-from mechbook.app.store_bounds import (
+from mechbook.app.store.bounds import (
     Oversized,
     attribute,
     attributes,
@@ -29,7 +28,7 @@ from mechbook.app.store_bounds import (
     new_budget,
     walk,
 )
-from mechbook.records import Status
+from mechbook.records import CrossCheck, Status
 
 FORMAT = 1  # the store format this mechbook reads and writes (the root's `format` attribute)
 
@@ -47,7 +46,7 @@ class Damaged(ValueError):
     """A record that is not what a check writes (a missing attribute, an unknown outcome)."""
 
 
-def _reason(exc: BaseException) -> str:
+def reason_of(exc: BaseException) -> str:
     """What went wrong, in one line (OSError's text without its errno prefix)."""
     if isinstance(exc, OSError) and exc.strerror and not exc.filename:
         return exc.strerror
@@ -97,7 +96,7 @@ def _typed(attrs: dict, wanted: dict, where: str) -> None:
             raise Damaged(f"{where}: the attribute {key!r} is {attrs[key]!r}")
 
 
-def _read_problem(g, budget: list[int] | None = None) -> dict:
+def read_problem_entry(g, budget: list[int] | None = None) -> dict:
     """A problem's record, read whole (every attribute and dataset of it, within the
     bounds; its simulations only by name: each is read on its own) and checked to be what
     a check writes: Damaged, Oversized or HDF5's own errors otherwise."""
@@ -105,12 +104,12 @@ def _read_problem(g, budget: list[int] | None = None) -> dict:
     unknown = sorted(set(g) - set(_GROUPS))
     if unknown:
         raise Damaged(f"{g.name} holds {unknown[0]!r}, which a check never writes")
-    attrs = {k: _plain(v) for k, v in attributes(g, budget).items()}
+    attrs = {k: plain_value(v) for k, v in attributes(g, budget).items()}
     checked = any(k in attrs for k in _PROBLEM_ATTRS) or any(k in g for k in _GROUPS[:3])
     if checked:
         _typed(attrs, _PROBLEM_ATTRS, g.name)
     out = {"attrs": attrs, "systems": {}, "checks": [], "checked": checked}
-    systems = _member(g, "systems")
+    systems = subgroup(g, "systems")
     if systems:
         attributes(systems, budget)
     for sname in members(systems) if systems else ():
@@ -127,22 +126,22 @@ def _read_problem(g, budget: list[int] | None = None) -> dict:
                 attributes(obj, budget)
                 _collect(entry[kind], name, obj)
         out["systems"][sname] = entry
-    checks = _member(g, "checks")
+    checks = subgroup(g, "checks")
     if checks:
         attributes(checks, budget)
     for part in members(checks) if checks else ():
         c = _group(member(checks, part), f"the check of part {part}")
         if len(c):
             raise Damaged(f"{c.name} holds members, which a check never writes")
-        a = {k: _plain(v) for k, v in attributes(c, budget).items()}
+        a = {k: plain_value(v) for k, v in attributes(c, budget).items()}
         _typed(a, _CHECK_ATTRS, c.name)
         if a["status"] not in set(Status):
             raise Damaged(f"{c.name}: the status {a['status']!r} is not an outcome")
         out["checks"].append({"part": part, **a})
     out["checks"].sort(key=lambda c: c.get("index", 0) if isinstance(c.get("index", 0), int)
                        else 0)
-    out["crosschecks"] = _crosschecks(g, budget)
-    sims = _member(g, "simulations")
+    out["crosschecks"] = read_crosschecks(g, budget)
+    sims = subgroup(g, "simulations")
     if sims:
         attributes(sims, budget)
     out["simulations"] = sorted(members(sims)) if sims else []
@@ -151,11 +150,9 @@ def _read_problem(g, budget: list[int] | None = None) -> dict:
     return out
 
 
-def _crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dict]:
-    from mechbook.records import CrossCheck
-
+def read_crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dict]:
     out = []
-    group = _member(g, "crosschecks")
+    group = subgroup(g, "crosschecks")
     if group:
         attributes(group, budget)
     for key in members(group) if group else ():
@@ -164,7 +161,7 @@ def _crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dict]:
         x = _group(member(group, key), f"the cross-check {key}")
         if len(x):
             raise Damaged(f"{x.name} holds members, which a check never writes")
-        entry = {k: _plain(v) for k, v in attributes(x, budget).items()}
+        entry = {k: plain_value(v) for k, v in attributes(x, budget).items()}
         for k in ("parts", "modes"):
             if isinstance(entry.get(k), str):
                 try:
@@ -188,14 +185,14 @@ def _crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dict]:
     return [e for _, e in sorted(out, key=lambda x: x[0])]
 
 
-def _read_simulation(s, budget: list[int] | None = None) -> dict:
+def read_simulation_entry(s, budget: list[int] | None = None) -> dict:
     """A stored simulation, read whole within the bounds: its float arrays and their
     attributes (every other dataset and attribute read too, so damage anywhere shows)."""
     s = _group(s, f"the simulation {s.name}")
-    out = {"attrs": {k: _plain(v) for k, v in attributes(s, budget).items()}, "arrays": {},
+    out = {"attrs": {k: plain_value(v) for k, v in attributes(s, budget).items()}, "arrays": {},
            "array_attrs": {}}
     for key, obj in walk(s, budget):
-        attrs = {k: _plain(v) for k, v in attributes(obj, budget).items()}
+        attrs = {k: plain_value(v) for k, v in attributes(obj, budget).items()}
         if isinstance(obj, h5py.Dataset):
             value = dataset(obj)
             if obj.dtype.kind == "f":
@@ -204,7 +201,7 @@ def _read_simulation(s, budget: list[int] | None = None) -> dict:
     return out
 
 
-def _member(group: h5py.Group, name: str):
+def subgroup(group: h5py.Group, name: str):
     """group[name] (a group), {} if there is none; an entry that is listed but cannot be
     opened (h5py's `get` gives None for it, which reads as absent) raises: it is damage,
     not absence; so does a link that is not a plain one, and anything but a group."""
@@ -215,21 +212,21 @@ def _member(group: h5py.Group, name: str):
 def _read_all(group: h5py.Group, budget: list[int] | None = None) -> None:
     """Read every attribute, dataset and string under `group`, within the bounds (raises on
     damage, on anything oversized, and past `budget` objects)."""
-    _decoded(attributes(group, budget))
+    decoded(attributes(group, budget))
     for _, obj in walk(group, budget):
-        _decoded(attributes(obj, budget))
+        decoded(attributes(obj, budget))
         if isinstance(obj, h5py.Dataset):
-            _decoded(dataset(obj))
+            decoded(dataset(obj))
 
 
-def _decoded(v):
+def decoded(v):
     """A value read from HDF5 with its strings decoded (UnicodeDecodeError if damaged)."""
     if isinstance(v, bytes):
         return v.decode("utf-8")
     if isinstance(v, dict):
-        return {k: _decoded(x) for k, x in v.items()}
+        return {k: decoded(x) for k, x in v.items()}
     if isinstance(v, np.ndarray) and v.dtype.kind == "O":
-        return [_decoded(x) for x in v.ravel()]
+        return [decoded(x) for x in v.ravel()]
     return v
 
 
@@ -239,19 +236,19 @@ def check_entry(top: str, name: str | None, obj, budget: list[int] | None = None
     `damage` and the rebuild of a damaged store judge every entry by this, so that a record
     `show` or a check's cache would call damaged is never called sound."""
     if top == "problems" and name is not None:
-        _read_problem(obj, budget)
-        sims = _member(obj, "simulations")
+        read_problem_entry(obj, budget)
+        sims = subgroup(obj, "simulations")
         for sim in sims:
-            _read_simulation(member(sims, sim), budget)
+            read_simulation_entry(member(sims, sim), budget)
     elif top == "sweeps" and name is not None:
         attributes(_group(obj, f"the sweeps of {name}"), budget)
         for sweep in obj:
-            _read_sweep(member(obj, sweep), budget)
+            read_sweep_entry(member(obj, sweep), budget)
     elif isinstance(obj, h5py.Group):
         _read_all(obj, budget)
     else:
-        _decoded(attributes(obj, budget))
-        _decoded(dataset(obj))
+        decoded(attributes(obj, budget))
+        decoded(dataset(obj))
 
 
 def damage(path: str | Path) -> str | None:
@@ -260,18 +257,18 @@ def damage(path: str | Path) -> str | None:
     budget = new_budget()
     try:
         with h5py.File(path, "r") as f:
-            _decoded(attributes(f, budget))
+            decoded(attributes(f, budget))
             for top in f:
                 obj = member(f, top)
                 if top in ("problems", "sweeps"):
                     obj = _group(obj, f"/{top}")
                     for name in obj:
                         check_entry(top, name, member(obj, name), budget)
-                    _decoded(attributes(obj, budget))
+                    decoded(attributes(obj, budget))
                 else:
                     check_entry(top, None, obj, budget)
     except Exception as exc:  # noqa: BLE001 - any failure to read is damage, described
-        return _reason(exc)
+        return reason_of(exc)
     return None
 
 
@@ -279,10 +276,11 @@ def _collect(target: dict, name: str, obj) -> None:
     if isinstance(obj, h5py.Dataset):
         data = dataset(obj)
         target[name] = data.decode() if isinstance(data, bytes) else (
-            np.array(data) if obj.dtype.kind == "f" else _plain(data))
+            np.array(data) if obj.dtype.kind == "f" else plain_value(data))
 
 
-def _plain(v) -> Any:
+def plain_value(v: object) -> object:
+    """A value read from HDF5 as plain Python (bytes decoded, NumPy scalars as numbers)."""
     if isinstance(v, bytes):
         return v.decode()
     if isinstance(v, np.generic):
@@ -290,8 +288,8 @@ def _plain(v) -> Any:
     return v
 
 
-def _read_sweep(g, budget: list[int] | None = None) -> dict:
-    """A stored sweep, read whole within the store's bounds (mechbook.app.store_bounds);
+def read_sweep_entry(g, budget: list[int] | None = None) -> dict:
+    """A stored sweep, read whole within the store's bounds (mechbook.app.store.bounds);
     raises on damage."""
     if not isinstance(g, h5py.Group):
         raise ValueError(f"{g.name} is not a group")

@@ -4,11 +4,10 @@ the numbers at one admissible point (mechbook.app.report.values)."""
 from __future__ import annotations
 
 from mechbook.app.report.values import book_math, engine_value, numeric_pair
+from mechbook.verify.context import Context
 
 
 def parts(page, analysis, key, views: dict) -> list[dict]:
-    from mechbook.verify.context import Context
-
     values = analysis.problem.values()
     default = next(iter(analysis.problem.systems), None)
     rows = []

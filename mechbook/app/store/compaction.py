@@ -18,6 +18,8 @@ from typing import BinaryIO
 
 import h5py
 
+from mechbook.app.store.repair import copy_group
+
 _REFERENCES = ("DIMENSION_LIST", "REFERENCE_LIST")
 # HDF5 1.14.2 (h5py 3.10's wheels) crashes copying a group that tracks its members' order
 # and holds more than eight attributes (dense attribute storage): every stored problem.
@@ -35,10 +37,8 @@ def compact(image: BinaryIO, out: BinaryIO) -> None:
     Example: ``with open(old, "rb") as a, open(new, "w+b") as b: compact(a, b)``.
     """
     if h5py.version.hdf5_version_tuple < NATIVE_COPY_SINCE:
-        from mechbook.app.store_repair import _copy_group
-
         with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
-            _copy_group(src, dst)  # member by member in Python: slower, and safe there
+            copy_group(src, dst)  # member by member in Python: slower, and safe there
         return
     with h5py.File(image, "r") as src, h5py.File(out, "w") as dst:
         for key in src.attrs:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED, UNSTABLE
+from mechbook.engine.linear_grid import MARGINAL, STABLE, UNDEFINED, UNSTABLE
 
 COLORS = {STABLE: "#9ecae1", MARGINAL: "#fdd49e", UNSTABLE: "#fc9272", UNDEFINED: "#d9d9d9"}
 LABELS = {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable",

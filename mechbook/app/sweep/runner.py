@@ -2,7 +2,7 @@
 
 The problem is derived once and its linear system (about `--about`, a steady motion
 `--steady`, an answer part's point `--part`, or the stable equilibrium) compiled once with
-the parameters as arguments (mechbook.engine.sweep); the grid is cut into blocks, evaluated
+the parameters as arguments (mechbook.engine.linear_grid); the grid is cut into blocks, evaluated
 in this process, on a local process pool (`-j`), or on a Dask cluster (`--scheduler`,
 mechbook.app.distributed), and put back together in grid order. Quantities:
 
@@ -17,7 +17,7 @@ The float64 path is then checked against the 30-digit one at sampled points (ran
 and, for a stability map, ones beside the boundary) and the largest relative difference is
 reported; the book's answer at the same point (its stability condition, its frequencies),
 evaluated over the same grid, is kept beside the engine's for the plot and for a count of
-where they disagree (mechbook.app.sweep_book).
+where they disagree (mechbook.app.sweep.book_answer).
 """
 
 from __future__ import annotations
@@ -31,17 +31,26 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from mechbook.app.batch import deferred_interrupt, kill_pool, pool_context, start_server
+from mechbook.app.distributed import connect, dask_distributed, limited, materialize, use_scratch
 from mechbook.app.options import SWEEP_SAMPLES
-from mechbook.app.sweep_spec import (  # noqa: F401 - re-exported: a sweep's definition
+from mechbook.app.sweep.book_answer import book_overlay
+from mechbook.app.sweep.precision import sample_accuracy
+from mechbook.app.sweep.spec import (
     AMPLITUDE,
-    MAX_POINTS,
-    QUANTITIES,
     SweepSpec,
     check_grid,
-    make_spec,
 )
-from mechbook.engine.sweep import UNDEFINED, Grid
+from mechbook.crosscheck.amplitude import amplitude_response
+from mechbook.engine.analysis import Analysis
+from mechbook.engine.linear_grid import UNDEFINED, Grid, LinearSweep, condition_mask
+from mechbook.engine.state_sweep import StateSweep
 from mechbook.errors import InputError, MechbookError, NotFoundError
+from mechbook.model.catalog import answer_path, problem_path
+from mechbook.model.expr import parse
+from mechbook.model.problem import load_problem
+from mechbook.verify.answers import load_answers
+from mechbook.verify.context import Context
 
 BLOCK_ENTRIES = 4_000_000  # matrix entries evaluated per block (bounds a block's memory)
 DRIFT_BLOCK = 4  # points per block of a drift sweep (each point is a simulation per mode)
@@ -51,13 +60,6 @@ class Sweeper:
     """A sweep's derived and compiled state, built once per process."""
 
     def __init__(self, spec: SweepSpec, base: Path):
-        from mechbook.engine.analysis import Analysis
-        from mechbook.engine.state_sweep import StateSweep
-        from mechbook.engine.sweep import LinearSweep
-        from mechbook.model.catalog import answer_path, problem_path
-        from mechbook.model.problem import load_problem
-        from mechbook.verify.answers import load_answers
-
         self.spec = spec
         self.problem = load_problem(problem_path(spec.pid, base))
         self.analysis = Analysis(self.problem)
@@ -91,8 +93,6 @@ class Sweeper:
 
     def _linearize_at_part(self, fixed: dict, symbols: list) -> None:
         """--part: the part's system, point and values (its own symbols join the grid's)."""
-        from mechbook.verify.context import Context
-
         self.context = Context(self.analysis, self._part(self.spec.part))
         self.system = self.context.system
         self.lin = self.context.linear()
@@ -117,8 +117,6 @@ class Sweeper:
 
     def _point(self, pairs, what: str) -> dict:
         """{coordinate: value} from the option's NAME=EXPR pairs (the safe parser)."""
-        from mechbook.model.expr import parse
-
         names = dict(self.system.names)
         out = {}
         for name, text in pairs:
@@ -202,13 +200,9 @@ class Sweeper:
 
     def admissible(self, X: np.ndarray) -> np.ndarray:
         """Where the conditions hold, at rows of X (columns: `lin_symbols`)."""
-        from mechbook.engine.sweep import condition_mask
-
         return condition_mask(self.conditions, self.lin_symbols, X, self.spec.backend)
 
     def _drift(self, X: np.ndarray) -> dict[str, np.ndarray]:
-        from mechbook.crosscheck.amplitude import amplitude_response
-
         k, n = X.shape[0], self.modes
         linear = np.full((k, n), np.nan)
         measured = np.full((k, n), np.nan)
@@ -237,8 +231,6 @@ _SWEEPERS: dict[str, Sweeper] = {}  # per process: one sweeper per sweep (compil
 
 def block_of(spec: SweepSpec, start: int, stop: int) -> dict[str, np.ndarray]:
     """One block on whatever process runs it: derived and compiled on first use there."""
-    from mechbook.app.distributed import materialize
-
     if spec.key not in _SWEEPERS:
         _SWEEPERS[spec.key] = Sweeper(spec, materialize(dict(spec.files)))
     return _SWEEPERS[spec.key].block(start, stop)
@@ -247,8 +239,6 @@ def block_of(spec: SweepSpec, start: int, stop: int) -> dict[str, np.ndarray]:
 def cluster_block(spec: SweepSpec, start: int, stop: int, timeout: float,
                   memory_mb: float) -> dict[str, np.ndarray]:
     """A block on a Dask worker, inside that worker's limited child process."""
-    from mechbook.app.distributed import limited
-
     return limited(block_of, (spec, start, stop), timeout, memory_mb)
 
 
@@ -259,7 +249,7 @@ class SweepResult:
     arrays: dict[str, np.ndarray]
     dims: dict[str, tuple[str, ...]]
     attrs: dict = field(default_factory=dict)
-    book: dict = field(default_factory=dict)  # mechbook.app.sweep_book.BookOverlay fields
+    book: dict = field(default_factory=dict)  # mechbook.app.sweep.book_answer.BookOverlay fields
 
 
 def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None = None,
@@ -289,7 +279,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
         where = "this process"
     seconds = time.perf_counter() - t1
     arrays, dims = _assemble(sweeper, [parts[a] for a, _ in ranges])
-    from mechbook.app.sweep_accuracy import sample_accuracy
 
     t2 = time.perf_counter()
     accuracy = sample_accuracy(sweeper, arrays, samples)
@@ -306,7 +295,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
     if spec.part:
         attrs["part"] = spec.part
     result = SweepResult(spec, sweeper.grid.coords(), arrays, dims, attrs)
-    from mechbook.app.sweep_book import book_overlay
 
     result.book = book_overlay(sweeper, result)
     return result
@@ -315,8 +303,6 @@ def run_sweep(spec: SweepSpec, base: Path, jobs: int = 1, scheduler: str | None 
 def _on_cluster(spec: SweepSpec, ranges: list[tuple[int, int]], scheduler: str,
                 timeout: float, memory_mb: float, progress: Callable[[int, int], None]) -> dict:
     """Every block on the Dask cluster, each under the limits on its worker."""
-    from mechbook.app.distributed import connect, dask_distributed
-
     as_completed = dask_distributed().as_completed
     parts: dict[int, dict] = {}
     with connect(scheduler) as client:
@@ -334,11 +320,8 @@ def _on_local_processes(spec: SweepSpec, ranges: list[tuple[int, int]], jobs: in
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import util
 
-    from mechbook.app.batch import _context, deferred_interrupt, kill_pool, start_server
-    from mechbook.app.distributed import use_scratch
-
     parts: dict[int, dict] = {}
-    context = _context()
+    context = pool_context()
     start_server()
     with deferred_interrupt():  # its workers are started as the blocks are submitted
         pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=use_scratch,

@@ -12,9 +12,9 @@ from pathlib import Path
 import h5py
 
 from mechbook.app.fingerprint import engine_sha256
-from mechbook.app.store_bounds import attribute, attributes, member
-from mechbook.app.store_check import _crosschecks, _member, _plain, _reason, refusal
-from mechbook.app.store_read import DEFAULT_PATH, StoreError, guarded
+from mechbook.app.store.bounds import attribute, attributes, member
+from mechbook.app.store.entries import plain_value, read_crosschecks, reason_of, refusal, subgroup
+from mechbook.app.store.reader import DEFAULT_PATH, StoreError, guarded
 from mechbook.records import CrossCheck, Outcome
 
 log = logging.getLogger("mechbook.store")
@@ -34,7 +34,7 @@ def cached(wanted: dict[str, tuple[str, str]], path: str | Path = DEFAULT_PATH,
     """The stored results of the problems in `wanted` ({id: (problem sha256, answers
     sha256)}) whose problem file, answer key and engine are unchanged since they were
     stored (and, with `crosschecks`, that were cross-checked). One read of the file (in a
-    child while the file is not known sound: mechbook.app.store_guard). A record that
+    child while the file is not known sound: mechbook.app.store.child_read). A record that
     cannot be read is not a hit (the problem is checked again); a store that cannot be
     read gives no hits (its first write moves it aside and rebuilds it)."""
     try:
@@ -54,18 +54,18 @@ def _cached(wanted: dict[str, tuple[str, str]], path: Path, crosschecks: bool,
         with h5py.File(path, "r") as f:
             if refusal(f) is not None:  # not a store of ours: no hits (its write is refused)
                 return {}
-            root = _member(f, "problems")
+            root = subgroup(f, "problems")
             for pid, shas in wanted.items():
                 try:
                     hit = _cached_one(root, pid, shas, engine, crosschecks)
                 except Exception as exc:  # noqa: BLE001 - damaged: check it again
                     log.debug("stored record of %s in %s unreadable: %s", pid, path,
-                              _reason(exc))
+                              reason_of(exc))
                     continue
                 if hit is not None:
                     out[pid] = hit
     except Exception as exc:  # noqa: BLE001 - a damaged store: no hits
-        log.debug("store %s unreadable: %s", path, _reason(exc))
+        log.debug("store %s unreadable: %s", path, reason_of(exc))
         return {}
     return out
 
@@ -75,11 +75,11 @@ def _cached_one(root, pid: str, shas: tuple[str, str], engine: str,
     if pid not in root:
         return None
     g = member(root, pid)
-    a = {k: _plain(v) for k, v in attributes(g).items()}
+    a = {k: plain_value(v) for k, v in attributes(g).items()}
     if (a.get("problem_sha256"), a.get("answers_sha256"), a.get("engine_sha256")) != \
             (*shas, engine):
         return None
-    crossed = [CrossCheck.from_dict(d) for d in _crosschecks(g)]
+    crossed = [CrossCheck.from_dict(d) for d in read_crosschecks(g)]
     if crosschecks and not crossed:
         return None
     return Cached(_outcomes(pid, g), crossed if crosschecks else [],
@@ -104,7 +104,7 @@ def _durations(path: Path) -> dict[str, float]:
         with h5py.File(path, "r") as f:
             if refusal(f) is not None:
                 return out
-            root = _member(f, "problems")
+            root = subgroup(f, "problems")
             for pid in root:
                 try:
                     g = member(root, pid)
@@ -120,9 +120,9 @@ def _durations(path: Path) -> dict[str, float]:
 def _outcomes(pid: str, g: h5py.Group) -> list[Outcome]:
     fields = ("quantity", "cite", "status", "method", "detail", "seconds", "origin", "power")
     rows = []
-    checks = _member(g, "checks")
+    checks = subgroup(g, "checks")
     for part in checks:
-        a = {k: _plain(v) for k, v in attributes(member(checks, part)).items()}
+        a = {k: plain_value(v) for k, v in attributes(member(checks, part)).items()}
         rows.append((a.get("index", 0), Outcome(pid, part, **{k: a[k] for k in fields
                                                               if k in a})))
     return [o for _, o in sorted(rows, key=lambda r: r[0])]

@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mechbook.numerics.native import NativeModel, address
+from mechbook.numerics.c_library import NativeModel, address
 
 BIG = 2**62  # "no budget" for the evaluation limit
 FIXED_CODES = {0: "", 1: "non-finite", 2: "budget", 3: "newton"}

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechbook.app.sweep import AMPLITUDE, SweepResult
-from mechbook.engine.sweep import STABILITY_NAMES, UNDEFINED
+from mechbook.app.sweep.runner import SweepResult
+from mechbook.app.sweep.spec import AMPLITUDE
+from mechbook.engine.linear_grid import STABILITY_NAMES, UNDEFINED
 
 
 def summary(result: SweepResult) -> list[str]:

@@ -1,7 +1,7 @@
 """The equilibria table of a system's section, from what the check found and linearized.
 
 Rows: the closed-form equilibria the check's SymPy search returned (those that exist at
-the default values: real and inside the coordinates' domains, mechbook.engine.domains)
+the default values: real and inside the coordinates' domains, mechbook.engine.existence)
 and every other point the check linearized about. For a point with a stored linear system
 the row gives, at the default values: stability, each mode's frequency or, for a mode that
 grows, its rate (mechbook.engine.growth), and the mode shapes as a matrix (columns,
@@ -18,7 +18,7 @@ import sympy as sp
 from mechbook.app.mathml import math
 from mechbook.app.report.derivation import StoredSystem, same_point
 from mechbook.core.numeval import NotNumeric, evaluate
-from mechbook.engine.domains import existing
+from mechbook.engine.existence import existing
 from mechbook.engine.growth import growth_rates
 from mechbook.engine.linear import classify_matrices
 from mechbook.engine.state_space import classify_exponents

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechbook.app.options import SWEEP_SAMPLES
-from mechbook.engine.sweep import UNDEFINED
+from mechbook.engine.linear_grid import UNDEFINED
 
 
 def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SWEEP_SAMPLES,

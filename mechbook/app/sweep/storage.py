@@ -21,6 +21,21 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from mechbook.app.outputs import OutputError, output_file, replaced
+from mechbook.app.store import (
+    StoreError,
+    atomic_edit,
+    attributes,
+    bounded_text,
+    check_run_name,
+    member,
+    names_in,
+    opened,
+    read_sweep_entry,
+    reason_of,
+    refusal,
+    there,
+)
 from mechbook.errors import NotFoundError
 from mechbook.version import __version__
 
@@ -55,23 +70,18 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        from mechbook.app.store import _text
-
-        return _text(v)
+        return bounded_text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    from mechbook.app.store import _text
 
-    return _text(json.dumps(v, default=float), cut=False)
+    return bounded_text(json.dumps(v, default=float), cut=False)
 
 
 def write_store(result, name: str, path: str | Path) -> Path:
     """Add (or replace) the sweep at /sweeps/<id>/<name> of the store, atomically."""
-    from mechbook.app.store import _atomic_edit
-
     _check_name(name)
     coords, vars_, attrs = variables(result)
-    with _atomic_edit(path) as f:
+    with atomic_edit(path) as f:
         root = f.require_group("sweeps").require_group(result.spec.pid)
         if name in root:
             del root[name]
@@ -95,31 +105,25 @@ def read_store(pid: str, name: str, path: str | Path) -> dict:
     """{"attrs": {...}, "coords": {...}, "variables": {name: (dims, array)}}; NotFoundError
     (also a KeyError) naming the problem's stored sweeps if it is absent, StoreError naming
     what is damaged."""
-    from mechbook.app.store_check import _read_sweep
-    from mechbook.app.store_read import StoreError, _names, _opened, _reason, there
-
-    with _opened(path) as f:
+    with opened(path) as f:
         try:
             g = f["sweeps"][pid][name]
         except KeyError:
-            stored = there(name, _names(f, "sweeps", pid), "sweep")
+            stored = there(name, names_in(f, "sweeps", pid), "sweep")
             raise NotFoundError(f"no sweep {name!r} of {pid} in {path} ({stored})") from None
         except Exception as exc:  # noqa: BLE001 - a damaged listing, described
-            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
+            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({reason_of(exc)})",
                              "read") from None
         try:
-            return _read_sweep(g)
+            return read_sweep_entry(g)
         except Exception as exc:  # noqa: BLE001 - damage inside the sweep, described
-            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({_reason(exc)})",
+            raise StoreError(path, f"the sweep {name} of {pid} is damaged ({reason_of(exc)})",
                              "read") from None
 
 
 def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
     """(name, one-line description) of a problem's stored sweeps (a damaged entry is one
     line that says so)."""
-    from mechbook.app.store_bounds import attributes, member
-    from mechbook.app.store_read import _reason, refusal
-
     out = []
     try:
         with h5py.File(path, "r") as f:
@@ -132,13 +136,13 @@ def stored_sweeps(pid: str, path: str | Path) -> list[tuple[str, str]]:
                     a = {k: (v.decode() if isinstance(v, bytes) else v)
                          for k, v in attributes(g).items()}
                 except Exception as exc:  # noqa: BLE001 - one damaged entry, said so
-                    out.append((name, f"damaged ({_reason(exc)})"))
+                    out.append((name, f"damaged ({reason_of(exc)})"))
                     continue
                 where = f" in {a['file']}" if a.get("file") else ""
                 out.append((name, f"{a.get('quantity')} over {a.get('axes')} about "
                                   f"{a.get('point')}{where}"))
     except Exception as exc:  # noqa: BLE001 - the store itself unreadable: said so
-        out.append(("?", f"the sweeps cannot be read ({_reason(exc)})"))
+        out.append(("?", f"the sweeps cannot be read ({reason_of(exc)})"))
     return out
 
 
@@ -146,8 +150,6 @@ def write_netcdf(result, path: str | Path) -> Path:
     """The sweep as a netCDF-4 file, replacing a regular file (or nothing) at `path` whole
     (mechbook.app.outputs); OutputError with the path and the reason if it cannot be."""
     import h5netcdf
-
-    from mechbook.app.outputs import OutputError, output_file, replaced
 
     path = Path(path)
     real = output_file(path, "netCDF file")
@@ -179,6 +181,4 @@ def read_netcdf(path: str | Path) -> dict:
 
 
 def _check_name(name: str) -> None:
-    from mechbook.app.store import check_run_name
-
     check_run_name(name, "sweep")

@@ -39,7 +39,9 @@ MAX_OBJECTS = 200_000  # groups, datasets and attributes walked in one store (a 
 # of the book stores about 14,000)
 MAX_MEMBERS = 10_000  # members of one group inside a record (a check writes a few hundred)
 MAX_DEPTH = 24  # nesting of groups (mechbook's deepest is about 9)
-_SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
+SCALE_ATTRS = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS"}
+# what a bounded read gives: an array, or one number, string or bytes (HDF5's scalars)
+Value = np.ndarray | np.generic | str | bytes | int | float | bool
 _NUMERIC = "fiub"  # float, signed and unsigned integers, booleans (an HDF5 enum)
 
 
@@ -76,7 +78,7 @@ def _check(what, shape, dtype: np.dtype, limit: int) -> bool:
     return False
 
 
-def dataset(d: h5py.Dataset) -> Any:
+def dataset(d: h5py.Dataset) -> Value:
     """The value of `d`, read only within the bounds (Oversized otherwise)."""
     def what() -> str:
         return f"the dataset {d.name}"
@@ -107,7 +109,7 @@ def _text(what, value: Any, limit: int = MAX_TEXT_BYTES) -> Any:
     return value
 
 
-def attribute(obj, name: str, attrs=None) -> Any:
+def attribute(obj, name: str, attrs=None) -> Value:
     """The attribute `name` of `obj`, read only within the bounds (Oversized otherwise);
     `attrs`: obj.attrs, where the caller has it already."""
     attrs = obj.attrs if attrs is None else attrs
@@ -133,7 +135,7 @@ def attribute(obj, name: str, attrs=None) -> Any:
     return value[()] if value.ndim == 0 else value
 
 
-def attributes(obj, budget: list[int] | None = None) -> dict[str, Any]:
+def attributes(obj, budget: list[int] | None = None) -> dict[str, Value]:
     """Every attribute of `obj` but the dimension scales' bookkeeping, each read within
     the bounds; `budget` ([objects left]) counts them against a walk's bound."""
     attrs = obj.attrs
@@ -141,7 +143,7 @@ def attributes(obj, budget: list[int] | None = None) -> dict[str, Any]:
     for name in attrs:
         if budget is not None:
             spend(budget, obj)
-        if name not in _SCALE_ATTRS:
+        if name not in SCALE_ATTRS:
             out[name] = attribute(obj, name, attrs)
     return out
 
@@ -164,7 +166,7 @@ def member(group: h5py.Group, name: str):
 
 
 def walk(group: h5py.Group, budget: list[int] | None = None, prefix: str = "",
-         level: int = 0) -> Iterator[tuple[str, Any]]:
+         level: int = 0) -> Iterator[tuple[str, h5py.Group | h5py.Dataset]]:
     """(relative name, object) of everything under `group`, parents first, by the groups'
     own listings (HDF5's visititems walks the metadata another way and fails on damage
     that leaves every member readable); bounded in depth and, with `budget`, in count."""

@@ -31,6 +31,7 @@ GUARD_CPU_PER_MB = 2.0    # whole in about 3 s; a file that loops takes this lon
 _SOUND: dict[str, tuple] = {}  # path -> signature of the version last found (or made) sound
 _ENDED: dict[str, tuple] = {}  # path -> signature of a version a child did not come back from
 F = TypeVar("F", bound=Callable[..., Any])
+R = TypeVar("R")
 
 
 class ChildEnded(Exception):
@@ -68,7 +69,7 @@ def cpu_limit(path: str | Path) -> float:
     return GUARD_CPU_SECONDS + GUARD_CPU_PER_MB * (sig[2] if sig else 0) / 2**20
 
 
-def in_child(path: str | Path, fn: Callable[..., Any], *args, **kwargs) -> Any:
+def in_child(path: str | Path, fn: Callable[..., R], *args, **kwargs) -> R:
     """fn(*args, **kwargs) computed in a forked child whose CPU time is bounded
     (`cpu_limit`); its result, or the exception it raised; ChildEnded when the limit ended
     it, or at once when a child already did not come back from this version of the file."""

@@ -25,7 +25,7 @@ A write edits a copy of the current file and renames it over the original, so an
 interrupted run leaves the previous file whole and readable (mechbook.app.outputs: the new
 file is anonymous until an instant before the rename, so a killed run leaves no temporary
 file). A single write edits the copy in memory and writes it anew with only what it holds
-(mechbook.app.store_compact: HDF5 keeps the space of a replaced group); a check writes each
+(mechbook.app.store.compaction: HDF5 keeps the space of a replaced group); a check writes each
 problem as it finishes without that and compacts once at its end, so a store's size depends
 on its contents, not on how many runs wrote it. Rewriting a problem's checks keeps its
 stored simulations; storing a simulation replaces only that simulation.
@@ -38,10 +38,11 @@ it is moved aside to `<name>.damaged-<time>`, rebuilt from every problem, simula
 sweep that can still be read whole, and a warning says what was kept and what was lost.
 Readers (`show`, `report`) raise StoreError naming what is damaged.
 
-The modules beside this one: store_read (reading, StoreError), store_check (records read
-whole and checked, `damage`), store_bounds (every read bounded), store_cache (the warm-run
-cache and durations), store_repair (rebuilding a damaged file). Their public names are
-importable from here too.
+The modules beside this one: reader (reading, StoreError), entries (records read whole and
+checked, `damage`), bounds (every read bounded), warm_cache (the warm-run cache and
+durations), repair (a damaged store moved aside and rebuilt), compaction (a store written
+anew), child_read (a store not yet found sound read in a child). The package's __init__
+exposes their public names.
 """
 
 from __future__ import annotations
@@ -49,7 +50,6 @@ from __future__ import annotations
 import fcntl
 import io
 import json
-import logging
 import os
 import re
 from collections.abc import Iterable, Iterator
@@ -65,37 +65,21 @@ import numpy as np
 
 from mechbook.app.fingerprint import engine_sha256
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
-from mechbook.app.store_bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
-from mechbook.app.store_cache import Cached, cached, durations  # noqa: F401 - re-exported
-from mechbook.app.store_compact import compact
-from mechbook.app.store_guard import ChildEnded, in_child, is_sound, mark_sound
-from mechbook.app.store_read import (  # noqa: F401 - re-exported: the store's readers
-    FORMAT,
-    StoreError,
-    _opened,
-    _reason,
-    damage,
-    hang_reason,
-    problems,
-    read,
-    read_simulation,
-    refusal,
-    vet,
-)
-from mechbook.app.store_repair import _salvage
+from mechbook.app.store.bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
+from mechbook.app.store.child_read import mark_sound
+from mechbook.app.store.compaction import compact
+from mechbook.app.store.entries import FORMAT, reason_of
+from mechbook.app.store.reader import DEFAULT_PATH, StoreError
+from mechbook.app.store.repair import ensure_sound
 from mechbook.app.text import storable
 from mechbook.errors import MechbookError
-from mechbook.model.catalog import DEFAULT_STORE
 from mechbook.records import Outcome, Results
 from mechbook.version import __version__
 
 if TYPE_CHECKING:
     from mechbook.model.problem import Problem
 
-DEFAULT_PATH = DEFAULT_STORE
 _STR = h5py.string_dtype("utf-8")
-log = logging.getLogger("mechbook.store")
-DAMAGED = ".damaged-"  # a damaged store is moved aside to <name>.damaged-<UTC time>
 _RUN_NAME = re.compile(r"[A-Za-z0-9_+-][A-Za-z0-9._+-]{0,99}")
 
 
@@ -129,7 +113,7 @@ def write(records: Iterable[ProblemRecord], path: str | Path = DEFAULT_PATH,
     leaves the space of what was replaced in the file (a run writing problem after problem
     compacts once, at its end: `compact_store`)."""
     records = list(records)
-    with _atomic_edit(path, compacted) as f:
+    with atomic_edit(path, compacted) as f:
         root = f.require_group("problems")
         for rec in records:
             _write_problem(root, rec)
@@ -151,15 +135,15 @@ def _locked(directory: Path) -> Iterator[None]:
 
 
 def compact_store(path: str | Path = DEFAULT_PATH) -> None:
-    """Write the store anew with only what it holds (mechbook.app.store_compact), atomically;
+    """Write the store anew with only what it holds (mechbook.app.store.compaction), atomically;
     StoreError as for `write`."""
     if Path(path).exists():
-        with _atomic_edit(path):
+        with atomic_edit(path):
             pass
 
 
 @contextmanager
-def _atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File]:
+def atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File]:
     """An open copy of the store (or a new file) that replaces `path` only on success,
     written anew with only what it holds when `compacted`. Every failure, whatever raised
     it (the file system, HDF5), is a StoreError."""
@@ -174,7 +158,7 @@ def _atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File
         with _locked(real.parent):
             remove_stale(real)  # what a writer killed mid-write left (we hold the lock)
             if real.exists():
-                _ensure_sound(real, shown)
+                ensure_sound(real, shown)
             with replaced(real, copy=not compacted) as fh:
                 image = fh if not compacted else \
                     io.BytesIO(real.read_bytes() if real.exists() else b"")
@@ -190,66 +174,7 @@ def _atomic_edit(path: str | Path, compacted: bool = True) -> Iterator[h5py.File
     except Exception as exc:  # noqa: BLE001 - every way a write fails is reported as one
         if entered and not isinstance(exc, OSError | RuntimeError | ValueError | TypeError):
             raise  # the caller's own fault, raised inside the edit: not the store's
-        raise StoreError(shown, _reason(exc)) from exc
-
-
-# ---- a damaged store: detected before an edit, moved aside, rebuilt --------------------------
-def _foreign(path: Path) -> str | None:
-    """Why the file at `path` is not a store this mechbook may write (HDF5 made by
-    something else, a newer store format), or None (a store of ours, or not HDF5 at all:
-    then it is damage, judged by `damage`)."""
-    try:
-        f = h5py.File(path, "r")
-    except Exception:  # noqa: BLE001 - not readable as HDF5: damage
-        return None
-    with f:
-        return refusal(f)
-
-
-def _ensure_sound(path: Path, shown: Path) -> None:
-    """Before an edit: a damaged store is moved aside and rebuilt from what still reads; a
-    file that is not a store of this mechbook's format is refused (StoreError), whole. The
-    file is read in a child under a CPU limit (mechbook.app.store_guard): HDF5 loops for
-    ever on some damage, and a file it does not come back from is moved aside unread."""
-    if is_sound(path):
-        return
-    try:
-        foreign = in_child(path, _foreign, path)
-        why = None if foreign is not None else in_child(path, damage, path)
-    except ChildEnded as end:
-        foreign, why = None, hang_reason(end.seconds)
-    if foreign is not None:
-        raise StoreError(shown, foreign)
-    if why is None:
-        mark_sound(path)
-        return
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S.%fZ")
-    aside = path.with_name(f"{path.name}{DAMAGED}{stamp}")
-    with replaced(path) as fh:  # the rebuilt store
-        try:
-            kept, lost = in_child(path, _rebuilt_into, path, fh)
-        except ChildEnded:
-            kept, lost = [], ["everything (HDF5 did not come back from reading it)"]
-            fh.seek(0)
-            fh.truncate()
-            with h5py.File(fh, "w") as out:
-                out.attrs["format"] = FORMAT
-        os.link(path, aside)  # the damaged file stays whole beside the new one
-    mark_sound(path)
-    lost_text = f"; could not read (lost here, kept in the damaged file): {', '.join(lost)}" \
-        if lost else ""
-    log.warning("the store %s was damaged (%s): moved aside to %s and rebuilt with the %d "
-                "entries that could still be read%s", shown, why, aside, len(kept), lost_text)
-
-
-def _rebuilt_into(path: Path, fh) -> tuple[list[str], list[str]]:
-    """In the child: the store rebuilt from what of `path` still reads, written into `fh`
-    (the parent's new file, shared across the fork); ([kept], [lost])."""
-    with h5py.File(fh, "w") as out:
-        out.attrs["format"] = FORMAT
-        kept, lost = _salvage(path, out)
-    fh.flush()
-    return kept, lost
+        raise StoreError(shown, reason_of(exc)) from exc
 
 
 def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
@@ -263,7 +188,7 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     if kept in root:
         root.move(kept, f"{pid}/simulations")
     g.attrs.update({
-        "title": _text(rec.title), "source": _text(rec.source),
+        "title": bounded_text(rec.title), "source": bounded_text(rec.source),
         "problem_sha256": rec.problem_sha256, "answers_sha256": rec.answers_sha256,
         "engine_sha256": engine_sha256(), "mechbook": __version__,
         "sympy": version("sympy"), "numpy": np.__version__, "h5py": h5py.__version__,
@@ -273,18 +198,18 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
     for res in rec.results:
         s = g.require_group("systems").create_group(res.system, track_order=True)
         for key, text in res.text.items():
-            s.create_dataset(f"symbolic/{key}", data=_text(text, MAX_TEXT_BYTES), dtype=_STR)
+            s.create_dataset(f"symbolic/{key}", data=bounded_text(text, MAX_TEXT_BYTES), dtype=_STR)
         for key, arr in res.arrays.items():
             s.create_dataset(f"numeric/{key}", data=np.asarray(arr, dtype=float))
         for key, text in res.notes.items():
-            s.create_dataset(f"notes/{key}", data=_text(text, MAX_TEXT_BYTES), dtype=_STR)
+            s.create_dataset(f"notes/{key}", data=bounded_text(text, MAX_TEXT_BYTES), dtype=_STR)
     checks = g.create_group("checks")
     for i, o in enumerate(rec.outcomes):
         c = checks.create_group(o.part)
         c.attrs.update({"index": i, "origin": o.origin, "quantity": o.quantity,
-                        "cite": _text(o.cite), "status": str(o.status),
-                        "method": _text(o.method), "detail": _text(o.detail),
-                        "seconds": float(o.seconds), "power": _text(o.power)})
+                        "cite": bounded_text(o.cite), "status": str(o.status),
+                        "method": bounded_text(o.method), "detail": bounded_text(o.detail),
+                        "seconds": float(o.seconds), "power": bounded_text(o.power)})
     if rec.crosschecks:
         cross = g.create_group("crosschecks", track_order=True)
         for i, x in enumerate(rec.crosschecks):
@@ -308,7 +233,7 @@ def write_simulation(pid: str, name: str, arrays: dict[str, np.ndarray], attrs: 
     """Store one simulation at /problems/<pid>/simulations/<name>, replacing only it,
     atomically (the rest of the file, checks included, is kept as it was)."""
     check_run_name(name, "simulation")
-    with _atomic_edit(path) as f:
+    with atomic_edit(path) as f:
         sims = f.require_group("problems").require_group(pid).require_group("simulations")
         if name in sims:
             del sims[name]
@@ -355,15 +280,15 @@ def _attr(v):
     if v is None:
         return ""
     if isinstance(v, str):
-        return _text(v)
+        return bounded_text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    return _text(json.dumps(v), cut=False)
+    return bounded_text(json.dumps(v), cut=False)
 
 
-def _text(text: str, limit: int = MAX_ATTRIBUTE_BYTES, cut: bool = True) -> str:
+def bounded_text(text: str, limit: int = MAX_ATTRIBUTE_BYTES, cut: bool = True) -> str:
     """`text` as the store holds it (mechbook.app.text.storable) and as its readers will
-    read it back: no longer than their bound (mechbook.app.store_bounds), cut with a note
+    read it back: no longer than their bound (mechbook.app.store.bounds), cut with a note
     if it is longer (a title or an error's detail of megabytes), or, for JSON that cutting
     would break (`cut` False), a ValueError."""
     text = storable(str(text))

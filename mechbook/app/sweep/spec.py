@@ -14,7 +14,7 @@ from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.errors import MechbookError
 
 if TYPE_CHECKING:
-    from mechbook.engine.sweep import Axis
+    from mechbook.engine.linear_grid import Axis
 
 QUANTITIES = ("frequencies", "stability", "drift")
 AMPLITUDE = "amplitude"
@@ -65,6 +65,7 @@ def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
               system: str | None = None, about: dict | None = None,
               steady: dict | None = None, part: str | None = None,
               backend: str = DEFAULT_BACKEND) -> SweepSpec:
+    # at call time: the command line reads this module at start-up (distributed: NumPy)
     from mechbook.app.distributed import tree_files
 
     if quantity not in QUANTITIES:

@@ -15,8 +15,9 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
-from mechbook.engine.sweep import MARGINAL, STABLE, UNDEFINED, relations, truth
+from mechbook.engine.linear_grid import MARGINAL, STABLE, UNDEFINED, relations, truth
 from mechbook.errors import MechbookError, UnsupportedError
+from mechbook.verify.context import Context
 from mechbook.verify.registry import default_quantities
 
 
@@ -27,7 +28,6 @@ def book_overlay(sweeper, result) -> dict:
     out: dict = {"lines": []}
     if key is None or sweeper.spec.quantity == "drift":
         return out
-    from mechbook.verify.context import Context
 
     table = default_quantities()
     for part in key.parts:

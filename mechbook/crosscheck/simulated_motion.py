@@ -26,7 +26,7 @@ from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL
-from mechbook.numerics.model import build_model
+from mechbook.numerics.rhs import build_model
 from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import Part
 

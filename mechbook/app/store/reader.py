@@ -3,7 +3,7 @@ take no lock: the store is only ever replaced by a rename (mechbook.app.store), 
 sees the old file or the new one. Every failure to read is a StoreError naming what is
 damaged and how to recover. Nothing is taken on trust: a file that is not a store of this
 mechbook's format is refused, and every record is read whole, within bounds and checked
-(mechbook.app.store_check, which `damage` and the rebuild judge by too).
+(mechbook.app.store.entries, which `damage` and the rebuild judge by too).
 """
 
 from __future__ import annotations
@@ -15,31 +15,22 @@ from pathlib import Path
 
 import h5py
 
-from mechbook.app.store_bounds import (  # noqa: F401 - re-exported for store_repair
-    _SCALE_ATTRS,
-    member,
-    walk,
-)
-from mechbook.app.store_check import (  # noqa: F401 - re-exported: the store's readers
-    FORMAT,
-    Damaged,
-    _decoded,
-    _member,
-    _plain,
-    _read_problem,
-    _read_simulation,
-    _reason,
-    check_entry,
-    damage,
-    refusal,
-)
-from mechbook.app.store_guard import (
+from mechbook.app.store.bounds import member, walk
+from mechbook.app.store.child_read import (
     ChildEnded,
     in_child,
     is_sound,
     mark_sound,
     sheltered,
     signature,
+)
+from mechbook.app.store.entries import (
+    damage,
+    read_problem_entry,
+    read_simulation_entry,
+    reason_of,
+    refusal,
+    subgroup,
 )
 from mechbook.errors import MechbookError, NotFoundError
 from mechbook.model.catalog import DEFAULT_STORE
@@ -55,7 +46,7 @@ class StoreError(MechbookError):
         self.path, self.reason = Path(path), reason
         super().__init__(f"cannot {action} the store {path}: {reason}")
 
-    def __reduce__(self):  # whole across a pipe (a read in a child: mechbook.app.store_guard)
+    def __reduce__(self):  # whole across a pipe (a read in a child: mechbook.app.store.child_read)
         return (_rebuilt, (type(self), str(self.path), self.reason, str(self)))
 
 
@@ -68,7 +59,7 @@ def _rebuilt(cls: type, path: str, reason: str, message: str) -> StoreError:
 
 class StoreHang(StoreError):
     """Reading the store did not end within the CPU limit: HDF5 loops on some damaged
-    files (mechbook.app.store_guard)."""
+    files (mechbook.app.store.child_read)."""
 
     def __init__(self, path: str | Path, seconds: float, action: str = "read"):
         super().__init__(path, f"{hang_reason(seconds)}: the file is damaged; the next "
@@ -84,7 +75,7 @@ guarded = sheltered(StoreHang)  # a reader of a store not yet found sound runs i
 
 
 @contextmanager
-def _opened(path: str | Path) -> Iterator[h5py.File]:
+def opened(path: str | Path) -> Iterator[h5py.File]:
     """The store opened for reading; StoreError (what is wrong, how to recover) if it cannot
     be; FileNotFoundError if there is none."""
     if not os.path.lexists(path):
@@ -95,7 +86,7 @@ def _opened(path: str | Path) -> Iterator[h5py.File]:
     try:
         f = h5py.File(path, "r")
     except Exception as exc:  # noqa: BLE001 - truncated, not HDF5, a directory, unreadable
-        raise StoreError(path, f"{_reason(exc)}: the file is damaged or not a mechbook store "
+        raise StoreError(path, f"{reason_of(exc)}: the file is damaged or not a mechbook store "
                          "(the next `mechbook check` into it moves it aside and rebuilds it "
                          "from what can still be read)", "read") from None
     with f:
@@ -106,7 +97,7 @@ def _opened(path: str | Path) -> Iterator[h5py.File]:
 
 
 def _damaged(path: str | Path, what: str, exc: BaseException) -> StoreError:
-    return StoreError(path, f"{what} is damaged ({_reason(exc)}); the next `mechbook check` "
+    return StoreError(path, f"{what} is damaged ({reason_of(exc)}); the next `mechbook check` "
                       "into this store moves it aside and rebuilds it", "read")
 
 
@@ -142,18 +133,18 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
     what is damaged). A problem that only has simulations stored has `checked` False and
     no attributes."""
     path = Path(path)
-    with _opened(path) as f:
+    with opened(path) as f:
         try:
-            root = _member(f, "problems")
+            root = subgroup(f, "problems")
             present = pid in root
-            stored = [] if present else _names(f, "problems")
+            stored = [] if present else names_in(f, "problems")
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, "the list of problems", exc) from None
         if not present:
             raise NotFoundError(f"{pid} is not in {path} ({there(pid, stored, 'problem')}); "
                                 f"run `mechbook check {pid}`")
         try:
-            return _read_problem(member(root, pid))
+            return read_problem_entry(member(root, pid))
         except Exception as exc:  # noqa: BLE001 - damage inside the record, described
             raise _damaged(path, f"the stored record of {pid}", exc) from None
 
@@ -162,17 +153,17 @@ def read(pid: str, path: str | Path = DEFAULT_PATH) -> dict:
 def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dict:
     """{"attrs": {...}, "arrays": {key: array}, "array_attrs": {key: {...}}} of one run
     (NotFoundError, also a KeyError, naming the problem's stored runs if it is absent)."""
-    with _opened(path) as f:
+    with opened(path) as f:
         try:
             s = f["problems"][pid]["simulations"][name]
         except KeyError:
-            stored = there(name, _names(f, "problems", pid, "simulations"), "simulation")
+            stored = there(name, names_in(f, "problems", pid, "simulations"), "simulation")
             raise NotFoundError(f"no simulation {name!r} of {pid} in {path} ({stored})") \
                 from None
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, f"the simulation {name} of {pid}", exc) from None
         try:
-            return _read_simulation(s)
+            return read_simulation_entry(s)
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, f"the simulation {name} of {pid}", exc) from None
 
@@ -180,14 +171,14 @@ def read_simulation(pid: str, name: str, path: str | Path = DEFAULT_PATH) -> dic
 @guarded
 def problems(path: str | Path = DEFAULT_PATH) -> list[str]:
     """The ids stored (StoreError if the store cannot be read)."""
-    with _opened(path) as f:
+    with opened(path) as f:
         try:
-            return sorted(_member(f, "problems").keys())
+            return sorted(subgroup(f, "problems").keys())
         except Exception as exc:  # noqa: BLE001
             raise _damaged(path, "the list of problems", exc) from None
 
 
-def _names(f: h5py.File, *keys: str) -> list[str]:
+def names_in(f: h5py.File, *keys: str) -> list[str]:
     """The names under f[keys[0]][keys[1]]..., [] where any of them is absent."""
     group = f
     for key in keys:
@@ -199,7 +190,7 @@ def _names(f: h5py.File, *keys: str) -> list[str]:
 
 def _walk(group: h5py.Group, prefix: str = "") -> Iterator[tuple[str, object]]:
     """(relative name, object) of everything under `group`, parents first, bounded
-    (mechbook.app.store_bounds.walk)."""
+    (mechbook.app.store.bounds.walk)."""
     return walk(group, prefix=prefix)
 
 

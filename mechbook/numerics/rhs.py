@@ -29,6 +29,8 @@ from mechbook.core.compile import (
 )
 from mechbook.core.secalc import either, same
 from mechbook.errors import UnsupportedError
+from mechbook.numerics import c_library
+from mechbook.numerics.friction import Phases
 from mechbook.numerics.lapack import solve_small as _gesv
 
 
@@ -96,26 +98,22 @@ class Model:
 
     @cached_property
     def native(self):
-        """The compiled loops' view of this model (`native.NativeModel`), or None where the
+        """The compiled loops' view of this model (`c_library.NativeModel`), or None where the
         loop library or the LLVM kernel is unavailable (then the Python paths run)."""
-        from mechbook.numerics import native
-
-        kernel = native.kernel_pointer(self._mf)
-        lib = native.library() if kernel else None
+        kernel = c_library.kernel_pointer(self._mf)
+        lib = c_library.library() if kernel else None
         if lib is None:
             return None
-        return native.NativeModel(lib, kernel, self.n, self.constraints, keep=(self._mf,))
+        return c_library.NativeModel(lib, kernel, self.n, self.constraints, keep=(self._mf,))
 
     @cached_property
     def native_canonical(self):
         """Like `native`, with the canonical kernel too (the implicit midpoint loop)."""
-        from mechbook.numerics import native
-
-        kernel, canon = native.kernel_pointer(self._mf), native.kernel_pointer(self.canonical)
-        lib = native.library() if kernel and canon else None
+        kernel, canon = c_library.kernel_pointer(self._mf), c_library.kernel_pointer(self.canonical)
+        lib = c_library.library() if kernel and canon else None
         if lib is None:
             return None
-        return native.NativeModel(lib, kernel, self.n, self.constraints, canonical=canon,
+        return c_library.NativeModel(lib, kernel, self.n, self.constraints, canonical=canon,
                                   keep=(self._mf, self.canonical))
 
     def accelerations(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
@@ -298,8 +296,6 @@ def build_model(system, dyn, values: dict, conserved: dict[str, sp.Expr] | None 
     model.generation_seconds = time.perf_counter() - start
     if system.contacts:  # stick and slip: an integrator of phases, built when first asked
         from functools import partial
-
-        from mechbook.numerics.friction import Phases
 
         model.phases = partial(Phases, system, dyn, values, model)
     return model
