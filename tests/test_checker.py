@@ -578,11 +578,11 @@ def _tensor_names(ctx: Context) -> dict:
     from the generic objects can take minutes), cached on the context."""
     if not hasattr(ctx, "_mutation_names"):
         from mechbook.verify.instances import branches, generic_symbols, rational_point
-        from mechbook.verify.quantities.tensors import _names
+        from mechbook.verify.quantities.tensors import branch_names
 
         branch = branches(ctx.part.data.get("for_all") or {})[0]
         point = rational_point(ctx.sampler, generic_symbols(branch))
-        ctx._mutation_names = _names(ctx, branch, point)
+        ctx._mutation_names = branch_names(ctx, branch, point)
     return ctx._mutation_names
 
 

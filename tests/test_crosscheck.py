@@ -298,7 +298,7 @@ def test_each_crosscheck_name_is_one_entry_of_the_table(monkeypatch):
     import re
 
     from mechbook.crosscheck import problem as problem_mod
-    from mechbook.crosscheck.problem import CROSSCHECKS, PartCheck, _each_part
+    from mechbook.crosscheck.problem import CROSSCHECKS, PartCheck, each_part
 
     for name, entry in CROSSCHECKS.items():
         if entry.run is None:
@@ -312,7 +312,7 @@ def test_each_crosscheck_name_is_one_entry_of_the_table(monkeypatch):
         calls.append(part.name)
         return CrossCheck(f"probe:{part.name}", "probe", "main", parts=[part.name])
 
-    run_probe = _each_part(probe, "probe")
+    run_probe = each_part(probe, "probe")
     table = {"probe": PartCheck("a probe", run_probe),
              "again": PartCheck("Newton's, by another name", CROSSCHECKS["newton"].run),
              "probe_too": PartCheck("the probe by another name", run_probe)}

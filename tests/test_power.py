@@ -284,7 +284,7 @@ def test_a_function_of_the_stated_integrals_means_the_same_and_nothing_else_does
     a function of the two and is conserved too (a pass that means the same); ωx² is not a
     function of them, and is not excused."""
     from mechbook.verify.context import Context
-    from mechbook.verify.power import _function_of
+    from mechbook.verify.power import is_function_of
 
     key, analysis = _load(ROOT / "answers" / "symon" / "11-06.yaml")
     part = next(p for p in key.parts if p.name == "b-magnitude")
@@ -296,6 +296,6 @@ def test_a_function_of_the_stated_integrals_means_the_same_and_nothing_else_does
         return ctx.parse(text, ("book", 0), names=names)
 
     stated = [parse("wx**2 + wy**2 + wz**2"), parse("wz")]
-    assert _function_of(parse("wx**2 + wy**2 + wz**(101/50)"), stated, ctx)
-    assert not _function_of(parse("wx**2"), stated, ctx)
-    assert not _function_of(parse("wx**2 + wy**2"), stated[1:], ctx)
+    assert is_function_of(parse("wx**2 + wy**2 + wz**(101/50)"), stated, ctx)
+    assert not is_function_of(parse("wx**2"), stated, ctx)
+    assert not is_function_of(parse("wx**2 + wy**2"), stated[1:], ctx)

@@ -332,7 +332,7 @@ def test_api_linearization_second_order(tmp_path):
 def test_simulated_wobble_confirms_the_first_order_linearization(tmp_path, monkeypatch):
     """The modes cross-check integrates the rolling coin itself, displaced along the
     wobble, and reads the frequency off the motion; a state matrix 1 % off fails it."""
-    from mechbook.crosscheck.problem import _modes_check
+    from mechbook.crosscheck.problem import modes_check
     from mechbook.engine.state_space import StateSpaceSystem
 
     an = _analysis(tmp_path, "9519", COIN.replace("SHAPE", "disk"))
@@ -341,12 +341,12 @@ def test_simulated_wobble_confirms_the_first_order_linearization(tmp_path, monke
     lin = an.steady_linear(None, {psi: names["Omega"]}, {phi: 0, theta: sp.pi / 2, psi: 0},
                            reduce=False)
     values = dict(an.problem.values())
-    good = _modes_check(an, lin, values, "modes", {})
+    good = modes_check(an, lin, values, "modes", {})
     assert good.status == "pass" and good.error < 1e-6, good.detail
     right = StateSpaceSystem.numeric_state_matrix
     monkeypatch.setattr(StateSpaceSystem, "numeric_state_matrix",
                         lambda self, v, core=False: 1.01 * right(self, v, core))
-    bad = _modes_check(an, lin, values, "modes", {})
+    bad = modes_check(an, lin, values, "modes", {})
     assert bad.status == "fail", bad.detail
 
 

@@ -9,7 +9,7 @@ one guard (guard.py): a fault in one never hides the others.
 
 Adding a cross-check of a part: a module of mechbook/crosscheck with its function
 `check(analysis, part, models) -> CrossCheck | None`, and one entry in CROSSCHECKS,
-`"name": PartCheck("what it checks", _each_part(check, "name"))`; a quantity's
+`"name": PartCheck("what it checks", each_part(check, "name"))`; a quantity's
 registration then names it in `crosschecks=`.
 """
 
@@ -34,7 +34,7 @@ from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import AnswerKey, Part
 
 
-def _modes_check(analysis: Analysis, lin, values: dict, name: str, models: dict) -> CrossCheck:
+def modes_check(analysis: Analysis, lin, values: dict, name: str, models: dict) -> CrossCheck:
     """The simulated-modes cross-check of a linear system: second order
     (mechbook.crosscheck.frequencies) or first order (mechbook.crosscheck.state_modes)."""
     if not lin.first_order:
@@ -59,7 +59,7 @@ class PartCheck:
     run: Runner | None = None
 
 
-def _each_part(check: Callable[[Analysis, Part, dict], CrossCheck | None], what: str) -> Runner:
+def each_part(check: Callable[[Analysis, Part, dict], CrossCheck | None], what: str) -> Runner:
     """Run `check(analysis, part, models)` for each part that names it; list its result
     (None: nothing to check)."""
     def run(checks: _ProblemChecks, part: Part, system: str | None,
@@ -106,7 +106,7 @@ def _trajectory_question(part: Part, system: str | None) -> tuple:
             data.get("rate"))
 
 
-_conserved = _each_part(conserved_part, "conserved")
+_conserved = each_part(conserved_part, "conserved")
 
 # every name a registration's `crosschecks=` may hold, run for a part in this order (a check
 # two names lead to, once)
@@ -211,7 +211,7 @@ class _ProblemChecks:
         tag = (sname, *numeric_key(lin, values, self.params))
         if tag not in self.freq:
             self.stage(f"cross-check modes:{sname}@{label}")
-            self.freq[tag] = _modes_check(self.analysis, lin, values,
+            self.freq[tag] = modes_check(self.analysis, lin, values,
                                                   f"modes:{sname}@{label}", self.models)
         self.freq[tag].parts.append(part.name)
 
@@ -232,5 +232,5 @@ class _ProblemChecks:
                 tag = (name, *numeric_key(lin, values, self.params))
                 if tag not in self.freq:
                     self.stage(f"cross-check modes:{name}@{label}")
-                    self.freq[tag] = _modes_check(self.analysis, lin, values,
+                    self.freq[tag] = modes_check(self.analysis, lin, values,
                                                           f"modes:{name}@{label}", self.models)

@@ -239,7 +239,7 @@ class LinearSystem:
                                     "singular point of the coordinates?): no normal "
                                     "frequencies") from None
             if _ill_conditioned(Ms, w2) or _near_zero(w2):  # decided at 50 digits
-                w2 = self._precise_squared(values)
+                w2 = self.precise_squared(values)
                 scale = max(1e-300, float(np.max(np.abs(w2))))
                 w2 = np.where(np.abs(w2) <= zero_below(50) * scale, 0.0, w2)
             return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
@@ -248,7 +248,7 @@ class LinearSystem:
         lam = np.linalg.eigvals(A)
         mags = np.abs(lam[np.abs(lam) > 0])
         if np.linalg.cond(M) > 1e6 or (len(mags) and mags.max() > 1e6 * mags.min()):
-            lam = self._precise_state_eigenvalues(values)
+            lam = self.precise_state_eigenvalues(values)
         lam = lam[np.argsort(-lam.imag)]
         return np.sort(np.abs(lam.imag[:n]))
 
@@ -267,7 +267,7 @@ class LinearSystem:
         with mpmath.workdps(dps):
             return state_matrix(*(mp_matrix(X, values, dps) for X in (self.M, self.C, self.K)))
 
-    def _precise_squared(self, values: dict, dps: int = 50) -> np.ndarray:
+    def precise_squared(self, values: dict, dps: int = 50) -> np.ndarray:
         """ω² by Cholesky reduction and a symmetric eigensolver in mpmath."""
         import mpmath
 
@@ -280,7 +280,7 @@ class LinearSystem:
             w2 = mpmath.eigsy(A, eigvals_only=True)
             return np.sort(np.array([float(x) for x in w2]))
 
-    def _precise_state_eigenvalues(self, values: dict, dps: int = 50) -> np.ndarray:
+    def precise_state_eigenvalues(self, values: dict, dps: int = 50) -> np.ndarray:
         """Eigenvalues of the first-order (state-space) form in mpmath."""
         import mpmath
 

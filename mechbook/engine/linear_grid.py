@@ -360,10 +360,10 @@ class LinearSweep:
         """Frequencies at one point with `dps` digits throughout: the matrices substituted
         symbolically (not through the compiled function), the eigenproblem in mpmath."""
         if self.gyroscopic:
-            lam = self.lin._precise_state_eigenvalues(values, dps)
+            lam = self.lin.precise_state_eigenvalues(values, dps)
             lam = lam[np.argsort(-lam.imag)]
             return np.sort(np.abs(lam.imag[: self.n]))
-        w2 = self.lin._precise_squared(values, dps)
+        w2 = self.lin.precise_squared(values, dps)
         scale = max(1e-300, float(np.max(np.abs(w2))))  # zero: what dps digits cannot
         w2 = np.where(np.abs(w2) <= zero_below(dps) * scale, 0.0, w2)  # tell from zero
         return np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
@@ -372,10 +372,10 @@ class LinearSweep:
         """(stability code, spectrum) at one point with `dps` digits: the spectrum is ω²
         ascending, or the state-space eigenvalues."""
         if self.gyroscopic:
-            lam = self.lin._precise_state_eigenvalues(values, dps)
+            lam = self.lin.precise_state_eigenvalues(values, dps)
             scale = max(1.0, float(np.max(np.abs(lam))))
             return (UNSTABLE if lam.real.max() > GROWTH_TOL * scale else STABLE), lam
-        w2 = np.sort(self.lin._precise_squared(values, dps))
+        w2 = np.sort(self.lin.precise_squared(values, dps))
         s1 = float(np.max(np.abs(w2)))  # as LinearSystem.precise_stability: relative, at
         tiny = zero_below(dps) * s1  # what dps digits resolve
         if np.any(w2 < -tiny):

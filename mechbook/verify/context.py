@@ -284,12 +284,12 @@ def _merge_declared(names: dict, extra: dict, part: Part) -> None:
 def split_named(text) -> tuple[str | None, object]:
     """(name, value) of a first integral written `name = value` (the book names the
     quantity: `p_psi = I3*omega3`), or (None, text) for a bare one; '= const' is dropped."""
-    from mechbook.model.expr import split_single_equals as _split_single_equals
+    from mechbook.model.expr import split_single_equals
 
     text = strip_const(text)
     if not isinstance(text, str):
         return None, text
-    pieces = _split_single_equals(text)
+    pieces = split_single_equals(text)
     if len(pieces) == 2:
         return pieces[0].strip(), pieces[1]
     return None, text

@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 
-from mechbook.model.expr import split_single_equals as _split_single_equals
+from mechbook.model.expr import split_single_equals
 
 WORDS = ("stable", "unstable", "marginal")
 COUNTS = ("equilibrium_count", "mode_count", "secular_growth")  # integers that are counts
@@ -109,7 +109,7 @@ text: str, names: set[str], delta: Fraction
                  ) -> Iterator[tuple[str, str, str, str]]:
     """(kind, label, new text, token) for each number and named parameter of `text` scaled
     by 1 + δ; equations 'lhs = rhs' are mutated on each side, a trailing '= const' kept."""
-    pieces = _split_single_equals(text)
+    pieces = split_single_equals(text)
     if len(pieces) > 2:
         return
     offset = 0
@@ -137,7 +137,7 @@ def shifted(text: str, size: Fraction, delta: Fraction) -> str | None:
     if amount == 0:
         return None
     add = f" + ({amount.numerator}/{amount.denominator})"
-    pieces = _split_single_equals(text)
+    pieces = split_single_equals(text)
     if len(pieces) == 2:
         rhs = pieces[1].strip()
         if rhs in ("const", "constant"):
@@ -226,7 +226,7 @@ def shift_sizes(ctx, value, root: tuple) -> dict:
                 expr = ctx.parse(text, path, relation=True)
                 rels = sorted(expr.atoms(sp.core.relational.Relational), key=str)
                 expr = rels[-1].rhs if rels else None
-            elif len(_split_single_equals(text)) == 2:
+            elif len(split_single_equals(text)) == 2:
                 expr = ctx.parse(strip_const(text), path, equation=True)
             else:
                 expr = ctx.parse(text, path)

@@ -32,7 +32,7 @@ import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_mp, holds
 from mechbook.core.timeout import Timeout, time_limit
-from mechbook.model.expr import split_single_equals as _split_single_equals
+from mechbook.model.expr import split_single_equals
 from mechbook.verify import boundary
 from mechbook.verify.compare import equal, vanishes
 from mechbook.verify.context import Context, split_named, strip_const
@@ -53,7 +53,7 @@ def _motion(ctx: Context) -> list[sp.Symbol]:
 def _kind(text: str) -> str:
     if any(c in text for c in "<>"):
         return "relation"
-    pieces = _split_single_equals(text)
+    pieces = split_single_equals(text)
     if len(pieces) == 2 and pieces[1].strip() not in ("const", "constant"):
         return "equation"
     return "expression"
@@ -80,7 +80,7 @@ def _functionally_dependent(a: sp.Expr, b: sp.Expr, ctx: Context) -> bool:
                for i in range(len(xs)) for j in range(i + 1, len(xs)))
 
 
-def _function_of(b: sp.Expr, stated: list[sp.Expr], ctx: Context) -> bool:
+def is_function_of(b: sp.Expr, stated: list[sp.Expr], ctx: Context) -> bool:
     """b is locally a function of the `stated` first integrals: its gradient in the motion
     variables lies in the span of theirs (every (k+1)-minor of the gradients vanishes at
     the sampled states), with more motion variables than integrals (else any b would do).
@@ -239,7 +239,7 @@ def same_meaning(ctx: Context, path: tuple, old, new, token: str = "") -> str:
         if _functionally_dependent(b, a, ctx):
             return "a function of the same conserved quantity"
         stated = [a, *_stated_integrals(ctx, path, parse)]
-        if len(stated) > 1 and _function_of(b, stated, ctx):
+        if len(stated) > 1 and is_function_of(b, stated, ctx):
             return "a function of the conserved quantities the part states"
         if _proved_first_integral(ctx, b):
             return "another first integral (its time derivative proved zero)"
@@ -254,7 +254,7 @@ def _tensor_same(ctx: Context, old: str, new: str) -> str:
     constant factor."""
     from mechbook.model.tensorexpr import parse_tensor, parse_tensor_equation
     from mechbook.verify.instances import branches, generic_symbols, rational_point
-    from mechbook.verify.quantities.tensors import _names
+    from mechbook.verify.quantities.tensors import branch_names
 
     def flat(x) -> list:
         return list(x) if isinstance(x, sp.MatrixBase) else [x]
@@ -262,7 +262,7 @@ def _tensor_same(ctx: Context, old: str, new: str) -> str:
     try:
         for branch in branches(ctx.part.data.get("for_all") or {})[:2]:
             for _ in range(2):
-                table = _names(ctx, branch, rational_point(ctx.sampler,
+                table = branch_names(ctx, branch, rational_point(ctx.sampler,
                                                            generic_symbols(branch)))
                 if old.count("=") == 1:
                     a = [x - y for x, y in zip(*map(flat, parse_tensor_equation(

@@ -159,7 +159,7 @@ class _Subject:
     def prepare_measured(self, pt: dict) -> None:
         from mechbook.numerics.measure import signal_functions
         from mechbook.numerics.rhs import build_model
-        from mechbook.verify.quantities.trajectory import _start
+        from mechbook.verify.quantities.trajectory import initial_state
 
         ctx, sys = self.ctx, self.ctx.system
         if self.var is not None and any(e.has(self.var) for e in ctx.dyn.residuals):
@@ -169,7 +169,7 @@ class _Subject:
         params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
         self._model = build_model(sys, ctx.dyn, params)
         self._fn = signal_functions(sys, ctx.dyn, pt, event.subs(pt))
-        self._start = _start(ctx)
+        self._start = initial_state(ctx)
         name = self.spec.get("advance")
         if name is not None and name not in sys.coord_names:
             raise ctx.part.error((_key(ctx), "advance"), f"{name!r} is not a coordinate")

@@ -55,19 +55,19 @@ def check(ctx: Context, build) -> Verdict:
             raise ctx.part.error(("for_all", name), f"{name!r} is already a name")
     if ctx.validate_only:  # `mechbook validate`: build once, judge nothing
         branch = branches(spec)[0]
-        build(_names(ctx, branch, rational_point(ctx.sampler, generic_symbols(branch))))
+        build(branch_names(ctx, branch, rational_point(ctx.sampler, generic_symbols(branch))))
         return Verdict(True, "validated")
     out = []
     memo: dict = {}
     for branch in branches(spec):
         def names_at(point, branch=branch):
-            return _names(ctx, branch, point)
+            return branch_names(ctx, branch, point)
 
         out.append(decide(names_at, build, generic_symbols(branch), ctx.sampler, memo))
     return combine(out)
 
 
-def _names(ctx: Context, branch: dict, point: dict | None) -> dict:
+def branch_names(ctx: Context, branch: dict, point: dict | None) -> dict:
     """The part's names with the branch's generic objects and `define:`; at `point` (unless
     None) the generic objects are numbers, but for the `variable`s: those and the
     parameters stay symbols until the statement is built, so that calculus acts on them
@@ -223,7 +223,7 @@ def _estimate_components(ctx: Context, val) -> Verdict:
     if ctx.part.data.get("for_all"):
         raise ctx.part.error(("estimate",), "an estimate is at one point: no `for_all:`")
     point = {k: sp.Float(v, 30) for k, v in ctx.sampler.base.items()}
-    names = _names(ctx, {}, point)
+    names = branch_names(ctx, {}, point)
     pairs = book_value(ctx, val, ("book",), names, subject(ctx, names))
     rtol = ctx.sampler.rtol
     values = []

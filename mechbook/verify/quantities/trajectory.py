@@ -47,7 +47,7 @@ class Motion:
     def __init__(self, ctx: Context):
         self.ctx = ctx
         data, sys = ctx.part.data, ctx.system
-        self.start = _start(ctx)
+        self.start = initial_state(ctx)
         name = data.get("coordinate")
         self.of = None
         if "signal" in data:
@@ -93,7 +93,7 @@ class Motion:
         return LEVEL_POINTS if self.level else MEASURED_POINTS
 
 
-def _start(ctx: Context) -> dict:
+def initial_state(ctx: Context) -> dict:
     """The initial state of `initial:` (coordinates and velocities; the rest zero)."""
     data, sys = ctx.part.data, ctx.system
     if "initial" not in data:
@@ -308,7 +308,7 @@ def check_event_time(ctx: Context, val) -> Verdict:
     if "event" not in ctx.part.data:
         raise ctx.part.error((), "an event time needs `event:` (what changes sign)")
     event = ctx.parse(ctx.part.data["event"], ("event",))
-    start = _start(ctx)
+    start = initial_state(ctx)
     name = ctx.part.data.get("advance")
     if name is not None and name not in sys.coord_names:
         raise ctx.part.error(("advance",), f"{name!r} is not a coordinate")
