@@ -112,11 +112,11 @@ def _tracebacks(into: list[str]) -> Iterator[None]:
 
 def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: Stage,
            start: float, loaded: Problem | None = None) -> None:
+    # the engine and the checks, imported here only: a warm `mechbook check` answers from
+    # the store (cached_runs) without loading them (docs/performance.md, warm check)
     from mechbook.app.validate import validated_parts
     from mechbook.crosscheck import crosscheck_problem
-    from mechbook.engine.analysis import (
-        Analysis,  # the engine: imported only where a problem is checked
-    )
+    from mechbook.engine.analysis import Analysis
     from mechbook.engine.derive import computed
     from mechbook.model.problem import load_problem
     from mechbook.verify.answers import load_answers

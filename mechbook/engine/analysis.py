@@ -20,6 +20,7 @@ from mechbook.engine.equilibria import Equilibria
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.linear import LinearSystem
 from mechbook.engine.routh import ReducedSystem
+from mechbook.engine.screen import screen
 from mechbook.errors import UnsupportedError
 from mechbook.model.built import Built
 from mechbook.model.declared import Declared
@@ -168,7 +169,6 @@ class Analysis:
     def _stable_origin(self, name: str | None) -> dict | None:
         """The origin, if it is an equilibrium and the only stable one a root finder sees
         at the default values (every other equilibrium found is unstable); else None."""
-        from mechbook.engine.screen import screen
 
         sys = self.system(name)
         eq = self.equilibria(name)

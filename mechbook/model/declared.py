@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from mechbook.core.numeval import is_zero
 from mechbook.errors import ExpressionError
 from mechbook.model.bodies import AXISYMMETRIC, CompositeBody, Piece, apex_offset
 from mechbook.model.bodies.composite import rotation_matrix
@@ -184,7 +185,6 @@ def _rotation(problem: Problem, spec, path: tuple, decl: Declared) -> sp.Matrix:
         except ValueError as exc:
             raise problem.doc.error(path + ("axis",), str(exc)) from None
     value = sp.Matrix(_object(problem, spec, path, decl, "tensor"))
-    from mechbook.core.numeval import is_zero
 
     if not all(is_zero(e) for e in value * value.T - sp.eye(3)) or not is_zero(value.det() - 1):
         raise problem.doc.error(path, "a part's rotation must be a proper orthogonal tensor "

@@ -23,9 +23,12 @@ from mechbook.model.attitude import body_rates, euler_chain, rotation_matrix
 from mechbook.model.bodies import body_kinetic, shape_inertia
 from mechbook.model.declared import Declared, declared
 from mechbook.model.domains import Domain, assumptions, domain_of
+from mechbook.model.field import field_names
+from mechbook.model.friction import contacts
 from mechbook.model.loads import attractor_potential, average_over, torque_forces
 from mechbook.model.problem import RESERVED, Problem, SystemSpec, T
 from mechbook.model.protocol import SystemLike
+from mechbook.model.rolling import velocity_constraints
 
 
 def motion_chains(system) -> tuple[list[tuple[sp.Symbol, sp.Symbol]], list[sp.Symbol]]:
@@ -186,8 +189,6 @@ class System(SystemLike):
         self.contacts = []  # sliding friction (mechbook.model.friction)
         self.forces_without_friction = list(self.forces)
         if s.get("friction"):
-            from mechbook.model.friction import contacts
-
             self.contacts = contacts(self, s["friction"])
             self.forces = [f + sp.Add(*(c.force[k] for c in self.contacts))
                            for k, f in enumerate(self.forces)]
@@ -205,8 +206,6 @@ class System(SystemLike):
         # velocity constraints A(q, t)·q̇ + b(q, t) = 0 and rolling contacts (model.rolling)
         self.velocity_constraints: list[tuple[str, sp.Expr]] = []
         if s.get("velocity_constraints") or s.get("rolling"):
-            from mechbook.model.rolling import velocity_constraints
-
             self.velocity_constraints = velocity_constraints(self)
 
     def _rigid_body(self, name: str, b: dict) -> sp.Expr:
@@ -416,7 +415,6 @@ class System(SystemLike):
             k = a + 1
             potential += tension * (k * sp.pi / length) ** 2 * (length / 2) * self.q[ia] ** 2 / 2
         if "field" in spec:  # u(x, t) and integrals over the string as names (model/field)
-            from mechbook.model.field import field_names
 
             named = field_names(spec["field"], x, modes, [self.q[i] for i in amps],
                                 [self.qd[i] for i in amps])

@@ -11,6 +11,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from mechbook.numerics import c_stepping as loops
 from mechbook.numerics.integrator_base import Integrator, IntegratorError, Trajectory
 from mechbook.numerics.rhs import Model
 
@@ -56,7 +57,6 @@ class FixedStep(Integrator):
 
     def _run_native(self, nat, model, t_span, start, t_eval, **kw) -> Trajectory:
         """The same run as `_run`, as one call into loops.c (`c_stepping.fixed`)."""
-        from mechbook.numerics import c_stepping as loops
 
         steps, h = self._grid(t_span)
         t0 = float(t_span[0])

@@ -9,6 +9,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from mechbook.numerics import c_stepping as loops
 from mechbook.numerics.integrator_base import Integrator, Trajectory
 
 
@@ -29,8 +30,6 @@ class SciPyMethod(Integrator):
         nat = model.native if compiled and self.name in ("DOP853", "RK45") else None
         if nat is not None and not events and not opts.get("dense_output") \
                 and not opts.get("vectorized"):
-            from mechbook.numerics import c_stepping as loops
-
             run = loops.adaptive(
                 nat, model.stats, self.name, t_span, y0, opts["rtol"], opts["atol"],
                 opts.get("max_step", math.inf), opts.get("first_step"), t_eval)

@@ -18,6 +18,7 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
+from mechbook.model.expr import split_single_equals
 from mechbook.model.hints import did_you_mean
 from mechbook.model.manifold import manifold_of
 from mechbook.records import NUMERIC, ProofPolicy
@@ -284,7 +285,6 @@ def _merge_declared(names: dict, extra: dict, part: Part) -> None:
 def split_named(text) -> tuple[str | None, object]:
     """(name, value) of a first integral written `name = value` (the book names the
     quantity: `p_psi = I3*omega3`), or (None, text) for a bare one; '= const' is dropped."""
-    from mechbook.model.expr import split_single_equals
 
     text = strip_const(text)
     if not isinstance(text, str):

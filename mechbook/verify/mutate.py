@@ -18,7 +18,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 
-from mechbook.model.expr import split_single_equals
+from mechbook.model.expr import FUNCTIONS, split_single_equals
+from mechbook.verify.compare import value_and_scale
+from mechbook.verify.context import strip_const
 
 WORDS = ("stable", "unstable", "marginal")
 COUNTS = ("equilibrium_count", "mode_count", "secular_growth")  # integers that are counts
@@ -90,7 +92,6 @@ def _sites(text: str, names: set[str]) -> list[tuple[int, int, str, str]]:
 def _index_arguments(tree: ast.AST) -> set[int]:
     """ids of the whole-number literals passed straight to a call that is not a function of
     real values (a table of the text's notation, a tensor's entry, a derivative's order)."""
-    from mechbook.model.expr import FUNCTIONS
 
     values = set(FUNCTIONS) - {"diff"}
     out = set()
@@ -210,8 +211,6 @@ def shift_sizes(ctx, value, root: tuple) -> dict:
     path to measure an earlier tree with the same mutants.)"""
     import sympy as sp
 
-    from mechbook.verify.compare import value_and_scale
-    from mechbook.verify.context import strip_const
 
     point = ctx.sampler.default()
     out = {}

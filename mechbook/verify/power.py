@@ -33,9 +33,14 @@ import sympy as sp
 from mechbook.core.numeval import NotNumeric, evaluate_mp, holds
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.model.expr import split_single_equals
+from mechbook.model.tensorexpr import parse_tensor, parse_tensor_equation
 from mechbook.verify import boundary
+from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import equal, vanishes
 from mechbook.verify.context import Context, split_named, strip_const
+from mechbook.verify.instances import branches, generic_symbols, rational_point
+from mechbook.verify.quantities.perturbation import formula_difference
+from mechbook.verify.quantities.tensors import branch_names
 
 PROOF_SECONDS = 10.0  # a symbolic proof that a mutant is itself a first integral
 TEXT_KEYS = {"part", "cite", "quantity", "note", "origin", "system", "derivation",
@@ -175,7 +180,6 @@ def _reparametrized(ctx: Context, old: sp.Expr | None, new: sp.Expr | None,
     motion = set(_motion(ctx))
     for name, sym in free.items():
         if not old.has(sym) or _occurrences(ctx, name) != 1:
-
             continue
         slope = sp.diff(old, sym)
         if slope.has(sym) or slope.free_symbols & motion:
@@ -252,9 +256,6 @@ def _tensor_same(ctx: Context, old: str, new: str) -> str:
     """A tensor part's value or equation, old and new, at random rational instances of its
     generic objects (exact arithmetic): the same value, or the same equation times a
     constant factor."""
-    from mechbook.model.tensorexpr import parse_tensor, parse_tensor_equation
-    from mechbook.verify.instances import branches, generic_symbols, rational_point
-    from mechbook.verify.quantities.tensors import branch_names
 
     def flat(x) -> list:
         return list(x) if isinstance(x, sp.MatrixBase) else [x]
@@ -334,11 +335,8 @@ def _asymptotically_equal(ctx: Context, a: sp.Expr, b: sp.Expr, path: tuple) -> 
     as fast as the book's error must)? Then both are equally right. A leaf of a vector (a
     mode shape) is measured against the whole vector, as the check measures its angle; a
     formula in the text's notation (`perturbation`) with its tables filled in."""
-    from mechbook.verify.asymptotic import asymptotic
 
     if ctx.part.quantity == "perturbation":
-        from mechbook.verify.quantities.perturbation import formula_difference
-
         return asymptotic(ctx, formula_difference(ctx, a, b), floor=1e-40).ok
 
     entries = [e for e in _siblings(ctx, path) if isinstance(e, str | int | float)]

@@ -34,10 +34,13 @@ from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine.extremum import Extremum, NoValue, locate, torus_maximum
 from mechbook.engine.linear import mp_matrix, state_matrix
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.measure import first_event, signal_functions
+from mechbook.numerics.rhs import build_model
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.parts import energy_at, linear_motion, part_energy_expr
+from mechbook.verify.quantities.trajectory import initial_state
 from mechbook.verify.registration import EXPR, LIMIT, POINT, Family
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
@@ -157,10 +160,6 @@ class _Subject:
 
     # ---- a measured subject (an event along the full motion) ---------------------------------
     def prepare_measured(self, pt: dict) -> None:
-        from mechbook.numerics.measure import signal_functions
-        from mechbook.numerics.rhs import build_model
-        from mechbook.verify.quantities.trajectory import initial_state
-
         ctx, sys = self.ctx, self.ctx.system
         if self.var is not None and any(e.has(self.var) for e in ctx.dyn.residuals):
             raise UnsupportedError("a measured extremum over a parameter of the equations of "
@@ -176,8 +175,6 @@ class _Subject:
         self._advance = None if name is None else sys.coord_names.index(name)
 
     def _measured(self, at: dict) -> float:
-        from mechbook.numerics.measure import first_event
-
         sys = self.ctx.system
         st = {k: complex(sp.N(v.subs(at), 20)).real for k, v in self._start.items()}
         q0 = np.array([st[q] for q in sys.q])

@@ -7,7 +7,14 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
+from mechbook.engine.phase import (
+    PhaseFlow,  # scipy's integrator, only when a phase part is checked
+    image_area,
+    image_bounds,
+    in_box,
+)
 from mechbook.errors import UndecidedError, UnsupportedError
+from mechbook.verify import boundary
 from mechbook.verify.compare import Sampler, Verdict, value
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import EXPR, REGION, Family
@@ -64,9 +71,6 @@ def _phasenumbers(ctx: Context, bounds, time, pt) -> tuple[np.ndarray, np.ndarra
 
 
 def _flow(ctx: Context):
-    from mechbook.engine.phase import (
-        PhaseFlow,  # scipy's integrator, only when a phase part is checked
-    )
 
     return PhaseFlow(ctx.system, ctx.dyn)
 
@@ -92,7 +96,6 @@ def check_phase_area(ctx: Context, val) -> Verdict:
     Compared at 3 parameter points to rtol 1e-8."""
     if len(ctx.system.q) != 1:
         raise UnsupportedError("phase-space area of more than one degree of freedom")
-    from mechbook.engine.phase import image_area
 
     book = ctx.parse(val, ("book",))
     _, bounds, time = _phase_box(ctx)
@@ -156,7 +159,6 @@ def check_phase_region(ctx: Context, val) -> Verdict:
     box covering the initial box and the image's bounding box (enlarged by a quarter on each
     side) must get the same verdict from the book's inequalities and from the flow; points
     within 1e-6 (relative) of either boundary are not judged. Any disagreement fails."""
-    from mechbook.engine.phase import image_bounds, in_box
 
     items = ctx.as_list(val, ("book",))
     conds = [ctx.parse(v, ("book", i), relation=True) for i, v in enumerate(items)]
@@ -223,8 +225,6 @@ def _region_boundary(ctx: Context, conds: list, variables: list, bounds, time, f
     inequalities; just inside and just outside each crossing (1e-8 of the size) the flow
     carried back must land inside and outside the initial box. Random points judge only
     away from the boundary (1e-6), so a region moved by less would pass them."""
-    from mechbook.engine.phase import image_bounds, in_box
-    from mechbook.verify import boundary
 
     pt = ctx.sampler.draw()
     lo, hi, tv = _phasenumbers(ctx, bounds, time, pt)
