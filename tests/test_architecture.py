@@ -472,3 +472,49 @@ def test_the_store_package_exports_what_it_lists():
 
     missing = [n for n in store.__all__ if not hasattr(store, n)]
     assert not missing, missing
+
+
+# ---- issue 35: no private name crosses a module, function-level imports only with a reason ----
+def _imports_from_mechbook(path: Path):
+    """(node, inside a function?) for each `from mechbook... import ...` of a file."""
+    tree = ast.parse(path.read_text("utf-8"))
+    inside = {id(n) for fn in ast.walk(tree)
+              if isinstance(fn, ast.FunctionDef | ast.AsyncFunctionDef)
+              for n in ast.walk(fn)}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("mechbook"):
+            yield node, id(node) in inside
+
+
+def private_imports(paths) -> list[str]:
+    return [f"{p.name}:{node.lineno} {node.module}.{a.name}"
+            for p in paths for node, _ in _imports_from_mechbook(p) for a in node.names
+            if a.name.startswith("_") and not a.name.startswith("__")]
+
+
+def test_no_module_imports_another_modules_private_name():
+    paths = [*PACKAGE.rglob("*.py"), *(ROOT / "tests").rglob("*.py"),
+             *(ROOT / "bench").rglob("*.py")]
+    assert private_imports(paths) == []
+
+
+def test_the_private_import_test_can_fail(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("def f():\n    from mechbook.verify.power import _hidden, public\n")
+    assert private_imports([probe]) == ["probe.py:2 mechbook.verify.power._hidden"]
+    assert [inside for _, inside in _imports_from_mechbook(probe)] == [True]  # in a function
+
+
+# where a function may import a mechbook module: start-up time (the command line, `import
+# mechbook`, books.yaml's reader, a sweep's spec, the editor's schemas) or the engine kept
+# out of a warm check and of `validate` (run, validate); each such import says why
+LAZY_IMPORTS = ("mechbook/__init__.py", "mechbook/app/cli/", "mechbook/app/run.py",
+                "mechbook/app/validate.py", "mechbook/app/editor.py",
+                "mechbook/app/sweep/spec.py", "mechbook/model/books.py")
+
+
+def test_function_level_imports_only_where_start_up_needs_them():
+    found = [f"{p.relative_to(ROOT)}:{node.lineno}" for p in PACKAGE.rglob("*.py")
+             for node, inside in _imports_from_mechbook(p)
+             if inside and not str(p.relative_to(ROOT)).startswith(LAZY_IMPORTS)]
+    assert found == []
