@@ -70,7 +70,7 @@ class LevelSet:
         return mass, V, u
 
     @cached_property
-    def _functions(self):
+    def numeric_functions(self):
         mass, V, u = self.reduced
         args = [self.c, *self.P, *self.params]
         return (sp.lambdify(args, mass, modules="mpmath"),
@@ -111,7 +111,7 @@ class Orbit:
 
     def kinetic(self, c):
         """E − V_eff(c): m ċ²/2 on the orbit (negative where the motion cannot go)."""
-        _, V, _ = self.level._functions
+        _, V, _ = self.level.numeric_functions
         try:
             return self.E - V(*self._args(c))
         except (ZeroDivisionError, ValueError):
@@ -193,7 +193,7 @@ class Orbit:
         very small orbit: 50 digits leave at least 20 there). What is left of the working
         precision is measured, where it matters, by computing the orbit at a second, higher
         one (mechbook.verify.quantities.trajectory)."""
-        mass, _, _ = self.level._functions
+        mass, _, _ = self.level.numeric_functions
         lo, hi = self.turning_points
         with mpmath.workdps(self.dps):  # mid, half at full precision: c − lo tiny near s = 0
             mid, half = (lo + hi) / 2, (hi - lo) / 2
@@ -228,5 +228,5 @@ class Orbit:
     def advance(self, coordinate: sp.Symbol):
         """How far a cyclic coordinate advances over one period."""
         i = self.level.cyclic.index(coordinate)
-        u = self.level._functions[2][i]
+        u = self.level.numeric_functions[2][i]
         return self._quad(lambda c: u(*self._args(c)))

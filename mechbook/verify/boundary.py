@@ -98,14 +98,14 @@ class Ray:
         return pt
 
 
-def _atoms(cond: sp.Basic) -> list[sp.Expr]:
+def atoms_of(cond: sp.Basic) -> list[sp.Expr]:
     """lhs − rhs of every relation in a condition (joined by and/or/not)."""
     rels = [a for a in cond.atoms(sp.core.relational.Relational)] \
         if isinstance(cond, sp.Basic) else []
     return [r.lhs - r.rhs for r in rels]
 
 
-def _value(f: sp.Expr, pt: dict) -> tuple[float, float] | None:
+def value_at(f: sp.Expr, pt: dict) -> tuple[float, float] | None:
     try:
         v, m = evaluate(f, pt, DIGITS)
     except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
@@ -186,13 +186,13 @@ def _bisect(fn: Callable, a: float, b: float, fa) -> tuple[float, float] | None:
     return a, b
 
 
-def _refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> tuple[mpmath.mpf, int]:
+def refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> tuple[mpmath.mpf, int]:
     """The crossing to 30 digits: the root of the atom that changes sign in [a, b], and
     that atom's index (the bisection's midpoint and -1 where none does cleanly)."""
     pa, pb = ray.point(a), ray.point(b)
     for i, f in enumerate(atoms):
-        va = _value(f, pa) if pa else None
-        vb = _value(f, pb) if pb else None
+        va = value_at(f, pa) if pa else None
+        vb = value_at(f, pb) if pb else None
         if va is None or vb is None or (va[0] > 0) == (vb[0] > 0):
             continue
 
@@ -234,7 +234,7 @@ def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
         vals = []
         for t in ts:
             pt = ray.point(t)
-            vals.append(None if pt is None else _value(f, pt))
+            vals.append(None if pt is None else value_at(f, pt))
         for k in range(1, len(ts) - 1):
             trio = vals[k - 1: k + 2]
             if any(v is None for v in trio):
@@ -254,7 +254,7 @@ def _golden(f: sp.Expr, ray: Ray, a: float, b: float, steps: int = 80):
 
     def h(t):
         pt = ray.point(t)
-        got = None if pt is None else _value(f, pt)
+        got = None if pt is None else value_at(f, pt)
         return (math.inf, 1.0) if got is None else (abs(got[0]), got[1])
 
     c, d = b - ratio * (b - a), a + ratio * (b - a)
@@ -307,7 +307,7 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
                       and s not in sampler.derived), key=lambda s: s.name)
     if not symbols:
         return BoundaryResult(False, detail="no free parameter to vary")
-    atoms = _atoms(cond)
+    atoms = atoms_of(cond)
     ts = np.linspace(-SPAN, SPAN, grid)
     res = BoundaryResult(True)
     seen = {True: 0, False: 0}
@@ -346,7 +346,7 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
             bracket = _bisect(judge.book, float(ts[k]), float(ts[k + 1]), b0)
             if bracket is None:
                 continue
-            t_star, side = _refine(atoms, ray, *bracket)
+            t_star, side = refine(atoms, ray, *bracket)
             crossed.add(side)
 
             bad = _judge_crossing(judge, t_star, res, words)

@@ -45,7 +45,7 @@ def probes(ctx: Context, cond: sp.Basic) -> list[sp.Symbol]:
     """The parameters along which the book's boundary is located."""
     sampler = ctx.sampler
     limit = ctx.names[ctx.part.data["limit"]["parameter"]]
-    direct = set().union(*(a.free_symbols for a in boundary._atoms(cond)))
+    direct = set().union(*(a.free_symbols for a in boundary.atoms_of(cond)))
     deps = set(direct)
     for sym, expr in sampler.derived.items():
         if sym in direct:
@@ -62,7 +62,7 @@ def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier) -> Verdic
     """The book's relation as an asymptotic claim: the distance between its boundary and
     the engine's must fall at the order `limit:` states."""
     along = probes(ctx, cond)
-    atoms = boundary._atoms(cond)
+    atoms = boundary.atoms_of(cond)
 
     last: dict = {}  # the probe along which the last step's error was largest
 
@@ -145,7 +145,7 @@ def _book_crossings(cond: sp.Basic, atoms: list, ray: boundary.Ray) -> list[tupl
                 break
             a, b = (m, b) if fm == fa else (a, m)
         else:
-            t_star, _ = boundary._refine(atoms, ray, a, b)
+            t_star, _ = boundary.refine(atoms, ray, a, b)
             if all(abs(t_star - other) > 1e-12 for other, _, _ in found):
                 found.append((t_star, fa, not fa))
     found.sort(key=lambda x: x[0])
@@ -159,7 +159,7 @@ def _book_crossings(cond: sp.Basic, atoms: list, ray: boundary.Ray) -> list[tupl
 
 def _signed(f: sp.Expr, ray: boundary.Ray, t) -> float | None:
     pt = ray.point(t)
-    got = None if pt is None else boundary._value(f, pt)
+    got = None if pt is None else boundary.value_at(f, pt)
     return None if got is None else got[0]
 
 
