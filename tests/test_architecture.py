@@ -518,3 +518,36 @@ def test_function_level_imports_only_where_start_up_needs_them():
              for node, inside in _imports_from_mechbook(p)
              if inside and not str(p.relative_to(ROOT)).startswith(LAZY_IMPORTS)]
     assert found == []
+
+
+def private_module_reads(paths) -> list[str]:
+    """`module._name` where `module` is a mechbook module the file imported by name."""
+    known = set(modules())
+    out = []
+    for p in paths:
+        tree = ast.parse(p.read_text("utf-8"))
+        bound = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("mechbook"):
+                bound |= {a.asname or a.name for a in node.names
+                          if f"{node.module}.{a.name}" in known}
+            elif isinstance(node, ast.Import):
+                bound |= {a.asname for a in node.names if a.asname and a.name in known}
+        out += [f"{p.name}:{n.lineno} {n.value.id}.{n.attr}" for n in ast.walk(tree)
+                if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name)
+                and n.value.id in bound and n.attr.startswith("_")
+                and not n.attr.startswith("__")]
+    return out
+
+
+def test_no_module_reads_another_modules_private_name_through_it():
+    assert private_module_reads(list(PACKAGE.rglob("*.py"))) == []
+
+
+def test_the_private_read_test_can_fail(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("from mechbook.verify import boundary\n"
+                     "import mechbook.verify.power as power\n"
+                     "x = boundary._hidden, power._other, boundary.public\n")
+    assert private_module_reads([probe]) == ["probe.py:3 boundary._hidden",
+                                             "probe.py:3 power._other"]
