@@ -11,6 +11,7 @@ without a traceback.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
 import re
@@ -126,13 +127,32 @@ def _watch(tree: Path, *args: str):
     then fails in it instead of filling the machine), its lines read on a thread."""
     from hostile import limited
 
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    # PYTHONFAULTHANDLER: a watch that crashes, or that _hung_ ends with SIGABRT, prints
+    # where each of its threads was
+    env = dict(os.environ, PYTHONUNBUFFERED="1", PYTHONFAULTHANDLER="1")
     proc = subprocess.Popen([sys.executable, "-m", "mechbook", "--root", str(tree), "watch",
                              *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True, env=env, preexec_fn=limited())
     lines: queue.Queue = queue.Queue()
     threading.Thread(target=_reader, args=(proc, lines), daemon=True).start()
     return proc, lines
+
+
+def _hung(proc, lines: queue.Queue, seen: list[str], pattern: str,
+          timeout: float = 60) -> str:
+    """`_until`, and when no line matches: whether the watch is still running and, if it
+    is, where it was (its stack, from SIGABRT under PYTHONFAULTHANDLER), in the message: a
+    missed save seen once in `make test-min` left no trace of its cause."""
+    try:
+        return _until(lines, pattern, seen, timeout=timeout)
+    except AssertionError as exc:
+        state = f"exit status {proc.poll()}" if proc.poll() is not None else "still running"
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGABRT)
+            with contextlib.suppress(AssertionError):
+                _until(lines, "(?!)", seen, timeout=10)  # its stack, until it ends
+        raise AssertionError(f"{exc}\nthe watch was {state}; after SIGABRT:\n"
+                             + "\n".join(seen[-60:])) from None
 
 
 def _stop(proc) -> None:
@@ -177,12 +197,12 @@ def test_watch_survives_special_files_and_links_in_place_of_its_files(tmp_path):
                                 (books, "fifo", "not a regular file"),
                                 (books, "devzero", "read only from inside the tree")]:
             replace(path, how)
-            line = _until(lines, r"^lim-2031: ", seen, timeout=60)
+            line = _hung(proc, lines, seen, r"^lim-2031: ")
             assert said in line, (how, line)
-            _until(lines, "waiting for a change", seen, timeout=60)
+            _hung(proc, lines, seen, "waiting for a change")
             replace(path, good if path == problem else books_text)
-            assert "6 pass" in _until(lines, r"lim-2031: .*checked in", seen, timeout=60)
-            _until(lines, "waiting for a change", seen, timeout=60)
+            assert "6 pass" in _hung(proc, lines, seen, r"lim-2031: .*checked in")
+            _hung(proc, lines, seen, "waiting for a change")
     finally:
         _stop(proc)
     assert proc.returncode == 0
