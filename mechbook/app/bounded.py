@@ -16,7 +16,7 @@ import json
 import os
 import stat
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import IO
 
@@ -54,6 +54,7 @@ def regular_file(path: str | Path, max_bytes: int) -> Iterator[IO[bytes]]:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
     except OSError as exc:
         raise Unreadable(path, exc.strerror or str(exc)) from None
+    fh = None
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
@@ -64,7 +65,14 @@ def regular_file(path: str | Path, max_bytes: int) -> Iterator[IO[bytes]]:
         os.set_blocking(fd, True)
         fh = os.fdopen(fd, "rb")
     except BaseException:
-        os.close(fd)
+        # a Ctrl-C inside fdopen may come after the new file object took the descriptor
+        # (and closed it): closing it again must not turn the KeyboardInterrupt into an
+        # OSError that escapes the caller's handler (seen once in `mechbook watch`)
+        if fh is not None:
+            fh.close()
+        else:
+            with suppress(OSError):
+                os.close(fd)
         raise
     with fh:
         yield fh
