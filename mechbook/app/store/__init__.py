@@ -32,6 +32,7 @@ from mechbook.app.store.warm_cache import Cached, cached, durations
 from mechbook.app.store.writer import (
     ProblemRecord,
     atomic_edit,
+    attribute_value,
     bounded_text,
     check_run_name,
     compact_store,
@@ -48,6 +49,7 @@ __all__ = [
     # the warm-run cache
     "Cached", "cached", "durations",
     # for the store's other entries (a sweep's: mechbook.app.sweep.storage)
-    "atomic_edit", "bounded_text", "opened", "names_in", "reason_of", "read_sweep_entry",
+    "atomic_edit", "attribute_value", "bounded_text", "opened", "names_in", "reason_of",
+    "read_sweep_entry",
     "attributes", "member",
 ]

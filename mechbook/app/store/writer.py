@@ -214,7 +214,7 @@ def _write_problem(root: h5py.Group, rec: ProblemRecord) -> None:
         cross = g.create_group("crosschecks", track_order=True)
         for i, x in enumerate(rec.crosschecks):
             c = cross.create_group(str(i))
-            c.attrs.update({k: _attr(v) for k, v in x.items()})
+            c.attrs.update({k: attribute_value(v) for k, v in x.items()})
 
 
 def check_run_name(name: object, what: str = "run") -> str:
@@ -238,11 +238,11 @@ def write_simulation(pid: str, name: str, arrays: dict[str, np.ndarray], attrs: 
         if name in sims:
             del sims[name]
         s = sims.create_group(name, track_order=True)
-        s.attrs.update({k: _attr(v) for k, v in attrs.items()})
+        s.attrs.update({k: attribute_value(v) for k, v in attrs.items()})
         for key, arr in arrays.items():
             d = s.create_dataset(key, data=np.asarray(arr, dtype=float), compression="gzip")
             for k, v in ((array_attrs or {}).get(key) or {}).items():
-                d.attrs[k] = _attr(v)
+                d.attrs[k] = attribute_value(v)
         _dimension_scales(s, str(attrs.get("coordinates") or ""))
     return Path(path)
 
@@ -275,15 +275,16 @@ def _dimension_scales(s: h5py.Group, coordinates: str) -> None:
     s.visititems(attach)
 
 
-def _attr(v):
-    """An attribute value HDF5 can hold (strings made storable, lists and dicts as JSON)."""
+def attribute_value(v: object) -> object:
+    """An attribute value HDF5 can hold (strings made storable, lists and dicts as JSON,
+    NumPy numbers inside them as floats); the store's records and a sweep's entries."""
     if v is None:
         return ""
     if isinstance(v, str):
         return bounded_text(v)
     if isinstance(v, (bool, int, float, np.generic)):
         return v
-    return bounded_text(json.dumps(v), cut=False)
+    return bounded_text(json.dumps(v, default=float), cut=False)
 
 
 def bounded_text(text: str, limit: int = MAX_ATTRIBUTE_BYTES, cut: bool = True) -> str:

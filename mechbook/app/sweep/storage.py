@@ -15,7 +15,6 @@ the store, which is rewritten whole on every edit, stays small.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import h5py
@@ -25,8 +24,8 @@ from mechbook.app.outputs import OutputError, output_file, replaced
 from mechbook.app.store import (
     StoreError,
     atomic_edit,
+    attribute_value,
     attributes,
-    bounded_text,
     check_run_name,
     member,
     names_in,
@@ -66,17 +65,6 @@ def variables(result) -> tuple[dict, dict, dict]:
     return coords, vars_, attrs
 
 
-def _attr(v):
-    if v is None:
-        return ""
-    if isinstance(v, str):
-        return bounded_text(v)
-    if isinstance(v, (bool, int, float, np.generic)):
-        return v
-
-    return bounded_text(json.dumps(v, default=float), cut=False)
-
-
 def write_store(result, name: str, path: str | Path) -> Path:
     """Add (or replace) the sweep at /sweeps/<id>/<name> of the store, atomically."""
     _check_name(name)
@@ -86,7 +74,7 @@ def write_store(result, name: str, path: str | Path) -> Path:
         if name in root:
             del root[name]
         g = root.create_group(name, track_order=True)
-        g.attrs.update({k: _attr(v) for k, v in attrs.items()})
+        g.attrs.update({k: attribute_value(v) for k, v in attrs.items()})
         if result.attrs["points"] > STORE_POINTS:
             return Path(path)  # the data went to a netCDF file; its path is in the attrs
         scales = {}
@@ -163,7 +151,7 @@ def write_netcdf(result, path: str | Path) -> Path:
             for key, (dims, arr) in vars_.items():
                 f.create_variable(key, dims, data=arr, compression="gzip")
             for k, v in attrs.items():  # netCDF has no boolean attributes
-                f.attrs[k] = int(v) if isinstance(v, (bool, np.bool_)) else _attr(v)
+                f.attrs[k] = int(v) if isinstance(v, (bool, np.bool_)) else attribute_value(v)
     except (OSError, RuntimeError, ValueError) as exc:
         raise OutputError(path, str(exc).splitlines()[0] if str(exc) else
                           type(exc).__name__, "netCDF file") from exc
