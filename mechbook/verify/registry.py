@@ -26,6 +26,7 @@ from mechbook.verify.quantities import (
     equilibria,
     expressions,
     extremum,
+    functional,
     motion,
     oscillations,
     parts,
@@ -42,8 +43,8 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, motion,
-           oscillations, parts, perturbation, phase, response, rotation, stability, steady,
+MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, functional,
+           motion, oscillations, parts, perturbation, phase, response, rotation, stability, steady,
            tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)

@@ -1,0 +1,411 @@
+"""Quantities of a declared functional (`functional:`, mechbook/model/functional.py): the
+Euler–Lagrange equations, the book's curve as an extremal meeting the end conditions, its
+first integrals, the functional's value on it, and whether it is a minimum.
+
+A curve is written in a part as `{y: "c*cosh(x/c)"}` (explicit, y(x)) or `{parameter:
+theta, x: "a*(theta - sin(theta))", y: "a*(1 - cos(theta))"}` (parametric), with optional
+`multipliers: {length: expr}` (λ of an isoperimetric constraint). `constants: {a: 0.57,
+theta1: 2.4}` names the curve's constants fixed by the end conditions, each with a start
+for Gauss–Newton at the problem's default values; `range: [0, theta1]` the parameter's
+values at the two ends (default: the ends' x). At a sampled point the constants are
+followed from the default values in straight steps, so a branch the start picks (the
+shallow catenoid, not the deep one) is the branch checked everywhere.
+"""
+
+from __future__ import annotations
+
+import mpmath
+import sympy as sp
+
+from mechbook.engine import curve as cv
+from mechbook.engine.variational import (
+    beltrami,
+    euler_lagrange,
+    noether,
+    on_shell_rate,
+    solved_top,
+    top_derivatives,
+)
+from mechbook.errors import UnsupportedError
+from mechbook.model.functional import Functional
+from mechbook.verify.compare import Verdict, all_vanish, combine, equal
+from mechbook.verify.context import Context, strip_const
+from mechbook.verify.registration import EXPR, NAME, Family
+
+FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
+quantity = FAMILY.quantity
+
+CURVE = {"type": "object", "minProperties": 1,
+         "properties": {"parameter": NAME,
+                        "multipliers": {"type": "object", "additionalProperties": EXPR}},
+         "additionalProperties": EXPR}
+RANGE = {"type": "array", "minItems": 2, "maxItems": 2, "items": EXPR}
+CONSTANTS = {"type": "object", "maxProperties": 8,
+             "propertyNames": {"pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
+             "additionalProperties": {"type": "number"}}
+SYMMETRY = {"type": "object", "minProperties": 1, "additionalProperties": EXPR}
+CURVE_KEYS = {"curve": CURVE, "range": RANGE, "constants": CONSTANTS}
+POINTS = 3  # parameter points a curve is checked at: the default values and 2 draws
+VANISH = 1e-18  # a residual at 30 digits, relative to what cancelled in it
+STATIONARY = 1e-9  # |J′(0)| relative to |J(0)| + |J″(0)| on the perturbed curves
+MINIMUM = ("minimum", "not a minimum")
+
+
+def functional(ctx: Context) -> Functional:
+    fn = ctx.analysis.functional()
+    if fn is None:
+        raise ctx.part.error(("quantity",), f"{ctx.part.quantity!r} needs a `functional:` "
+                             "in the problem file")
+    return fn
+
+
+def jet_names(ctx: Context) -> dict:
+    """The names a functional's answer may use: the part's, x, y, y′, …, the multipliers."""
+    fn = ctx.analysis.functional()
+    names = dict(ctx.names)
+    if fn is not None:
+        names.update(fn.names())
+    return names
+
+
+# ---- the equations and first integrals -----------------------------------------------------
+@quantity('euler_lagrange',
+          book='list of equations, one per function of the functional',
+          how=('the Euler–Lagrange equations Σₖ(−d/dx)ᵏ ∂F̃/∂y⁽ᵏ⁾ = 0 of the `functional:` '
+               '(F̃ = F + Σλ·G + Σμ·φ with its constraints\' multipliers `lambda_<name>`, '
+               '`mu_<name>`), both sides solved for the highest derivatives (y″ of F(x, y, '
+               'y′)), agree at random points of x, y, y′ and the parameters: any '
+               'rearrangement or combination of the book\'s equations passes'),
+          names=jet_names, needs_system=False)
+def check_euler_lagrange(ctx: Context, val) -> Verdict:
+    fn = functional(ctx)
+    names = jet_names(ctx)
+    book = [ctx.parse(v, ("book", i), equation=True, names=names)
+            for i, v in enumerate(ctx.as_list(val, ("book",)))]
+    if len(book) != len(fn.functions):
+        raise ctx.part.error(("book",), f"give {len(fn.functions)} equation(s), one per "
+                             "function")
+    top = top_derivatives(fn)
+    engine = solved_top(euler_lagrange(fn), top)
+    try:
+        theirs = solved_top([_lhs(e) for e in book], top)
+    except UnsupportedError as exc:
+        return Verdict(False, "symbolic", f"the book's equations: {exc.capability}")
+    return combine([equal(theirs[s], engine[s], ctx.sampler) for s in top])
+
+
+def _lhs(e) -> sp.Expr:
+    return e.lhs - e.rhs if isinstance(e, sp.Equality) else e
+
+
+@quantity('functional_integral',
+          book='expression in x, y, y′ (`… = const` allowed)',
+          how=('a first integral of the Euler–Lagrange equations: its total derivative, '
+               'with y″ from the equations, vanishes at random points of x, y, y′ and the '
+               'parameters, and it is a function of the engine\'s integral (their '
+               'gradients in x, y, y′ are parallel): Beltrami\'s F̃ − y′·∂F̃/∂y′ when F '
+               'holds no x, else Noether\'s Σ∂F̃/∂y′·(η − y′ξ) + F̃ξ of the generator '
+               '`symmetry: {x: ξ, y: η}`, whose invariance is checked first'),
+          keys={"symmetry": SYMMETRY}, names=jet_names, needs_system=False,
+          equivalent=("function",))
+def check_functional_integral(ctx: Context, val) -> Verdict:
+    fn = functional(ctx)
+    names = jet_names(ctx)
+    book = ctx.parse(strip_const(val), ("book",), names=names)
+    sym = ctx.part.data.get("symmetry")
+    checks = []
+    if sym is None:
+        engine = beltrami(fn)
+    else:
+        known = [str(fn.x), *fn.functions]
+        extra = sorted(set(sym) - set(known))
+        if extra:
+            raise ctx.part.error(("symmetry", extra[0]), "a generator's components are "
+                                 f"given for {', '.join(known)}")
+        comp = {k: ctx.parse(sym.get(k, "0"), ("symmetry", k), names=names) for k in known}
+        residual, engine = noether(fn, comp[str(fn.x)], [comp[f] for f in fn.functions])
+        invariant = all_vanish([residual], ctx.sampler)
+        if not invariant.ok:
+            return Verdict(False, invariant.method, "the generator is not a symmetry of the "
+                           f"functional: {invariant.detail}")
+        checks.append(invariant)
+    jet = [fn.x, *fn.function_symbols(0), *fn.function_symbols(1)]
+    if not any(sp.diff(book, s) != 0 for s in jet):
+        return Verdict(False, "symbolic", "the book's integral is a constant")
+    checks.append(all_vanish([on_shell_rate(fn, book)], ctx.sampler))
+    gb = [sp.diff(book, s) for s in jet]
+    ge = [sp.diff(engine, s) for s in jet]
+    minors = [gb[i] * ge[j] - gb[j] * ge[i] for i in range(len(jet))
+              for j in range(i + 1, len(jet))]
+    checks.append(all_vanish(minors, ctx.sampler))
+    return combine(checks)
+
+
+# ---- a curve: its constants at a point -------------------------------------------------------
+class CurveSpec:
+    """A part's curve with its constants, range and multipliers, parsed once."""
+
+    def __init__(self, ctx: Context, spec, sub: tuple):
+        self.fn = fn = functional(ctx)
+        spec = ctx.as_map(spec, sub)
+        consts = ctx.as_map(ctx.part.data.get("constants") or {}, ("constants",))
+        names = dict(ctx.names)
+        for k in consts:
+            if k in names or k in fn.names():
+                raise ctx.part.error(("constants", k), f"{k!r} is already a name")
+            names[k] = sp.Symbol(k, real=True)
+        self.constants = [names[k] for k in consts]
+        self.start = {names[k]: v for k, v in consts.items()}
+        param = spec.get("parameter")
+        x = str(fn.x)
+        if param is None:
+            s = fn.x
+            xs = fn.x
+            if x in spec:
+                raise ctx.part.error(sub + (x,), f"an explicit curve gives the functions of "
+                                     f"{x}; a parametric one names its `parameter:`")
+        else:
+            if param in names or param in fn.names():
+                raise ctx.part.error(sub + ("parameter",), f"{param!r} is already a name")
+            s = sp.Symbol(param, real=True)
+            if x not in spec:
+                raise ctx.part.error(sub, f"a parametric curve gives {x} as a function of "
+                                     f"{param}")
+        local = dict(names)
+        local[str(s)] = s
+        if param is not None:
+            xs = ctx.parse(spec[x], sub + (x,), names=local)
+        extra = sorted(set(spec) - {"parameter", "multipliers", x, *fn.functions})
+        if extra:
+            raise ctx.part.error(sub + (extra[0],), f"{extra[0]!r} is not a function of the "
+                                 f"functional ({', '.join(fn.functions)})")
+        missing = [f for f in fn.functions if f not in spec]
+        if missing:
+            raise ctx.part.error(sub, f"the curve gives every function ({missing[0]!r} is "
+                                 "missing)")
+        ys = [ctx.parse(spec[f], sub + (f,), names=local) for f in fn.functions]
+        mults = {}
+        bynames = {c.name: c for c in fn.constraints}
+        for k, v in (spec.get("multipliers") or {}).items():
+            if k not in bynames:
+                raise ctx.part.error(sub + ("multipliers", k), f"{k!r} is not a constraint "
+                                     "of the functional")
+            if bynames[k].kind != "integral":
+                raise ctx.part.error(sub + ("multipliers", k), "a holonomic constraint's "
+                                     "multiplier is a function, found along the curve")
+            mults[bynames[k].multiplier] = ctx.parse(v, sub + ("multipliers", k), names=names)
+        self.multipliers = mults
+        self.unknown = [c.multiplier for c in fn.constraints
+                        if c.kind == "integral" and c.multiplier not in mults]
+        if "range" in ctx.part.data:
+            ends = tuple(ctx.parse(v, ("range", i), names=names)
+                         for i, v in enumerate(ctx.part.data["range"]))
+        elif param is None:
+            ends = (fn.ends[0].at, fn.ends[1].at)
+        else:
+            raise ctx.part.error(sub, "a parametric curve needs `range:`, its parameter's "
+                                 "values at the two ends")
+        self.curve = cv.Curve(s, xs, ys, ends, self.constants)
+        self.names = names
+        if any(c.kind == "holonomic" for c in fn.constraints):
+            raise UnsupportedError("a holonomic constraint on the curve (its multiplier "
+                                   "function is not solved for yet)")
+        self.conditions = cv.conditions(fn, self.curve, mults)
+        self.ctx = ctx
+
+    def unknowns(self) -> list[sp.Symbol]:
+        return self.constants + self.unknown
+
+    def points(self) -> list[tuple[dict, dict | None]]:
+        """(parameter values, the unknowns there or None) at the default values and at
+        POINTS − 1 sampled ones."""
+        base = {k: sp.Float(v, 30) for k, v in self.ctx.sampler.base.items()}
+        start = {**self.start, **{m: 0 for m in self.unknown}}
+        out = [(base, cv.solve_unknowns(self.conditions, self.curve, self.unknowns(), start,
+                                        base) if self.unknowns() else {})]
+        if out[0][1] is None:
+            return out
+        for _ in range(POINTS - 1):
+            pt = self.ctx.sampler.draw()
+            pt = {k: v for k, v in pt.items() if k in base}
+            got = cv.continued(self.conditions, self.curve, self.unknowns(),
+                               {**out[0][1]}, base, pt)
+            out.append((pt, got))
+        return out
+
+    def at(self, params: dict, unknowns: dict) -> dict:
+        """The point: parameters, constants, the multipliers (given or solved)."""
+        pt = {**params, **unknowns}
+        for m, e in self.multipliers.items():
+            pt[m] = cv.mp_value(e, pt)
+        return pt
+
+
+def _solved_points(spec: CurveSpec) -> list[dict]:
+    """The points where the constants were found; UnsupportedError if not at the default."""
+    out = []
+    for params, unknowns in spec.points():
+        if unknowns is None:
+            if not out:
+                names = ", ".join(map(str, spec.unknowns()))
+                raise UnsupportedError(f"no values of {names} near the key's start make the "
+                                       "curve meet its end conditions at the default "
+                                       "parameter values (Gauss–Newton did not converge)")
+            continue
+        out.append(spec.at(params, unknowns))
+    return out
+
+
+# ---- the extremal -----------------------------------------------------------------------------
+@quantity('extremal',
+          book='a curve: `{y: expr}` (y(x)) or `{parameter: s, x: expr, y: expr}`, with '
+               '`multipliers:` if any',
+          how=('the curve\'s `constants:` (and the isoperimetric multipliers it does not '
+               'give) are solved by Gauss–Newton at 30 digits from the end conditions '
+               '(each end\'s x, the fixed values, ∂F̃/∂y′ = 0 at a free end), the '
+               'constraints\' integrals, and the Euler–Lagrange residuals at six interior '
+               'points; every residual must then vanish to 1e-18 of its scale, at the '
+               'default values and two sampled points (the constants followed there by '
+               'continuation). Second computation: the functional on perturbed curves y + '
+               'εη (η vanishing at fixed ends; two variations per function) at 30 digits: '
+               'its first variation J′(0) (Richardson, O(ε⁴)) vanishes to 1e-9 of |J| + '
+               '|J″|'),
+          keys={"range": RANGE, "constants": CONSTANTS}, names=jet_names, needs_system=False)
+def check_extremal(ctx: Context, val) -> Verdict:
+    spec = CurveSpec(ctx, val, ("book",))
+    if ctx.validate_only:
+        return Verdict(True, "validated")
+    points = _solved_points(spec)
+    for pt in points:
+        for name, v, scale in cv.residuals(spec.conditions, spec.curve, pt):
+            if abs(v) > VANISH * scale:
+                return Verdict(False, f"numeric({len(points)} points, 30 digits)",
+                               f"{name} is {mpmath.nstr(abs(v), 3)} (scale "
+                               f"{scale:.3g}) at {_fmt(pt)}")
+    first = _first_variation(spec, points[0])
+    if first is not None:
+        return first
+    solved = ", ".join(map(str, spec.unknowns())) or "none"
+    power = (f"{len(points)} parameter points (constants solved: {solved}); end conditions, "
+             f"integrals and Euler–Lagrange at 6 interior points to {VANISH:g} of their "
+             f"scale; first variation on {2 * len(spec.fn.functions)} perturbed curves "
+             f"≤ {STATIONARY:g}")
+    return Verdict(True, f"numeric({len(points)} points, 30 digits)", power=power)
+
+
+def _first_variation(spec: CurveSpec, pt: dict) -> Verdict | None:
+    """A fail if the functional is not stationary at the curve on perturbed curves."""
+    from mechbook.engine.variational import augmented
+
+    F = augmented(spec.fn).xreplace({m: pt[m] for m in spec.fn.names().values() if m in pt})
+    for p in cv.perturbed(spec.fn, spec.curve, pt, F):
+        scale = abs(p.value) + abs(p.curvature)
+        if abs(p.slope) > STATIONARY * scale:
+            return Verdict(False, "numeric(perturbed curves, 30 digits)",
+                           f"the first variation along {p.label} is "
+                           f"{mpmath.nstr(p.slope, 3)} (J = {mpmath.nstr(p.value, 8)}, J″ = "
+                           f"{mpmath.nstr(p.curvature, 3)}): the curve is not stationary")
+    return None
+
+
+def _fmt(pt: dict) -> str:
+    return ", ".join(f"{k} = {mpmath.nstr(mpmath.re(v), 8)}" for k, v in
+                     sorted(pt.items(), key=lambda kv: str(kv[0])) if not str(k).startswith("_"))
+
+
+# ---- the value on the extremal ----------------------------------------------------------------
+@quantity('functional_value',
+          book='expression in the parameters and the curve\'s constants',
+          how=('∫F dx along the curve `curve:` (its constants solved as for `extremal`; '
+               '`constraint: <name>` integrates that constraint\'s G instead, e.g. a '
+               'length) by tanh-sinh quadrature at 30 digits (integrable end singularities '
+               'allowed), equal to the book\'s to 1e-15, at the default values and two '
+               'sampled points'),
+          keys={**CURVE_KEYS, "constraint": {"type": "string"}}, needs_system=False)
+def check_functional_value(ctx: Context, val) -> Verdict:
+    if "curve" not in ctx.part.data:
+        raise ctx.part.error(("quantity",), "a `functional_value` part gives its `curve:`")
+    spec = CurveSpec(ctx, ctx.part.data["curve"], ("curve",))
+    book = ctx.parse(val, ("book",), names=spec.names)
+    if ctx.validate_only:
+        return Verdict(True, "validated")
+    fn = spec.fn
+    integrand = fn.integrand
+    if "constraint" in ctx.part.data:
+        which = {c.name: c for c in fn.constraints if c.kind == "integral"}
+        name = ctx.part.data["constraint"]
+        if name not in which:
+            raise ctx.part.error(("constraint",), f"{name!r} is not an integral constraint "
+                                 "of the functional")
+        integrand = which[name].expr
+    f_s = cv.functional_integrand(fn, spec.curve, integrand)
+    points = _solved_points(spec)
+    for pt in points:
+        got, err = cv.integral(f_s, spec.curve, pt)
+        want = cv.mp_value(book, pt)
+        rel = abs(got - want) / max(abs(got), abs(want), mpmath.mpf(10) ** -300)
+        if rel > 1e-15:
+            return Verdict(False, f"numeric({len(points)} points, 30 digits)",
+                           f"the functional is {mpmath.nstr(got, 15)} on the curve, the "
+                           f"book's {mpmath.nstr(want, 15)} (relative {mpmath.nstr(rel, 3)})"
+                           f" at {_fmt(pt)}")
+    return Verdict(True, f"numeric({len(points)} points, 30 digits)",
+                   power=f"{len(points)} parameter points, quadrature at 30 digits, "
+                         "relative 1e-15")
+
+
+# ---- a minimum ----------------------------------------------------------------------------------
+@quantity('minimum',
+          book='`minimum` or `not a minimum`',
+          how=('decided at the default values and two sampled points: Legendre\'s matrix '
+               'F̂_{y′y′} positive definite at 25 points along the curve `curve:` and no '
+               'point conjugate to the start (the Jacobi field\'s determinant has no zero '
+               'on (s_a, s_b]): a (weak) minimum; Legendre\'s matrix negative somewhere or '
+               'a conjugate point inside: not a minimum; a conjugate point within 1e-6 of '
+               'the end: undecided (unsupported). Second computation: on perturbed curves '
+               'y + εη at 30 digits the value does not decrease for a minimum'),
+          keys=CURVE_KEYS, literals=MINIMUM, needs_system=False)
+def check_minimum(ctx: Context, val) -> Verdict:
+    if val not in MINIMUM:
+        raise ctx.part.error(("book",), "the book's verdict is `minimum` or `not a minimum`")
+    if "curve" not in ctx.part.data:
+        raise ctx.part.error(("quantity",), "a `minimum` part gives its `curve:`")
+    spec = CurveSpec(ctx, ctx.part.data["curve"], ("curve",))
+    if ctx.validate_only:
+        return Verdict(True, "validated")
+    if spec.fn.constraints:
+        raise UnsupportedError("the second variation under a constraint (the Jacobi "
+                               "condition of the constrained problem)")
+    points = _solved_points(spec)
+    verdicts = []
+    for pt in points:
+        sv = cv.second_variation(spec.fn, spec.curve, pt)
+        sa, sb = sv.ends
+        L = abs(sb - sa)
+        if min(sv.legendre_min) < 0:
+            engine, why = "not a minimum", "Legendre's matrix is not positive"
+        elif sv.conjugate is not None and abs(sb - sv.conjugate) <= 1e-6 * L:
+            raise UnsupportedError(f"a conjugate point at the end (s = {sv.conjugate:.8g}): "
+                                   "the Jacobi condition is at its boundary")
+        elif sv.conjugate is not None:
+            engine, why = "not a minimum", f"a conjugate point at s = {sv.conjugate:.8g}"
+        elif min(sv.legendre_min) > 0:
+            engine, why = "minimum", "Legendre strict, no conjugate point on (s_a, s_b]"
+        else:
+            raise UnsupportedError("Legendre's matrix is singular along the curve")
+        if engine != val:
+            return Verdict(False, f"Legendre and Jacobi ({len(points)} points)",
+                           f"{why} at {_fmt(pt)}: {engine}, the book says {val}")
+        verdicts.append(why)
+    detail = f"decided at {len(points)} sampled parameter points: {verdicts[0]}"
+    if val == "minimum":
+        F = spec.fn.integrand
+        for p in cv.perturbed(spec.fn, spec.curve, points[0], F):
+            if p.least_change < -STATIONARY * abs(p.value):
+                return Verdict(False, "perturbed curves (30 digits)",
+                               f"the functional decreases along {p.label} by "
+                               f"{mpmath.nstr(-p.least_change, 3)}, though Legendre and "
+                               "Jacobi say a minimum")
+        detail += "; the value does not decrease on 2 perturbed curves per function"
+    return Verdict(True, f"Legendre and Jacobi ({len(points)} points)", detail,
+                   power=f"the verdict at {len(points)} sampled points ({detail})")
