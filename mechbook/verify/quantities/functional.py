@@ -45,7 +45,7 @@ CONSTANTS = {"type": "object", "maxProperties": 8,
              "additionalProperties": {"type": "number"}}
 SYMMETRY = {"type": "object", "minProperties": 1, "additionalProperties": EXPR}
 CURVE_KEYS = {"curve": CURVE, "range": RANGE, "constants": CONSTANTS}
-POINTS = 3  # parameter points a curve is checked at: the default values and 2 draws
+POINTS = 2  # parameter points a curve is checked at: the default values and a draw
 VANISH = 1e-18  # a residual at 30 digits, relative to what cancelled in it
 STATIONARY = 1e-9  # |J′(0)| relative to |J(0)| + |J″(0)| on the perturbed curves
 MINIMUM = ("minimum", "not a minimum")
@@ -265,10 +265,10 @@ def _solved_points(spec: CurveSpec) -> list[dict]:
                '(each end\'s x, the fixed values, ∂F̃/∂y′ = 0 at a free end), the '
                'constraints\' integrals, and the Euler–Lagrange residuals at six interior '
                'points; every residual must then vanish to 1e-18 of its scale, at the '
-               'default values and two sampled points (the constants followed there by '
+               'default values and a sampled point (the constants followed there by '
                'continuation). Second computation: the functional on perturbed curves y + '
                'εη (η vanishing at fixed ends; two variations per function) at 30 digits: '
-               'its first variation J′(0) (Richardson, O(ε⁴)) vanishes to 1e-9 of |J| + '
+               'its first variation J′(0) (central difference, ε = 1e-5) vanishes to 1e-9 of |J| + '
                '|J″|'),
           keys={"range": RANGE, "constants": CONSTANTS}, names=jet_names, needs_system=False)
 def check_extremal(ctx: Context, val) -> Verdict:
@@ -319,8 +319,8 @@ def _fmt(pt: dict) -> str:
           how=('∫F dx along the curve `curve:` (its constants solved as for `extremal`; '
                '`constraint: <name>` integrates that constraint\'s G instead, e.g. a '
                'length) by tanh-sinh quadrature at 30 digits (integrable end singularities '
-               'allowed), equal to the book\'s to 1e-15, at the default values and two '
-               'sampled points'),
+               'allowed), equal to the book\'s to 1e-15, at the default values and a '
+               'sampled point'),
           keys={**CURVE_KEYS, "constraint": {"type": "string"}}, needs_system=False)
 def check_functional_value(ctx: Context, val) -> Verdict:
     if "curve" not in ctx.part.data:
@@ -357,7 +357,7 @@ def check_functional_value(ctx: Context, val) -> Verdict:
 # ---- a minimum ----------------------------------------------------------------------------------
 @quantity('minimum',
           book='`minimum` or `not a minimum`',
-          how=('decided at the default values and two sampled points: Legendre\'s matrix '
+          how=('decided at the default values and a sampled point: Legendre\'s matrix '
                'F̂_{y′y′} positive definite at 25 points along the curve `curve:` and no '
                'point conjugate to the start (the Jacobi field\'s determinant has no zero '
                'on (s_a, s_b]): a (weak) minimum; Legendre\'s matrix negative somewhere or '
