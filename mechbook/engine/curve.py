@@ -131,19 +131,23 @@ def functional_integrand(fn: Functional, curve: Curve, integrand: sp.Expr | None
 
 @dataclass
 class Conditions:
-    """What fixes a curve's unknowns (its constants and the multipliers not given): the end
-    conditions (x(s_e) = x_e, a fixed value, or a free end's natural condition ∂F̃/∂y′ = 0),
-    the isoperimetric integrals' values, and the Euler–Lagrange residuals at interior
-    points; each a named residual, zero on an extremal that meets them."""
+    """What fixes a curve's unknowns and what an extremal must satisfy: the end conditions
+    (x(s_e) = x_e, a fixed value, or a free end's natural condition ∂F̃/∂y′ = 0) and the
+    isoperimetric integrals' values, which fix the constants; the Euler–Lagrange residuals
+    at interior points, affine in the multipliers not given, which fix those. Each a named
+    residual, zero on an extremal that meets them."""
 
     names: list[str]
-    pointwise: list[sp.Expr]  # residuals evaluated at a point
+    pointwise: list[sp.Expr]  # end conditions, evaluated at a point
     integrals: list[tuple[str, sp.Expr, sp.Expr]]  # (name, integrand in s, value)
+    el_names: list[str]
+    el: list[sp.Expr]  # Euler–Lagrange residuals at interior points
+    multipliers: list[sp.Symbol]  # those not given: solved from `el` (linear)
 
 
 def conditions(fn: Functional, curve: Curve, multipliers: dict) -> Conditions:
     """The curve's residuals (see `Conditions`), with the multipliers `multipliers` gives
-    substituted (the rest stay symbols, solved for with the constants)."""
+    substituted (the rest stay symbols, solved for from the Euler–Lagrange residuals)."""
     Ft = augmented(fn).xreplace(multipliers)
     names, exprs = [], []
     for i, end in enumerate(fn.ends):
@@ -160,22 +164,46 @@ def conditions(fn: Functional, curve: Curve, multipliers: dict) -> Conditions:
             else:
                 names.append(f"natural condition dF/d{jet[1]} = 0 at end {i + 1}")
                 exprs.append(along(sp.diff(Ft, jet[1]), curve, fn).xreplace(at))
+    unknown = [c.multiplier for c in fn.constraints
+               if c.kind == "integral" and c.multiplier not in multipliers]
+    if any(e.has(m) for e in exprs for m in unknown):
+        raise UnsupportedError("a free end's natural condition with a multiplier the curve "
+                               "does not give (give it in `multipliers:`)")
     integrals = [(f"integral {c.name}", functional_integrand(fn, curve, c.expr), c.value)
                  for c in fn.constraints if c.kind == "integral"]
     el = [along(e, curve, fn) for e in euler_lagrange(fn, Ft)]
+    el_names, el_exprs = [], []
     for t in INTERIOR:
         s_t = curve.ends[0] + (curve.ends[1] - curve.ends[0]) * sp.Rational(str(t))
         for f, e in zip(fn.functions, el, strict=True):
-            names.append(f"Euler–Lagrange ({f}) at s = s_a + {t}·(s_b − s_a)")
-            exprs.append(e.xreplace({curve.s: s_t}))
-    return Conditions(names, exprs, integrals)
+            el_names.append(f"Euler–Lagrange ({f}) at s = s_a + {t}·(s_b − s_a)")
+            el_exprs.append(e.xreplace({curve.s: s_t}))
+    return Conditions(names, exprs, integrals, el_names, el_exprs, unknown)
+
+
+def multipliers_at(cond: Conditions, point: dict) -> dict:
+    """The multipliers not given, by least squares from the Euler–Lagrange residuals (affine
+    in them) at `point` (parameters and constants); {} if there are none."""
+    if not cond.multipliers:
+        return {}
+    zero = {m: mpmath.mpf(0) for m in cond.multipliers}
+    with mpmath.workdps(DIGITS + 10):
+        b = mpmath.matrix([mpmath.re(fast_value(e, {**point, **zero})) for e in cond.el])
+        A = mpmath.matrix(len(cond.el), len(cond.multipliers))
+        for j, m in enumerate(cond.multipliers):
+            one = dict(zero)
+            one[m] = mpmath.mpf(1)
+            for i, e in enumerate(cond.el):
+                A[i, j] = mpmath.re(fast_value(e, {**point, **one})) - b[i]
+        sol = mpmath.lu_solve(A.T * A, -(A.T * b))
+    return {m: sol[j] for j, m in enumerate(cond.multipliers)}
 
 
 def residuals(cond: Conditions, curve: Curve, point: dict) -> list[tuple[str, object, float]]:
     """(name, value, scale) of every residual at `point` (parameters, constants and
     unknown multipliers given): a scale is the magnitude of what cancelled."""
     out = []
-    for name, e in zip(cond.names, cond.pointwise, strict=True):
+    for name, e in zip(cond.names + cond.el_names, cond.pointwise + cond.el, strict=True):
         v, m = evaluate(e, point, DIGITS)
         out.append((name, mpmath.mpc(v), max(m, 1e-300)))
     for name, e, value in cond.integrals:

@@ -134,19 +134,20 @@ def functional_of(doc: Document, names: dict[str, sp.Basic]) -> Functional | Non
 
     integrand = expr(data["integrand"], root + ("integrand",))
     order = _order(integrand, jets)
+    if order > MAX_ORDER:
+        raise doc.error(root + ("integrand",), f"derivatives up to the {MAX_ORDER}nd only")
     _differentiable(doc, integrand, jets, root + ("integrand",))
     for c, spec in zip(constraints, data.get("constraints") or [], strict=True):
         if c.kind == "integral":
             c.expr = expr(spec["integral"], c.path + ("integral",))
-            if _order(c.expr, jets) > order:
-                raise doc.error(c.path + ("integral",), "the constraint's integrand holds a "
-                                "higher derivative than the functional's")
+            order = max(order, _order(c.expr, jets))  # F̃ = F + λG holds both
             _differentiable(doc, c.expr, jets, c.path + ("integral",))
             c.value = expr(spec["value"], c.path + ("value",), names)
         else:
             point = {str(x): x, **{f: jet[0] for f, jet in zip(functions, jets, strict=True)},
                      **names}
             c.expr = expr(spec["holonomic"], c.path + ("holonomic",), point)
+    order = max(order, 1)  # F(x, y) alone: its Euler–Lagrange equation is F_y = 0
     ends = [_end(doc, e, root + ("ends", i), x, functions, names, expr)
             for i, e in enumerate(data["ends"])]
     return Functional(x, functions, jets, integrand, order, ends, constraints, root)

@@ -195,8 +195,6 @@ class CurveSpec:
                                      "multiplier is a function, found along the curve")
             mults[bynames[k].multiplier] = ctx.parse(v, sub + ("multipliers", k), names=names)
         self.multipliers = mults
-        self.unknown = [c.multiplier for c in fn.constraints
-                        if c.kind == "integral" and c.multiplier not in mults]
         if "range" in ctx.part.data:
             ends = tuple(ctx.parse(v, ("range", i), names=names)
                          for i, v in enumerate(ctx.part.data["range"]))
@@ -214,13 +212,14 @@ class CurveSpec:
         self.ctx = ctx
 
     def unknowns(self) -> list[sp.Symbol]:
-        return self.constants + self.unknown
+        """The constants the end conditions fix (the multipliers not given follow)."""
+        return self.constants
 
     def points(self) -> list[tuple[dict, dict | None]]:
         """(parameter values, the unknowns there or None) at the default values and at
         POINTS − 1 sampled ones."""
         base = {k: sp.Float(v, 30) for k, v in self.ctx.sampler.base.items()}
-        start = {**self.start, **{m: 0 for m in self.unknown}}
+        start = self.start
         out = [(base, cv.solve_unknowns(self.conditions, self.curve, self.unknowns(), start,
                                         base) if self.unknowns() else {})]
         if out[0][1] is None:
@@ -238,6 +237,7 @@ class CurveSpec:
         pt = {**params, **unknowns}
         for m, e in self.multipliers.items():
             pt[m] = cv.mp_value(e, pt)
+        pt.update(cv.multipliers_at(self.conditions, pt))
         return pt
 
 
@@ -285,7 +285,7 @@ def check_extremal(ctx: Context, val) -> Verdict:
     first = _first_variation(spec, points[0])
     if first is not None:
         return first
-    solved = ", ".join(map(str, spec.unknowns())) or "none"
+    solved = ", ".join(map(str, spec.unknowns() + spec.conditions.multipliers)) or "none"
     power = (f"{len(points)} parameter points (constants solved: {solved}); end conditions, "
              f"integrals and Euler–Lagrange at 6 interior points to {VANISH:g} of their "
              f"scale; first variation on {2 * len(spec.fn.functions)} perturbed curves "
