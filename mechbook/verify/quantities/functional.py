@@ -19,6 +19,7 @@ import sympy as sp
 
 from mechbook.engine import curve as cv
 from mechbook.engine.variational import (
+    augmented,
     beltrami,
     euler_lagrange,
     noether,
@@ -295,8 +296,6 @@ def check_extremal(ctx: Context, val) -> Verdict:
 
 def _first_variation(spec: CurveSpec, pt: dict) -> Verdict | None:
     """A fail if the functional is not stationary at the curve on perturbed curves."""
-    from mechbook.engine.variational import augmented
-
     F = augmented(spec.fn).xreplace({m: pt[m] for m in spec.fn.names().values() if m in pt})
     for p in cv.perturbed(spec.fn, spec.curve, pt, F):
         scale = abs(p.value) + abs(p.curvature)
