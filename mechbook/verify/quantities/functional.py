@@ -276,7 +276,13 @@ def check_extremal(ctx: Context, val) -> Verdict:
     spec = CurveSpec(ctx, val, ("book",))
     if ctx.validate_only:
         return Verdict(True, "validated")
-    points = _solved_points(spec)
+    try:
+        points = _solved_points(spec)
+    except UnsupportedError:
+        not_extremal = _not_extremal_at_start(spec)
+        if not_extremal is None:
+            raise
+        return not_extremal
     for pt in points:
         for name, v, scale in cv.residuals(spec.conditions, spec.curve, pt):
             if abs(v) > VANISH * scale:
@@ -292,6 +298,22 @@ def check_extremal(ctx: Context, val) -> Verdict:
              f"scale; first variation on {2 * len(spec.fn.functions)} perturbed curves "
              f"≤ {STATIONARY:g}")
     return Verdict(True, f"numeric({len(points)} points, 30 digits)", power=power)
+
+
+def _not_extremal_at_start(spec: CurveSpec) -> Verdict | None:
+    """Where no constants near the key's start meet the end conditions: a fail if the curve
+    is no extremal at the start either (an Euler–Lagrange residual that does not vanish),
+    else None (the part is then unsupported: an extremal the ends cannot be fitted to)."""
+    base = {k: sp.Float(v, 30) for k, v in spec.ctx.sampler.base.items()}
+    pt = spec.at(base, {k: mpmath.mpf(str(v)) for k, v in spec.start.items()})
+    for name, e in zip(spec.conditions.el_names, spec.conditions.el, strict=True):
+        v, scale = cv.evaluate(e, pt, cv.DIGITS)
+        if abs(v) > VANISH * max(scale, 1e-300):
+            return Verdict(False, "numeric(the key's start, 30 digits)",
+                           "no constants near the key's start make the curve meet its end "
+                           f"conditions, and it is no extremal there: {name} is "
+                           f"{abs(v):.3g} (scale {scale:.3g}) at {_fmt(pt)}")
+    return None
 
 
 def _first_variation(spec: CurveSpec, pt: dict) -> Verdict | None:
