@@ -218,11 +218,19 @@ class CurveSpec:
 
     def points(self) -> list[tuple[dict, dict | None]]:
         """(parameter values, the unknowns there or None) at the default values and at
-        POINTS − 1 sampled ones."""
+        POINTS − 1 sampled ones; kept by the analysis, so the parts that share a curve
+        (its extremal, value, minimum) solve its constants once."""
+        key = ("functional curve", self.curve.x, tuple(self.curve.ys), self.curve.ends,
+               tuple(sorted((str(k), v) for k, v in self.start.items())),
+               tuple(sorted((str(k), v) for k, v in self.multipliers.items())),
+               tuple(sorted((str(k), v) for k, v in self.ctx.sampler.base.items())),
+               tuple(map(str, self.ctx.sampler.conditions)))
+        return self.ctx.analysis.reuse(key, self._points)
+
+    def _points(self) -> list[tuple[dict, dict | None]]:
         base = {k: sp.Float(v, 30) for k, v in self.ctx.sampler.base.items()}
-        start = self.start
-        out = [(base, cv.solve_unknowns(self.conditions, self.curve, self.unknowns(), start,
-                                        base) if self.unknowns() else {})]
+        out = [(base, cv.solve_unknowns(self.conditions, self.curve, self.unknowns(),
+                                        self.start, base) if self.unknowns() else {})]
         if out[0][1] is None:
             return out
         for _ in range(POINTS - 1):
