@@ -300,3 +300,32 @@ def test_a_kink_in_yp_is_refused_at_its_line(tmp_path):
     with pytest.raises(SpecError) as exc:
         load_problem(f)
     assert exc.value.line == 8 and "not differentiable in yp" in str(exc.value)
+
+
+def test_a_kink_stops_check_before_anything_is_written(tmp_path):
+    """`mechbook check` of a problem whose integrand has Abs(yp): the error names the
+    file and line, the exit status is nonzero, and no store is written."""
+    import shutil
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from mechbook.app.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    shutil.copy(root / "books.yaml", tmp_path / "books.yaml")
+    for sub in ("problems", "answers"):
+        (tmp_path / sub / "classic").mkdir(parents=True)
+    (tmp_path / "problems" / "classic" / "kink.yaml").write_text(
+        "id: classic-kink\nsource: test\ntitle: a kink\nparameters: {}\n"
+        "functional:\n  independent: x\n  functions: [y]\n"
+        "  integrand: \"Abs(yp) + y**2\"\n  ends: [{x: 0, y: 0}, {x: 1, y: 1}]\n")
+    (tmp_path / "answers" / "classic" / "kink.yaml").write_text(
+        "problem: classic-kink\nsource: test\nparts:\n  - part: a\n    cite: t\n"
+        "    quantity: euler_lagrange\n    book: [\"ypp = 0\"]\n")
+    path = tmp_path / "results" / "store.h5"
+    result = CliRunner().invoke(main, ["--root", str(tmp_path), "check", "classic-kink",
+                                       "--store", str(path), "-j", "1"])
+    assert result.exit_code != 0
+    assert "kink.yaml:8" in result.output and "not differentiable in yp" in result.output
+    assert not path.exists()
