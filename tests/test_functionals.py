@@ -329,3 +329,28 @@ def test_a_kink_stops_check_before_anything_is_written(tmp_path):
     assert result.exit_code != 0
     assert "kink.yaml:8" in result.output and "not differentiable in yp" in result.output
     assert not path.exists()
+
+
+SPHERE_3D = """
+parameters: {R: {value: 1.5}, T: {value: 2.0}, alpha: {value: 0.6}, h: {value: 0.5}}
+conditions: ["h < R"]
+functional:
+  independent: t
+  functions: [x, y, z]
+  integrand: "sqrt(xp**2 + yp**2 + zp**2)"
+  ends: [{t: 0, x: R, y: 0, z: 0},
+         {t: T, x: R*cos(T), y: R*sin(T)*cos(alpha), z: R*sin(T)*sin(alpha)}]
+  constraints: [{name: sphere, holonomic: "x**2 + y**2 + z**2 - R**2"}]
+"""
+
+
+def test_geodesic_on_a_sphere_with_a_holonomic_constraint(tmp_path):
+    """A tilted great circle x = R cos t, y = R sin t cos α, z = R sin t sin α is a geodesic
+    (its Euler–Lagrange residual is along ∇φ); a small circle on the sphere is not; its
+    length is R·T; the Euler–Lagrange equations with μ: ẍ/|v| − … hold as F + μφ gives."""
+    great = "{x: \"R*cos(t)\", y: \"R*sin(t)*cos(alpha)\", z: \"R*sin(t)*sin(alpha)\"}"
+    tilted = "{x: \"R*cos(t)\", y: \"R*sin(t)*cos(alpha)\", z: \"(101/100)*R*sin(t)*sin(alpha)\"}"
+    parts = (f"- {{part: a, cite: t, quantity: extremal, book: {great}}}\n"
+             f"- {{part: b, cite: t, quantity: functional_value, curve: {great}, book: \"R*T\"}}\n"
+             f"- {{part: c, cite: t, quantity: extremal, book: {tilted}}}\n")
+    assert _check(tmp_path, "sphere3", SPHERE_3D, parts) == ["pass", "pass", "fail"]

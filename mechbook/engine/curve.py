@@ -134,7 +134,8 @@ class Conditions:
     """What fixes a curve's unknowns and what an extremal must satisfy: the end conditions
     (x(s_e) = x_e, a fixed value, or a free end's natural condition ∂F̃/∂y′ = 0) and the
     isoperimetric integrals' values, which fix the constants; the Euler–Lagrange residuals
-    at interior points, affine in the multipliers not given, which fix those. Each a named
+    at interior points, affine in the multipliers not given, which fix those (a holonomic
+    constraint's μ(x)·∇φ projected out of them, and φ = 0 there). Each a named
     residual, zero on an extremal that meets them."""
 
     names: list[str]
@@ -171,13 +172,26 @@ def conditions(fn: Functional, curve: Curve, multipliers: dict) -> Conditions:
                                "does not give (give it in `multipliers:`)")
     integrals = [(f"integral {c.name}", functional_integrand(fn, curve, c.expr), c.value)
                  for c in fn.constraints if c.kind == "integral"]
-    el = [along(e, curve, fn) for e in euler_lagrange(fn, Ft)]
+    holonomic = [c for c in fn.constraints if c.kind == "holonomic"]
+    Ft = Ft.xreplace({c.multiplier: 0 for c in holonomic})
+    el = sp.Matrix([along(e, curve, fn) for e in euler_lagrange(fn, Ft)])
+    on = []  # the curve on each holonomic surface, and E with μ·∇φ projected out
+    if holonomic:
+        G = sp.Matrix([[along(sp.diff(c.expr, y), curve, fn) for c in holonomic]
+                       for y in fn.function_symbols(0)])
+        el = el - G * (G.T * G).inv() * (G.T * el)
+        on = [(c.name, along(c.expr, curve, fn)) for c in holonomic]
     el_names, el_exprs = [], []
     for t in INTERIOR:
         s_t = curve.ends[0] + (curve.ends[1] - curve.ends[0]) * sp.Rational(str(t))
+        where = f"at s = s_a + {t}·(s_b − s_a)"
         for f, e in zip(fn.functions, el, strict=True):
-            el_names.append(f"Euler–Lagrange ({f}) at s = s_a + {t}·(s_b − s_a)")
+            el_names.append(f"Euler–Lagrange ({f}{', μ·∇φ projected out' if on else ''}) "
+                            + where)
             el_exprs.append(e.xreplace({curve.s: s_t}))
+        for name, phi in on:
+            el_names.append(f"holonomic constraint {name} {where}")
+            el_exprs.append(phi.xreplace({curve.s: s_t}))
     return Conditions(names, exprs, integrals, el_names, el_exprs, unknown)
 
 

@@ -96,7 +96,7 @@ def functional_of(doc: Document, names: dict[str, sp.Basic]) -> Functional | Non
     taken = dict(names)
 
     def claim(name: str, path: tuple) -> sp.Symbol:
-        if name in taken or name in ("t", "pi"):
+        if name in taken or name == "pi":
             raise doc.error(path, f"{name!r} is already a name (a parameter, another "
                             "function or its derivative yp, ypp)")
         taken[name] = sp.Symbol(name, real=True)

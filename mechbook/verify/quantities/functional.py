@@ -206,9 +206,6 @@ class CurveSpec:
                                  "values at the two ends")
         self.curve = cv.Curve(s, xs, ys, ends, self.constants)
         self.names = names
-        if any(c.kind == "holonomic" for c in fn.constraints):
-            raise UnsupportedError("a holonomic constraint on the curve (its multiplier "
-                                   "function is not solved for yet)")
         self.conditions = cv.conditions(fn, self.curve, mults)
         self.ctx = ctx
 
@@ -303,8 +300,10 @@ def check_extremal(ctx: Context, val) -> Verdict:
     solved = ", ".join(map(str, spec.unknowns() + spec.conditions.multipliers)) or "none"
     power = (f"{len(points)} parameter points (constants solved: {solved}); end conditions, "
              f"integrals and Euler–Lagrange at 6 interior points to {VANISH:g} of their "
-             f"scale; first variation on {2 * len(spec.fn.functions)} perturbed curves "
-             f"≤ {STATIONARY:g}")
+             "scale; " + ("on a holonomic constraint: no perturbed curves" if any(
+                 c.kind == "holonomic" for c in spec.fn.constraints) else
+                 f"first variation on {2 * len(spec.fn.functions)} perturbed curves ≤ "
+                 f"{STATIONARY:g}"))
     return Verdict(True, f"numeric({len(points)} points, 30 digits)", power=power)
 
 
@@ -325,7 +324,10 @@ def _not_extremal_at_start(spec: CurveSpec) -> Verdict | None:
 
 
 def _first_variation(spec: CurveSpec, pt: dict) -> Verdict | None:
-    """A fail if the functional is not stationary at the curve on perturbed curves."""
+    """A fail if the functional is not stationary at the curve on perturbed curves (none
+    on a holonomic constraint: a perturbed curve leaves the surface)."""
+    if any(c.kind == "holonomic" for c in spec.fn.constraints):
+        return None
     F = augmented(spec.fn).xreplace({m: pt[m] for m in spec.fn.names().values() if m in pt})
     for p in cv.perturbed(spec.fn, spec.curve, pt, F):
         scale = abs(p.value) + abs(p.curvature)
