@@ -354,3 +354,20 @@ def test_geodesic_on_a_sphere_with_a_holonomic_constraint(tmp_path):
              f"- {{part: b, cite: t, quantity: functional_value, curve: {great}, book: \"R*T\"}}\n"
              f"- {{part: c, cite: t, quantity: extremal, book: {tilted}}}\n")
     assert _check(tmp_path, "sphere3", SPHERE_3D, parts) == ["pass", "pass", "fail"]
+
+
+@pytest.mark.parametrize("shape, multiplier, status", [
+    ("c*cosh((x - x0)/c) + k", None, "pass"),  # λ found: −k
+    ("c*cosh((x - x0)/c) + k", "-k", "pass"),
+    ("c*cosh((x - x0)/c) + k", "k", "fail"),
+    ("c*cosh((x - x0)/((1000001/1000000)*c)) + k", None, "fail"),
+])
+def test_catenary_between_unequal_heights(tmp_path, shape, multiplier, status):
+    """A chain of length 3 from (0, 0) to (2, 1/2): y = c·cosh((x − x0)/c) + k with three
+    constants fixed by the two ends and the length (c = 0.628, x0 = 0.894, k = −1.380 by
+    hand-started Newton), and λ = −k (F + λG = (y + λ)·√(1 + y′²))."""
+    chain = CHAIN.replace("{x: -d, y: 0}, {x: d, y: 0}", "{x: 0, y: 0}, {x: 2*d, y: d/2}")
+    mult = f", multipliers: {{length: \"{multiplier}\"}}" if multiplier else ""
+    part = ("quantity: extremal\nconstants: {c: 0.6, x0: 0.9, k: -1.4}\n"
+            f"book: {{y: \"{shape}\"{mult}}}\n")
+    assert _one(tmp_path, "chain2", chain, part) == status
