@@ -371,3 +371,22 @@ def test_catenary_between_unequal_heights(tmp_path, shape, multiplier, status):
     part = ("quantity: extremal\nconstants: {c: 0.6, x0: 0.9, k: -1.4}\n"
             f"book: {{y: \"{shape}\"{mult}}}\n")
     assert _one(tmp_path, "chain2", chain, part) == status
+
+
+@pytest.mark.parametrize("curve, status", [
+    ("x**2 + y**2 - r**2", "pass"),  # Fermat's ray in n0/y: a circle about the axis
+    ("x**2 + (101/100)*y**2 - r**2", "fail"),
+    ("x**2 + (1000001/1000000)*y**2 - r**2", "fail"),
+    ("(x - r/10)**2 + y**2 - r**2", "fail"),  # off the axis: does not meet both ends
+])
+def test_implicit_ray(tmp_path, curve, status):
+    medium = """
+    parameters: {n0: {value: 1.5}, d: {value: 1.0}, h: {value: 0.8}}
+    functional:
+      independent: x
+      functions: [y]
+      integrand: "n0*sqrt(1 + yp**2)/y"
+      ends: [{x: -d, y: h}, {x: d, y: h}]
+    """
+    part = f"quantity: extremal\nconstants: {{r: 1.2}}\nbook: {{implicit: \"{curve}\"}}\n"
+    assert _one(tmp_path, "fermat", medium, part) == status

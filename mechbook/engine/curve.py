@@ -457,3 +457,35 @@ def _size(fn: Functional, curve: Curve, point: dict):
             if vals:
                 span = max(span, max(vals) - min(vals))
     return sp.Float(str(span / 10 if span else 1), DIGITS)
+
+
+# ---- an implicit curve G(x, y) = 0 ---------------------------------------------------------
+def implicit_jets(G: sp.Expr, fn: Functional) -> dict[sp.Symbol, sp.Expr]:
+    """{y′: −G_x/G_y, y″: −(G_xx + 2G_xy·y′ + G_yy·y′²)/G_y} of the curve G(x, y) = 0 (one
+    function): the jets as functions of the point (x, y) on it."""
+    x, y = fn.x, fn.jets[0][0]
+    gy = sp.diff(G, y)
+    yp = -sp.diff(G, x) / gy
+    ypp = -(sp.diff(G, x, 2) + 2 * sp.diff(G, x, y) * yp + sp.diff(G, y, 2) * yp**2) / gy
+    return {fn.jets[0][1]: yp, fn.jets[0][2]: ypp}
+
+
+def on_implicit(G: sp.Expr, fn: Functional, point: dict, x_value, y_start):
+    """The y of G(x, y) = 0 at x = `x_value`, by Newton at 30 digits from `y_start` (the
+    chord between the ends picks the branch); None if Newton does not converge."""
+    x, y = fn.x, fn.jets[0][0]
+    f = G.xreplace({x: x_value})
+    df = sp.diff(G, y).xreplace({x: x_value})
+    pt = dict(point)
+    with mpmath.workdps(DIGITS + 10):
+        v = mpmath.mpf(y_start)
+        for _ in range(NEWTON_STEPS):
+            pt[y] = v
+            try:
+                step = fast_value(f, pt) / fast_value(df, pt)
+            except ZeroDivisionError:
+                return None
+            v -= mpmath.re(step)
+            if abs(step) <= mpmath.mpf(10) ** -(DIGITS + 5) * (1 + abs(v)):
+                return v
+    return None

@@ -265,7 +265,7 @@ def _solved_points(spec: CurveSpec) -> list[dict]:
 # ---- the extremal -----------------------------------------------------------------------------
 @quantity('extremal',
           book='a curve: `{y: expr}` (y(x)) or `{parameter: s, x: expr, y: expr}`, with '
-               '`multipliers:` if any',
+               '`multipliers:` if any, or `{implicit: G}` (G(x, y) = 0)',
           how=('the curve\'s `constants:` (and the isoperimetric multipliers it does not '
                'give) are solved by Gauss–Newton at 30 digits from the end conditions '
                '(each end\'s x, the fixed values, ∂F̃/∂y′ = 0 at a free end), the '
@@ -275,9 +275,13 @@ def _solved_points(spec: CurveSpec) -> list[dict]:
                'continuation). Second computation: the functional on perturbed curves y + '
                'εη (η vanishing at fixed ends; two variations per function) at 30 digits: '
                'its first variation J′(0) (central difference, ε = 1e-5) vanishes to 1e-9 of |J| + '
-               '|J″|'),
+               '|J″|. An implicit curve (one function, no constraints): the ends on it, and '
+               'Euler–Lagrange with y′, y″ by implicit differentiation at six points of it '
+               '(y by Newton from the chord)'),
           keys={"range": RANGE, "constants": CONSTANTS}, names=jet_names, needs_system=False)
 def check_extremal(ctx: Context, val) -> Verdict:
+    if isinstance(val, dict) and "implicit" in val:
+        return _implicit_extremal(ctx, val)
     spec = CurveSpec(ctx, val, ("book",))
     if ctx.validate_only:
         return Verdict(True, "validated")
@@ -305,6 +309,72 @@ def check_extremal(ctx: Context, val) -> Verdict:
                  f"first variation on {2 * len(spec.fn.functions)} perturbed curves ≤ "
                  f"{STATIONARY:g}"))
     return Verdict(True, f"numeric({len(points)} points, 30 digits)", power=power)
+
+
+def _implicit_extremal(ctx: Context, val: dict) -> Verdict:
+    """`{implicit: G}`: the curve G(x, y) = 0 meets the fixed ends (its constants solved
+    there) and the Euler–Lagrange residual, with y′ and y″ by implicit differentiation,
+    vanishes at six points of it between the ends (y found by Newton from the chord)."""
+    fn = functional(ctx)
+    if len(fn.functions) != 1 or fn.order != 1 or fn.constraints:
+        raise UnsupportedError("an implicit curve other than G(x, y) = 0 of one function of "
+                               "an integrand F(x, y, y′) without constraints")
+    extra = sorted(set(val) - {"implicit"})
+    if extra:
+        raise ctx.part.error(("book", extra[0]), "an implicit curve is `{implicit: G}`")
+    consts = ctx.as_map(ctx.part.data.get("constants") or {}, ("constants",))
+    names = dict(ctx.names)
+    for k in consts:
+        if k in names or k in fn.names():
+            raise ctx.part.error(("constants", k), f"{k!r} is already a name")
+        names[k] = sp.Symbol(k, real=True)
+    constants = [names[k] for k in consts]
+    x, y = fn.x, fn.jets[0][0]
+    G = ctx.parse(val["implicit"], ("book", "implicit"), names={**names, str(x): x, str(y): y})
+    if ctx.validate_only:
+        return Verdict(True, "validated")
+    if any(e.values[fn.functions[0]] is None for e in fn.ends):
+        raise UnsupportedError("a free end of an implicit curve")
+    ends = [G.xreplace({x: e.at, y: e.values[fn.functions[0]]}) for e in fn.ends]
+    cond = cv.Conditions([f"the curve at end {i + 1}" for i in range(2)], ends, [], [], [],
+                         [])
+    E = euler_lagrange(fn)[0].xreplace(cv.implicit_jets(G, fn))
+    curve = cv.Curve(x, x, [y], (fn.ends[0].at, fn.ends[1].at), constants)
+    base = {k: sp.Float(v, 30) for k, v in ctx.sampler.base.items()}
+    start = {names[k]: v for k, v in consts.items()}
+    solved = cv.solve_unknowns(cond, curve, constants, start, base) if constants else {}
+    if solved is None:
+        raise UnsupportedError("no constants near the key's start put the ends on the curve")
+    points = [{**base, **solved}]
+    drawn = {k: v for k, v in ctx.sampler.draw().items() if k in base}
+    again = cv.continued(cond, curve, constants, solved, base, drawn) if constants else {}
+    if again is not None:
+        points.append({**drawn, **again})
+    for pt in points:
+        for name, e in zip(cond.names, ends, strict=True):
+            v, scale = cv.evaluate(e, pt, cv.DIGITS)
+            if abs(v) > VANISH * max(scale, 1e-300):
+                return Verdict(False, f"numeric({len(points)} points, 30 digits)",
+                               f"{name}: G = {abs(v):.3g} at {_fmt(pt)}")
+        xa, xb = (cv.mp_value(e.at, pt) for e in fn.ends)
+        ya, yb = (cv.mp_value(e.values[fn.functions[0]], pt) for e in fn.ends)
+        for t in cv.INTERIOR:
+            t = mpmath.mpf(str(t))
+            xt = xa + t * (xb - xa)
+            yt = cv.on_implicit(G, fn, pt, xt, ya + t * (yb - ya))
+            if yt is None:
+                raise UnsupportedError(f"no point of the curve found at {x} = "
+                                       f"{mpmath.nstr(xt, 8)} (Newton from the chord)")
+            v, scale = cv.evaluate(E, {**pt, x: xt, y: yt}, cv.DIGITS)
+            if abs(v) > VANISH * max(scale, 1e-300):
+                return Verdict(False, f"numeric({len(points)} points, 30 digits)",
+                               f"Euler–Lagrange at ({x}, {y}) = ({mpmath.nstr(xt, 8)}, "
+                               f"{mpmath.nstr(yt, 8)}) is {abs(v):.3g} (scale {scale:.3g}) "
+                               f"at {_fmt(pt)}")
+    return Verdict(True, f"numeric({len(points)} points, 30 digits)",
+                   power=f"{len(points)} parameter points: the ends on the curve and "
+                         f"Euler–Lagrange (y′, y″ implicit) at 6 points of it to {VANISH:g} "
+                         "of their scale; no perturbed curves")
 
 
 def _not_extremal_at_start(spec: CurveSpec) -> Verdict | None:
