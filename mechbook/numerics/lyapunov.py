@@ -1,0 +1,117 @@
+"""The largest Lyapunov exponent of a trajectory, by the tangent-map (Benettin) method.
+
+One tangent vector is carried along the motion by the variational equations
+(mechbook.numerics.tangent) and renormalized to length 1 after each of `windows` equal
+windows of the run; the logarithms of its growth in each window are kept (nothing else, so
+a long run needs no memory). From them:
+
+- the estimate λ: the growth over the second half of the run divided by its length (the
+  first half lets the vector turn into the most unstable direction);
+- its spread: the difference between the estimates of the third and the fourth quarter,
+  the run's own measure of how far it has converged;
+- its resolution b = RESOLUTION / span: a regular motion, whose tangent vectors grow like a
+  power of t (linearly on an invariant torus), has a second-half growth of a few times
+  ln 2 with bounded oscillations; below b an exponent cannot be told from zero.
+
+The state must stay bounded: a coordinate that is not an angle of the equations, or a
+velocity, leaving BOUND times the start's size ends the run (`UnboundedMotion`). The run
+keeps to a CPU budget: after the first windows it projects its cost and stops (an
+`UnsupportedError` saying so) rather than run past what a check may take.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechbook.errors import UnsupportedError
+from mechbook.numerics.tangent import TangentFlow, angle_coordinates
+
+WINDOWS = 64
+RESOLUTION = 8.0  # b = RESOLUTION / span: what a regular motion's second half can show
+BOUND = 1e4  # the state may grow to this times (1 + |start|) and no further
+BUDGET_SECONDS = 60.0  # CPU seconds a run may take
+RTOL = 1e-10
+
+
+class UnboundedMotion(Exception):
+    """The motion left every bound: it has no Lyapunov exponent of a bounded orbit."""
+
+
+@dataclass
+class ExponentRun:
+    """The logs of one run and what they give."""
+
+    span: float
+    logs: np.ndarray  # ln(growth) in each window
+    evaluations: int
+    seconds: float
+
+    @property
+    def estimate(self) -> float:
+        half = len(self.logs) // 2
+        return float(np.sum(self.logs[half:]) / (self.span / 2))
+
+    @property
+    def spread(self) -> float:
+        w = len(self.logs)
+        q3 = np.sum(self.logs[w // 2: 3 * w // 4]) / (self.span / 4)
+        q4 = np.sum(self.logs[3 * w // 4:]) / (self.span / 4)
+        return float(abs(q3 - q4))
+
+    @property
+    def resolution(self) -> float:
+        return RESOLUTION / self.span
+
+
+def largest_exponent(system, dyn, values: dict, y0: np.ndarray, span: float,
+                     windows: int = WINDOWS, seed: int = 1,
+                     progress: Callable[[str], None] | None = None,
+                     budget: float = BUDGET_SECONDS) -> ExponentRun:
+    """The Benettin run from the state y0 (2n: q, q̇) over `span` time units at `values`.
+    Example: `largest_exponent(sys, dyn, values, np.array([0.1, 0.0]), 500.0).estimate`."""
+    if not span > 0 or not math.isfinite(span):
+        raise ValueError("the span of a Lyapunov run must be a positive number")
+    flow = TangentFlow(system, dyn, values, 1)
+    n = flow.n
+    free = [not a for a in angle_coordinates(flow.base, n)] + [True] * n
+    limit = BOUND * (1.0 + float(np.max(np.abs(y0))))
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(2 * n, 1))
+    v /= np.linalg.norm(v)
+    y, t, dt = np.array(y0, float), 0.0, span / windows
+    logs = np.empty(windows)
+    start = time.process_time()
+    for w in range(windows):
+        try:
+            with np.errstate(all="ignore"):
+                y, v = flow.flow(t, t + dt, y, v, rtol=RTOL)
+        except UnsupportedError as exc:
+            raise UnboundedMotion(f"the integration stopped at t = {t:.6g}: {exc}") from None
+        t += dt
+        size = float(np.max(np.abs(y[free]))) if any(free) else 0.0
+        if not (np.all(np.isfinite(y)) and size <= limit):
+            raise UnboundedMotion(f"the state reached {size:.3g} by t = {t:.6g} (from "
+                                  f"{float(np.max(np.abs(y0))):.3g}): the motion is unbounded")
+        norm = float(np.linalg.norm(v))
+        if not (norm > 0 and math.isfinite(norm)):
+            raise UnsupportedError("the tangent vector vanished or overflowed within a window "
+                                   "(use more windows: a shorter span per window)")
+        logs[w] = math.log(norm)
+        v /= norm
+        spent = time.process_time() - start
+        if w == 3 and spent * windows / 4 > budget:
+            raise UnsupportedError(f"the Lyapunov run would take about "
+                                   f"{spent * windows / 4:.0f} s, more than the "
+                                   f"{budget:.0f} s a part may take")
+        if progress is not None and (w + 1) % 16 == 0:
+            progress(f"t = {t:.4g} of {span:.4g}")
+    return ExponentRun(span, logs, flow.evaluations, time.process_time() - start)
+
+
+__all__ = ["BOUND", "ExponentRun", "RESOLUTION", "UnboundedMotion", "WINDOWS",
+           "largest_exponent"]
