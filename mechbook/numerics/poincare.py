@@ -256,4 +256,4 @@ def stability(multipliers: np.ndarray, resolution: float) -> str | None:
     return None
 
 
-__all__ = ["NoCrossing", "Orbit", "ReturnMap", "Section", "stability"]
+__all__ = ["NEWTON_TOL", "NoCrossing", "Orbit", "ReturnMap", "Section", "stability"]

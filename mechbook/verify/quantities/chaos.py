@@ -20,7 +20,7 @@ import sympy as sp
 from mechbook.core.compile import compile_exprs
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.lyapunov import UnboundedMotion, largest_exponent
-from mechbook.numerics.poincare import NoCrossing, ReturnMap, Section, stability
+from mechbook.numerics.poincare import NEWTON_TOL, NoCrossing, ReturnMap, Section, stability
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 from mechbook.verify.quantities.extremum import OVER
@@ -177,7 +177,9 @@ def _point_error(ctx: Context, rm: ReturnMap, book: dict, points: list, pt: dict
     scale = max([abs(v) for v in target.values()] + [1e-300])
     for p in points:
         d = rm.difference(p, np.array([target.get(i, p[i]) for i in range(len(p))]))
-        if all(abs(d[i]) <= rtol * max(abs(v), 1e-3 * scale) for i, v in target.items()):
+        newton = 10 * NEWTON_TOL * (1 + float(np.max(np.abs(p))))  # where Newton stopped
+        if all(abs(d[i]) <= rtol * max(abs(v), 1e-3 * scale) + newton
+               for i, v in target.items()):
             return ""
     names = ctx.system.coord_names + [c + "dot" for c in ctx.system.coord_names]
     found = "; ".join(", ".join(f"{names[i]} = {p[i]:.10g}" for i in target) for p in points)
@@ -193,7 +195,8 @@ def _point_error(ctx: Context, rm: ReturnMap, book: dict, points: list, pt: dict
                '`order:` n (default 1), at the problem\'s values (or `estimate:`\'s): the '
                'orbit passes the book\'s point, its multipliers (eigenvalues of DPⁿ from '
                'the variational equations, on a surface without the energy\'s 1) are the '
-               'book\'s, to 1e-8 (an estimate\'s rtol), and it is stable exactly when '
+               'book\'s, to 1e-8 (an estimate\'s rtol; a point also to Newton\'s '
+               '1e-9·(1 + |x|)), and it is stable exactly when '
                'every |μ| ≤ 1 + 1e-8 (unstable beyond 1 + 1e-6; between: undecided). DPⁿ '
                'must agree with central differences of the map to 1e-5'),
           keys=ORBIT_KEYS, complex_values=True)
@@ -248,9 +251,10 @@ KINDS = {"period_doubling": -1.0, "fold": 1.0}  # the multiplier's value at the 
           book='expression: the value of the parameter of `over:` where the bifurcation sets in',
           how=('the orbit of `poincare` (same `section:`, `initial:`, `order:`) followed '
                'through `over: {p: [lo, hi]}`, an interval of the parameter p (Newton from the '
-               'nearest orbit found), g(p) = Re μ* − μ0 for the multiplier μ* nearest μ0 = −1 '
-               '(`kind: period_doubling`) or +1 (`kind: fold`, also a pitchfork), or the '
-               'orbit\'s end where Newton finds none; the one change of side in the bracket '
+               'nearest orbit found), on one side of the onset where a multiplier has passed '
+               'μ0 = −1 (`kind: period_doubling`: Re μ < −1) or +1 (`kind: fold`, also a '
+               'pitchfork: Re μ > 1), or where Newton finds no orbit (a fold\'s end); the '
+               'change of side in the bracket '
                'bisected to 1e-12 and equal to the book\'s value to 1e-8 (an estimate\'s '
                'rtol); each side\'s monodromy cross-checked by finite differences'),
           keys={**ORBIT_KEYS, "over": OVER, "kind": {"enum": list(KINDS)}})
@@ -279,8 +283,8 @@ def check_bifurcation(ctx: Context, val) -> Verdict:
         except UnsupportedError:
             return 0
         guesses[p] = orbit.points[0]
-        mu = orbit.multipliers[int(np.argmin(np.abs(orbit.multipliers - target)))]
-        return 1 if (mu.real - target) * target < 0 else -1  # +1: not yet through μ0
+        beyond = np.any(orbit.multipliers.real * target > 1)  # a multiplier past μ0
+        return -1 if beyond else 1
 
     a, b = side(lo), side(hi)
     if a == 0 or a == b:
