@@ -71,8 +71,9 @@ class ExponentRun:
 def largest_exponent(system, dyn, values: dict, y0: np.ndarray, span: float,
                      windows: int = WINDOWS, seed: int = 1,
                      progress: Callable[[str], None] | None = None,
-                     budget: float = BUDGET_SECONDS) -> ExponentRun:
-    """The Benettin run from the state y0 (2n: q, q̇) over `span` time units at `values`.
+                     budget: float = BUDGET_SECONDS, max_step: float = math.inf) -> ExponentRun:
+    """The Benettin run from the state y0 (2n: q, q̇) over `span` time units at `values`
+    (`max_step`: no longer steps, for a drive in short pulses).
     Example: `largest_exponent(sys, dyn, values, np.array([0.1, 0.0]), 500.0).estimate`."""
     if not span > 0 or not math.isfinite(span):
         raise ValueError("the span of a Lyapunov run must be a positive number")
@@ -89,7 +90,7 @@ def largest_exponent(system, dyn, values: dict, y0: np.ndarray, span: float,
     for w in range(windows):
         try:
             with np.errstate(all="ignore"):
-                y, v = flow.flow(t, t + dt, y, v, rtol=RTOL)
+                y, v = flow.flow(t, t + dt, y, v, rtol=RTOL, max_step=max_step)
         except UnsupportedError as exc:
             raise UnboundedMotion(f"the integration stopped at t = {t:.6g}: {exc}") from None
         t += dt

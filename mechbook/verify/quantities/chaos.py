@@ -38,7 +38,7 @@ BISECTIONS = 60
 SECTION = {"type": "object", "additionalProperties": False,
            "properties": {"period": EXPR, "phase": EXPR, "coordinate": {"type": "string"},
                           "value": EXPR, "direction": {"enum": ["up", "down"]},
-                          "within": EXPR}}
+                          "within": EXPR, "max_step": EXPR}}
 ORBIT_KEYS = {"initial": POINT, "section": SECTION,
               "order": {"type": "integer", "minimum": 1, "maximum": 64}, "energy": EXPR,
               "estimate": ESTIMATE}
@@ -85,6 +85,11 @@ def _section(ctx: Context, pt: dict) -> Section:
     if not isinstance(data, dict):
         raise ctx.part.error((), "a return map needs `section:`: `{period: T}` (stroboscopic) "
                              "or `{coordinate: q, value: c, direction: up}` (a surface)")
+    step = None
+    if "max_step" in data:
+        step = _number(ctx, data["max_step"], ("section", "max_step"), pt)
+        if not step > 0:
+            raise ctx.part.error(("section", "max_step"), "the longest step must be positive")
     if "period" in data:
         if "coordinate" in data:
             raise ctx.part.error(("section",), "a section is stroboscopic (`period:`) or a "
@@ -93,14 +98,15 @@ def _section(ctx: Context, pt: dict) -> Section:
         if not T > 0:
             raise ctx.part.error(("section", "period"), "the period must be positive")
         phase = _number(ctx, data.get("phase", 0), ("section", "phase"), pt)
-        return Section(period=T, phase=phase)
+        return Section(period=T, phase=phase, max_step=step)
     if "coordinate" not in data:
         raise ctx.part.error(("section",), "name the section's `period:` or `coordinate:`")
     index = _state_index(ctx, data["coordinate"], ("section", "coordinate"))
     within = _number(ctx, data.get("within", 1000), ("section", "within"), pt)
     return Section(index=index, value=_number(ctx, data.get("value", 0), ("section", "value"),
                                               pt),
-                   direction=-1 if data.get("direction") == "down" else 1, within=within)
+                   direction=-1 if data.get("direction") == "down" else 1, within=within,
+                   max_step=step)
 
 
 def _return_map(ctx: Context, params: dict, pt: dict) -> ReturnMap:
@@ -310,6 +316,16 @@ def check_bifurcation(ctx: Context, val) -> Verdict:
 
 
 # ---- the largest Lyapunov exponent -------------------------------------------------------
+def _max_step(ctx: Context, pt: dict) -> float:
+    """`max_step:` (a drive in short pulses must not be stepped over), else no bound."""
+    if "max_step" not in ctx.part.data:
+        return math.inf
+    h = _number(ctx, ctx.part.data["max_step"], ("max_step",), pt)
+    if not h > 0:
+        raise ctx.part.error(("max_step",), "the longest step must be positive")
+    return h
+
+
 CLAIMS = ("positive", "zero", "negative")
 
 
@@ -324,9 +340,11 @@ CLAIMS = ("positive", "zero", "negative")
                'positive: λ − s > b (fails where λ + s ≤ b); zero: |λ| + s ≤ b (fails where '
                '|λ| − s > b); negative: λ + s < −b; a value: |λ − v| ≤ tolerance with s ≤ '
                'tolerance; otherwise unsupported. An unbounded motion (a non-angle coordinate '
-               'or a velocity past 1e4 times the start) is an error'),
+               'or a velocity past 1e4 times the start) is an error. `max_step:` bounds the '
+               'steps (a drive in pulses shorter than the steps would be missed)'),
           literals=CLAIMS,
-          keys={"initial": POINT, "time": EXPR, "tolerance": EXPR, "estimate": ESTIMATE})
+          keys={"initial": POINT, "time": EXPR, "tolerance": EXPR, "max_step": EXPR,
+                "estimate": ESTIMATE})
 def check_lyapunov(ctx: Context, val) -> Verdict:
     data = ctx.part.data
     pt, params = _values(ctx)
@@ -340,7 +358,8 @@ def check_lyapunov(ctx: Context, val) -> Verdict:
     progress = None if stage is None else (
         lambda text: stage(f"part {ctx.part.name} (lyapunov): {text}"))
     try:
-        run = largest_exponent(ctx.system, ctx.dyn, params, y0, span, progress=progress)
+        run = largest_exponent(ctx.system, ctx.dyn, params, y0, span, progress=progress,
+                               max_step=_max_step(ctx, pt))
     except UnboundedMotion as exc:
         raise ctx.part.error(("initial",), f"no Lyapunov exponent of a bounded motion: {exc}") \
             from None
