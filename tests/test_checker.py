@@ -541,6 +541,10 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
                    for q, qd in zip(sys.q, sys.qd, strict=True))
     if slot.kind == "potential":
         return all(_zero(sp.diff(b - a, q)) for q in sys.q)
+    if ctx.quantity.name == "poincare" and "at" in slot.path and \
+            slot.path[-1] in sys.coord_names:  # an orbit's angle: the same modulo 2π
+        turns = (b - a) / (2 * sp.pi)
+        return turns.is_integer is True or _zero(b - a)
     return _zero(b - a)
 
 

@@ -79,7 +79,7 @@ def largest_exponent(system, dyn, values: dict, y0: np.ndarray, span: float,
         raise ValueError("the span of a Lyapunov run must be a positive number")
     flow = TangentFlow(system, dyn, values, 1)
     n = flow.n
-    free = [not a for a in angle_coordinates(flow.base, n)] + [True] * n
+    free = [not a for a in angle_coordinates(flow.model, n)] + [True] * n
     limit = BOUND * (1.0 + float(np.max(np.abs(y0))))
     rng = np.random.default_rng(seed)
     v = rng.normal(size=(2 * n, 1))

@@ -79,13 +79,16 @@ class Orbit:
 class ReturnMap:
     """The return map of one section at fixed parameter values, with its derivative."""
 
-    def __init__(self, system, dyn, values: dict, section: Section):
+    def __init__(self, system, dyn, values: dict, section: Section,
+                 conserved: bool | None = None):
+        """`conserved`: whether the energy function is conserved (decided by the engine
+        when not given; a caller building many maps of one system decides it once)."""
         self.flow = TangentFlow(system, dyn, values, 2 * len(dyn.q))
         self.n = len(dyn.q)
         self.section = section
-        self.angles = angle_coordinates(self.flow.base, self.n) + [False] * self.n
+        self.angles = angle_coordinates(self.flow.model, self.n) + [False] * self.n
         self.energy = None
-        self.conserved = bool(dyn.energy_conserved)
+        self.conserved = bool(dyn.energy_conserved) if conserved is None else conserved
         self.evaluations = 0
 
     # ---- the map ---------------------------------------------------------------------

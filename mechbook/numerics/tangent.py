@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import sympy as sp
@@ -67,9 +68,14 @@ class TangentFlow:
             raise UnsupportedError("the tangent flow of a system with constraints or "
                                    "contacts (its tangent space is not the whole state)")
         self.n, self.copies = len(dyn.q), copies
-        self.base = build_model(system, dyn, values)
+        self._source = (system, dyn, values)
         self.model = _augmented(system, dyn, values, copies)
         self.evaluations = 0
+
+    @cached_property
+    def base(self) -> Model:
+        """The motion alone (its rate on a surface section), compiled when first asked."""
+        return build_model(*self._source)
 
     def flow(self, t0: float, t1: float, y: np.ndarray, V: np.ndarray,
              rtol: float = RTOL, max_step: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
@@ -119,19 +125,24 @@ def _augmented(system, dyn, values: dict, copies: int) -> Model:
 
 
 def angle_coordinates(model: Model, n: int, seed: int = 7) -> list[bool]:
-    """Which coordinates are angles of the equations: the accelerations unchanged when the
-    coordinate alone is moved by 2π, at ANGLE_STATES random states (to 1e-9). An angle's
+    """Which of the first n coordinates of `model` are angles of the equations: the
+    accelerations unchanged when the coordinate alone is moved by 2π, at ANGLE_STATES random
+    states (to 1e-9; a tangent flow's displacements, after them, held at zero). An angle's
     value is then meaningful only modulo 2π (a pendulum that turns over is still bounded)."""
     rng = np.random.default_rng(seed)
+    rest = np.zeros(model.n - n)
     out = []
     for i in range(n):
         same = True
         for _ in range(ANGLE_STATES):
-            t, q, v = rng.uniform(0, 1), rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
+            t = rng.uniform(0, 1)
+            q = np.concatenate((rng.uniform(-1, 1, n), rest))
+            v = np.concatenate((rng.uniform(-1, 1, n), rest))
             shifted = q.copy()
             shifted[i] += 2 * np.pi
             with np.errstate(all="ignore"):
-                a, b = model.accelerations(t, q, v), model.accelerations(t, shifted, v)
+                a = model.accelerations(t, q, v)[:n]
+                b = model.accelerations(t, shifted, v)[:n]
             if not (np.all(np.isfinite(a)) and np.allclose(a, b, rtol=1e-9, atol=1e-9)):
                 same = False
                 break

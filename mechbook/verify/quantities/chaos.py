@@ -111,7 +111,9 @@ def _section(ctx: Context, pt: dict) -> Section:
 
 def _return_map(ctx: Context, params: dict, pt: dict) -> ReturnMap:
     section = _section(ctx, pt)
-    rm = ReturnMap(ctx.system, ctx.dyn, params, section)
+    conserved = ctx.analysis.reuse(("energy-conserved", ctx.part.system),
+                                   lambda: bool(ctx.dyn.energy_conserved))
+    rm = ReturnMap(ctx.system, ctx.dyn, params, section, conserved)
     if "energy" in ctx.part.data:
         if section.period is not None:
             raise ctx.part.error(("energy",), "an energy level applies to a surface section")
@@ -138,12 +140,16 @@ def _energy(ctx: Context, params: dict):
     return energy
 
 
-def _orbit(ctx: Context, rm: ReturnMap, guess: np.ndarray, order: int):
-    """Newton's orbit, its monodromy cross-checked by finite differences."""
+def _orbit(ctx: Context, rm: ReturnMap, guess: np.ndarray, order: int,
+           cross_check: bool = True):
+    """Newton's orbit, its monodromy cross-checked by finite differences (unless not
+    `cross_check`: then the second value is None)."""
     try:
         orbit = rm.orbit(guess, order)
     except NoCrossing as exc:
         raise ctx.part.error(("section",), f"{exc} from the start of `initial:`") from None
+    if not cross_check:
+        return orbit, None
     fd = rm.finite_difference(orbit.points[0], order)
     gap = float(np.max(np.abs(fd - orbit.jacobian)))
     scale = max(1.0, float(np.max(np.abs(orbit.jacobian))))
@@ -262,7 +268,7 @@ KINDS = {"period_doubling": -1.0, "fold": 1.0}  # the multiplier's value at the 
                'pitchfork: Re μ > 1), or where Newton finds no orbit (a fold\'s end); the '
                'change of side in the bracket '
                'bisected to 1e-12 and equal to the book\'s value to 1e-8 (an estimate\'s '
-               'rtol); each side\'s monodromy cross-checked by finite differences'),
+               'rtol); the monodromy on either side of it cross-checked by finite differences'),
           keys={**ORBIT_KEYS, "over": OVER, "kind": {"enum": list(KINDS)}})
 def check_bifurcation(ctx: Context, val) -> Verdict:
     data = ctx.part.data
@@ -279,14 +285,16 @@ def check_bifurcation(ctx: Context, val) -> Verdict:
     target, order = KINDS[data["kind"]], int(data.get("order", 1))
     guesses = {}
 
-    def side(p: float):
-        """(+1, −1 or 0 where no orbit is found, the orbit's point or None)."""
+    def side(p: float, cross_check: bool = False):
+        """+1 before the onset, −1 past it, 0 where Newton finds no orbit."""
         near = min(guesses, key=lambda q: abs(q - p), default=None)
         guess = guesses[near] if near is not None else _start(ctx, pt)
         rm = _return_map(ctx, {**params, sym: p}, {**pt, sym: sp.Float(p, 30)})
         try:
-            orbit, _ = _orbit(ctx, rm, guess, order)
+            orbit, _ = _orbit(ctx, rm, guess, order, cross_check)
         except UnsupportedError:
+            if cross_check:
+                raise
             return 0
         guesses[p] = orbit.points[0]
         beyond = np.any(orbit.multipliers.real * target > 1)  # a multiplier past μ0
@@ -306,6 +314,9 @@ def check_bifurcation(ctx: Context, val) -> Verdict:
         else:
             hi = mid
     onset = (lo + hi) / 2
+    for p in (lo, hi):  # the monodromy on either side of the onset, cross-checked
+        if side(p, cross_check=True) == 0:
+            raise UnsupportedError(f"no orbit found at {name} = {p:.12g} beside the onset")
     rtol = ctx.sampler.rtol if "estimate" in data else RTOL
     claimed = _number(ctx, val, ("book",), pt)
     method = f"continuation and bisection in {name} ({len(guesses)} orbits)"
