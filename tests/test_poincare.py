@@ -275,3 +275,31 @@ def test_driven_pendulum_period_one_orbit_is_harmonic_balance_at_small_forcing(t
     assert errors[0] < 1e-3
     ratio = errors[0] / errors[1]
     assert 3.0 < ratio < 5.0  # relative error ~ A²: halving F quarters it
+
+
+def test_a_surface_section_of_a_driven_system_is_an_error(osc, tmp_path):
+    got = check(osc, tmp_path, quantity="poincare",
+                section={"coordinate": "x", "value": 0, "direction": "up"},
+                initial={"x": 0, "xdot": 0.5}, book={"stable": True})
+    assert got[0] == "error" and "key.yaml:" in got[1] and "autonomous" in got[1], got
+
+
+def test_a_constrained_system_is_unsupported(tmp_path):
+    text = """id: x
+source: a test
+title: a bead held on a circle
+parameters:
+  R: {value: 1.0}
+  F: {value: 0.1}
+coordinates:
+  x: {}
+  y: {}
+kinetic: (xdot**2 + ydot**2)/2
+constraints:
+  - {name: hoop, expr: x**2 + y**2 - R**2}
+forces: {x: F*cos(t)}
+"""
+    an = load_analysis(tmp_path, text, "9105")
+    got = check(an, tmp_path, quantity="poincare", section={"period": "2*pi"},
+                initial={"x": 1}, book={"stable": True})
+    assert got[0] == "unsupported" and "constraints" in got[1], got

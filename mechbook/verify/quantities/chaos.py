@@ -102,7 +102,13 @@ def _section(ctx: Context, pt: dict) -> Section:
     if "coordinate" not in data:
         raise ctx.part.error(("section",), "name the section's `period:` or `coordinate:`")
     index = _state_index(ctx, data["coordinate"], ("section", "coordinate"))
+    if any(e.has(ctx.system.t) for e in ctx.dyn.residuals):
+        raise ctx.part.error(("section",), "a surface section needs an autonomous system (t "
+                             "occurs in its equations, so a crossing's state alone does not "
+                             "fix the next one): use a stroboscopic `period:`")
     within = _number(ctx, data.get("within", 1000), ("section", "within"), pt)
+    if not within > 0:
+        raise ctx.part.error(("section", "within"), "the time allowed must be positive")
     return Section(index=index, value=_number(ctx, data.get("value", 0), ("section", "value"),
                                               pt),
                    direction=-1 if data.get("direction") == "down" else 1, within=within,
