@@ -20,11 +20,13 @@ from __future__ import annotations
 import copy
 import math
 
+import numpy as np
 import pytest
 from ruamel.yaml import YAML
 from systems import load_analysis
 
-from mechbook.numerics.lyapunov import RESOLUTION
+from mechbook.errors import UnsupportedError
+from mechbook.numerics.lyapunov import RESOLUTION, largest_exponent
 from mechbook.verify.answers import load_answers
 from mechbook.verify.checker import check_problem
 
@@ -227,3 +229,14 @@ def test_the_standard_map_exponent_grows_like_log_k_over_2(tree, tmp_path):
                 max_step=0.005, book="log(3)", tolerance="0.15")
     assert got[0] == "pass", got
     assert math.log(3) == pytest.approx(1.0986, abs=1e-4)
+
+
+def test_a_run_past_its_budget_stops_and_says_so(tree):
+    """After four windows the run projects its cost; past the budget it stops (check's time
+    limit is then never reached by a part that would not finish)."""
+    an = load_analysis(tree, HENON_HEILES, "9303")
+    y0 = np.array([0.0, 0.1, math.sqrt(2 / 12 - 0.01 + 2e-3 / 3), 0.0])
+    with pytest.raises(UnsupportedError, match="would take about"):
+        largest_exponent(an.system(), an.dynamics(), {}, y0, 1000.0, budget=1e-9)
+    run = largest_exponent(an.system(), an.dynamics(), {}, y0, 1000.0)
+    assert len(run.logs) == 64 and run.seconds < 60

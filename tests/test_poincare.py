@@ -303,3 +303,37 @@ forces: {x: F*cos(t)}
     got = check(an, tmp_path, quantity="poincare", section={"period": "2*pi"},
                 initial={"x": 1}, book={"stable": True})
     assert got[0] == "unsupported" and "constraints" in got[1], got
+
+
+def test_period_two_orbit_born_in_the_doubling(tree):
+    """Past the onset K*, the period-2 orbit around θ = π: two distinct points that P swaps,
+    det DP² = 1 (a Hamiltonian map), on the unit circle (stable), and its size growing like
+    √(K − K*) (the normal form of a period doubling): quartering K − K* halves it."""
+    kstar = rotor_doubling()
+    sizes = []
+    for n, dk in enumerate((0.04, 0.01)):
+        an = rotor(tree, kstar + dk, f"911{n}")
+        rm = ReturnMap(an.system(), an.dynamics(), an.problem.values(),
+                       Section(period=1.0, phase=0.5))
+        orbit = rm.orbit(np.array([math.pi + 0.3, 0.0]), 2)
+        a, b = orbit.points
+        assert np.max(np.abs(rm.difference(rm(a, tangent=False)[0], b))) < 1e-9
+        assert np.max(np.abs(rm.difference(a, b))) > 0.1
+        assert abs(np.linalg.det(orbit.jacobian) - 1) < 1e-9
+        assert abs(orbit.spectral_radius - 1) < 1e-8
+        sizes.append(float(np.max(np.abs(rm.difference(a, np.array([math.pi, 0.0]))))))
+    assert sizes[0] / sizes[1] == pytest.approx(2.0, rel=0.02)
+
+
+@pytest.mark.parametrize("initial, book, status", [
+    ({"theta": "pi + 0.3", "thetadot": 0}, {"stable": True}, "pass"),
+    ({"theta": "pi + 0.3", "thetadot": 0}, {"stable": False}, "fail"),
+    ({"theta": "pi", "thetadot": 0}, {"stable": False}, "fail"),  # the fixed point itself
+])
+def test_a_period_two_claim(tree, tmp_path, initial, book, status):
+    an = rotor(tree, rotor_doubling() + 0.04, "9112")
+    got = check(an, tmp_path, quantity="poincare", section=ROTOR_SECTION, order=2,
+                initial=initial, book=book)
+    assert got[0] == status, got
+    if initial["theta"] == "pi":
+        assert "period shorter than 2" in got[1]
