@@ -337,3 +337,41 @@ def test_a_period_two_claim(tree, tmp_path, initial, book, status):
     assert got[0] == status, got
     if initial["theta"] == "pi":
         assert "period shorter than 2" in got[1]
+
+
+SPRING_ROTOR = """id: x
+source: a test
+title: a kicked rotor on a spring
+parameters:
+  K: {value: 0.5}
+  eps: {value: 0.02}
+  s: {value: 1.0}
+coordinates:
+  theta: {}
+kinetic: thetadot**2/2
+potential: s*theta**2/2 + K*cos(theta)*(1 + sign(cos(2*pi*t) - cos(pi*eps)))/(2*eps)
+"""
+
+
+def spring_rotor_fold() -> float:
+    """K where θ = 0 turns hyperbolic through μ = +1: between kicks the spring turns the
+    state by F(τ) = [[cos wτ, sin wτ/w], [−w sin wτ, cos wτ]] (w = √s = 1), in a kick
+    δθ̈ = (K/ε − s)δθ; the trace of F·E·F reaches +2."""
+    tau = (1 - EPS) / 2
+    Fm = np.array([[math.cos(tau), math.sin(tau)], [-math.sin(tau), math.cos(tau)]])
+
+    def trace(k):
+        E = sl.expm(np.array([[0, 1], [k / EPS - 1.0, 0]]) * EPS)
+        return np.trace(Fm @ E @ Fm) - 2
+
+    return brentq(trace, 0.1, 3.0, xtol=1e-14)
+
+
+@pytest.mark.parametrize("scale, status", [(1, "pass"), (1.01, "fail"), (1.000001, "fail")])
+def test_fold_of_a_kicked_rotor_on_a_spring(tree, tmp_path, scale, status):
+    kstar = spring_rotor_fold()
+    an = load_analysis(tree, SPRING_ROTOR, "9120")
+    got = check(an, tmp_path, quantity="bifurcation", section=ROTOR_SECTION,
+                initial={"theta": 0, "thetadot": 0}, over={"K": [0.1, 3]}, kind="fold",
+                book=repr(kstar * scale))
+    assert got[0] == status, got

@@ -80,16 +80,22 @@ class ReturnMap:
     """The return map of one section at fixed parameter values, with its derivative."""
 
     def __init__(self, system, dyn, values: dict, section: Section,
-                 conserved: bool | None = None):
+                 conserved: bool | None = None, free=None):
         """`conserved`: whether the energy function is conserved (decided by the engine
-        when not given; a caller building many maps of one system decides it once)."""
-        self.flow = TangentFlow(system, dyn, values, 2 * len(dyn.q))
+        when not given; a caller building many maps of one system decides it once);
+        `free`: a parameter whose value (`move`) may change without compiling again."""
+        self.flow = TangentFlow(system, dyn, values, 2 * len(dyn.q), free)
         self.n = len(dyn.q)
         self.section = section
-        self.angles = angle_coordinates(self.flow.model, self.n) + [False] * self.n
+        self.angles = angle_coordinates(self.flow.model, self.n,
+                                        self.flow.padding()) + [False] * self.n
         self.energy = None
         self.conserved = bool(dyn.energy_conserved) if conserved is None else conserved
         self.evaluations = 0
+
+    def move(self, value: float, section: Section) -> None:
+        """The free parameter at `value`, with the section that goes with it there."""
+        self.flow.value, self.section = float(value), section
 
     # ---- the map ---------------------------------------------------------------------
     def __call__(self, x: np.ndarray, times: int = 1, tangent: bool = True):
@@ -122,10 +128,7 @@ class ReturnMap:
         s, n = self.section, self.n
         model = self.flow.model
         N = model.n
-        k = 2 * n
-        q0 = np.concatenate([y[:n]] + [np.eye(k)[:n, j] for j in range(k)])
-        qd0 = np.concatenate([y[n:]] + [np.eye(k)[n:, j] for j in range(k)])
-        z = np.concatenate((q0, qd0))
+        z = np.concatenate(self.flow.pack(y, np.eye(2 * n)))
         pos = s.index if s.index < n else N + (s.index - n)
 
         def event(t, z):
@@ -145,22 +148,10 @@ class ReturnMap:
                     if te > t0 + 1e-9 * max(1.0, abs(t0))]
             if hits:
                 te, ze = hits[0]
-                return float(te), self._state(ze), self._tangents(ze)
+                return (float(te), *self.flow.unpack(ze[:N], ze[N:]))
             t, z = sol.t[-1], sol.y[:, -1]
             chunk *= 2
         raise NoCrossing(f"the orbit does not cross the section within t = {s.within:g}")
-
-    def _state(self, z: np.ndarray) -> np.ndarray:
-        n, N = self.n, self.flow.model.n
-        return np.concatenate((z[:n], z[N:N + n]))
-
-    def _tangents(self, z: np.ndarray) -> np.ndarray:
-        n, N, k = self.n, self.flow.model.n, 2 * self.n
-        V = np.empty((k, k))
-        for j in range(k):
-            V[:n, j] = z[n * (j + 1): n * (j + 2)]
-            V[n:, j] = z[N + n * (j + 1): N + n * (j + 2)]
-        return V
 
     # ---- fixed points ------------------------------------------------------------------
     def difference(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -115,17 +115,29 @@ def _section(ctx: Context, pt: dict) -> Section:
                    max_step=step)
 
 
-def _return_map(ctx: Context, params: dict, pt: dict) -> ReturnMap:
+def _return_map(ctx: Context, params: dict, pt: dict, free=None) -> ReturnMap:
+    """The part's return map at `params` (`free`: a parameter `_move` may change)."""
     section = _section(ctx, pt)
     conserved = ctx.analysis.reuse(("energy-conserved", ctx.part.system),
                                    lambda: bool(ctx.dyn.energy_conserved))
-    rm = ReturnMap(ctx.system, ctx.dyn, params, section, conserved)
+    rm = ReturnMap(ctx.system, ctx.dyn, params, section, conserved, free)
+    _hold_energy(ctx, rm, params, pt)
+    return rm
+
+
+def _hold_energy(ctx: Context, rm: ReturnMap, params: dict, pt: dict) -> None:
     if "energy" in ctx.part.data:
-        if section.period is not None:
+        if rm.section.period is not None:
             raise ctx.part.error(("energy",), "an energy level applies to a surface section")
         rm.set_energy(_energy(ctx, params), _number(ctx, ctx.part.data["energy"],
                                                     ("energy",), pt))
-    return rm
+
+
+def _move(ctx: Context, rm: ReturnMap, params: dict, pt: dict, sym, value: float) -> None:
+    """The map's free parameter `sym` at `value` (the section and energy level with it)."""
+    at = {**pt, sym: sp.Float(value, 30)}
+    rm.move(value, _section(ctx, at))
+    _hold_energy(ctx, rm, {**params, sym: value}, at)
 
 
 def _energy(ctx: Context, params: dict):
@@ -290,12 +302,13 @@ def check_bifurcation(ctx: Context, val) -> Verdict:
     lo, hi = (_number(ctx, v, ("over", name, i), pt) for i, v in enumerate(bracket))
     target, order = KINDS[data["kind"]], int(data.get("order", 1))
     guesses = {}
+    rm = _return_map(ctx, params, pt, free=sym)  # compiled once, the parameter moved
 
     def side(p: float, cross_check: bool = False):
         """+1 before the onset, −1 past it, 0 where Newton finds no orbit."""
         near = min(guesses, key=lambda q: abs(q - p), default=None)
         guess = guesses[near] if near is not None else _start(ctx, pt)
-        rm = _return_map(ctx, {**params, sym: p}, {**pt, sym: sp.Float(p, 30)})
+        _move(ctx, rm, params, pt, sym, p)
         try:
             orbit, _ = _orbit(ctx, rm, guess, order, cross_check)
         except UnsupportedError:
