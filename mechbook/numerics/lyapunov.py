@@ -15,8 +15,9 @@ a long run needs no memory). From them:
 
 The state must stay bounded: a coordinate that is not an angle of the equations, or a
 velocity, leaving BOUND times the start's size ends the run (`UnboundedMotion`). The run
-keeps to a CPU budget: after the first windows it projects its cost and stops (an
-`UnsupportedError` saying so) rather than run past what a check may take.
+keeps to a CPU budget: it times a probe of 1/PROBE of its first window, and again its
+first four windows, projects its cost and stops (an `UnsupportedError` saying so) rather
+than run past what a check may take.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ WINDOWS = 64
 RESOLUTION = 8.0  # b = RESOLUTION / span: what a regular motion's second half can show
 BOUND = 1e4  # the state may grow to this times (1 + |start|) and no further
 BUDGET_SECONDS = 60.0  # CPU seconds a run may take
+PROBE = 64  # the first window starts with 1/PROBE of itself, timed
 RTOL = 1e-10
 
 
@@ -87,12 +89,27 @@ def largest_exponent(system, dyn, values: dict, y0: np.ndarray, span: float,
     y, t, dt = np.array(y0, float), 0.0, span / windows
     logs = np.empty(windows)
     start = time.process_time()
-    for w in range(windows):
+    def advance(a: float, b: float, y, v):
         try:
             with np.errstate(all="ignore"):
-                y, v = flow.flow(t, t + dt, y, v, rtol=RTOL, max_step=max_step)
-        except UnsupportedError as exc:
-            raise UnboundedMotion(f"the integration stopped at t = {t:.6g}: {exc}") from None
+                return flow.flow(a, b, y, v, rtol=RTOL, max_step=max_step)
+        except UnsupportedError as exc:  # the state ran away, or the steps could not go on
+            t, z = flow.reach(a, b, y)
+            size = float(np.max(np.abs(z[free]))) if any(free) else 0.0
+            if not (np.all(np.isfinite(z)) and size <= limit):
+                raise UnboundedMotion(f"the state reached {size:.3g} by t = {t:.6g}: the "
+                                      "motion is unbounded") from None
+            raise UnsupportedError(f"the Lyapunov run's integration failed between t = "
+                                   f"{a:.6g} and {b:.6g} with the state bounded: "
+                                   f"{exc.capability}") from None
+
+    for w in range(windows):
+        if w == 0:  # a probe of 1/PROBE of a window first: a run far too long stops at once
+            y, v = advance(t, t + dt / PROBE, y, v)
+            _within(time.process_time() - start, PROBE * windows, budget)
+            y, v = advance(t + dt / PROBE, t + dt, y, v)
+        else:
+            y, v = advance(t, t + dt, y, v)
         t += dt
         size = float(np.max(np.abs(y[free]))) if any(free) else 0.0
         if not (np.all(np.isfinite(y)) and size <= limit):
@@ -104,14 +121,18 @@ def largest_exponent(system, dyn, values: dict, y0: np.ndarray, span: float,
                                    "(use more windows: a shorter span per window)")
         logs[w] = math.log(norm)
         v /= norm
-        spent = time.process_time() - start
-        if w == 3 and spent * windows / 4 > budget:
-            raise UnsupportedError(f"the Lyapunov run would take about "
-                                   f"{spent * windows / 4:.0f} s, more than the "
-                                   f"{budget:.0f} s a part may take")
+        if w == 3:
+            _within(time.process_time() - start, windows / 4, budget)
         if progress is not None and (w + 1) % 16 == 0:
             progress(f"t = {t:.4g} of {span:.4g}")
     return ExponentRun(span, logs, flow.evaluations, time.process_time() - start)
+
+
+def _within(spent: float, times: float, budget: float) -> None:
+    """UnsupportedError if `times` more of what took `spent` CPU seconds exceeds `budget`."""
+    if spent * times > budget:
+        raise UnsupportedError(f"the Lyapunov run would take about {spent * times:.0f} s, "
+                               f"more than the {budget:.0f} s a part may take")
 
 
 __all__ = ["BOUND", "ExponentRun", "RESOLUTION", "UnboundedMotion", "WINDOWS",

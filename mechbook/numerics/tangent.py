@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import sympy as sp
+from scipy.integrate import solve_ivp
 
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.integrators import integrate
@@ -104,6 +105,14 @@ class TangentFlow:
         if not run.success or run.q.shape[1] == 0:
             raise UnsupportedError(f"the tangent flow's integration failed: {run.message}")
         return self.unpack(run.q[:, -1], run.qd[:, -1])
+
+    def reach(self, t0: float, t1: float, y: np.ndarray) -> tuple[float, np.ndarray]:
+        """How far the motion alone gets from y toward t1 (where an integration failed:
+        whether the state ran away, or the steps did), as (t, state)."""
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(self.rate, (t0, t1), np.asarray(y, float), method="DOP853",
+                            rtol=RTOL, atol=RTOL)
+        return float(sol.t[-1]), sol.y[:, -1]
 
     def rate(self, t: float, y: np.ndarray) -> np.ndarray:
         """dy/dt of the motion itself (2n)."""
