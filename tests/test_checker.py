@@ -270,6 +270,12 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
             if len(mode.get("shape", {})) > 1:
                 for c in mode["shape"]:
                     yield Slot(root + (i, "shape", c), "component")
+    elif q == "lyapunov":
+        yield Slot(root, "exponent_sign" if val in ("positive", "zero", "negative") else "value")
+    elif q == "poincare":  # the orbit's point and multipliers; its stability a flag
+        yield from walk({k: v for k, v in val.items() if k != "stable"}, root)
+        if "stable" in val:
+            yield Slot(root + ("stable",), "flag")
     else:  # a quantity this test does not know yet: walk the value's structure
         yield from walk(val, root)
 
@@ -352,6 +358,11 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
         return
     if slot.kind == "verdict":  # stable / unstable / marginal
         for other in ("stable", "unstable", "marginal"):
+            if other != value:
+                yield f"say {other}", other
+        return
+    if slot.kind == "exponent_sign":  # a Lyapunov exponent's claim: positive / zero / negative
+        for other in ("positive", "zero", "negative"):
             if other != value:
                 yield f"say {other}", other
         return
@@ -470,7 +481,7 @@ def _free_of(expr, symbols) -> bool:
 def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     if str(old) == str(new):
         return True
-    if slot.kind in ("count", "flag", "verdict"):
+    if slot.kind in ("count", "flag", "verdict", "exponent_sign"):
         return False
     if slot.kind == "relation":  # the same condition once parsed (factors reordered), or
         # the same up to moving terms (e.g. a symmetric one with names swapped)
@@ -530,6 +541,10 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
                    for q, qd in zip(sys.q, sys.qd, strict=True))
     if slot.kind == "potential":
         return all(_zero(sp.diff(b - a, q)) for q in sys.q)
+    if ctx.quantity.name == "poincare" and "at" in slot.path and \
+            slot.path[-1] in sys.coord_names:  # an orbit's angle: the same modulo 2π
+        turns = (b - a) / (2 * sp.pi)
+        return turns.is_integer is True or _zero(b - a)
     return _zero(b - a)
 
 

@@ -302,8 +302,13 @@ def without_absent(expr: sp.Basic, symbols) -> sp.Basic:
     cancel; dropping it (a substitution, exact once ∂/∂φ vanishes identically, decided
     numerically by `is_zero`) keeps cyclic coordinates, autonomous systems and linear
     equations recognisable without simplify. A symbol is kept where dropping it would
-    land on a singularity."""
+    land on a singularity. A symbol inside `sign(...)` is kept: a piecewise-constant
+    function's derivative vanishes almost everywhere (a delta at each jump), so random
+    points would call a pulsed drive (a kicked rotor's kicks) independent of t."""
+    stepped = set().union(*(a.free_symbols for a in expr.atoms(sp.sign)))
     for s in symbols:
+        if s in stepped:
+            continue
         if expr.has(s) and is_zero(derivative(expr, s)):  # SymEngine's: core.secalc
             dropped = expr.xreplace({s: sp.S.Zero})
             if not dropped.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
