@@ -353,6 +353,13 @@ def _setting(ctx: Context, val) -> tuple[PhaseSpace, Transformation, dict]:
     return space, Transformation(Q, P, values), names
 
 
+def _open_claim(data: dict) -> tuple:
+    """"Not canonical" holds for every map near a map that is not canonical: a small
+    change of such a map is the same (true) claim (mechbook.verify.power)."""
+    book = data.get("book")
+    return ("open",) if isinstance(book, dict) and book.get("canonical") is False else ()
+
+
 def _canonical_names(ctx: Context) -> dict:
     return _setting(ctx, ctx.part.data.get("book"))[2]
 
@@ -447,7 +454,7 @@ def new_hamiltonian(ctx: Context, space: PhaseSpace, tr: Transformation, names: 
                'Ṗ = −∂K/∂Q) and, with a generating function, equal H + ∂F/∂t (without '
                'one K is fixed only up to a function of t, and the verdict says so)'),
           keys={"variables": PAIRS, "new": PAIRS, "H": EXPR},
-          names=_canonical_names)
+          names=_canonical_names, equivalent=_open_claim)
 def check_canonical(ctx: Context, val) -> Verdict:
     """The map's fundamental brackets, its generating function, its new Hamiltonian."""
     space, tr, names = _setting(ctx, val)
