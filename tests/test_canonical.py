@@ -339,3 +339,35 @@ def test_bad_input_is_refused_at_its_line(tmp_path, part, message):
     assert isinstance(faults["p0"], SpecError)
     assert message in str(faults["p0"]), str(faults["p0"])
     assert "9820.yaml:" in str(faults["p0"])
+
+
+NO_SYSTEM = """\
+id: lim-NUM
+source: test
+title: no system, only a parameter and a vector
+parameters:
+  a: {value: 2.0}
+vectors:
+  k: [0, 0, 1]
+"""
+
+
+def test_a_problem_without_a_system_names_its_pairs(tmp_path):
+    """Pairs (u, w), (r, s): {u s, w r} = (∂f/∂u ∂g/∂w − ∂f/∂w ∂g/∂u) + (∂f/∂r ∂g/∂s −
+    ∂f/∂s ∂g/∂r) = s·r − u·w. The exchange Q = w, P = −u of H = w²/2 + a u²/2 (F1 = uQ)
+    has K = H(u = −P, w = Q) = Q²/2 + a P²/2. Without `variables:` there is nothing to
+    take a bracket over: an error at the part."""
+    pair = [["u", "w"], ["r", "s"]]
+    for book, status in (("r*s - u*w", "pass"), ("s*w - u*r", "fail")):
+        out = _check(tmp_path, "9830", NO_SYSTEM, quantity="poisson_bracket", variables=pair,
+                     bracket=["u*s", "w*r"], book=book)
+        assert out.status == status, out.detail
+    out = _check(tmp_path, "9831", NO_SYSTEM, quantity="canonical", variables=[["u", "w"]],
+                 H="w**2/2 + a*u**2/2",
+                 book={"transformation": {"Q": "w", "P": "-u"}, "generating": {"F1": "u*Q"},
+                       "hamiltonian": "Q**2/2 + a*P**2/2"})
+    assert out.status == "pass", out.detail
+    out = _check(tmp_path, "9832", NO_SYSTEM, quantity="poisson_bracket", bracket=["u", "w"],
+                 book="1")
+    assert out.status == "error" and "names its canonical pairs" in out.detail, out.detail
+    assert "9832.yaml:" in out.detail

@@ -151,7 +151,8 @@ def _in_phase_space(ctx: Context, text, sub: tuple, names: dict, allowed: set) -
     stray = sorted(str(s) for s in expr.free_symbols
                    if s not in allowed and s not in ctx.sampler.base)
     if stray:
-        known = ", ".join(sorted(map(str, allowed)))
+        known = ", ".join(sorted(str(s) for s in allowed if s.name != "H"))
+        known += " (and H, the Hamiltonian)" if any(s.name == "H" for s in allowed) else ""
         hint = " (a velocity: write the momentum p_<q>)" if any(
             s.endswith("dot") for s in stray) else ""
         raise ctx.part.error(sub, f"{', '.join(stray)} is not a canonical variable of this "
