@@ -355,10 +355,16 @@ def _setting(ctx: Context, val) -> tuple[PhaseSpace, Transformation, dict]:
 
 
 def _open_claim(data: dict) -> tuple:
-    """"Not canonical" holds for every map near a map that is not canonical: a small
-    change of such a map is the same (true) claim (mechbook.verify.power)."""
+    """What a change of the part's book cannot show (mechbook.verify.power): "not
+    canonical" holds for every map near one that is not ("open"), and a generating function
+    is defined up to an added constant ("shift": a shifted map or K then fails the
+    generating function's relations, so only F's constant is left unseen)."""
     book = data.get("book")
-    return ("open",) if isinstance(book, dict) and book.get("canonical") is False else ()
+    if not isinstance(book, dict):
+        return ()
+    if book.get("canonical") is False:
+        return ("open",)
+    return ("shift",) if "generating" in book else ()
 
 
 def _canonical_names(ctx: Context) -> dict:
