@@ -371,3 +371,38 @@ def test_a_problem_without_a_system_names_its_pairs(tmp_path):
                  book="1")
     assert out.status == "error" and "names its canonical pairs" in out.detail, out.detail
     assert "9832.yaml:" in out.detail
+
+
+# ---- the cross-check: {f, H} against df/dt from Lagrange's equations ----------------------
+def _bracket_crosscheck(tmp_path, num, problem, **part):
+    from mechbook.crosscheck.brackets import bracket_part
+
+    analysis, key = _tree(tmp_path, num, problem, [part])
+    return check_problem(analysis, key)[0], bracket_part(analysis, key.parts[0], {})
+
+
+def test_the_bracket_cross_check_passes_and_reads_explicit_time(tmp_path):
+    """{x − v t, H} = p/m: along the motion d(x − v t)/dt = ẋ − v = p/m + ∂f/∂t."""
+    for of, book in ((["x", "H"], "p_x/m"), (["x - v*t", "H"], "p_x/m"),
+                     (["H", "p_x"], "m*omega**2*x")):  # {H, p} = −{p, H}
+        out, x = _bracket_crosscheck(tmp_path, "9840", OSCILLATOR, quantity="poisson_bracket",
+                                     bracket=of, book=book)
+        assert out.status == "pass", out.detail
+        assert x.status == "pass" and x.error < 1e-12, x.detail
+    out, x = _bracket_crosscheck(tmp_path, "9841", OSCILLATOR, quantity="poisson_bracket",
+                                 bracket=["x", "p_x"], book="1")
+    assert x is None  # no H: nothing moves
+
+
+def test_the_bracket_cross_check_sees_a_wrong_hamiltonian(tmp_path, monkeypatch):
+    """An engine whose Hamiltonian were twice the true one would pass a book that agrees
+    with it ({x, 2H} = 2p/m); the cross-check, which never reads H, fails it."""
+    import mechbook.verify.quantities.canonical as canonical
+
+    right = canonical.old_hamiltonian
+    monkeypatch.setattr(canonical, "old_hamiltonian",
+                        lambda ctx, space, sub: 2 * right(ctx, space, sub))
+    out, x = _bracket_crosscheck(tmp_path, "9842", OSCILLATOR, quantity="poisson_bracket",
+                                 bracket=["x", "H"], book="2*p_x/m")
+    assert out.status == "pass", out.detail
+    assert x.status == "fail" and "from Lagrange's equations" in x.detail, x.detail

@@ -256,6 +256,21 @@ def _bracket_of(ctx: Context, space: PhaseSpace) -> tuple[sp.Expr, sp.Expr]:
     return f, g
 
 
+def bracket_claim(ctx: Context) -> tuple | None:
+    """(f, g, h, H) of a bracket part over the system's own variables, H the placeholder
+    of the engine's Hamiltonian (for a cross-check: mechbook.crosscheck.brackets); None
+    where the part names its variables or its Hamiltonian."""
+    if ctx.part.data.get("variables") is not None or "H" in ctx.part.data:
+        return None
+    space = phase_space(ctx)
+    if space.hsym is None:
+        return None
+    f, g = _bracket_of(ctx, space)
+    allowed = space.variables | {space.hsym}
+    h = _in_phase_space(ctx, ctx.part.data.get("book"), ("book",), space.names, allowed)
+    return f, g, h, space.hsym
+
+
 @quantity('poisson_bracket',
           book='expression h: the bracket {f, g} of the two functions `bracket: [f, g]`',
           how=('{f, g} = Σ ∂f/∂q ∂g/∂p − ∂f/∂p ∂g/∂q over the system\'s canonical variables '
@@ -267,7 +282,7 @@ def _bracket_of(ctx: Context, space: PhaseSpace) -> tuple[sp.Expr, sp.Expr]:
                'brackets are `bracket: [q, p]`, `book: 1`'),
           keys={"bracket": {"type": "array", "minItems": 2, "maxItems": 2, "items": EXPR},
                 "variables": PAIRS, "H": EXPR},
-          names=_bracket_names)
+          names=_bracket_names, crosschecks=("bracket_flow",))
 def check_poisson_bracket(ctx: Context, val) -> Verdict:
     """{f, g} = h as an identity in the part's phase space."""
     space = phase_space(ctx)
