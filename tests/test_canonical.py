@@ -406,3 +406,33 @@ def test_the_bracket_cross_check_sees_a_wrong_hamiltonian(tmp_path, monkeypatch)
                                  bracket=["x", "H"], book="2*p_x/m")
     assert out.status == "pass", out.detail
     assert x.status == "fail" and "from Lagrange's equations" in x.detail, x.detail
+
+
+@pytest.mark.parametrize("num, problem, part", [
+    ("9850", OSCILLATOR, {"book": MOVING}),            # time-dependent: K = H − vP
+    ("9851", OSCILLATOR, {"book": ACTION_ANGLE}),
+    ("9852", PLANE, {"book": POLAR, "new": POLAR_NEW, "assume": ["x > 0"]}),
+], ids=["moving-frame", "action-angle", "polar"])
+def test_the_new_hamiltonian_cross_check(tmp_path, monkeypatch, num, problem, part):
+    """The new variables, computed along a run of Lagrange's equations, move by the book's
+    K; with an engine whose H were doubled, a K that agrees with it (2K for these maps,
+    whose F has no t or adds −vP) passes the part and fails the cross-check."""
+    from mechbook.crosscheck.brackets import new_hamiltonian_part
+
+    analysis, key = _tree(tmp_path, num, problem, [{"quantity": "canonical", **part}])
+    assert check_problem(analysis, key)[0].status == "pass"
+    x = new_hamiltonian_part(analysis, key.parts[0], {})
+    assert x.status == "pass" and x.error < 1e-10, x.detail
+    if num != "9851":
+        return
+    import mechbook.verify.quantities.canonical as canonical
+
+    right = canonical.old_hamiltonian
+    monkeypatch.setattr(canonical, "old_hamiltonian",
+                        lambda ctx, space, sub: 2 * right(ctx, space, sub))
+    wrong = {**ACTION_ANGLE, "hamiltonian": "2*omega*P"}
+    analysis, key = _tree(tmp_path / "wrong", num, problem,
+                          [{"quantity": "canonical", "book": wrong}])
+    assert check_problem(analysis, key)[0].status == "pass"
+    x = new_hamiltonian_part(analysis, key.parts[0], {})
+    assert x.status == "fail" and "from Lagrange's equations" in x.detail, x.detail

@@ -19,7 +19,7 @@ from mechbook.verify.answers import Part
 from mechbook.verify.compare import value
 from mechbook.verify.context import Context
 from mechbook.verify.context import split_named as _split_named
-from mechbook.verify.quantities.canonical import bracket_claim
+from mechbook.verify.quantities.canonical import bracket_claim, hamiltonian_claim
 from mechbook.verify.quantities.steady import family
 from mechbook.verify.quantities.trajectory import Motion
 
@@ -77,6 +77,11 @@ class PartView:
         symbol standing for the engine's Hamiltonian (mechbook.verify.quantities.canonical);
         None where the part names its own variables or Hamiltonian."""
         return bracket_claim(self._ctx)
+
+    def new_hamiltonian(self) -> tuple | None:
+        """A canonical map's new pairs, its values in (q, p_q, t) and the book's K (None
+        where the part states no K or names its own variables)."""
+        return hamiltonian_claim(self._ctx)
 
     def motion(self) -> Motion:
         """The trajectory a trajectory part derives (mechbook.verify.quantities.trajectory:

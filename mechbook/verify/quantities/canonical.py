@@ -459,6 +459,21 @@ def new_hamiltonian(ctx: Context, space: PhaseSpace, tr: Transformation, names: 
     return out
 
 
+def hamiltonian_claim(ctx: Context) -> tuple | None:
+    """(new pairs [(Q, P)], {new symbol: its value in (q, p, t)}, K) of a canonical part
+    that states a new Hamiltonian over the system's own variables (for a cross-check:
+    mechbook.crosscheck.brackets); None otherwise."""
+    val = ctx.part.data.get("book")
+    if ctx.part.data.get("variables") is not None or "H" in ctx.part.data or \
+            not isinstance(val, dict) or "hamiltonian" not in val or \
+            val.get("canonical", True) is False:
+        return None
+    space, tr, names = _setting(ctx, val)
+    K = _in_phase_space(ctx, val["hamiltonian"], ("book", "hamiltonian"), names,
+                        set(tr.Q) | set(tr.P) | {space.t})
+    return list(zip(tr.Q, tr.P, strict=True)), dict(tr.values), K
+
+
 @quantity('canonical',
           book=('`{transformation: {Q: …, P: …}, canonical: true or false, generating: '
                 '{F2: F} (or F1, F3, F4), hamiltonian: K}` (only `transformation` required)'),
@@ -476,7 +491,8 @@ def new_hamiltonian(ctx: Context, space: PhaseSpace, tr: Transformation, names: 
                'Ṗ = −∂K/∂Q) and, with a generating function, equal H + ∂F/∂t (without '
                'one K is fixed only up to a function of t, and the verdict says so)'),
           keys={"variables": PAIRS, "new": PAIRS, "H": EXPR},
-          names=_canonical_names, equivalent=_open_claim)
+          names=_canonical_names, equivalent=_open_claim,
+          crosschecks=("new_hamiltonian",))
 def check_canonical(ctx: Context, val) -> Verdict:
     """The map's fundamental brackets, its generating function, its new Hamiltonian."""
     space, tr, names = _setting(ctx, val)
