@@ -89,6 +89,11 @@ SCALE = {"transformation": {"Q": "lam*x", "P": "p_x/lam"}, "generating": {"F2": 
 MOVING = {"transformation": {"Q": "x - v*t", "P": "p_x"},
           "generating": {"F2": "(x - v*t)*P"},
           "hamiltonian": "P**2/(2*m) + m*omega**2*(Q + v*t)**2/2 - v*P"}
+# The same maps from the other two kinds: F3(p, Q) gives q = −∂F3/∂p, P = −∂F3/∂Q, and
+# F3 = −pQ/λ gives q = Q/λ, P = p/λ (the scale); F4(p, P) gives q = −∂F4/∂p, Q = ∂F4/∂P,
+# and F4 = pP gives q = −P, Q = p (the exchange).
+SCALE_F3 = {**SCALE, "generating": {"F3": "-p_x*Q/lam"}}
+EXCHANGE_F4 = {**EXCHANGE, "generating": {"F4": "p_x*P"}}
 # Plane polar coordinates r = √(x² + y²), θ = atan(y/x) as a point transformation: the
 # momenta follow from F2 = P_r √(x² + y²) + P_θ atan(y/x), p = ∂F2/∂(x, y):
 # p_x = P_r x/r − P_θ y/r², p_y = P_r y/r + P_θ x/r², solved: P_r = (x p_x + y p_y)/r,
@@ -202,8 +207,9 @@ def test_a_time_dependent_bracket(tmp_path):
 
 
 # ---- canonical ---------------------------------------------------------------------------
-@pytest.mark.parametrize("book", [ACTION_ANGLE, EXCHANGE, SCALE, MOVING],
-                         ids=["action-angle", "exchange", "scale", "moving-frame"])
+@pytest.mark.parametrize("book", [ACTION_ANGLE, EXCHANGE, SCALE, MOVING, SCALE_F3, EXCHANGE_F4],
+                         ids=["action-angle", "exchange", "scale", "moving-frame", "scale-F3",
+                              "exchange-F4"])
 def test_canonical_maps_pass(tmp_path, book):
     out = _check(tmp_path, "9805", OSCILLATOR, quantity="canonical", book=book)
     assert out.status == "pass", out.detail
@@ -229,6 +235,9 @@ def test_polar_point_transformation(tmp_path):
     ({**MOVING, "hamiltonian": "P**2/(2*m) + m*omega**2*(Q + v*t)**2/2"}, "fail",
      "not K"),  # the −vP of ∂F2/∂t left out
     ({**MOVING, "generating": {"F2": "(x + v*t)*P"}}, "fail", "does not generate"),
+    ({**SCALE, "generating": {"F3": "p_x*Q/lam"}}, "fail", "F3 does not generate"),
+    ({**EXCHANGE, "generating": {"F4": "-p_x*P"}}, "fail", "F4 does not generate"),
+    ({**EXCHANGE, "generating": {"F4": "x*P"}}, "error", "not a canonical variable"),
 ])
 def test_wrong_claims_fail(tmp_path, book, status, why):
     out = _check(tmp_path, "9807", OSCILLATOR, quantity="canonical", book=book)
@@ -257,6 +266,8 @@ CASES = [
                      "assume": ["x > 0"]}),
     ("9815", OSCILLATOR, {"quantity": "poisson_bracket", "bracket": ["x", "H"],
                           "book": "p_x/m"}),
+    ("9817", OSCILLATOR, {"quantity": "canonical", "book": SCALE_F3}),
+    ("9818", OSCILLATOR, {"quantity": "canonical", "book": EXCHANGE_F4}),
     ("9816", SPACE, {"quantity": "poisson_bracket",
                      "bracket": ["y*p_z - z*p_y", "z*p_x - x*p_z"],
                      "book": "x*p_y - y*p_x"}),
