@@ -31,7 +31,7 @@ from mechbook.verify.answers import Part, load_answers
 from mechbook.verify.checker import check_part, check_problem
 from mechbook.verify.context import Context
 from mechbook.verify.mutate import part_mutants, shift_sizes
-from mechbook.verify.quantities.canonical import bracket
+from mechbook.verify.quantities.brackets import bracket
 from mechbook.verify.wellformed import validate_key
 
 OSCILLATOR = """\
@@ -408,10 +408,10 @@ def test_the_bracket_cross_check_passes_and_reads_explicit_time(tmp_path):
 def test_the_bracket_cross_check_sees_a_wrong_hamiltonian(tmp_path, monkeypatch):
     """An engine whose Hamiltonian were twice the true one would pass a book that agrees
     with it ({x, 2H} = 2p/m); the cross-check, which never reads H, fails it."""
-    import mechbook.verify.quantities.canonical as canonical
+    import mechbook.verify.quantities.brackets as brackets
 
-    right = canonical.old_hamiltonian
-    monkeypatch.setattr(canonical, "old_hamiltonian",
+    right = brackets.old_hamiltonian
+    monkeypatch.setattr(brackets, "old_hamiltonian",
                         lambda ctx, space, sub: 2 * right(ctx, space, sub))
     out, x = _bracket_crosscheck(tmp_path, "9842", OSCILLATOR, quantity="poisson_bracket",
                                  bracket=["x", "H"], book="2*p_x/m")

@@ -19,7 +19,8 @@ from mechbook.verify.answers import Part
 from mechbook.verify.compare import value
 from mechbook.verify.context import Context
 from mechbook.verify.context import split_named as _split_named
-from mechbook.verify.quantities.canonical import bracket_claim, hamiltonian_claim
+from mechbook.verify.quantities.brackets import bracket_claim
+from mechbook.verify.quantities.canonical import hamiltonian_claim
 from mechbook.verify.quantities.steady import family
 from mechbook.verify.quantities.trajectory import Motion
 
@@ -74,7 +75,7 @@ class PartView:
 
     def bracket(self) -> tuple | None:
         """A bracket part's (f, g, h, H): its functions and value in (q, p_q, t), H the
-        symbol standing for the engine's Hamiltonian (mechbook.verify.quantities.canonical);
+        symbol standing for the engine's Hamiltonian (mechbook.verify.quantities.brackets);
         None where the part names its own variables or Hamiltonian."""
         return bracket_claim(self._ctx)
 
