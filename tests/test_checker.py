@@ -225,7 +225,21 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
         for k in val:
             yield Slot(root + (k,), kind)
     elif q == "mode_count":
-        yield Slot(root, "count")
+        if isinstance(val, dict):  # {configuration: k, velocity: d}: each count apart
+            for k in val:
+                yield Slot(root + (k,), "count")
+        else:
+            yield Slot(root, "count")
+    elif q == "canonical":
+        if val.get("canonical", True) is False:  # an open claim: only the flag can be wrong
+            yield Slot(root + ("canonical",), "flag")
+            return
+        for k in val["transformation"]:
+            yield Slot(root + ("transformation", k), "value")
+        for k in val.get("generating") or {}:
+            yield Slot(root + ("generating", k), "generating")
+        if "hamiltonian" in val:
+            yield Slot(root + ("hamiltonian",), "value")
     elif q == "mode_node":
         for k in val:
             yield Slot(root + (k,), "value")
@@ -367,7 +381,7 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
                 yield f"say {other}", other
         return
     s = str(value)
-    if slot.kind in ("lagrangian", "value", "potential"):
+    if slot.kind in ("lagrangian", "value", "potential", "generating"):
         yield from expression_mutants(s, names)
     elif slot.kind == "steady":  # -rate (time reversal) and mirrored angles are steady too
         yield "double", f"2*({s})"
@@ -508,6 +522,10 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
                 name in ("E", "h", "energy", "jacobi") and _free_of(b - a, motion)))
         return _free_of(b - a, motion) or _zero(a - b) or (a != 0 and _free_of(b / a, motion))
     extra = ctx.quantity.names
+    if slot.kind == "generating":  # a generating function is defined up to a constant
+        names = extra(ctx)
+        d = ctx.parse(new, slot.path, names=names) - ctx.parse(old, slot.path, names=names)
+        return d.free_symbols <= set(ctx.sampler.base)
     if extra is not None:  # the quantity's own names (a polynomial's variable, W0(j), ...)
         names = extra(ctx)
         a = ctx.parse(old, slot.path, names=names)

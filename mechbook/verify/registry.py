@@ -22,6 +22,8 @@ from mechbook.model.schema import bundled
 from mechbook.verify.quantities import (
     access,
     adiabatic,
+    brackets,
+    canonical,
     chaos,
     equations,
     equilibria,
@@ -43,9 +45,9 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, adiabatic, chaos, equations, equilibria, expressions, extremum, motion,
-           oscillations, parts, perturbation, phase, response, rotation, stability, steady,
-           tensors, trajectory, words)
+MODULES = (access, adiabatic, brackets, canonical, chaos, equations, equilibria, expressions,
+           extremum, motion, oscillations, parts, perturbation, phase, response, rotation,
+           stability, steady, tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
