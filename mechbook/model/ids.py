@@ -16,7 +16,10 @@ import re
 from mechbook.errors import MechbookError
 
 BOOK = r"[a-z][a-z0-9]{0,39}"
-NUMBER = r"(?=[A-Za-z0-9._-]{1,80}\Z)[A-Za-z0-9]+(?:[._-][A-Za-z0-9]+)*"
+# The length limit is a lookahead that ends where the id's characters end, not at `\Z`: the
+# pattern is copied into the problem schema, and editors' validators (ECMA-262 regexes, as
+# JSON Schema specifies) know no `\Z`.
+NUMBER = r"(?=[A-Za-z0-9._-]{1,80}(?![A-Za-z0-9._-]))[A-Za-z0-9]+(?:[._-][A-Za-z0-9]+)*"
 PATTERN = rf"({BOOK})-({NUMBER})"
 ID = re.compile(PATTERN)
 EXAMPLES = "e.g. lim-2031 or symon-09-12"
