@@ -38,6 +38,8 @@ WRONG = [
     ("problem", PROBLEM.replace("mybook-1.1", "mybook-1..1"), "an id with '..'"),
     ("problem", PROBLEM.replace("mybook-1.1", "Mybook-1"), "an upper-case book"),
     ("problem", PROBLEM.replace("mybook-1.1", "mybook-" + "1" * 81), "an id too long"),
+    ("problem", PROBLEM.replace("id: mybook-1.1", 'id: "mybook-1.1\\n"'),
+     "an id with a final newline"),
     ("problem", PROBLEM.replace("coordinates:", "coordinate:"), "a misspelt key"),
     ("problem", PROBLEM.replace("mass: m,", "mass: [m],"), "a list for an expression"),
     ("problem", PROBLEM.replace("id: mybook-1.1\n", ""), "no id"),
@@ -57,7 +59,7 @@ def test_the_id_pattern_is_ecma262():
 
     for pid in GOOD_IDS:
         assert re.search(pattern, pid) and ID.fullmatch(pid), pid
-    for pid in ["a-" + "x" * 81, "lim-20..31", "lim-", "Lim-1", "lim-1-", "lim-/1"]:
+    for pid in ["a-" + "x" * 81, "lim-20..31", "lim-", "Lim-1", "lim-1-", "lim-/1", "lim-1\n"]:
         assert not re.search(pattern, pid) and not ID.fullmatch(pid), pid
 
 
