@@ -180,6 +180,7 @@ def test_a_plate_is_drawn_as_a_plate_with_its_springs(report, browser):  # noqa:
     assert fixed == [[-0.2, 0.0], [0.2, 0.0]]
     page.click("figure.animation:last-of-type button")  # pause; read the frame drawn
     page.wait_for_timeout(100)
+    trouble = list(trouble)  # the page's own (the readback below warns of itself)
     dark = page.evaluate("""() => {
       const figs = document.querySelectorAll("figure.animation");
       const fig = figs[figs.length - 1];
