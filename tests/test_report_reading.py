@@ -84,6 +84,20 @@ def test_a_kept_form_that_is_not_the_expression_is_refused(tmp_path, caplog):
     assert "simplified again" in caplog.text
 
 
+def test_a_link_in_the_kept_folder_is_not_written_through(tmp_path):
+    x, y = sp.symbols("x y", positive=True)
+    expr = sp.sin(x) ** 2 * y + sp.cos(x) ** 2 * y
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    kept = tmp_path / "kept"
+    probe = SimplifiedCache(kept)
+    target = probe._path(expr)
+    target.parent.mkdir(parents=True)
+    target.symlink_to(outside / "planted.txt")
+    probe.put(expr, y)
+    assert list(outside.iterdir()) == [] and target.is_symlink()
+
+
 def test_durations_read_as_a_reader_says_them():
     assert [duration(s) for s in (0.536591, 7.51844, 42.4, 125.0, 0.0031)] == \
         ["0.54 s", "7.5 s", "42 s", "2 min 05 s", "3.1 ms"]

@@ -8,7 +8,7 @@ expression it came from (its `srepr`, with SymPy's version: another SymPy may si
 otherwise), one small file per expression under the report's folder (`.simplified/`), so
 the next run of any page that shows the same expression reads it back instead of spending
 time. Pages built in parallel write distinct files, each written whole and renamed into
-place.
+place; a symbolic link in the folder is never written through.
 
 The folder is a file anyone can change, so what is read back is checked, never trusted:
 read only as a regular file of bounded size, parsed by the safe parser (never `eval`), in
@@ -80,11 +80,21 @@ class SimplifiedCache:
         path = self._path(expr)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
+            if not self._inside(path):  # a link planted in the folder: never written through
+                log.warning("%s: a symbolic link in the way; the form is not kept", path)
+                return
             with replaced(output_file(path, "simplified form")) as fh:
                 fh.write(sp.sstr(form).encode("utf-8"))
             self.stored += 1
         except (OSError, OutputError) as exc:
             log.debug("%s: not kept (%s)", path, exc)
+
+
+    def _inside(self, path: Path) -> bool:
+        """Whether `path` is a name inside the folder with no symbolic link on the way (the
+        folder, its subfolder, the file)."""
+        top = self.directory
+        return not any(p.is_symlink() for p in (top, path.parent, path))
 
 
 def _same(a: sp.Expr, b: sp.Expr) -> bool:
