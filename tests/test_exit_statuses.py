@@ -45,6 +45,7 @@ def test_the_statuses_are_distinct_and_as_pytest():
     assert (OK, FAILED, USAGE, NOTHING_SELECTED) == (0, 1, 4, 5)  # pytest's 0, 1, 4, 5
 
 
+@pytest.mark.slow  # two checks of the starter problem
 def test_pass_fail_and_nothing_selected_differ(tree):
     assert run(tree, "check", "--serial", "--no-store", "mybook-1.1").exit_code == OK
     failed = run(tree, "check", "--serial", "--no-store", "mybook-1.2")
@@ -112,6 +113,7 @@ def test_plural():
     assert plural(1, "body", "bodies") == "1 body" and plural(3, "body", "bodies") == "3 bodies"
 
 
+@pytest.mark.slow  # a check of the starter problem
 def test_one_problem_is_one_problem(tree):
     res = run(tree, "check", "--serial", "--no-store", "mybook-1.1")
     assert "1 problem, 3 parts: 3 pass" in res.output, res.output
