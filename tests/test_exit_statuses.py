@@ -70,7 +70,9 @@ def test_every_command_says_no_such_problem_with_its_status(tree, command):
 
 @pytest.mark.parametrize("args", [["--bogus"], ["check", "--bogus"], ["check", "-j", "x"],
                                   ["check", "--serial", "-j", "2"], ["schema"],
-                                  ["list", "extra"]])
+                                  ["list", "extra"], ["check", "bad..id", "--no-store"],
+                                  ["simulate", "lim-2031/x", "--no-store"],
+                                  ["show", "Lim-1"]])
 def test_a_usage_error_exits_4(tree, args):
     res = run(tree, *args)
     assert res.exit_code == USAGE, (args, res.exit_code, res.output)

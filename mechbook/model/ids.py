@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from mechbook.errors import MechbookError
+from mechbook.errors import MalformedIdError
 
 BOOK = r"[a-z][a-z0-9]{0,39}"
 # The length limit is a lookahead that ends where the id's characters end, not at `\Z`: the
@@ -30,7 +30,7 @@ def split_id(pid: object) -> tuple[str, str]:
     for anything that is not a well-formed id."""
     m = ID.fullmatch(pid) if isinstance(pid, str) else None
     if m is None:
-        raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, {EXAMPLES}: "
+        raise MalformedIdError(f"bad problem id {pid!r} (expected <book>-<number>, {EXAMPLES}: "
                             "a book of lower-case letters and digits, a number of letters "
                             "and digits with single '.', '_' or '-' between them)")
     return m.group(1), m.group(2)

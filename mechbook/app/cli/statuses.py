@@ -15,7 +15,7 @@ import textwrap
 import click
 
 from mechbook.app.text import for_terminal
-from mechbook.errors import NothingSelectedError
+from mechbook.errors import MalformedIdError, NothingSelectedError
 
 OK = 0
 FAILED = 1
@@ -27,8 +27,8 @@ TABLE = (
     (OK, "success: every part checked passed (check), or the command did what it was asked"),
     (FAILED, "a part failed or errored, a cross-check failed, a file is invalid, or results "
              "could not be written (the message says which)"),
-    (USAGE, "usage error: an unknown option, a missing or malformed argument, options that "
-            "cannot go together"),
+    (USAGE, "usage error: an unknown option, a missing or malformed argument (a problem id "
+            "that is no <book>-<number>), options that cannot go together"),
     (NOTHING_SELECTED, "nothing selected: no such problem (an id with no file), or a "
                        "pattern or book that matches no problem of the tree"),
     (INTERRUPTED, "interrupted (Ctrl-C)"),
@@ -44,11 +44,14 @@ def epilog() -> str:
 
 def failure(exc: BaseException) -> click.ClickException:
     """The ClickException a command raises for `exc`: its message, made safe for the
-    terminal, exiting with NOTHING_SELECTED for a NothingSelectedError, else FAILED.
+    terminal, exiting with NOTHING_SELECTED for a NothingSelectedError, USAGE for a
+    MalformedIdError (an id given on the command line), else FAILED.
 
     Example: raise failure(exc) from None, in a command's `except MechbookError as exc:`.
     """
     out = click.ClickException(for_terminal(str(exc)))
     if isinstance(exc, NothingSelectedError):
         out.exit_code = NOTHING_SELECTED
+    elif isinstance(exc, MalformedIdError):
+        out.exit_code = USAGE
     return out
