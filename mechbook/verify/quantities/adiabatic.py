@@ -23,6 +23,7 @@ import random
 
 import sympy as sp
 
+from mechbook.core.words import plural
 from mechbook.engine.adiabatic import frozen, simulate
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, value_and_scale
@@ -91,7 +92,7 @@ def check_adiabatic_invariant(ctx: Context, val) -> Verdict:
         rel = abs(one - two) / scale
         worst = max(worst, rel)
         if not rel <= RTOL:
-            return Verdict(False, f"exact({k} points)",
+            return Verdict(False, f"exact({plural(k, 'point')})",
                            f"not a function of the action J = {sp.sstr(J)}: f_A·J_r − f_r·J_A "
                            f"is {rel:.2g} of its terms at {slow} = {float(at[slow]):.6g}")
     return _simulated(ctx, book, J, amp, slow, r0_e, r1_e, worst)

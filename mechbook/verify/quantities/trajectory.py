@@ -21,6 +21,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_mp
+from mechbook.core.words import plural
 from mechbook.engine.levelset import LevelSet
 from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
@@ -159,10 +160,10 @@ def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
         eng = engine_of(pt)
         ok, why = match_multiset(_at_start(motion.start, book, pt), eng, partial, rtol=motion.rtol)
         if not ok:
-            return Verdict(False, f"{how}({n} points)", f"{what}: {why}")
-    return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})",
+            return Verdict(False, f"{how}({plural(n, 'point')})", f"{what}: {why}")
+    return Verdict(True, f"{how}({plural(motion.points(), 'point')}, rtol {motion.rtol:g})",
                    power=(f"within the stated {motion.rtol:g}" if "estimate" in ctx.part.data
-                          else f"{motion.points()} points, each value to {motion.rtol:g} "
+                          else f"{plural(motion.points(), 'point')}, each value to {motion.rtol:g} "
                                f"({how})"))
 
 
@@ -339,6 +340,6 @@ def check_event_time(ctx: Context, val) -> Verdict:
             engine = float(y[i] - q0[i])
         ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
         if not ok:
-            return Verdict(False, f"measured({n} points)", f"event: {why}")
-    return Verdict(True, f"measured({points} points, rtol {rtol:g})",
-                   power=f"{points} points, measured by integration to {rtol:g}")
+            return Verdict(False, f"measured({plural(n, 'point')})", f"event: {why}")
+    return Verdict(True, f"measured({plural(points, 'point')}, rtol {rtol:g})",
+                   power=f"{plural(points, 'point')}, measured by integration to {rtol:g}")
