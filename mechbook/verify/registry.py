@@ -21,6 +21,7 @@ from functools import cache
 from mechbook.model.schema import bundled
 from mechbook.verify.quantities import (
     access,
+    action,
     adiabatic,
     equations,
     equilibria,
@@ -42,7 +43,7 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, motion,
+MODULES = (access, action, adiabatic, equations, equilibria, expressions, extremum, motion,
            oscillations, parts, perturbation, phase, response, rotation, stability, steady,
            tensors, trajectory, words)
 
