@@ -27,6 +27,7 @@ from mechbook.verify.quantities import (
     equilibria,
     expressions,
     extremum,
+    hamilton_jacobi,
     motion,
     oscillations,
     parts,
@@ -43,9 +44,9 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, action, adiabatic, equations, equilibria, expressions, extremum, motion,
-           oscillations, parts, perturbation, phase, response, rotation, stability, steady,
-           tensors, trajectory, words)
+MODULES = (access, action, adiabatic, equations, equilibria, expressions, extremum,
+           hamilton_jacobi, motion, oscillations, parts, perturbation, phase, response,
+           rotation, stability, steady, tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
