@@ -293,6 +293,7 @@ TIME_TO = "sqrt(l/g)*elliptic_f(asin(sin(theta1/2)/sin(theta0/2)), sin(theta0/2)
 @pytest.mark.parametrize("book, want", [
     (TIME_TO, "pass"),
     (f"({TIME_TO})*(1 + 1e-6)", "fail"),
+    (f"({TIME_TO})*(1 + 1e-12)", "fail"),   # the level set's quadrature: exact to 1e-15
     (f"({TIME_TO})*1.01", "fail"),
     (TIME_TO.replace("sin(theta0/2)**2)", "sin(theta0/2))"), "fail"),  # k for m = k²
 ])
@@ -304,6 +305,21 @@ def test_a_pendulums_time_to_an_angle(tmp_path, book, want):
             "event": "theta - theta1", "book": book}
     symbols = {"theta0": {"value": 1.6}, "theta1": {"value": 0.8}}
     assert _status(tmp_path, an, part, symbols) == want
+
+
+def test_a_time_across_the_bottom_from_rest(tmp_path):
+    """Released from rest at θ0 (a turning point: the quadrature's inverse square root at
+    its start) the pendulum reaches −θ1 past the bottom: a quarter period plus the time
+    from the bottom, sqrt(l/g)·(K(m) + F(φ1, m))."""
+    text = pendulum(1.0, 1.3, header="id: lim-9705\nsource: test\ntitle: a pendulum\n")
+    an = load_analysis(tmp_path, text, "9705")
+    both = ("sqrt(l/g)*(elliptic_k(sin(theta0/2)**2) + "
+            "elliptic_f(asin(sin(theta1/2)/sin(theta0/2)), sin(theta0/2)**2))")
+    for book, want in ((both, "pass"), (f"({both})*(1 + 1e-6)", "fail")):
+        part = {"quantity": "event_time", "initial": {"theta": "theta0"},
+                "event": "theta + theta1", "book": book}
+        assert _status(tmp_path, an, part, {"theta0": {"value": 1.6},
+                                            "theta1": {"value": 0.8}}) == want
 
 
 def test_a_key_outside_the_domain_is_an_error_at_its_line(tmp_path):

@@ -242,6 +242,31 @@ class Orbit:
     def period(self):
         return self._quad(lambda c: mpmath.mpf(1))
 
+    def time_to(self, target):
+        """The time the motion takes from c0 to c = `target`, or None where it does not get
+        there directly (the target lies behind the start or beyond the turning point
+        ahead). ∫ √(m/(2(E − V_eff))) |dc| by tanh-sinh quadrature, which absorbs the
+        inverse square root at a turning point c0 (a start from rest)."""
+        mass, _, _ = self.level.numeric_functions
+        lo, hi = self.turning_points
+        with mpmath.workdps(self.dps):
+            target = mpmath.mpf(target)
+            ahead = hi if self.cdot0 > 0 or (self.cdot0 == 0 and self.c0 == lo) else lo
+            if not min(self.c0, ahead) < target < max(self.c0, ahead) and target != self.c0:
+                return None
+
+            def f(c):
+                k = self.kinetic(c)
+                if k <= 0:
+                    raise UnsupportedError("level set: the motion leaves the allowed region "
+                                           "before the target")
+                return mpmath.sqrt(mass(*self._args(c)) / (2 * k))
+
+            value, err = mpmath.quad(f, sorted([self.c0, target]), error=True)
+            if not err <= mpmath.mpf(10) ** (30 - self.dps) * abs(value):
+                raise UnsupportedError("level set: the time quadrature did not converge")
+            return value
+
     @cached_property
     def action(self):
         """J = (1/2π)∮ p dc over one libration (the 1/2π convention: J = E/ω for an

@@ -47,7 +47,8 @@ TOLERANCE = 1e-12
                'β and p = ∂S/∂q at 6 times to 1e-7 (until `duration:`, or until a momentum '
                'first changes sign)'),
           keys={"constants": {"type": "array", "minItems": 1, "items": {"type": "string"}},
-                "start": POINT, "duration": EXPR})
+                "start": POINT, "duration": EXPR},
+          equivalent=("shift",))  # S + a constant is the same complete integral
 def check_hamilton_jacobi(ctx: Context, val) -> Verdict:
     sys, dyn, data = ctx.system, ctx.dyn, ctx.part.data
     if sys.forces and any(f != 0 for f in sys.forces):
