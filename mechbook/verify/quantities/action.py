@@ -18,8 +18,9 @@ takes the book's energy H(J1, J2, ...) as a function of the actions (`actions:` 
 action symbol's coordinate): at each point H at the engine's actions must be the energy,
 and each frequency ∂H/∂J_i must be the engine's 2π/T (the libration's period, a second
 quadrature) or, for a cyclic angle, its mean rate (advance per period / T). At one point
-the frequency is also measured by integrating the full equations from the start
-(mechbook.numerics.measure, at its 1e-7) where `initial:` gives one.
+the frequency is also measured by integrating the full equations (mechbook.numerics.
+measure, at its 1e-7) from `initial:`, or from the state at `inside:` with the part's
+energy and momenta.
 """
 
 from __future__ import annotations
@@ -137,6 +138,36 @@ class Actions:
         p = sp.diff(ctx.dyn.L, qd).xreplace({k: v.subs(pt) for k, v in self.start.items()})
         return evaluate_mp(p, pt, DPS)
 
+    def start_state(self, c, pt: dict) -> dict:
+        """A state of the part's motion at `pt`: the start, or (given by energy) c at
+        `inside:`, the other coordinates 0 (cyclic: their values do not matter), the cyclic
+        rates from their momenta and ċ > 0 from the energy."""
+        if self.start is not None:
+            return {k: v.subs(pt) for k, v in self.start.items()}
+        sys, dyn = self.ctx.system, self.ctx.dyn
+        level = self.level(c)
+        orbit = self.orbit(c, pt, DPS)
+        fixed = dict(pt)
+        fixed.update({q: sp.S.Zero for q in sys.q})
+        fixed[c] = sp.Float(orbit.c0, 30)
+        cdot = sys.qd[sys.q.index(c)]
+        rates = [sys.qd[sys.q.index(q)] for q in level.cyclic]
+        eqs = [dyn.momenta[sys.q.index(q)].xreplace(fixed) - sp.Float(P, 30)
+               for q, P in zip(level.cyclic, orbit.P, strict=True)]
+        sol = sp.solve(eqs, rates, dict=True) if eqs else [{}]
+        if len(sol) != 1:
+            raise UnsupportedError("the cyclic rates from their momenta")
+        energy = dyn.energy_function.xreplace(fixed).xreplace(sol[0])
+        roots = [r for r in sp.Poly(sp.expand(energy - sp.Float(orbit.E, 30)), cdot).nroots(
+            n=30) if r.is_real and r > 0]
+        if not roots:
+            raise UnsupportedError("a state at `inside:` with the part's energy")
+        state = {q: fixed[q] for q in sys.q}
+        state[cdot] = roots[-1]
+        state.update({v: sol[0].get(v, sp.S.Zero).xreplace({cdot: roots[-1]})
+                      for v in rates})
+        return state
+
     def action(self, c, pt: dict):
         """(J, its resolution): the quadrature at DPS digits and its distance from CHECK_DPS."""
         if c not in self.librating():
@@ -210,8 +241,8 @@ def check_action(ctx: Context, val) -> Verdict:
                '`actions:` names (action symbol: coordinate) put into the book\'s H give the '
                'energy to 1e-15, and each ∂H/∂J_i is the engine\'s frequency to 1e-15: 2π '
                'over the libration\'s period (a quadrature), or a cyclic angle\'s mean rate; '
-               'with `initial:`, the frequency also measured by integrating the full '
-               'equations (1e-7)'),
+               'the frequency also measured by integrating the full equations (1e-7) '
+               'from the start, or from the state at `inside:`'),
           keys={"actions": {"type": "object", "minProperties": 1,
                             "additionalProperties": {"type": "string"}}, **MOTION})
 def check_action_hamiltonian(ctx: Context, val) -> Verdict:
@@ -270,9 +301,8 @@ def check_action_hamiltonian(ctx: Context, val) -> Verdict:
 
 def _measured(ctx: Context, acts: Actions, pairs, slopes, librating_c):
     """At the default point, ∂H/∂J of the librating coordinate against 2π over the period
-    measured by integrating the full equations from `initial:` (None without a start)."""
-    if acts.start is None:
-        return None
+    measured by integrating the full equations from `initial:`, or from the state at
+    `inside:` that has the part's energy and momenta."""
     pt = ctx.sampler.default()
     i = [c for _, c in pairs].index(librating_c)
     at = dict(pt)
@@ -285,7 +315,7 @@ def _measured(ctx: Context, acts: Actions, pairs, slopes, librating_c):
         params = {k: float(v) for k, v in pt.items() if k in sys.problem.values()}
         model = build_model(sys, ctx.dyn, params)
         fn = signal_functions(sys, ctx.dyn, pt, librating_c)
-        st = {k: v.subs(pt) for k, v in acts.start.items()}
+        st = acts.start_state(librating_c, pt)
         q0 = np.array([float(st[q]) for q in sys.q])
         qd0 = np.array([float(st[v]) for v in sys.qd])
         q0, qd0 = ctx.settled(q0, qd0, pt)
