@@ -219,6 +219,9 @@ def test_the_motion_must_be_given(tmp_path):
     part = {"quantity": "action", "coordinate": "x", "book": "E"}
     out = _outcome(tmp_path, "9810", well(2), part, {"E": {"value": 1}})
     assert out.status.value == "error" and "give the motion" in out.detail
+    out = _outcome(tmp_path, "9812", well(2), {"quantity": "action", "energy": "E",
+                                               "inside": 0, "book": "E"}, {"E": {"value": 1}})
+    assert out.status.value == "error" and "name the `coordinate:`" in out.detail
     with pytest.raises(SpecError):
         _outcome(tmp_path, "9811", well(2), {**part, "energy": "E", "frobnicate": 1},
                  {"E": {"value": 1}})

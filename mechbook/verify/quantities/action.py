@@ -58,6 +58,8 @@ class Actions:
         self.ctx, sys, data = ctx, ctx.system, ctx.part.data
         self.coords = []
         for name in coordinates:
+            if name is None:
+                raise ctx.part.error((), "name the `coordinate:` whose action is given")
             if name not in sys.coord_names:
                 raise ctx.part.error(where, f"{name!r} is not a coordinate")
             self.coords.append(sys.q[sys.coord_names.index(name)])
