@@ -225,3 +225,17 @@ def test_the_motion_must_be_given(tmp_path):
     with pytest.raises(SpecError):
         _outcome(tmp_path, "9811", well(2), {**part, "energy": "E", "frobnicate": 1},
                  {"E": {"value": 1}})
+
+
+def test_a_quadrature_short_of_its_digits_is_unsupported(tmp_path, monkeypatch):
+    """Where the 50- and 60-digit quadratures do not agree to what is asked, the part is
+    unsupported with the reason, never a fail (the demand raised beyond 60 digits here)."""
+    import mpmath as mp
+
+    from mechbook.verify.quantities import action
+
+    monkeypatch.setattr(action, "RESOLVED", mp.mpf(10) ** -70)
+    part = {"quantity": "action", "coordinate": "x", "energy": "E", "inside": 0,
+            "book": f"2*({OSC_J})"}   # even a wrong key: not a fail
+    out = _outcome(tmp_path, "9813", well(2), part, {"E": {"value": 0.4}})
+    assert out.status.value == "unsupported" and "quadrature reached only" in out.detail
