@@ -17,6 +17,7 @@ from collections import OrderedDict
 import mpmath
 import sympy as sp
 
+from mechbook.core import special
 from mechbook.core.secalc import derivative
 
 _FUNCS = {
@@ -28,7 +29,11 @@ _FUNCS = {
     sp.atan2: mpmath.atan2, sp.re: mpmath.re, sp.im: mpmath.im,
     sp.conjugate: mpmath.conj,
     # one argument: the complete integrals K(m), E(m) (m = k², as in SymPy and mpmath)
-    sp.elliptic_k: mpmath.ellipk, sp.elliptic_e: mpmath.ellipe, sp.gamma: mpmath.gamma,
+    sp.elliptic_k: mpmath.ellipk, sp.gamma: mpmath.gamma,
+    # the incomplete integrals, E(m) and E(φ, m), Jacobi's functions, Bessel's and their
+    # zeros: each refuses (DomainError, a ValueError: a singular point) a point outside
+    # its real domain (mechbook.core.special)
+    **special.MPMATH,
 }
 
 

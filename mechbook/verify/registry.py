@@ -21,6 +21,7 @@ from functools import cache
 from mechbook.model.schema import bundled
 from mechbook.verify.quantities import (
     access,
+    action,
     adiabatic,
     brackets,
     canonical,
@@ -29,6 +30,7 @@ from mechbook.verify.quantities import (
     equilibria,
     expressions,
     extremum,
+    hamilton_jacobi,
     motion,
     oscillations,
     parts,
@@ -45,9 +47,9 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, adiabatic, brackets, canonical, chaos, equations, equilibria, expressions,
-           extremum, motion, oscillations, parts, perturbation, phase, response, rotation,
-           stability, steady, tensors, trajectory, words)
+MODULES = (access, action, adiabatic, brackets, canonical, chaos, equations, equilibria,
+           expressions, extremum, hamilton_jacobi, motion, oscillations, parts, perturbation,
+           phase, response, rotation, stability, steady, tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
