@@ -3,6 +3,7 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
+AJV     = .ci/ajv/node_modules/.package-lock.json
 
 .PHONY: check test test-quick test-mutation test-min test-install lint fuzz report bench bench-check bench-sweep bench-power clean
 
@@ -19,13 +20,19 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 	-$(BIN)/mechbook check  # a failing part is shown in the report, not an end to it
 	$(BIN)/mechbook report
 
-test: $(STAMP)   ## the test suite, the mutation tests on a sample of six answer keys (~10 min on two cores)
+# ajv, the JavaScript JSON Schema validator tests/test_schema_editors.py runs the shipped
+# schemas through (ECMA-262 regexes, as editors compile them); skipped where npm is absent
+# (the test then installs it itself, or skips where node is absent)
+$(AJV): .ci/ajv/package.json .ci/ajv/package-lock.json
+	if command -v npm >/dev/null 2>&1; then npm ci --silent --no-audit --no-fund --prefix .ci/ajv; fi
+
+test: $(STAMP) $(AJV)   ## the test suite, the mutation tests on a sample of six answer keys (~10 min on two cores)
 	$(BIN)/python -m pytest -q -n auto -m 'not mutation'
 
 test-mutation: $(STAMP)  ## the mutation tests on every other answer key (~6 min on two cores; CI runs it)
 	$(BIN)/python -m pytest -q -n auto -m mutation
 
-test-quick: $(STAMP)  ## the suite without the slow tests, for every change (1950 of 2409 tests, on two cores)
+test-quick: $(STAMP) $(AJV)  ## the suite without the slow tests, for every change (1950 of 2409 tests, on two cores)
 	$(BIN)/python -m pytest -q -n auto -m 'not slow'
 
 # The oldest versions pyproject.toml's ranges allow (.ci/min_versions.py), mechbook itself
@@ -90,4 +97,4 @@ lint: $(STAMP)
 	$(BIN)/ruff check mechbook tests bench
 
 clean:
-	rm -rf $(VENV) $(MIN) results .pytest_cache
+	rm -rf $(VENV) $(MIN) results .pytest_cache .ci/ajv/node_modules

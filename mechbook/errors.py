@@ -42,6 +42,17 @@ class NotFoundError(MechbookError, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
+class NothingSelectedError(NotFoundError):
+    """No problem is what a command was given: an id with no file, a pattern or a book that
+    matches none. The command line exits with its own status for it (5, as pytest's "no
+    tests collected"), so a script can tell it from a part that failed (1)."""
+
+
+class MalformedIdError(MechbookError):
+    """A problem id that is not `<book>-<number>` at all: the command line exits with its
+    usage status for it (4), as for any malformed argument."""
+
+
 class InputError(MechbookError, ValueError):
     """A value the user gave (on the command line or to the Python API) that is not valid;
     the message says what is expected. Also a ValueError, for callers that catch one."""

@@ -64,12 +64,12 @@ def spring(tmp_path_factory):
     return _analysis(tmp_path_factory, SPRING)
 
 
-def check(analysis, tmp_path, book, coordinate, slow, about):
+def check(analysis, tmp_path, book, coordinate, slow, about, **extra):
     doc = {"problem": analysis.problem.id, "source": "test",
            "symbols": {"A": {"value": 0.01}, "s0": {"value": 1.0}},
            "parts": [{"part": "x", "cite": "test", "quantity": "adiabatic_invariant",
                       "about": about, "coordinate": coordinate, "amplitude": "A",
-                      "slow": slow, "book": book}]}
+                      "slow": slow, "book": book, **extra}]}
     YAML().dump(copy.deepcopy(doc), (tmp_path / "key.yaml").open("w"))
     out = check_problem(analysis, load_answers(tmp_path / "key.yaml"))[0]
     return out.status, out.detail
@@ -114,3 +114,34 @@ def test_simulated_slow_change_gives_the_closed_form_amplitude(pendulum, spring)
     k = spring.system().free_driven[0][0]
     run = simulate(spring.dynamics(), k, spring.problem.values(), 1.0, 4.0, 0.3)
     assert abs(run.a1 / (0.3 / 4 ** 0.25) - 1) < 1e-6   # linear: no amplitude correction
+
+
+# `invariant: action`: the law is the action itself, J = (1/2π)∮p dx. For the spring the
+# orbit is an ellipse of semi-axes A and sqrt(mk)·A (p = m·ẋ, |ẋ| ≤ ωA, ω = sqrt(k/m)), of
+# area π·sqrt(mk)·A², so J = sqrt(mk)·A²/2 (= E/ω); for the drawn pendulum M = m r²,
+# K = m g r, so J = m·sqrt(g)·r^(3/2)·A²/2.
+@pytest.mark.slow
+@pytest.mark.parametrize("book, status", [
+    ("A**2*sqrt(m*k)/2", "pass"),
+    ("A**2*sqrt(m*k)", "fail"),               # 2J
+    ("pi*A**2*sqrt(m*k)", "fail"),            # the area ∮p dx = 2πJ
+    ("A**2*sqrt(m*k)/2*(1 + 1e-6)", "fail"),
+    ("A**2*sqrt(m*k)/2*1.01", "fail"),
+    ("A**4*k", "fail"),                       # a function of J, not J
+])
+def test_spring_the_action_itself(spring, tmp_path, book, status):
+    got, detail = check(spring, tmp_path, book, "x", {"k": ["s0", "4*s0"]}, {"x": 0},
+                        invariant="action")
+    assert got == status, detail
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("book, status", [
+    ("m*sqrt(g)*r**(3/2)*A**2/2", "pass"),
+    ("m*sqrt(g)*r**(3/2)*A**2", "fail"),
+    ("m*sqrt(g)*r**(3/2)*A**2/2*(1 + 1e-6)", "fail"),
+])
+def test_pendulum_the_action_itself(pendulum, tmp_path, book, status):
+    got, detail = check(pendulum, tmp_path, book, "theta", {"r": ["s0", "s0/2"]},
+                        {"theta": 0}, invariant="action")
+    assert got == status, detail

@@ -2,7 +2,8 @@
 namespace (in a scratch directory, the repository's tree as $MECHBOOK_ROOT), so what the
 page shows is what mechbook does (issue 34's "done when": load, equilibria by string key,
 frequencies at other parameter values, simulate, to_xarray(), the equations as a callable
-integrated by solve_ivp agreeing with `mechbook simulate`)."""
+integrated by solve_ivp agreeing with `mechbook simulate`; issue 43: the function with
+inputs per call, and the motion shown inline by animate() and plot())."""
 
 from __future__ import annotations
 
@@ -22,7 +23,8 @@ def cells() -> list[str]:
 def test_the_page_has_the_session():
     text = "\n".join(cells())
     for needed in ('e["theta"]', "params={", "to_xarray()", "ode_function()", "solve_ivp(",
-                   '"simulate"', "TypeError"):
+                   '"simulate"', "TypeError", "ode_function(inputs=", "fu(0.0, y, [omega])",
+                   "run.animate()", "run.plot()"):
         assert needed in text, needed
 
 

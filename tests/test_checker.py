@@ -227,7 +227,21 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
         for k in val:
             yield Slot(root + (k,), kind)
     elif q == "mode_count":
-        yield Slot(root, "count")
+        if isinstance(val, dict):  # {configuration: k, velocity: d}: each count apart
+            for k in val:
+                yield Slot(root + (k,), "count")
+        else:
+            yield Slot(root, "count")
+    elif q == "canonical":
+        if val.get("canonical", True) is False:  # an open claim: only the flag can be wrong
+            yield Slot(root + ("canonical",), "flag")
+            return
+        for k in val["transformation"]:
+            yield Slot(root + ("transformation", k), "value")
+        for k in val.get("generating") or {}:
+            yield Slot(root + ("generating", k), "generating")
+        if "hamiltonian" in val:
+            yield Slot(root + ("hamiltonian",), "value")
     elif q == "mode_node":
         for k in val:
             yield Slot(root + (k,), "value")
@@ -272,6 +286,12 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
             if len(mode.get("shape", {})) > 1:
                 for c in mode["shape"]:
                     yield Slot(root + (i, "shape", c), "component")
+    elif q == "lyapunov":
+        yield Slot(root, "exponent_sign" if val in ("positive", "zero", "negative") else "value")
+    elif q == "poincare":  # the orbit's point and multipliers; its stability a flag
+        yield from walk({k: v for k, v in val.items() if k != "stable"}, root)
+        if "stable" in val:
+            yield Slot(root + ("stable",), "flag")
     else:  # a quantity this test does not know yet: walk the value's structure
         yield from walk(val, root)
 
@@ -407,8 +427,13 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
             if other != value:
                 yield f"say {other}", other
         return
+    if slot.kind == "exponent_sign":  # a Lyapunov exponent's claim: positive / zero / negative
+        for other in ("positive", "zero", "negative"):
+            if other != value:
+                yield f"say {other}", other
+        return
     s = str(value)
-    if slot.kind in ("lagrangian", "value", "potential"):
+    if slot.kind in ("lagrangian", "value", "potential", "generating"):
         yield from expression_mutants(s, names)
     elif slot.kind == "steady":  # -rate (time reversal) and mirrored angles are steady too
         yield "double", f"2*({s})"
@@ -522,7 +547,7 @@ def _free_of(expr, symbols) -> bool:
 def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     if str(old) == str(new):
         return True
-    if slot.kind in ("count", "flag", "verdict"):
+    if slot.kind in ("count", "flag", "verdict", "exponent_sign"):
         return False
     if slot.kind == "relation":  # the same condition once parsed (factors reordered), or
         # the same up to moving terms (e.g. a symmetric one with names swapped)
@@ -549,6 +574,10 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
                 name in ("E", "h", "energy", "jacobi") and _free_of(b - a, motion)))
         return _free_of(b - a, motion) or _zero(a - b) or (a != 0 and _free_of(b / a, motion))
     extra = ctx.quantity.names
+    if slot.kind == "generating":  # a generating function is defined up to a constant
+        names = extra(ctx)
+        d = ctx.parse(new, slot.path, names=names) - ctx.parse(old, slot.path, names=names)
+        return d.free_symbols <= set(ctx.sampler.base)
     if extra is not None:  # the quantity's own names (a polynomial's variable, W0(j), ...)
         names = extra(ctx)
         a = ctx.parse(old, slot.path, names=names)
@@ -582,6 +611,10 @@ def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
                    for q, qd in zip(sys.q, sys.qd, strict=True))
     if slot.kind == "potential":
         return all(_zero(sp.diff(b - a, q)) for q in sys.q)
+    if ctx.quantity.name == "poincare" and "at" in slot.path and \
+            slot.path[-1] in sys.coord_names:  # an orbit's angle: the same modulo 2π
+        turns = (b - a) / (2 * sp.pi)
+        return turns.is_integer is True or _zero(b - a)
     return _zero(b - a)
 
 

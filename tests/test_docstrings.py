@@ -18,7 +18,8 @@ from mechbook.app.linearization import Linearization
 
 PUBLIC = [load, results, Problem.system, Problem.check, SystemView.frequencies,
           SystemView.modes, SystemView.simulate, SystemView.linearize,
-          SystemView.ode_function, Simulation.to_xarray, Simulation.plot, Simulation.store,
+          SystemView.ode_function, Simulation.to_xarray, Simulation.plot, Simulation.animate,
+          Simulation.store,
           CheckResult.to_frame, Linearization.exponents, Linearization.frequencies,
           Linearization.stability]
 # the shortcuts on a problem are its system's methods, with their docstrings

@@ -51,7 +51,7 @@ functional:
   integrand: "sqrt((1 + yp**2)/(2*g*y))"
   ends: [{x: 0, y: 0}, {x: X, y: Y}]
 """
-CYCLOID = ("  quantity: extremal\n  constants: {a: 0.5, theta1: 3.4}\n  range: [0, theta1]\n"
+CYCLOID = ("  quantity: extremal\n  solve_for: {a: 0.5, theta1: 3.4}\n  range: [0, theta1]\n"
            "  book: {parameter: theta, x: \"%s\", y: \"a*(1 - cos(theta))\"}\n")
 
 
@@ -84,7 +84,7 @@ def test_cycloid_is_the_extremal(tmp_path, x, status):
     ("(1000001/1000000)*sqrt(a/g)*theta1", "fail"),
 ])
 def test_descent_time(tmp_path, book, status):
-    part = ("quantity: functional_value\nconstants: {a: 0.5, theta1: 3.4}\n"
+    part = ("quantity: functional_value\nsolve_for: {a: 0.5, theta1: 3.4}\n"
             "range: [0, theta1]\ncurve: {parameter: theta, x: \"a*(theta - sin(theta))\", "
             f"y: \"a*(1 - cos(theta))\"}}\nbook: \"{book}\"\n")
     assert _one(tmp_path, "brach", BRACHISTOCHRONE, part) == status
@@ -119,7 +119,7 @@ functional:
     (0.24, "minimum", "fail"),
 ])
 def test_catenoid_branches(tmp_path, start, verdict, status):
-    part = (f"quantity: minimum\nconstants: {{c: {start}}}\ncurve: {{y: \"c*cosh(x/c)\"}}\n"
+    part = (f"quantity: minimum\nsolve_for: {{c: {start}}}\ncurve: {{y: \"c*cosh(x/c)\"}}\n"
             f"book: {verdict}\n")
     assert _one(tmp_path, "catenoid", CATENOID, part) == status
 
@@ -130,7 +130,7 @@ def test_catenoid_branches(tmp_path, start, verdict, status):
     ("c*d + c**2*sinh((2000002/1000000)*d/c)/2", "fail"),
 ])
 def test_catenoid_area(tmp_path, book, status):
-    part = (f"quantity: functional_value\nconstants: {{c: 0.85}}\ncurve: {{y: \"c*cosh(x/c)\"}}"
+    part = (f"quantity: functional_value\nsolve_for: {{c: 0.85}}\ncurve: {{y: \"c*cosh(x/c)\"}}"
             f"\nbook: \"{book}\"\n")
     assert _one(tmp_path, "catenoid", CATENOID, part) == status
 
@@ -139,13 +139,13 @@ def test_no_catenoid_past_the_limit(tmp_path):
     """d/R = 0.7 > 0.6627: R = c·cosh(d/c) has no root, so no extremal meets the rings."""
     far = CATENOID.replace("value: 0.5", "value: 0.7").replace('conditions: ["d < 0.6*R"]\n',
                                                                "")
-    part = "quantity: extremal\nconstants: {c: 0.5}\nbook: {y: \"c*cosh(x/c)\"}\n"
+    part = "quantity: extremal\nsolve_for: {c: 0.5}\nbook: {y: \"c*cosh(x/c)\"}\n"
     assert _one(tmp_path, "catenoid", far, part) in ("fail", "unsupported")
 
 
 def test_a_wrong_catenoid_constant_fails(tmp_path):
     for k in ("101/100", "1000001/1000000"):
-        part = f"quantity: extremal\nconstants: {{c: 0.85}}\nbook: {{y: \"c*cosh(x/(({k})*c))\"}}\n"
+        part = f"quantity: extremal\nsolve_for: {{c: 0.85}}\nbook: {{y: \"c*cosh(x/(({k})*c))\"}}\n"
         assert _one(tmp_path, "catenoid", CATENOID, part) == "fail"
 
 
@@ -205,12 +205,12 @@ def test_fermat_rays_in_n_over_y(tmp_path):
       ends: [{x: -d, y: h}, {x: d, y: h}]
     """
     ray = "{y: \"sqrt(r**2 - x**2)\"}"
-    parts = (f"- {{part: a, cite: t, quantity: extremal, constants: {{r: 1.2}}, book: {ray}}}\n"
-             f"- {{part: b, cite: t, quantity: functional_value, constants: {{r: 1.2}}, "
+    parts = (f"- {{part: a, cite: t, quantity: extremal, solve_for: {{r: 1.2}}, book: {ray}}}\n"
+             f"- {{part: b, cite: t, quantity: functional_value, solve_for: {{r: 1.2}}, "
              f"curve: {ray}, book: \"2*n0*log((r + d)/h)\"}}\n"
-             f"- {{part: c, cite: t, quantity: functional_value, constants: {{r: 1.2}}, "
+             f"- {{part: c, cite: t, quantity: functional_value, solve_for: {{r: 1.2}}, "
              f"curve: {ray}, book: \"2*n0*log((r + (1000001/1000000)*d)/h)\"}}\n"
-             "- {part: d, cite: t, quantity: extremal, constants: {r: 1.2}, "
+             "- {part: d, cite: t, quantity: extremal, solve_for: {r: 1.2}, "
              "book: {y: \"sqrt(r**2 - (101/100)*x**2)\"}}\n")
     assert _check(tmp_path, "fermat", medium, parts) == ["pass", "pass", "fail", "fail"]
 
@@ -236,13 +236,13 @@ functional:
 ])
 def test_hanging_chain(tmp_path, multiplier, status):
     mult = f", multipliers: {{length: \"{multiplier}\"}}" if multiplier else ""
-    part = ("quantity: extremal\nconstants: {c: 0.6}\n"
+    part = ("quantity: extremal\nsolve_for: {c: 0.6}\n"
             f"book: {{y: \"c*cosh(x/c) - c*cosh(d/c)\"{mult}}}\n")
     assert _one(tmp_path, "chain", CHAIN, part) == status
 
 
 def test_hanging_chain_length_and_euler_lagrange(tmp_path):
-    parts = ("- {part: a, cite: t, quantity: functional_value, constants: {c: 0.6}, "
+    parts = ("- {part: a, cite: t, quantity: functional_value, solve_for: {c: 0.6}, "
              "constraint: length, curve: {y: \"c*cosh(x/c) - c*cosh(d/c)\"}, book: l}\n"
              "- {part: b, cite: t, quantity: euler_lagrange, "
              "book: [\"1 + yp**2 - (y + lambda_length)*ypp = 0\"]}\n"
@@ -264,9 +264,9 @@ def test_isoperimetric_arc(tmp_path):
       constraints: [{name: length, integral: "sqrt(1 + yp**2)", value: l}]
     """
     arc = "y: \"sqrt(r**2 - x**2) - sqrt(r**2 - a**2)\""
-    parts = (f"- {{part: a, cite: t, quantity: extremal, constants: {{r: 1.3}}, "
+    parts = (f"- {{part: a, cite: t, quantity: extremal, solve_for: {{r: 1.3}}, "
              f"book: {{{arc}, multipliers: {{length: \"-r\"}}}}}}\n"
-             f"- {{part: b, cite: t, quantity: extremal, constants: {{r: 1.3}}, "
+             f"- {{part: b, cite: t, quantity: extremal, solve_for: {{r: 1.3}}, "
              f"book: {{{arc}, multipliers: {{length: \"r\"}}}}}}\n")
     assert _check(tmp_path, "dido", dido, parts) == ["pass", "fail"]
 
@@ -368,7 +368,7 @@ def test_catenary_between_unequal_heights(tmp_path, shape, multiplier, status):
     hand-started Newton), and λ = −k (F + λG = (y + λ)·√(1 + y′²))."""
     chain = CHAIN.replace("{x: -d, y: 0}, {x: d, y: 0}", "{x: 0, y: 0}, {x: 2*d, y: d/2}")
     mult = f", multipliers: {{length: \"{multiplier}\"}}" if multiplier else ""
-    part = ("quantity: extremal\nconstants: {c: 0.6, x0: 0.9, k: -1.4}\n"
+    part = ("quantity: extremal\nsolve_for: {c: 0.6, x0: 0.9, k: -1.4}\n"
             f"book: {{y: \"{shape}\"{mult}}}\n")
     assert _one(tmp_path, "chain2", chain, part) == status
 
@@ -388,5 +388,5 @@ def test_implicit_ray(tmp_path, curve, status):
       integrand: "n0*sqrt(1 + yp**2)/y"
       ends: [{x: -d, y: h}, {x: d, y: h}]
     """
-    part = f"quantity: extremal\nconstants: {{r: 1.2}}\nbook: {{implicit: \"{curve}\"}}\n"
+    part = f"quantity: extremal\nsolve_for: {{r: 1.2}}\nbook: {{implicit: \"{curve}\"}}\n"
     assert _one(tmp_path, "fermat", medium, part) == status

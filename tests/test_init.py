@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 from hostile import mechbook
 
-STARTER = sorted(["Makefile", "answers/mybook/1.1.yaml", "books.yaml", "problems/mybook/1.1.yaml",
+STARTER = sorted([".gitignore", "Makefile", "README.md", "answers/mybook/1.1.yaml",
+                  "books.yaml", "problems/mybook/1.1.yaml",
                   *(f"schemas/{name}.json" for name in ("problem", "answers", "books",
                                                         "check-result"))])
 

@@ -314,7 +314,7 @@ def test_good_ids_map_into_the_tree():
 def test_commands_refuse_ids_outside_the_tree(tmp_path, command):
     tree(tmp_path)
     res = run("--root", str(tmp_path), command, "lim-../../../etc/passwd")
-    assert res.exit_code == 1, res.output
+    assert res.exit_code == 4, res.output  # a malformed id: a usage error
     assert "bad problem id" in res.output
 
 

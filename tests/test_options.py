@@ -51,7 +51,7 @@ def test_hostile_numbers_are_refused_before_anything_runs(monkeypatch, cmd, opti
     monkeypatch.setattr(sweep, "run_sweep", _must_not_run)
     start = time.perf_counter()
     result = run("--root", ROOT, *cmd, f"{option}={value}")
-    assert result.exit_code == 2, result.output
+    assert result.exit_code == 4, result.output
     assert option in result.output or option.lstrip("-")[0] in result.output
     assert ("not a finite number" in result.output or "not in the range" in result.output
             or "is not a valid" in result.output), result.output
@@ -78,7 +78,7 @@ def test_a_sweep_grid_too_large_is_refused_before_anything_is_allocated(monkeypa
     for p in param.split(","):
         args += ["--param", p]
     result = run("--root", ROOT, "sweep", PID, *args, "--no-store")
-    assert result.exit_code == 2, result.output
+    assert result.exit_code == 4, result.output
     assert "points; at most 10,000,000" in result.output
 
 
@@ -86,7 +86,7 @@ def test_a_sweep_grid_past_the_memory_bound_is_refused(monkeypatch):
     monkeypatch.setattr(sweep, "run_sweep", _must_not_run)
     result = run("--root", ROOT, "sweep", PID, "--param", "omega=0.5:10:5000000",
                  "--memory", "100", "--no-store")
-    assert result.exit_code == 2, result.output
+    assert result.exit_code == 4, result.output
     assert "more than the memory bound of 100 MB" in result.output
 
 
@@ -98,7 +98,7 @@ def test_a_bad_run_name_is_refused_before_the_run(monkeypatch, name):
     assert result.exit_code == 1, result.output
     assert "invalid simulation name" in result.output
     result = run("--root", ROOT, "sweep", PID, "--param", "omega=1:2:3", "--name", name)
-    assert result.exit_code == 2 and "invalid sweep name" in result.output
+    assert result.exit_code == 4 and "invalid sweep name" in result.output
 
 
 @pytest.mark.parametrize("command", [["simulate", PID], ["sweep", PID, "--param",
@@ -107,7 +107,7 @@ def test_a_plot_whose_format_is_unknown_is_refused_before_the_run(monkeypatch, c
     monkeypatch.setattr(simrun, "run_simulation", _must_not_run)
     monkeypatch.setattr(sweep, "run_sweep", _must_not_run)
     result = run("--root", ROOT, *command, "--plot", "x.xyz", "--no-store")
-    assert result.exit_code == 2, result.output
+    assert result.exit_code == 4, result.output
     assert "the suffix names the format" in result.output
 
 

@@ -51,7 +51,7 @@ def test_problems_by_pattern_and_by_book(tree):
     for arg, said in (("other-*", "no problem id matches 'other-*'"),
                       ("other", "no problem of book 'other'")):
         res = check(tree, arg, "--no-store")
-        assert res.exit_code == 1 and said in res.output and "books there: mybook" in \
+        assert res.exit_code == 5 and said in res.output and "books there: mybook" in \
             res.output, res.output
 
 
@@ -117,7 +117,7 @@ def test_schema_prints_and_writes(tmp_path):
     assert written.exit_code == 0
     assert sorted(p.name for p in (tmp_path / "s").iterdir()) == [
         "answers.json", "books.json", "check-result.json", "problem.json"]
-    assert runner.invoke(main, ["schema"]).exit_code == 2  # neither: a usage error
+    assert runner.invoke(main, ["schema"]).exit_code == 4  # neither: a usage error
 
 
 def test_init_hands_the_schemas_to_the_editor(tmp_path):

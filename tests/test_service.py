@@ -85,7 +85,7 @@ def test_an_option_that_would_be_dropped_is_refused(monkeypatch, args, says):
     monkeypatch.setattr(simrun, "run_simulation", _must_not_run)
     monkeypatch.setattr(sweep, "run_sweep", _must_not_run)
     result = run("--root", ROOT, *args, "--no-store")
-    assert result.exit_code == 2, result.output
+    assert result.exit_code == 4, result.output
     assert says in " ".join(result.output.split()), result.output
 
 

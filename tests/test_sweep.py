@@ -297,7 +297,7 @@ def test_sweep_command_prints_stores_and_plots(tmp_path):
         "Omega=0.2:3:40 k2=0.5:5:20 about x = 0, y = 0" in listed.output, listed.output
     bad = CliRunner().invoke(main, ["--root", str(TREE), "sweep", "lim-9001", "--param",
                                     "Omega=1:3"])
-    assert bad.exit_code == 2 and "NAME=LO:HI:N" in bad.output
+    assert bad.exit_code == 4 and "NAME=LO:HI:N" in bad.output
 
 
 def test_ill_conditioned_points_are_recomputed_with_50_digits(tmp_path):

@@ -155,7 +155,8 @@ def test_show_of_a_problem_not_in_the_store_is_a_clean_message(tmp_path):
 def test_check_of_a_problem_with_no_file_is_not_found(tmp_path):
     from mechbook.app.service import resolve_ids
 
-    with pytest.raises(NotFoundError, match=r"^no problem lim-2013 \(no file .*2013\.yaml\)$"):
+    with pytest.raises(NotFoundError, match=r"^no problem lim-2013 \(no file .*2013\.yaml; "
+                       r"`mechbook list` shows the problems there are\)$"):
         resolve_ids(["lim-2013"], ROOT)
     res = run("--root", ROOT, "check", "lim-2013", "--no-store")
     assert res.exit_code != 0 and "Traceback" not in res.output

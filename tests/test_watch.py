@@ -116,7 +116,7 @@ def test_watch_names_a_missing_problem(tmp_path):
     tree = _tree(tmp_path)
     result = subprocess.run([sys.executable, "-m", "mechbook", "--root", str(tree), "watch",
                              "lim-2099"], capture_output=True, text=True, timeout=120)
-    assert result.returncode == 1
+    assert result.returncode == 5  # nothing selected
     assert "no problem" in result.stderr or "2099" in result.stderr
     assert "Traceback" not in result.stderr
 

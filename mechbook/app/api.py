@@ -36,7 +36,7 @@ from mechbook.app.service import check_loaded
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import NotFoundError
 from mechbook.model.books import Book, book_of
-from mechbook.model.catalog import problem_path, root
+from mechbook.model.catalog import existing_problem_path, root
 from mechbook.model.problem import Problem as Model
 from mechbook.model.problem import load_problem
 
@@ -69,7 +69,7 @@ def load(problem_id: str, root_dir: str | Path | None = None,
     'Bead on a hoop spinning about a vertical diameter'
     """
     base = Path(root_dir) if root_dir is not None else root()
-    return Problem(load_problem(problem_path(problem_id, base)), base, simplify)
+    return Problem(load_problem(existing_problem_path(problem_id, base)), base, simplify)
 
 
 def _on_the_system(name: str):
@@ -81,6 +81,14 @@ def _on_the_system(name: str):
         return getattr(self.system(system), name)(*args, **kwargs)
 
     return call
+
+
+def _of_the_system(result: property) -> property:
+    """A result of the problem's only system (p.system().NAME), with its docstring."""
+    name, doc = result.fget.__name__, result.__doc__
+    return property(lambda self: getattr(self.system(), name),
+                    doc=f"{doc}\n\n(Of the problem's only system, or the one named main: "
+                        "``p.system(name)`` for another.)")
 
 
 class Problem:
@@ -97,13 +105,16 @@ class Problem:
         self.fast = Analysis(model, built=self.analysis.built) if simplify else self.analysis
         self._views: dict[str, SystemView] = {}
 
-    id = property(lambda self: self.model.id)
-    title = property(lambda self: self.model.title)
-    source = property(lambda self: self.model.source)
-    description = property(lambda self: self.model.description.strip())
+    id = property(lambda self: self.model.id, doc="The problem id, ``<book>-<number>``.")
+    title = property(lambda self: self.model.title, doc="The problem's title, our own words.")
+    source = property(lambda self: self.model.source,
+                      doc="The book and the problem's number in it.")
+    description = property(lambda self: self.model.description.strip(),
+                           doc="The problem file's own short description of the system.")
 
     @property
     def book(self) -> Book | None:
+        """The book of books.yaml the problem belongs to (None if it declares none)."""
         return book_of(self.id, self.base)
 
     @property
@@ -114,6 +125,7 @@ class Problem:
 
     @property
     def systems(self) -> list[str]:
+        """The names of the problem's systems (``main`` for a problem with one)."""
         return list(self.model.systems)
 
     def system(self, name: str | None = None) -> SystemView:
@@ -148,16 +160,16 @@ class Problem:
         return self._views[name]
 
     # the only system's results, for the common case
-    lagrangian = property(lambda self: self.system().lagrangian)
-    kinetic = property(lambda self: self.system().kinetic)
-    potential = property(lambda self: self.system().potential)
-    eom = property(lambda self: self.system().eom)
-    accelerations = property(lambda self: self.system().accelerations)
-    momenta = property(lambda self: self.system().momenta)
-    cyclic = property(lambda self: self.system().cyclic)
-    energy = property(lambda self: self.system().energy)
-    hamiltonian = property(lambda self: self.system().hamiltonian)
-    equilibria = property(lambda self: self.system().equilibria)
+    lagrangian = _of_the_system(SystemView.lagrangian)
+    kinetic = _of_the_system(SystemView.kinetic)
+    potential = _of_the_system(SystemView.potential)
+    eom = _of_the_system(SystemView.eom)
+    accelerations = _of_the_system(SystemView.accelerations)
+    momenta = _of_the_system(SystemView.momenta)
+    cyclic = _of_the_system(SystemView.cyclic)
+    energy = _of_the_system(SystemView.energy)
+    hamiltonian = _of_the_system(SystemView.hamiltonian)
+    equilibria = _of_the_system(SystemView.equilibria)
     frequencies = _on_the_system("frequencies")
     modes = _on_the_system("modes")
     linearize = _on_the_system("linearize")

@@ -1,4 +1,4 @@
-"""Parameter values, initial states and the equations as a function, for the Python API.
+"""Parameter values and initial states, for the Python API.
 
 One way to evaluate at other parameter values: `params={name: value}` on every numeric
 method (`frequencies`, `modes`, `simulate`, `ode_function`, and a linearization's
@@ -18,7 +18,6 @@ import sympy as sp
 
 from mechbook.errors import InputError, NotFoundError
 from mechbook.model.hints import did_you_mean
-from mechbook.numerics.simulate import initial_state
 
 # keyword arguments people reach for, and what mechbook calls them
 ALIASES = {"initial": "init", "initial_conditions": "init", "initial_state": "init",
@@ -108,39 +107,3 @@ def refuse_unknown(method: str, given: Mapping, known: tuple[str, ...]) -> None:
         hint = (f"did you mean {meant!r}?" if meant in known else
                 did_you_mean(name, known) or f"it takes: {', '.join(known)}")
         raise TypeError(f"{method}() got an unexpected keyword argument {name!r}; {hint}")
-
-
-class OdeFunction:
-    """dy/dt = f(t, y) of one system's full nonlinear equations of motion, for
-    `scipy.integrate.solve_ivp` or an integrator or controller of one's own.
-
-    The state is y = (q, q̇): the coordinates, then their rates, in the order of `states`.
-    It is the compiled right-hand side `mechbook simulate` integrates (the same kernel,
-    the same constraint handling), at fixed parameter values.
-
-    Attributes
-    ----------
-    states : list of str
-        The names of y's components (``theta``, then ``thetadot``).
-    parameters : dict of str to float
-        The parameter values the function was compiled at.
-    """
-
-    def __init__(self, model, analysis, system: str, values: dict[sp.Symbol, float]):
-        self._model, self._analysis, self._system = model, analysis, system
-        self._values = values
-        self.states = [*model.names, *(f"{c}dot" for c in model.names)]
-        self.parameters = {str(k): float(v) for k, v in values.items()}
-
-    def __call__(self, t: float, y) -> np.ndarray:
-        return self._model.rhs(float(t), np.asarray(y, dtype=float))
-
-    def initial(self, init: Mapping | None = None) -> np.ndarray:
-        """The state `simulate` starts from with the same `init` ({coordinate or
-        coordinate + 'dot': number or text}; the problem's `initial:` and then zeros for
-        what it leaves out)."""
-        q0, qd0, _ = initial_state(self._analysis, self._system, texts(init), self._values)
-        return np.concatenate((q0, qd0))
-
-    def __repr__(self) -> str:
-        return f"<ode function of {self._system}: y = ({', '.join(self.states)})>"

@@ -7,9 +7,12 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from mechbook.app.api_animation import Animation, Picture
+from mechbook.app.report import animation
 from mechbook.app.store import write_simulation
 from mechbook.core.optional import require
-from mechbook.numerics.plot import plot_simulation
+from mechbook.errors import UnsupportedError
+from mechbook.numerics.plot import plot_simulation, simulation_png
 from mechbook.records import FAILING, CrossCheck, Outcome
 
 
@@ -95,8 +98,9 @@ class Simulation:
         The largest relative drift of each conserved quantity the engine found.
     """
 
-    def __init__(self, run):
+    def __init__(self, run, system=None):
         self.run = run
+        self._system = system  # the model's system, for animate() (None: not animated)
 
     t = property(lambda self: self.run.trajectory.t)
     q = property(lambda self: self.run.trajectory.q)
@@ -136,24 +140,68 @@ class Simulation:
         return xr.Dataset(data, coords={"t": self.t, "coordinate": self.coordinates},
                           attrs=attrs)
 
-    def plot(self, path: str | Path) -> Path:
-        """Draw the coordinates against time and the phase portrait.
+    def plot(self, path: str | Path | None = None) -> Path | Picture:
+        """Draw the coordinates against time, the phase portrait and the drifts.
 
         Parameters
         ----------
-        path : str or pathlib.Path
-            The image file to write (PNG, SVG or PDF, by its suffix).
+        path : str or pathlib.Path, optional
+            The image file to write (PNG, SVG or PDF, by its suffix). Without it, the
+            picture itself, which a notebook shows inline (nothing is written).
 
         Returns
         -------
-        pathlib.Path
-            The file written.
+        pathlib.Path or Picture
+            The file written; or the picture (its PNG in ``.png``).
 
         Examples
         --------
-        >>> mechbook.load("lim-2031").simulate(t_end=5).plot("run.png")   # doctest: +SKIP
+        >>> run = mechbook.load("lim-2031").simulate(t_end=5)   # doctest: +SKIP
+        >>> run.plot()                  # shown inline in a notebook   # doctest: +SKIP
+        >>> run.plot("run.png")                                  # doctest: +SKIP
         """
+        if path is None:
+            return Picture(simulation_png(self.run), self._title())
         return plot_simulation(self.run, path)
+
+    def animate(self, frames: int = animation.MAX_FRAMES) -> Animation:
+        """The bodies moving as simulated, for a notebook (Jupyter shows it: a canvas and
+        a small script, offline), as the report animates them.
+
+        Parameters
+        ----------
+        frames : int, default 240
+            At most this many frames (samples of the run, evenly spaced).
+
+        Returns
+        -------
+        Animation
+            Shown by Jupyter's rich display; ``html()`` is the markup, ``motion`` the
+            frames.
+
+        Raises
+        ------
+        UnsupportedError
+            When the positions of the bodies cannot be evaluated along the run.
+
+        Examples
+        --------
+        >>> run = mechbook.load("lim-2031").simulate(t_end=5)   # doctest: +SKIP
+        >>> run.animate()                                        # doctest: +SKIP
+        """
+        if self._system is None:
+            raise UnsupportedError("this simulation keeps no system to draw")
+        values = {self._system.params[n].symbol: v for n, v in self.run.values.items()
+                  if n in self._system.params}
+        motion = animation.frames(self._system, self.run.trajectory, values,
+                                  max(2, int(frames)))
+        if motion is None:
+            raise UnsupportedError(f"{self._title()}: the bodies' positions cannot be "
+                                   "evaluated along the run: nothing to animate")
+        return Animation(motion, self._title())
+
+    def _title(self) -> str:
+        return f"{self.run.problem_id} [{self.run.system}]"
 
     def store(self, path: str | Path, name: str | None = None) -> str:
         """Write the run into an HDF5 store, as `mechbook simulate` does.

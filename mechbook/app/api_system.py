@@ -5,12 +5,13 @@ default parameter values or at `params=` (mechbook.app.api_params)."""
 from __future__ import annotations
 
 import html
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import sympy as sp
 
-from mechbook.app.api_params import OdeFunction, parameter_values, refuse_unknown, texts
+from mechbook.app.api_ode import OdeFunction
+from mechbook.app.api_params import parameter_values, refuse_unknown, texts
 from mechbook.app.api_results import Simulation
 from mechbook.app.display import MathDict, MathList
 from mechbook.app.linearization import Linearization, linearization
@@ -18,8 +19,7 @@ from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
 from mechbook.core.timeout import try_simplify
 from mechbook.engine.existence import existing
-from mechbook.errors import NotFoundError
-from mechbook.numerics.rhs import build_model
+from mechbook.errors import InputError, NotFoundError, SpecError
 from mechbook.numerics.simulate import simulate
 
 if TYPE_CHECKING:
@@ -48,18 +48,23 @@ class SystemView:
 
     @property
     def coordinates(self) -> list[sp.Symbol]:
+        """The generalized coordinates q, as SymPy symbols, in the problem file's order."""
         return list(self._sys.q)
 
     @property
     def lagrangian(self) -> sp.Expr:
+        """The Lagrangian L = T − V in q and q̇ (simplified for reading unless the problem
+        was loaded with ``simplify=False``)."""
         return self._readable(self._sys.lagrangian)
 
     @property
     def kinetic(self) -> sp.Expr:
+        """The kinetic energy T in q and q̇ (of every particle and rigid body)."""
         return self._readable(self._sys.kinetic)
 
     @property
     def potential(self) -> sp.Expr:
+        """The potential energy V in q (gravity, springs, declared potentials)."""
         return self._readable(self._sys.potential)
 
     @property
@@ -75,10 +80,12 @@ class SystemView:
 
     @property
     def accelerations(self) -> dict[sp.Symbol, sp.Expr]:
+        """The equations of motion solved for the accelerations, {q̈: expression}."""
         return MathDict(self._dyn.solved)
 
     @property
     def momenta(self) -> dict[sp.Symbol, sp.Expr]:
+        """The generalized momenta p = ∂L/∂q̇, {q: p} (shown as p_q)."""
         return MathDict(zip(self._sys.q, self._dyn.momenta, strict=True), label=_momentum)
 
     @property
@@ -93,10 +100,13 @@ class SystemView:
 
     @property
     def energy_conserved(self) -> bool:
+        """Whether the energy function is conserved (L has no explicit t, no
+        nonconservative forces)."""
         return bool(self._dyn.energy_conserved)
 
     @property
     def hamiltonian(self) -> sp.Expr:
+        """The Hamiltonian H(q, p) = Σ p q̇ − L, q̇ eliminated for the momenta p_q."""
         return self._dyn.hamiltonian
 
     @property
@@ -108,9 +118,11 @@ class SystemView:
                              self.problem.model.values())
         return MathList(MathDict(p) for p in points)
 
-    def point(self, about: Mapping | None = None) -> dict:
+    def point(self, about: Mapping | None = None, what: str = "about") -> dict:
         """An equilibrium as {coordinate symbol: value}: `about` ({name or symbol: text or
-        number}), or the system's one stable equilibrium when `about` is None."""
+        number}), or the system's one stable equilibrium when `about` is None. Text that
+        does not parse is the fault of the argument `what` (about= or steady=), never of a
+        line of the problem file."""
         if about is None:
             return self._an.default_point(self.name)
         sys = self._sys
@@ -121,7 +133,10 @@ class SystemView:
                 raise NotFoundError(f"{key!r} is not a coordinate of {self.problem.id} "
                                     f"({', '.join(sys.coord_names)})")
             if isinstance(val, str):
-                val = self.problem.model.parse(val, (), dict(sys.names))
+                try:
+                    val = self.problem.model.parse(val, (), dict(sys.names))
+                except SpecError as exc:
+                    raise InputError(f"{what}={{{key!r}: {val!r}}}: {exc.bare}") from None
             out[sys.q[sys.coord_names.index(key)]] = as_expr(val)
         return out
 
@@ -158,7 +173,7 @@ class SystemView:
         """
         point = self.point(about) if (about is not None or not steady) else {}
         if steady:
-            rates = self.point(steady)
+            rates = self.point(steady, "steady")
             sys = self._sys
             if reduce is None:
                 reduce = not (sys.constraints or sys.velocity_constraints)
@@ -279,36 +294,39 @@ class SystemView:
         if options.get("backend") is None:
             options.pop("backend", None)
         run = simulate(self.problem.fast, self.name, t_span=(0.0, float(t_end)), **options)
-        return Simulation(run)
+        return Simulation(run, self.problem.fast.system(self.name))
 
-    def ode_function(self, params: Mapping | None = None) -> OdeFunction:
-        """The equations of motion as a fast function dy/dt = f(t, y), y = (q, q̇), for
+    def ode_function(self, params: Mapping | None = None,
+                     inputs: Sequence[str] = ()) -> OdeFunction:
+        """The equations of motion as a fast function dy/dt = f(t, y, u), y = (q, q̇), for
         `scipy.integrate.solve_ivp` or one's own integrator or controller (what PyDy's
-        `generate_ode_function` gives).
+        `generate_ode_function` gives, its "specifieds" given per call).
 
         Parameters
         ----------
         params : dict, optional
             Parameter values instead of the defaults, {name: number or text}; they are
             compiled in.
+        inputs : list of str, optional
+            Parameters given per call instead (a force, a torque: what a controller sets
+            at each step). A driven coordinate the problem leaves free (`{free: true}`) is
+            always an input: its value, rate and acceleration.
 
         Returns
         -------
         OdeFunction
-            Callable as f(t, y); `states` names y's components; `initial(init)` is the
-            state `simulate(init=...)` starts from.
+            Callable as f(t, y, u) (f(t, y) without inputs); `states` names y's
+            components, `inputs` u's; `initial(init)` is the state `simulate(init=...)`
+            starts from.
 
         Examples
         --------
         >>> from scipy.integrate import solve_ivp
-        >>> f = mechbook.load("lim-2031").ode_function()                   # doctest: +SKIP
-        >>> sol = solve_ivp(f, (0, 5), f.initial({"theta": 1.0}), rtol=1e-10)  # doctest: +SKIP
+        >>> f = mechbook.load("lim-2031").ode_function(inputs=["omega"])     # doctest: +SKIP
+        >>> sol = solve_ivp(f, (0, 5), f.initial({"theta": 1.0}), args=([6.0],))  # doctest: +SKIP
         """
         values = parameter_values(self.problem.model, params)
-        an = self.problem.fast
-        sys, dyn = an.system(self.name), an.dynamics(self.name)
-        model = build_model(sys, dyn, values)
-        return OdeFunction(model, an, sys.name, values)
+        return OdeFunction(self.problem.fast, self.name, values, inputs)
 
     def _readable(self, expr):
         if not self.problem.simplify:

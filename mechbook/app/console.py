@@ -8,6 +8,7 @@ from collections import Counter
 
 import click
 
+from mechbook.core.words import plural
 from mechbook.records import FAILING, Status
 
 # the order a summary counts outcomes in: of the parts, and of the cross-checks
@@ -80,7 +81,7 @@ def print_table(runs: list, verbose: bool) -> None:
                        f"{info[:160] if not verbose else info}")
     click.echo("-" * 112)
     parts = sum(total.values())
-    click.echo(f"{len(runs)} problems, {parts} parts: " +
+    click.echo(f"{plural(len(runs), 'problem')}, {plural(parts, 'part')}: " +
                ", ".join(f"{total[s]} {s}" for s in STATUS_ORDER if total[s]))
     if crossed:
         click.echo(f"cross-checks: {sum(crossed.values())}: " +

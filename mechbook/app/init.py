@@ -2,7 +2,8 @@
 
 The starter tree (mechbook/app/starter, shipped in the package) holds books.yaml with one
 book, one example problem (a pendulum on a spring, its radius declared positive) with its
-answer key, and a Makefile with the usual targets; and the JSON Schemas of those files
+answer key, a Makefile with the usual targets, a README that says what is where and how to
+go on, a .gitignore for what mechbook writes (results/); and the JSON Schemas of those files
 under schemas/, which the first line of each names for an editor's YAML language server
 (mechbook.app.editor). Nothing is overwritten: a file that
 exists already is refused, naming it.
@@ -25,8 +26,10 @@ from mechbook.app.editor import DIRECTORY, NAMES
 from mechbook.app.editor import text as schema_text
 from mechbook.errors import MechbookError
 
+# starter file -> where it goes (`gitignore`: a package's data files are not dot files)
 FILES = {"books.yaml": "books.yaml", "problem.yaml": "problems/mybook/1.1.yaml",
-         "answers.yaml": "answers/mybook/1.1.yaml", "Makefile": "Makefile"}
+         "answers.yaml": "answers/mybook/1.1.yaml", "Makefile": "Makefile",
+         "README.md": "README.md", "gitignore": ".gitignore"}
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _DIRECTORY = getattr(os, "O_DIRECTORY", 0)
 

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from mechbook.app.bounded import Unreadable, json_value, read_regular
 from mechbook.app.outputs import replaced
-from mechbook.errors import NotFoundError
+from mechbook.errors import NothingSelectedError
 from mechbook.model.catalog import all_ids
 from mechbook.model.ids import BOOK, ID, split_id
 
@@ -32,7 +32,7 @@ _BOOK = re.compile(BOOK)
 def select(args: Sequence[str], base: Path) -> list[str]:
     """The problem ids `args` name, in their order, each once. An argument that is a
     well-formed id stays as it is (its file is looked up later); a pattern or a book that
-    names no problem of the tree is a NotFoundError saying which there are."""
+    names no problem of the tree is a NothingSelectedError saying which there are."""
     out: list[str] = []
     tree: list[str] | None = None
     for arg in args:
@@ -54,7 +54,7 @@ def _matching(arg: str, tree: list[str], base: Path) -> list[str]:
         what = f"no problem of book {arg!r}"
     if not found:
         books = sorted({split_id(pid)[0] for pid in tree})
-        raise NotFoundError(f"{what} under {base / 'problems'} (books there: "
+        raise NothingSelectedError(f"{what} under {base / 'problems'} (books there: "
                             f"{', '.join(books) or 'none'}; a pattern such as "
                             f"'{books[0] if books else 'mybook'}-*' selects a book's "
                             "problems)")

@@ -28,8 +28,8 @@ from mechbook.app.run import ProblemRun, RunOptions, cached_runs, run_problem
 from mechbook.app.selection import select
 from mechbook.app.store import durations, write
 from mechbook.app.unsaved import Saver
-from mechbook.errors import MechbookError, NotFoundError
-from mechbook.model.catalog import DEFAULT_STORE, all_ids, problem_path
+from mechbook.errors import MechbookError
+from mechbook.model.catalog import DEFAULT_STORE, all_ids, existing_problem_path
 
 if TYPE_CHECKING:
     from mechbook.app.unsaved import Saver
@@ -100,14 +100,11 @@ def resolve_ids(ids: Sequence[str], base: Path) -> tuple[list[str], dict[str, Pr
     refused: dict[str, ProblemRun] = {}
     for pid in out:
         try:
-            path = problem_path(pid, base)
+            existing_problem_path(pid, base)
         except MechbookError as exc:
             if named:
                 raise
             refused[pid] = ProblemRun(pid, error=str(exc))
-            continue
-        if not path.exists():
-            raise NotFoundError(f"no problem {pid} (no file {path})")
     return out, refused
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mechbook.core.timeout import Timeout, hard_time_limit
+from mechbook.core.words import plural
 from mechbook.errors import MechbookError, SpecError
 from mechbook.model.built import Built
 from mechbook.model.catalog import problem_path, root
@@ -72,7 +73,7 @@ def _validate_answers(path: Path) -> str:
         err = SpecError(f"its problem file is invalid: {exc}", str(path))
         err.problem_file = str(ppath)  # the command line says so once per file
         raise err from None
-    return f"{path}: answer key for {key.problem_id} is valid ({len(key.parts)} parts)"
+    return f"{path}: answer key for {key.problem_id} is valid ({plural(len(key.parts), 'part')})"
 
 
 @contextmanager

@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import sympy as sp
 
+from mechbook.core import special
 from mechbook.core.backends import BACKENDS, DEFAULT_BACKEND  # the names' owner
 from mechbook.errors import UnsupportedError
 
@@ -34,14 +35,41 @@ Compiled = Callable[[np.ndarray], np.ndarray]
 
 
 def numpy_modules() -> list:
-    """lambdify's namespaces for NumPy: SciPy's special functions (Γ) and the complete
-    elliptic integrals K(m), E(m) (scipy.special.ellipk, ellipe: the same parameter
-    m = k² as SymPy's), which neither SymEngine nor SymPy's printers translate. SciPy is
-    imported here, when an expression needs this fallback, not when mechbook starts."""
+    """lambdify's namespaces for NumPy: SciPy's special functions (Γ, Bessel's J_ν, Y_ν) and
+    the elliptic integrals K(m), E(m), F(φ, m), E(φ, m) (scipy.special.ellipk, ellipe,
+    ellipkinc, ellipeinc: the same parameter m = k² as SymPy's), which neither SymEngine nor
+    SymPy's printers translate; Π, Jacobi's sn, cn, dn and the Bessel zeros, which SciPy has
+    not for every argument, element by element from mechbook.core.special at double
+    precision (NaN outside their domain). SciPy is imported here, when an expression needs
+    this fallback, not when mechbook starts."""
     import scipy.special
 
-    return [{"elliptic_k": scipy.special.ellipk, "elliptic_e": scipy.special.ellipe},
-            "numpy", "scipy"]
+    def elliptic_e(*args):
+        return scipy.special.ellipe(*args) if len(args) == 1 else \
+            scipy.special.ellipeinc(*args)
+
+    names = {"elliptic_k": scipy.special.ellipk, "elliptic_e": elliptic_e,
+             "elliptic_f": scipy.special.ellipkinc}
+    for fn, mp in special.MPMATH.items():
+        names.setdefault(fn.__name__, _elementwise(mp))
+    return [names, "numpy", "scipy"]
+
+
+def _elementwise(mp) -> Callable:
+    """An mpmath evaluator as a NumPy function of arrays, at double precision: NaN where it
+    refuses the point (outside its domain)."""
+    import mpmath
+
+    def one(*args) -> float:
+        try:
+            with mpmath.workprec(53):
+                v = mp(*(mpmath.mpf(float(a)) for a in args))
+            return float(v) if mpmath.im(v) == 0 else float("nan")
+        except (ValueError, ZeroDivisionError, OverflowError):
+            return float("nan")
+
+    vectorized = np.vectorize(one, otypes=[float])
+    return lambda *args: vectorized(*args)[()]
 
 
 def as_expr(e) -> sp.Basic:

@@ -17,6 +17,7 @@ from collections import OrderedDict
 import mpmath
 import sympy as sp
 
+from mechbook.core import special
 from mechbook.core.secalc import derivative
 
 _FUNCS = {
@@ -28,7 +29,11 @@ _FUNCS = {
     sp.atan2: mpmath.atan2, sp.re: mpmath.re, sp.im: mpmath.im,
     sp.conjugate: mpmath.conj,
     # one argument: the complete integrals K(m), E(m) (m = k², as in SymPy and mpmath)
-    sp.elliptic_k: mpmath.ellipk, sp.elliptic_e: mpmath.ellipe, sp.gamma: mpmath.gamma,
+    sp.elliptic_k: mpmath.ellipk, sp.gamma: mpmath.gamma,
+    # the incomplete integrals, E(m) and E(φ, m), Jacobi's functions, Bessel's and their
+    # zeros: each refuses (DomainError, a ValueError: a singular point) a point outside
+    # its real domain (mechbook.core.special)
+    **special.MPMATH,
 }
 
 
@@ -302,8 +307,13 @@ def without_absent(expr: sp.Basic, symbols) -> sp.Basic:
     cancel; dropping it (a substitution, exact once ∂/∂φ vanishes identically, decided
     numerically by `is_zero`) keeps cyclic coordinates, autonomous systems and linear
     equations recognisable without simplify. A symbol is kept where dropping it would
-    land on a singularity."""
+    land on a singularity. A symbol inside `sign(...)` is kept: a piecewise-constant
+    function's derivative vanishes almost everywhere (a delta at each jump), so random
+    points would call a pulsed drive (a kicked rotor's kicks) independent of t."""
+    stepped = set().union(*(a.free_symbols for a in expr.atoms(sp.sign)))
     for s in symbols:
+        if s in stepped:
+            continue
         if expr.has(s) and is_zero(derivative(expr, s)):  # SymEngine's: core.secalc
             dropped = expr.xreplace({s: sp.S.Zero})
             if not dropped.has(sp.nan, sp.zoo, sp.oo, -sp.oo):

@@ -19,6 +19,8 @@ from mechbook.verify.answers import Part
 from mechbook.verify.compare import value
 from mechbook.verify.context import Context
 from mechbook.verify.context import split_named as _split_named
+from mechbook.verify.quantities.brackets import bracket_claim
+from mechbook.verify.quantities.canonical import hamiltonian_claim
 from mechbook.verify.quantities.steady import family
 from mechbook.verify.quantities.trajectory import Motion
 
@@ -70,6 +72,17 @@ class PartView:
         """The steady motions a `steady_rates`/`steady_exists` part derives
         (mechbook.verify.quantities.steady: `real_rates(values)`, `point`, `rates`, `x`)."""
         return family(self._ctx)
+
+    def bracket(self) -> tuple | None:
+        """A bracket part's (f, g, h, H): its functions and value in (q, p_q, t), H the
+        symbol standing for the engine's Hamiltonian (mechbook.verify.quantities.brackets);
+        None where the part names its own variables or Hamiltonian."""
+        return bracket_claim(self._ctx)
+
+    def new_hamiltonian(self) -> tuple | None:
+        """A canonical map's new pairs, its values in (q, p_q, t) and the book's K (None
+        where the part states no K or names its own variables)."""
+        return hamiltonian_claim(self._ctx)
 
     def motion(self) -> Motion:
         """The trajectory a trajectory part derives (mechbook.verify.quantities.trajectory:

@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from mechbook.crosscheck.brackets import bracket_part, new_hamiltonian_part
 from mechbook.crosscheck.conserved import conserved_part
 from mechbook.crosscheck.frequencies import frequency_crosscheck
 from mechbook.crosscheck.guard import guarded
@@ -129,6 +130,12 @@ CROSSCHECKS: dict[str, PartCheck] = {
                        "(frequencies.py)", _modes),
     "response": PartCheck("with `modes`: the steady amplitude measured from the driven "
                           "motion (response.py)"),
+    "bracket_flow": PartCheck("a bracket with H against the rate of change along a run, from "
+                              "Lagrange's equations (brackets.py)",
+                              each_part(bracket_part, "bracket_flow")),
+    "new_hamiltonian": PartCheck("a canonical map's new variables moving by the book's K "
+                                 "along a run, from Lagrange's equations (brackets.py)",
+                                 each_part(new_hamiltonian_part, "new_hamiltonian")),
 }
 
 

@@ -185,34 +185,68 @@ def linearize_on_manifold(eq, point: dict, velocity: dict | None = None,
 
 
 def reference_rates(eq, point: dict, velocity: dict, given: dict | None = None) -> dict:
-    """Every coordinate's rate along the reference motion: stated (`velocity`), zero for a
-    coordinate the point names, else solved from the constraints at the velocity level
-    (the stated rates and the point fix them: a rolling disk's centre follows its spin)."""
+    """Every coordinate's rate along the reference motion: stated (`velocity`), else solved
+    from the constraints at the velocity level (the stated rates and the point fix them: a
+    rolling disk's centre follows its spin). A coordinate the point names is at rest unless
+    the constraints make it move: then its rate is solved for too (a rolling coin placed at
+    x = y = 0 and spun: its centre's rate follows from the spin, not from `steady:`)."""
     dyn = eq.dyn
     values = eq.sys.numeric_values()
-    rates = {q: sp.S(velocity[q]) for q in dyn.q if q in velocity}
-    rates.update({q: sp.S.Zero for q in dyn.q if q not in velocity and q in point})
-    open_ = [i for i, q in enumerate(dyn.q) if q not in rates]
-    if not open_:
-        return rates
+    stated = {q: sp.S(velocity[q]) for q in dyn.q if q in velocity}
+    open_ = [i for i, q in enumerate(dyn.q) if q not in stated and q not in point]
+    resting = [i for i, q in enumerate(dyn.q) if q not in stated and q in point]
+    if not dyn.velocity_jacobian.rows:
+        if open_:
+            raise _open_rates(dyn, open_)
+        return {**stated, **{dyn.q[i]: sp.S.Zero for i in resting}}
     at = {q: sp.S(point.get(q, 0)) for q in dyn.q}
     A = dyn.velocity_jacobian.xreplace(at)
     rest = {v: sp.S.Zero for v in dyn.qd}
     b = sp.Matrix([c.xreplace(rest).xreplace(at) for c in dyn.velocity_rows])
-    known = [i for i in range(len(dyn.q)) if i not in open_]
-    rhs = -b - A[:, known] * sp.Matrix([rates[dyn.q[i]] for i in known]) if known else -b
-    Ao = A[:, open_]
-    if A.rows == 0 or sp.Matrix(Ao).rank(iszerofunc=lambda x: is_zero(x, values)) < len(open_):
-        names = ", ".join(str(dyn.q[i]) for i in open_)
-        raise UnsupportedError(f"the reference motion leaves the rates of {names} open: give "
-                               "them (`steady:`) or the coordinates' values (`about:`)")
-    solved = (Ao.T * Ao).LUsolve(Ao.T * rhs).applyfunc(sp.cancel)
-    left = [r for r in Ao * solved - rhs if not is_zero(sp.S(r).subs(given or {}), values)]
-    if left:
+    solved, left = _solve_rates(dyn, A, b, stated, open_, given, values)
+    while left and resting:  # free the resting coordinate that leaves the least unmet
+        tries = []
+        for i in resting:
+            attempt = _solve_rates(dyn, A, b, stated, sorted(open_ + [i]), given, values)
+            if attempt[0] is not None:
+                tries.append((len(attempt[1]), i, attempt))
+        if not tries or min(tries)[0] >= len(left):
+            break
+        _, i, (solved, left) = min(tries, key=lambda x: x[:2])
+        open_, resting = sorted(open_ + [i]), [j for j in resting if j != i]
+    if solved is None:
+        raise _open_rates(dyn, open_)
+    if left and open_:
         raise NotEquilibriumError("the stated rates break the velocity constraints: "
                                   f"{sp.sstr(left[0])[:120]} is left")
-    rates.update({dyn.q[i]: solved[k] for k, i in enumerate(open_)})
-    return rates
+    return {**stated, **{dyn.q[i]: sp.S.Zero for i in resting}, **solved}
+
+
+def _open_rates(dyn, open_: list[int]) -> UnsupportedError:
+    names = ", ".join(str(dyn.q[i]) for i in open_)
+    return UnsupportedError(f"the reference motion leaves the rates of {names} open: give "
+                            "them (`steady:`) or the coordinates' values (`about:`)")
+
+
+def _solve_rates(dyn, A: sp.Matrix, b: sp.Matrix, stated: dict, open_: list[int],
+                 given: dict | None, values: dict) -> tuple[dict | None, list]:
+    """The rates of the coordinates `open_` (indices) that meet A q̇ + b = 0 with the
+    stated ones and the others at rest, by least squares; with the constraint rows left
+    unmet. (None, []) where they are not fixed (A's columns of `open_` dependent)."""
+    fixed = {i: stated.get(q, sp.S.Zero) for i, q in enumerate(dyn.q) if i not in open_}
+    known = sorted(fixed)
+    rhs = -b - A[:, known] * sp.Matrix([fixed[i] for i in known]) if known else -b
+    if not open_:
+        solved = sp.zeros(0, 1)
+        residual = -rhs
+    else:
+        Ao = A[:, open_]
+        if sp.Matrix(Ao).rank(iszerofunc=lambda x: is_zero(x, values)) < len(open_):
+            return None, []
+        solved = (Ao.T * Ao).LUsolve(Ao.T * rhs).applyfunc(sp.cancel)
+        residual = Ao * solved - rhs
+    left = [r for r in residual if not is_zero(sp.S(r).subs(given or {}), values)]
+    return {dyn.q[i]: solved[k] for k, i in enumerate(open_)}, left
 
 
 def linearize_first_order(eq, point: dict, velocity: dict | None = None,

@@ -94,6 +94,23 @@ class LevelSet:
                          mpmath.mpf(str(sp.N(full[self.c], dps))),
                          mpmath.mpf(str(sp.N(full.get(self.cdot, 0), dps))), params, dps)
 
+    def orbit_at(self, energy, momenta: list, inside, values: dict, dps: int = DPS) -> Orbit:
+        """The orbit of energy `energy` and cyclic momenta `momenta` (in `self.cyclic`'s
+        order) that passes through c = `inside` (a point of the allowed region, not a
+        turning point): an action or a frequency asked at a given energy rather than from a
+        start. UnsupportedError if the motion cannot reach `inside` at that energy."""
+        with mpmath.workdps(dps):
+            def mp(v):
+                return mpmath.mpf(str(sp.N(v, dps)))
+
+            params = [mp(values[p]) for p in self.params]
+            orbit = Orbit(self, [mp(x) for x in momenta], mp(energy), mp(inside),
+                          mpmath.mpf(1), params, dps)  # ċ0 ≠ 0: search both ways
+            if not orbit.kinetic(orbit.c0) > 0:
+                raise UnsupportedError(f"level set: at this energy the motion does not reach "
+                                       f"{self.c} = {mpmath.nstr(orbit.c0, 8)}")
+            return orbit
+
 
 @dataclass
 class Orbit:
@@ -224,6 +241,41 @@ class Orbit:
     @cached_property
     def period(self):
         return self._quad(lambda c: mpmath.mpf(1))
+
+    def time_to(self, target):
+        """The time the motion takes from c0 to c = `target`, or None where it does not get
+        there directly (the target lies behind the start or beyond the turning point
+        ahead). ∫ √(m/(2(E − V_eff))) |dc| by tanh-sinh quadrature, which absorbs the
+        inverse square root at a turning point c0 (a start from rest)."""
+        mass, _, _ = self.level.numeric_functions
+        lo, hi = self.turning_points
+        with mpmath.workdps(self.dps):
+            target = mpmath.mpf(target)
+            ahead = hi if self.cdot0 > 0 or (self.cdot0 == 0 and self.c0 == lo) else lo
+            if not min(self.c0, ahead) < target < max(self.c0, ahead) and target != self.c0:
+                return None
+
+            def f(c):
+                k = self.kinetic(c)
+                if k <= 0:
+                    raise UnsupportedError("level set: the motion leaves the allowed region "
+                                           "before the target")
+                return mpmath.sqrt(mass(*self._args(c)) / (2 * k))
+
+            value, err = mpmath.quad(f, sorted([self.c0, target]), error=True)
+            if not err <= mpmath.mpf(10) ** (30 - self.dps) * abs(value):
+                raise UnsupportedError("level set: the time quadrature did not converge")
+            return value
+
+    @cached_property
+    def action(self):
+        """J = (1/2π)∮ p dc over one libration (the 1/2π convention: J = E/ω for an
+        oscillator). p = m·ċ plus a part of the reduced Lagrangian linear in ċ, a function
+        of c alone whose ∮ over the back-and-forth vanishes; m·ċ² = 2(E − V_eff), so
+        J = (1/2π)·2∫ 2(E − V_eff)·√(m/(2(E − V_eff))) dc, the period's quadrature with the
+        weight 2(E − V_eff) (smooth after the same substitution)."""
+        with mpmath.workdps(self.dps):
+            return self._quad(lambda c: 2 * self.kinetic(c)) / (2 * mpmath.pi)
 
     def advance(self, coordinate: sp.Symbol):
         """How far a cyclic coordinate advances over one period."""

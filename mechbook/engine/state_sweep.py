@@ -19,6 +19,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import DEFAULT_BACKEND, compile_batch
+from mechbook.core.words import plural
 from mechbook.engine.linear import ZERO_CLUSTER
 from mechbook.engine.linear_grid import (
     GROWTH_TOL,
@@ -94,7 +95,8 @@ class StateSweep:
                 self._one(exact, i, freq, stab, growth)
                 block.precise += 1
         elif block.ill:
-            block.notes.append(f"{block.ill} points with exponents double precision cannot "
+            block.notes.append(f"{plural(block.ill, 'point')} with exponents double precision "
+                               f"cannot "
                                f"place kept at float64 (more than {PRECISE_LIMIT} in a block)")
         return block.keep(want, freq, stab, growth)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from mechbook.errors import MechbookError
+from mechbook.errors import MechbookError, NothingSelectedError
 from mechbook.model.books import declared_book
 from mechbook.model.ids import check_id, split_id  # noqa: F401 - the id grammar, re-exported
 
@@ -70,6 +70,16 @@ def _tree_file(folder: str, pid: str, base: Path) -> Path:
 def problem_path(pid: str, base: Path) -> Path:
     """problems/<book>/<number>.yaml (see _tree_file)."""
     return _tree_file("problems", pid, base)
+
+
+def existing_problem_path(pid: str, base: Path) -> Path:
+    """`problem_path`, and a NothingSelectedError when no file is there: the one message
+    for "no such problem" of the command line and the API alike."""
+    path = problem_path(pid, base)
+    if not os.path.lexists(path):
+        raise NothingSelectedError(f"no problem {pid} (no file {path}; `mechbook list` "
+                                   "shows the problems there are)")
+    return path
 
 
 def answer_path(pid: str, base: Path) -> Path:

@@ -17,6 +17,8 @@ import math
 import mpmath
 import sympy as sp
 
+from mechbook.core import special
+
 _NOT_FINITE = (sp.zoo, sp.oo, -sp.oo, sp.nan)
 
 
@@ -25,7 +27,7 @@ def _real_mp(f):
     K(m) and E(m) are complex for m > 1."""
     def value(*args):
         with mpmath.workprec(53):
-            v = f(*args)
+            v = f(*(mpmath.mpf(a) for a in args))
         if mpmath.im(v) != 0:
             raise ValueError("not real")
         return float(mpmath.re(v))
@@ -44,6 +46,7 @@ _FUNCTIONS = {
     sp.sign: lambda x: math.copysign(1.0, x) if x else 0.0,
     sp.elliptic_k: _real_mp(mpmath.ellipk), sp.elliptic_e: _real_mp(mpmath.ellipe),
     sp.gamma: math.gamma,
+    **{f: _real_mp(mp) for f, mp in special.MPMATH.items()},
 }
 
 
@@ -103,6 +106,8 @@ def _apply(expr: sp.Basic, args: list[float]) -> float | None:
         return fn(*args) if fn is not None else None
     except OverflowError:
         raise NotAConstant("is too large for double precision") from None
+    except special.DomainError as exc:  # a special function outside its domain: why
+        raise NotAConstant(f"is outside its function's domain: {exc}") from None
     except (ValueError, ZeroDivisionError):  # a math domain error: no real value
         raise NotAConstant("has no finite real value") from None
 

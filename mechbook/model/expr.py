@@ -23,6 +23,7 @@ from collections.abc import Mapping
 
 import sympy as sp
 
+from mechbook.core.special import PARSER_FUNCTIONS as SPECIAL
 from mechbook.errors import ExpressionError
 from mechbook.model.constants import bad_constant
 from mechbook.model.hints import did_you_mean, operator_hint
@@ -51,6 +52,11 @@ FUNCTIONS: dict[str, object] = {
     # first and second kind in SymPy's (and mpmath's) parameter m = k², K(m) and E(m)
     # (a pendulum of amplitude θ0: T = 4·sqrt(l/g)·K(sin²(θ0/2))), and Euler's Γ(x)
     "elliptic_k": sp.elliptic_k, "elliptic_e": sp.elliptic_e, "gamma": sp.gamma,
+    # and, in the same parameter m (mechbook.core.special): the incomplete integrals
+    # elliptic_f(φ, m), elliptic_e(φ, m), elliptic_pi(n[, φ], m), Jacobi's jacobi_sn(u, m),
+    # jacobi_cn, jacobi_dn, Bessel's besselj(ν, x), bessely(ν, x) and their n-th positive
+    # zeros bessel_j_zero(ν, n), bessel_y_zero(ν, n)
+    **{name: fn for name, (fn, _) in SPECIAL.items()},
 }
 # function names a problem or answer key may also declare as names of its own (gamma is a
 # common parameter, coordinate or angle): where it does, the name is its own and a call of
@@ -66,7 +72,8 @@ def _diff(expr, var, times=1):
 
 
 FUNCTIONS["diff"] = _diff
-ARITY = {"atan2": (2, 2), "log": (1, 2), "diff": (2, 3)}
+ARITY = {"atan2": (2, 2), "log": (1, 2), "diff": (2, 3),
+         **{name: arity for name, (_, arity) in SPECIAL.items()}}
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}  # E and I stay free: books use them as symbols
 
 

@@ -13,10 +13,13 @@ from __future__ import annotations
 
 import re
 
-from mechbook.errors import MechbookError
+from mechbook.errors import MalformedIdError
 
 BOOK = r"[a-z][a-z0-9]{0,39}"
-NUMBER = r"(?=[A-Za-z0-9._-]{1,80}\Z)[A-Za-z0-9]+(?:[._-][A-Za-z0-9]+)*"
+# The length limit is a lookahead that ends where the id's characters end, not at `\Z`: the
+# pattern is copied into the problem schema, and editors' validators (ECMA-262 regexes, as
+# JSON Schema specifies) know no `\Z`.
+NUMBER = r"(?=[A-Za-z0-9._-]{1,80}(?![A-Za-z0-9._-]))[A-Za-z0-9]+(?:[._-][A-Za-z0-9]+)*"
 PATTERN = rf"({BOOK})-({NUMBER})"
 ID = re.compile(PATTERN)
 EXAMPLES = "e.g. lim-2031 or symon-09-12"
@@ -27,7 +30,7 @@ def split_id(pid: object) -> tuple[str, str]:
     for anything that is not a well-formed id."""
     m = ID.fullmatch(pid) if isinstance(pid, str) else None
     if m is None:
-        raise MechbookError(f"bad problem id {pid!r} (expected <book>-<number>, {EXAMPLES}: "
+        raise MalformedIdError(f"bad problem id {pid!r} (expected <book>-<number>, {EXAMPLES}: "
                             "a book of lower-case letters and digits, a number of letters "
                             "and digits with single '.', '_' or '-' between them)")
     return m.group(1), m.group(2)

@@ -22,7 +22,9 @@ def bundled(name: str) -> dict:
         .read_text("utf-8")
     schema = json.loads(text)
     if name == "problem":  # the id grammar has one owner (mechbook.model.ids)
-        schema["properties"]["id"]["pattern"] = f"^{ID_PATTERN}$"
+        # ends with "no character follows", not `$`: Python's `$` also matches before a
+        # final newline, and `\Z` is Python's alone (ECMA-262 has neither meaning)
+        schema["properties"]["id"]["pattern"] = f"^{ID_PATTERN}(?![\\s\\S])"
     elif name == "books":
         schema["$defs"]["book"]["properties"]["id"]["pattern"] = f"^{BOOK}$"
     return schema

@@ -184,12 +184,20 @@ def _calculus_symbol(s, verb: str) -> sp.Symbol:
     refused always, whichever way the statement is built."""
     if is_variable(s) or (isinstance(s, sp.Symbol) and for_all_name(s) is None):
         return s
-    owners = sorted({n for x in getattr(s, "free_symbols", ()) if (n := for_all_name(x))})
-    if owners:
+    generic = [x for x in getattr(s, "free_symbols", ()) if for_all_name(x)]
+    owners = sorted({for_all_name(x) for x in generic})
+    if owners and all(x.name.endswith(".x") for x in generic):  # scalar, positive, angle
         name = owners[0]
         raise TypeError(f"to {verb} {name!r}, declare it a variable (for_all: {{{name}: "
                         f"variable}}): a `for_all` object of another kind is drawn as "
                         "numbers at each instance")
+    if owners:  # a vector, tensor or rotation (or a component of one): not a scalar
+        name = owners[0]
+        raise TypeError(f"to {verb} {name!r} (or a component of it): it is a generic "
+                        "vector, tensor or rotation, drawn as numbers at each instance, and "
+                        "a `variable` is a scalar; declare its components as variables "
+                        "(for_all: {a1: variable, a2: variable, a3: variable}) and write "
+                        "the vector [a1, a2, a3]")
     raise TypeError(f"{verb} a plain symbol: a parameter, or a `for_all` name of kind "
                     "`variable` (for_all: {x: variable})")
 

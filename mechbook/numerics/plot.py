@@ -1,5 +1,6 @@
 """Plots of a simulation: coordinates against time, the phase portrait of each coordinate,
-and the relative drift of every monitored conserved quantity. Headless (Agg backend)."""
+and the relative drift of every monitored conserved quantity. Headless (a Figure with its own
+Agg canvas, no pyplot): to a file, or as PNG bytes for a notebook."""
 
 from __future__ import annotations
 
@@ -8,16 +9,33 @@ from pathlib import Path
 
 def plot_simulation(sim, path: str | Path) -> Path:
     """Write a PNG (or any format matplotlib infers from the suffix) of `sim` to `path`."""
-    import matplotlib
+    fig = simulation_figure(sim)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    return path
 
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
+
+def simulation_png(sim, dpi: int = 90) -> bytes:
+    """The same figure as PNG bytes, for a notebook's inline display (nothing written)."""
+    import io
+
+    out = io.BytesIO()
+    simulation_figure(sim).savefig(out, format="png", dpi=dpi)
+    return out.getvalue()
+
+
+def simulation_figure(sim):
+    """The matplotlib Figure of `sim`: coordinates, phase portrait, drifts. Made without
+    pyplot (its own Agg canvas): headless, never a window, and a notebook's backend is left
+    as it is."""
+    from matplotlib.figure import Figure
 
     traj = sim.trajectory
     names = sim.model.names
     n = len(names)
     rows = 2 if sim.drifts else 1
-    fig = plt.figure(figsize=(11, 4.2 * rows), constrained_layout=True)
+    fig = Figure(figsize=(11, 4.2 * rows), constrained_layout=True)
     grid = fig.add_gridspec(rows, 2)
     ax_t = fig.add_subplot(grid[0, 0])
     for i, name in enumerate(names):
@@ -49,9 +67,5 @@ def plot_simulation(sim, path: str | Path) -> Path:
     info = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
                      for k, v in settings.items())
     fig.suptitle(f"{sim.problem_id} [{sim.system}]: {info}", fontsize=10)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return fig
 

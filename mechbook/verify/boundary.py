@@ -32,6 +32,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, holds
+from mechbook.core.words import plural
 from mechbook.errors import MechbookError, UndecidedError, UnsupportedError, WrongAnswerError
 from mechbook.verify.compare import DIGITS, Sampler, Verdict
 
@@ -371,12 +372,14 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
                           f"{rays} rays (it does not evaluate there)")
         else:
             res.outcome, why = silence.reason()
-            res.detail = (f"{why} (no verdict of the engine at any of {book_points} points "
+            res.detail = (f"{why} (no verdict of the engine at any of "
+                          f"{plural(book_points, 'point')} "
                           f"on {rays} rays: nothing was compared)")
         return res
     if res.crossings + res.tangencies == 0 or min(seen.values()) == 0:
         res.ok, res.outcome = False, "undecided"
-        res.detail = (f"no ray crossed the book's boundary ({rays} rays, {res.points} points: "
+        res.detail = (f"no ray crossed the book's boundary ({rays} rays, "
+                      f"{plural(res.points, 'point')}: "
                       f"{seen[True]} {words[0]}, {seen[False]} {words[1]}, all agreeing): the "
                       "check cannot discriminate (widen the parameters or `assume:` a region)")
         return res
@@ -393,7 +396,7 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
                  (f", all {len(sides)} sides crossed" if len(sides) > 1 else ""))
     res.sides = (len(sides) - missed, len(sides))
     res.detail = (f"boundary agrees at {judged} crossings to {res.eps:g}{tang}{skipped}"
-                  f"{side_note}; {res.points} points on {rays} rays ({seen[True]} "
+                  f"{side_note}; {plural(res.points, 'point')} on {rays} rays ({seen[True]} "
                   f"{words[0]}, {seen[False]} {words[1]})")
     return res
 
@@ -438,5 +441,5 @@ def verdict(result: BoundaryResult, crossings_word: str = "crossings") -> Verdic
              f" (all {sides} sides)" if sides > 1 else "")
     return Verdict(True, f"boundary({judged} {crossings_word} to {result.eps:g})", result.detail,
                    power=f"boundary at {judged} {crossings_word}{tang}{where} to "
-                         f"{result.eps:g}, {result.points} points on both sides")
+                         f"{result.eps:g}, {plural(result.points, 'point')} on both sides")
 

@@ -30,9 +30,10 @@ Stage = Callable[[str], None]  # told the stage a check is in, e.g. "part a (fre
 
 
 def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC,
-               quantities: QuantityTable | None = None) -> Outcome:
+               quantities: QuantityTable | None = None, stage: Stage | None = None) -> Outcome:
     """The part's outcome (never raises for the part's own faults: they are its outcome).
-    `quantities`: the table to check with (default: the one its key was read against)."""
+    `quantities`: the table to check with (default: the one its key was read against);
+    `stage`: told the progress of a long computation inside the part."""
     start = time.perf_counter()
     out = Outcome(analysis.problem.id, part.name, part.quantity, part.data["cite"], Status.ERROR,
                   origin=part.data.get("origin", "book"))
@@ -40,7 +41,7 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC,
         if "unsupported" in part.data:
             out.status, out.detail = Status.UNSUPPORTED, part.data["unsupported"]
             return out
-        ctx = Context(analysis, part, policy, quantities=quantities)
+        ctx = Context(analysis, part, policy, quantities=quantities, stage=stage)
         fn = ctx.quantity.check
         verdict = fn(ctx, part.data.get("book"))
         if "erratum" in part.data:
@@ -104,5 +105,5 @@ def check_problem(analysis: Analysis, key: AnswerKey, policy: ProofPolicy = NUME
     for part in key.parts:
         if stage is not None:
             stage(f"part {part.name} ({part.quantity})")
-        outcomes.append(check_part(analysis, part, policy, quantities))
+        outcomes.append(check_part(analysis, part, policy, quantities, stage))
     return outcomes

@@ -16,6 +16,7 @@ import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_resolved, holds
 from mechbook.core.timeout import Timeout, time_limit
+from mechbook.core.words import plural
 from mechbook.records import NUMERIC, ProofPolicy
 
 RTOL = 1e-10  # relative tolerance of a numeric comparison
@@ -203,20 +204,21 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
             # what cancels? Decided with the precision raised until it stands clear
             deeper = _resolved(expr, point)
             if deeper:
-                return Verdict(False, f"numeric({valid} points, to {DEEP_DIGITS} digits)",
+                return Verdict(False, f"numeric({plural(valid, 'point')}, to {DEEP_DIGITS} digits)",
                                f"residual {abs(deeper):.3g} at {_fmt(point)} (below 30 "
                                f"digits' reach: {rel:.2g} of the terms that cancel)")
         worst = max(worst, rel)
         if rel > rtol:
-            return Verdict(False, f"numeric({valid} points)",
+            return Verdict(False, f"numeric({plural(valid, 'point')})",
                            f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
         return Verdict(True, "symbolic", power="proved symbolically")
-    return Verdict(True, f"numeric({valid} points, rtol {rtol:g})",
+    return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
-                   power=f"{valid} points at {DIGITS} digits, residual ≤ {rtol:g} of its scale")
+                   power=f"{plural(valid, 'point')} at {DIGITS} digits, residual ≤ {rtol:g} "
+                         "of its scale")
 
 
 AMBIGUOUS = 1e-27  # a residual above this fraction of its scale is more than rounding
@@ -305,7 +307,7 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
                 # decided with the precision raised until the difference stands clear
                 deeper = _resolved(diff, point)
                 if deeper and abs(deeper) > rtol * size:
-                    return Verdict(False, f"numeric({valid + 1} points, to {DEEP_DIGITS} "
+                    return Verdict(False, f"numeric({plural(valid + 1, 'point')}, to {DEEP_DIGITS} "
                                    "digits)", f"{_num(va)} vs {_num(vb)} differ by "
                                    f"{abs(deeper):.3g} (relative {abs(deeper) / size:.2g}) "
                                    f"at {_fmt(point)}")
@@ -314,16 +316,16 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
         valid += 1
         worst = max(worst, rel)
         if rel > rtol:
-            return Verdict(False, f"numeric({valid} points)",
+            return Verdict(False, f"numeric({plural(valid, 'point')})",
                            f"{_num(va)} vs {_num(vb)} (relative {rel:.2g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
     if _prove(sampler, symbolic) and _symbolic_zero(diff, sampler.policy.seconds):
         return Verdict(True, "symbolic", power="proved symbolically")
-    return Verdict(True, f"numeric({valid} points, rtol {rtol:g})",
+    return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=(f"within the stated {sampler.rtol:.2g}" if sampler.rtol > RTOL else
-                          f"{valid} points at {DIGITS} digits, within {rtol:g}"))
+                          f"{plural(valid, 'point')} at {DIGITS} digits, within {rtol:g}"))
 
 
 def _num(z: complex) -> str:

@@ -10,6 +10,7 @@ families of quantities live here too.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
@@ -38,6 +39,9 @@ class Context:
     policy: ProofPolicy = NUMERIC
     validate_only: bool = False  # tensor parts: build the statement once, judge nothing
     quantities: QuantityTable | None = None  # None: the table the part's key was read with
+    # told how a long computation goes ("part a (lyapunov): t = 400 of 1000"), as the
+    # checker's stage: a check stopped from outside then says how far it got
+    stage: Callable[[str], None] | None = None
 
     def __post_init__(self):
         self.quantity: Quantity = self._entry()

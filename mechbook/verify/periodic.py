@@ -9,6 +9,7 @@ system serves every parameter point of a part and of the parts after it.
 
 from __future__ import annotations
 
+from mechbook.core.words import plural
 from mechbook.engine.linear import LinearSystem
 from mechbook.engine.periodic import time_dependent
 from mechbook.numerics.floquet import ARITHMETIC, RESOLVED, Floquet
@@ -52,5 +53,5 @@ class FloquetVerdicts:
     def power(self) -> str:
         return (f"the engine's verdicts from Floquet multipliers (the monodromy over one "
                 f"period T = {self.floquet.period}, {ARITHMETIC}; Liouville's determinant "
-                f"agreed to {max(self.worst, 1e-36):.0e} at {self.points} points, "
+                f"agreed to {max(self.worst, 1e-36):.0e} at {plural(self.points, 'point')}, "
                 f"{RESOLVED:g} needed)")

@@ -36,7 +36,8 @@ class Quantity:
     complex_values: bool = False  # its expressions may hold complex constants (sqrt(-1))
     # changes of one value the check does not see by definition (mechbook.verify.power):
     # "shift" (a constant added), "scale" (a factor), "function" (a conserved quantity's
-    # function), "direction" (a mode shape's length); stated in docs/answers.md
+    # function), "direction" (a mode shape's length), "open" (a claim true of every value
+    # near the book's, such as a map that is not canonical); stated in docs/answers.md
     equivalent: tuple | Callable = ()
     # how other stages use the quantity, as plain names they map to their own code (verify
     # imports neither): the independent checks that vouch for it (mechbook.crosscheck.

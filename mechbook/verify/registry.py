@@ -21,12 +21,17 @@ from functools import cache
 from mechbook.model.schema import bundled
 from mechbook.verify.quantities import (
     access,
+    action,
     adiabatic,
+    brackets,
+    canonical,
+    chaos,
     equations,
     equilibria,
     expressions,
     extremum,
     functional,
+    hamilton_jacobi,
     motion,
     oscillations,
     parts,
@@ -43,9 +48,10 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, functional,
-           motion, oscillations, parts, perturbation, phase, response, rotation, stability, steady,
-           tensors, trajectory, words)
+MODULES = (access, action, adiabatic, brackets, canonical, chaos, equations, equilibria,
+           expressions, extremum, functional, hamilton_jacobi, motion, oscillations, parts,
+           perturbation, phase, response, rotation, stability, steady, tensors, trajectory,
+           words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",

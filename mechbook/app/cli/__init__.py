@@ -32,17 +32,23 @@ from mechbook.app.cli import (
     watch,
 )
 from mechbook.app.cli.common import say, set_logging
-from mechbook.app.text import for_terminal
+from mechbook.app.cli.statuses import INTERRUPTED, USAGE, epilog, failure
 from mechbook.errors import MechbookError
 from mechbook.version import __version__
-
-INTERRUPTED = 130  # the shell's convention for a command ended by Ctrl-C (128 + SIGINT)
 
 
 class _Group(click.Group):
     """The command group; Ctrl-C ends any command with one line and exit status 130, never
     a traceback or click's "Aborted!" with status 1 (the workers ignore SIGINT: the run
-    stops them, mechbook.app.batch); a MechbookError no command caught is its message."""
+    stops them, mechbook.app.batch); a MechbookError no command caught is its message; a
+    usage error (the group's or a command's) exits 4, as pytest's (statuses.TABLE)."""
+
+    def make_context(self, *args, **kwargs) -> click.Context:
+        try:
+            return super().make_context(*args, **kwargs)
+        except click.UsageError as exc:
+            exc.exit_code = USAGE
+            raise
 
     def invoke(self, ctx: click.Context):
         try:
@@ -50,11 +56,15 @@ class _Group(click.Group):
         except KeyboardInterrupt:
             say("\ninterrupted", err=True)
             raise click.exceptions.Exit(INTERRUPTED) from None
+        except click.UsageError as exc:
+            exc.exit_code = USAGE
+            raise
         except MechbookError as exc:  # one a command did not catch: still a message
-            raise click.ClickException(for_terminal(str(exc))) from None
+            raise failure(exc) from None
 
 
-@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]},
+             epilog=epilog())
 @click.version_option(__version__, prog_name="mechbook")
 @click.option("--root", "root_dir", type=click.Path(file_okay=False, path_type=Path),
               default=None,

@@ -24,11 +24,12 @@ from mechbook.app.cli.common import (
     store_option,
     timeout_option,
 )
+from mechbook.app.cli.statuses import epilog, failure
 from mechbook.app.text import json_safe
 from mechbook.errors import MechbookError
 
 
-@click.command("check")
+@click.command("check", epilog=epilog())
 @problem_ids_argument()
 @store_option("HDF5 file to write results to.")
 @no_store_option("Do not write results.")
@@ -70,7 +71,8 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
             timeout: float, memory_mb: float, serial: bool, prove: bool,
             prove_seconds: float, scheduler: str | None, fmt: str,
             junit_path: Path | None, exitfirst: bool, last_failed: bool) -> None:
-    """Check problems against their answer keys (all by default); exit 1 on any fail.
+    """Check problems against their answer keys (all by default); exit 1 on any fail, 5
+    when nothing is selected (the statuses below).
 
     PROBLEM_IDS are ids (lim-2031), patterns over ids ('mybook-*', quoted for the shell)
     or a book's id (mybook: all its problems).
@@ -98,8 +100,8 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
                                               exitfirst=exitfirst))
     try:
         ids = service.resolve(problem_ids)
-    except MechbookError as exc:
-        raise click.ClickException(str(exc)) from None
+    except MechbookError as exc:  # no such problem: its own status (statuses.TABLE)
+        raise failure(exc) from None
     if last_failed:
         ids = _last_failed(service.store, ids)
     checked_output(junit_path, "JUnit XML file")

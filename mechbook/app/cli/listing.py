@@ -7,6 +7,7 @@ import sys
 import click
 
 from mechbook.app.cli.common import resolve_root, say
+from mechbook.core.words import plural
 from mechbook.errors import MechbookError
 from mechbook.model.books import file_id_error
 from mechbook.model.catalog import all_ids, answer_path, problem_path
@@ -59,7 +60,7 @@ def _parts(pid: str, base) -> tuple[str, int]:
         if apath.exists():
             found = load(apath).data.get("parts")
             if isinstance(found, list):
-                return f"{len(found)} parts", 0
+                return f"{plural(len(found), 'part')}", 0
             return "INVALID answer key", 1
     except MechbookError:
         return "INVALID answer key", 1

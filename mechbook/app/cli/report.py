@@ -16,6 +16,7 @@ from mechbook.app.cli.common import (
     serial_option,
     store_option,
 )
+from mechbook.app.cli.statuses import failure
 from mechbook.errors import MechbookError
 
 
@@ -31,9 +32,11 @@ from mechbook.errors import MechbookError
               show_default=True, help="Time limit of each step of a page that computes "
                                       "(a simulation, an equation the check did not store).")
 @click.option("--simplify-seconds", type=opt.Finite(min=0, max=opt.MAX_STEP_SECONDS),
-              default=0.3, show_default=True,
+              default=3.0, show_default=True,
               help="Time limit of simplifying each expression shown, for reading (0: show "
-                   "them as the check stored them); a page spends at most five times this.")
+                   "them as the check stored them); a page spends at most five times this. "
+                   "Each simplified form is kept (OUT/.simplified/), so it is spent once: "
+                   "a rerun reads it back.")
 @click.option("--no-simulate", is_flag=True, help="Leave out the simulated trajectories.")
 @click.option("--t-end", type=opt.Finite(min=0, min_open=True, max=1e6), default=10.0,
               show_default=True, help="End time of the simulated trajectories.")
@@ -56,8 +59,8 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     base = resolve_root(ctx)
     try:  # named ones must exist; of all, a bad file gets a page saying so
         ids, _ = resolve_ids(problem_ids, base)
-    except MechbookError as exc:
-        raise click.ClickException(str(exc)) from None
+    except MechbookError as exc:  # no such problem: its own status (statuses.TABLE)
+        raise failure(exc) from None
     page = PageOptions(seconds=seconds, simplify_seconds=simplify_seconds,
                        simplify_budget=5 * simplify_seconds, simulate=not no_simulate,
                        t_end=t_end, simulate_seconds=seconds)

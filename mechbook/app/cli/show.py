@@ -13,7 +13,7 @@ from mechbook.app.cli.common import (
     say,
     store_option,
 )
-from mechbook.app.text import for_terminal
+from mechbook.app.cli.statuses import failure
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import check_id
 
@@ -30,8 +30,8 @@ def command(ctx: click.Context, problem_id: str, store_path: Path) -> None:
     path = in_tree(ctx, store_path)
     try:
         rec = read(check_id(problem_id), path)
-    except MechbookError as exc:
-        raise click.ClickException(for_terminal(str(exc))) from None
+    except MechbookError as exc:  # a malformed id: a usage error (statuses.TABLE)
+        raise failure(exc) from None
     except FileNotFoundError as exc:  # no store at all; a problem not in it: NotFoundError
         raise click.ClickException(str(exc)) from None
     if rec.get("checked", True):

@@ -27,9 +27,10 @@ from mechbook.app.cli.common import (
     system_option,
     timeout_option,
 )
+from mechbook.app.cli.statuses import failure
 from mechbook.app.text import for_terminal
 from mechbook.errors import MechbookError
-from mechbook.model.catalog import check_id
+from mechbook.model.catalog import existing_problem_path
 
 # an integrator option given on the command line, by the keyword the integrator takes
 TOLERANCES = {"rtol": "--rtol", "atol": "--atol", "max_step": "--max-step", "step": "--step"}
@@ -99,11 +100,11 @@ def command(ctx: click.Context, problem_id: str, system: str | None, method: str
     base = resolve_root(ctx)
     path = in_tree(ctx, store_path)
     try:
-        check_id(problem_id)
+        existing_problem_path(problem_id, base)
         if name is not None:
             check_run_name(name, "simulation")
-    except MechbookError as exc:
-        raise click.ClickException(str(exc)) from None
+    except MechbookError as exc:  # no such problem: its own status (statuses.TABLE)
+        raise failure(exc) from None
     if not no_store:
         checked_output(path, "store")
     checked_output(plot_path, "plot")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from mechbook.app.cli.common import numeric_text, problem_id_argument, resolve_root, system_option
+from mechbook.app.cli.statuses import failure
 from mechbook.errors import MechbookError
 
 
@@ -44,4 +45,4 @@ def command(ctx: click.Context, problem_id: str, system: str | None, no_simplify
             for key, text in res.text.items():
                 click.echo(f"{key}:\n    {text}")
     except (MechbookError, KeyError) as exc:
-        raise click.ClickException(str(exc)) from None
+        raise failure(exc) from None

@@ -27,6 +27,7 @@ from mechbook.app.cli.common import (
     system_option,
     timeout_option,
 )
+from mechbook.app.cli.statuses import failure
 from mechbook.app.sweep.spec import QUANTITIES
 from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.errors import MechbookError, message
@@ -102,7 +103,9 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
         result = run_sweep(spec, base, jobs=jobs, scheduler=address,
                            timeout=timeout, memory_mb=memory_mb, samples=samples)
     except (MechbookError, KeyError) as exc:
-        raise click.ClickException(message(exc)) from None
+        out = failure(exc)  # no such problem: its own status (statuses.TABLE)
+        out.message = message(exc)
+        raise out from None
     run_name = name or "-".join([quantity] + [a.name for a in axes])
     failed = not _write(result, base, path, run_name, out_path, stored=not no_store)
     if plot_path is not None:

@@ -14,9 +14,9 @@ from mechbook.app.cli.common import (
     say,
     timeout_option,
 )
-from mechbook.app.text import for_terminal
+from mechbook.app.cli.statuses import failure
 from mechbook.errors import MechbookError
-from mechbook.model.catalog import problem_path
+from mechbook.model.catalog import existing_problem_path, problem_path
 from mechbook.model.ids import split_id
 
 
@@ -50,11 +50,10 @@ def command(ctx: click.Context, problem_id: str, no_crosscheck: bool, timeout: f
         except MechbookError:
             if not os.path.lexists(plain):  # a link gone bad: watched, the check says why
                 raise
+        if not os.path.lexists(plain):
+            existing_problem_path(problem_id, base)  # no such problem: its own status
     except MechbookError as exc:
-        raise click.ClickException(for_terminal(str(exc))) from None
-    if not os.path.lexists(plain):
-        raise click.ClickException(f"no problem {problem_id} (no file {plain}; "
-                                   "`mechbook list` shows the problems there are)")
+        raise failure(exc) from None
     watch_problem(problem_id, base, say,
                   WatchOptions(crosscheck=not no_crosscheck,
                                timeout=seconds if seconds is not None else timeout,

@@ -16,6 +16,7 @@ import sympy as sp
 
 from mechbook.app.report.linkage import links
 from mechbook.app.report.outlines import entries, outline_specs, projected, triad
+from mechbook.app.report.spring_ends import length_springs
 from mechbook.core.compile import as_expr, compile_exprs
 
 MAX_FRAMES = 240
@@ -67,6 +68,8 @@ def frames(sys, traj, values: dict, max_frames: int = MAX_FRAMES) -> dict | None
                           {frozenset(p) for p in _body_pairs(ends, names)}, span)
     pivot_uv = [np.asarray(p, float)[axes] for _, p in pivots]
     masses = {n: _number(sys.masses.get(n), values) for n in names}
+    reach = [uv[:, s["body"]] + d for s in specs for d in _reach(s["lines"])]
+    ends += length_springs(sys, names, values, args, idx, traj, xyz, rots, turning, axes)
     return {"t": [round(float(traj.t[i]), 5) for i in idx],
             "bodies": [{"name": n, "mass": masses[n],
                         "path": np.round(uv[:, k, :], 5).tolist()}
@@ -78,7 +81,18 @@ def frames(sys, traj, values: dict, max_frames: int = MAX_FRAMES) -> dict | None
                        for (k, _), p in zip(pivots, pivot_uv, strict=True)],
             "outlines": _outlines(specs, rots, axes, span),
             "axes": [AXES[a] for a in axes],
-            "box": _box(np.concatenate([flat, *[p.reshape(1, 2) for p in pivot_uv]]))}
+            "box": _box(np.concatenate([flat, *[p.reshape(1, 2) for p in pivot_uv],
+                                        *reach]))}
+
+
+def _reach(lines: list) -> list[np.ndarray]:
+    """How far an outline reaches from its body's centre, as the four offsets (±r, ±r)
+    that keep the whole of it inside the drawing's box, whichever way it turns."""
+    pts = [p for line in lines for p in line]
+    if not pts:
+        return []
+    r = float(np.max(np.linalg.norm(np.asarray(pts, float), axis=1)))
+    return [np.array([[a * r, b * r]]) for a in (-1, 1) for b in (-1, 1)]
 
 
 def _away(path: np.ndarray, pivot: np.ndarray) -> list[float]:
@@ -190,6 +204,8 @@ def _pairs(ends: list) -> list:
 
 def _end(end: tuple, names: list[str]):
     kind, value = end
+    if kind == "path":  # a point of a body that is not its centre (a plate's corner)
+        return {"path": value}
     return names.index(value) if kind == "body" else value
 
 

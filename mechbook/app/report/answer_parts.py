@@ -3,7 +3,15 @@ the numbers at one admissible point (mechbook.app.report.values)."""
 
 from __future__ import annotations
 
-from mechbook.app.report.values import book_math, engine_value, numeric_pair
+import sympy as sp
+
+from mechbook.app.report.values import (
+    book_math,
+    display_of,
+    engine_value,
+    numeric_pair,
+    stability_boundary,
+)
 from mechbook.verify.context import Context
 
 
@@ -16,7 +24,8 @@ def parts(page, analysis, key, views: dict) -> list[dict]:
         row = {"part": part.name, "cite": data.get("cite", ""), "quantity": part.quantity,
                "origin": data.get("origin", "book"), "system": part.system,
                "note": str(data.get("note", "")).strip(), "book": "", "engine": None,
-               "numeric": None, "erratum": None, "unsupported": data.get("unsupported")}
+               "numeric": None, "erratum": None, "unsupported": data.get("unsupported"),
+               "boundary": None}
         rows.append(row)
         ctx = page.step(f"part {part.name}", lambda part=part: Context(analysis, part))
         row["book"] = book_math(ctx, data.get("book"))
@@ -32,6 +41,12 @@ def parts(page, analysis, key, views: dict) -> list[dict]:
                           lambda ctx=ctx, view=view: engine_value(ctx, view, values))
         if value is not None:
             row["engine"] = page.show(value)
+        if display_of(part.quantity) == "sylvester_criterion":
+            found = page.step(f"part {part.name}: the engine's boundary",
+                              lambda ctx=ctx, view=view: stability_boundary(ctx, view, values))
+            if found:
+                row["boundary"] = page.show([sp.Eq(s, r, evaluate=False)
+                                             for s, roots in found.items() for r in roots])
         row["numeric"] = page.step(f"part {part.name}: values at one point",
                                    lambda ctx=ctx, view=view: numeric_pair(ctx, view, values))
     return rows

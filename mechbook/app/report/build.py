@@ -27,8 +27,10 @@ from mechbook.app.quiet import warnings_as_notes
 from mechbook.app.report import cache
 from mechbook.app.report.page import PageOptions, build_page
 from mechbook.app.report.progress import Progress
+from mechbook.app.report.simplified import DIRECTORY as SIMPLIFIED
 from mechbook.app.store import StoreError, problems, read, vet
 from mechbook.app.text import unicode_safe
+from mechbook.core.words import duration, plural
 from mechbook.errors import MechbookError, describe
 from mechbook.model.books import books, split_id
 from mechbook.model.catalog import all_ids
@@ -72,7 +74,7 @@ def build_report(base: Path, store: Path, out: Path, ids: list[str] | None = Non
     if todo:
         _build_pages(base, store, out, todo, keys, pages, stored, options, log)
     else:
-        log(f"all {len(ids)} pages are up to date")
+        log(f"all {plural(len(ids), 'page')} are up to date")
     declared = books(base)
     rows, problems_index = [], []
     for pid in ids:
@@ -134,7 +136,7 @@ def page_task(pid: str, base: Path, task: _Task, stage) -> dict:
     try:
         with warnings_as_notes(notes):
             stage("building the page")
-            page = build_page(pid, base, stored, task.page)
+            page = build_page(pid, base, stored, task.page, task.out / SIMPLIFIED)
     except MechbookError as exc:  # a problem file that does not load: said on its page
         return {"pid": pid, "failed": str(exc), "seconds": time.monotonic() - start}
     except Exception as exc:  # noqa: BLE001 - one page must not end the report
@@ -280,6 +282,7 @@ def _environment():
             autoescape=jinja2.select_autoescape(["html"]), undefined=jinja2.StrictUndefined,
             trim_blocks=True, lstrip_blocks=True)
         _ENV.filters["num"] = _num
+        _ENV.filters["duration"] = duration
     return _ENV
 
 

@@ -47,7 +47,7 @@ def equilibria_rows(page, sys_, view: StoredSystem, values: dict) -> tuple[list,
         out.append(page.step(f"equilibrium {sys_.name} {len(out) + 1}",
                              lambda point=point, lin=lin: _row(page, sys_, point, lin, values))
                    or {"point": math(point), "kind": "", "stability": "", "frequencies": "",
-                       "modes": "", "exact": ""})
+                       "modes": "", "exact": "", "mck": ""})
     if len(rows) > MAX_ROWS:
         page.notes.append(f"equilibria ({sys_.name}): {len(rows) - MAX_ROWS} more not shown")
     return out, left_out
@@ -55,8 +55,8 @@ def equilibria_rows(page, sys_, view: StoredSystem, values: dict) -> tuple[list,
 
 def _row(page, sys_, point: dict, lin, values: dict) -> dict:
     row = {"point": page.show(point), "kind": "equilibrium", "stability": "",
-           "frequencies": "", "modes": "", "exact": "", "values": _numbers(sys_, point,
-                                                                          values)}
+           "frequencies": "", "modes": "", "exact": "", "mck": "",
+           "values": _numbers(sys_, point, values)}
     if lin is None:
         row["stability"] = "not linearized by the check"
         return row
@@ -76,6 +76,7 @@ def _row(page, sys_, point: dict, lin, values: dict) -> dict:
             freqs = _frequencies(M, C, K)
         rates = growth_rates(M, C, K)
     row["frequencies"] = _modes_text(freqs, rates)
+    row["mck"] = page.step("M, C and K", lambda: _matrices(page, lin, M, C, K)) or ""
     if not np.any(C) and row["stability"] in ("stable", "marginal") and M.shape[0] > 1:
         row["modes"] = _shapes(M, K)
     if M.shape[0] == 1 and not np.any(C) and row["stability"] == "stable":
@@ -83,6 +84,21 @@ def _row(page, sys_, point: dict, lin, values: dict) -> dict:
                       evaluate=False)
         row["exact"] = page.step("exact frequency", lambda: page.show(exact)) or ""
     return row
+
+
+def _matrices(page, lin, M, C, K) -> str:
+    """M·δq̈ + C·δq̇ + K·δq = 0 about the point: M and K (and C where it is not zero) as
+    derived, simplified for reading, each with its numbers at the default values."""
+    shown = [("M", lin.M, M), ("K", lin.K, K)]
+    if np.any(C):
+        shown.insert(1, ("C", lin.C, C))
+    cells = []
+    for name, exact, numbers in shown:
+        num = sp.Matrix(numbers.shape[0], numbers.shape[1],
+                        [sp.Float(float(f"{x:.6g}"), 6) for x in numbers.flatten()])
+        cells.append(f'<div class="matrix"><span class="name">{name} =</span>'
+                     f"{page.show(exact)}<span class=\"note\">=</span>{math(num)}</div>")
+    return "".join(cells)
 
 
 def _first_order_row(row: dict, lin) -> dict:

@@ -6,9 +6,12 @@ a sphere its equator and a meridian, a block or plate its edges, a cone its base
 an ellipsoid two principal sections. A 3-D body with an attitude (Euler angles or a chain of
 rotations) is drawn through its rotation matrix R(q, t), body → space, at every frame; a
 body with no shape given (an inertia tensor, a body made of parts) shows its three axes
-instead. A planar body's angle is not a declared function of q, so only an outline that
-does not depend on it is drawn (the rim of a disk, ring, cylinder or sphere); a body with no
-attitude in 3-D likewise. The outlines are numbers in the body's axes; the script turns
+instead. A planar body turns by the angle its `angular_velocity` is the rate of: where
+that is a sum of coordinates' rates with constant coefficients (θ̇, or θ̇₁ + θ̇₂), the
+angle is the same sum of the coordinates, and its outline (a plate's edges, a rod) turns
+with it in the plane of the positions; otherwise (and for a body with no attitude in 3-D)
+only an outline that does not depend on the angle is drawn (the rim of a disk, ring,
+cylinder or sphere). The outlines are numbers in the body's axes; the script turns
 them with R's two rows for the drawing plane.
 """
 
@@ -97,11 +100,40 @@ def outline_specs(sys, names: list[str], values: dict) -> list[dict]:
             R = rotation_matrix(attitude).xreplace(values)
             out.append({"body": names.index(name), "lines": lines, "R": R,
                         "triad": not lines})
+        elif found and (angle := planar_angle(sys, name, spec)) is not None:
+            out.append({"body": names.index(name), "lines": shape_lines(*found),
+                        "R": _about_z(angle).xreplace(values), "triad": False})
         elif found and found[0] in ROUND:  # its rim, whatever its angle
             r = found[1].get("radius", 0.0)
             out.append({"body": names.index(name), "lines": [_circle(r, r)], "R": None,
                         "triad": False})
     return out
+
+
+def planar_angle(sys, name: str, spec: dict) -> sp.Expr | None:
+    """The angle φ(q) whose rate is the planar body's `angular_velocity` (a scalar), where
+    that rate is Σ cᵢ q̇ᵢ with constant cᵢ; None otherwise (or for a 3-D body)."""
+    w = spec.get("angular_velocity")
+    if w is None or isinstance(w, list):
+        return None
+    try:
+        omega = sp.expand(sys.parse(w, ("rigid_bodies", name, "angular_velocity")))
+    except Exception:  # noqa: BLE001 - the system was built from it; a drawing is optional
+        return None
+    coeffs = [omega.diff(v) for v in sys.qd]
+    moving = set(sys.q) | set(sys.qd) | {sys.t}
+    if any(c.free_symbols & moving for c in coeffs):
+        return None
+    if sp.expand(omega - sum(c * v for c, v in zip(coeffs, sys.qd, strict=True))) != 0:
+        return None
+    angle = sum((c * q for c, q in zip(coeffs, sys.q, strict=True)), sp.S.Zero)
+    return angle if angle != 0 else None
+
+
+def _about_z(angle: sp.Expr) -> sp.Matrix:
+    """The rotation by `angle` in the x-y plane (a planar body's own axes → space)."""
+    c, s = sp.cos(angle), sp.sin(angle)
+    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
 
 
 def projected(R_frames: np.ndarray, axes: list[int]) -> list[list[float]]:

@@ -31,6 +31,7 @@ from mechbook.app.mathml import math
 from mechbook.app.report import svg
 from mechbook.app.report.answer_parts import parts
 from mechbook.app.report.derivation import StoredSystem
+from mechbook.app.report.simplified import SimplifiedCache
 from mechbook.app.report.systems import system_section
 from mechbook.app.report.values import point_math
 from mechbook.core.timeout import Timeout, hard_time_limit, time_limit
@@ -49,8 +50,11 @@ log = logging.getLogger("mechbook.faults")
 @dataclass(frozen=True)
 class PageOptions:
     seconds: float = 10.0  # limit of each step that computes
-    simplify_seconds: float = 0.3  # limit of each expression's simplification
-    simplify_budget: float = 1.5  # all simplification of one page
+    # limit of each expression's simplification, and of all of one page's: spent once, as
+    # the forms are kept (mechbook.app.report.simplified); the double pendulum's L takes
+    # 1-3 s on a loaded machine
+    simplify_seconds: float = 3.0
+    simplify_budget: float = 15.0
     simulate: bool = True
     t_end: float = 10.0
     simulate_seconds: float = 10.0
@@ -66,6 +70,7 @@ class Page:
     timings: list[tuple[str, float]] = field(default_factory=list)  # the slow steps
     simplifying: float = 0.0
     raw: set = field(default_factory=set)  # why expressions were left as derived
+    kept: SimplifiedCache = field(default_factory=lambda: SimplifiedCache(None))
 
     def step(self, label: str, fn, seconds: float | None = None):
         """fn() within the step limit; None (and a line under "Not shown") if it cannot."""
@@ -101,6 +106,10 @@ class Page:
             return sp.Eq(self.readable(obj.lhs), self.readable(obj.rhs), evaluate=False)
         if not isinstance(obj, sp.Expr) or obj.is_Atom:
             return obj
+        if self.options.simplify_seconds > 0:
+            kept = self.kept.get(obj)  # simplified on an earlier run: nothing to spend
+            if kept is not None:
+                return kept
         seconds = min(self.options.simplify_seconds, self.budget)
         if seconds <= 0 < self.options.simplify_seconds and sp.count_ops(obj) <= SMALL:
             seconds = self.options.simplify_seconds  # past the budget, but costs little
@@ -112,6 +121,7 @@ class Page:
         try:
             with time_limit(seconds):
                 out = sp.simplify(obj)
+            self.kept.put(obj, out)
         except Timeout:  # too long (or the alarm arrived just after simplify returned)
             out = obj
             why = "slow" if seconds >= self.options.simplify_seconds else "budget"
@@ -165,10 +175,12 @@ def _short(text: str) -> str:
 
 
 def build_page(pid: str, base: Path, stored: dict | None,
-               options: PageOptions = PageOptions()) -> dict:
-    """Everything the problem's page shows, as plain data (HTML fragments, numbers)."""
+               options: PageOptions = PageOptions(), kept: Path | None = None) -> dict:
+    """Everything the problem's page shows, as plain data (HTML fragments, numbers); the
+    simplified forms kept under `kept` are reused and new ones added
+    (mechbook.app.report.simplified)."""
     start = time.monotonic()
-    page = Page(options, budget=options.simplify_budget)
+    page = Page(options, budget=options.simplify_budget, kept=SimplifiedCache(kept))
     problem = load_problem(problem_path(pid, base))
     analysis = Analysis(problem)
     out = {"id": pid, "title": problem.title, "source": problem.source,

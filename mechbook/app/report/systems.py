@@ -19,6 +19,7 @@ from mechbook.app.report.animation import frames
 from mechbook.app.report.derivation import StoredSystem
 from mechbook.app.report.equilibria_table import equilibria_rows
 from mechbook.app.report.stored import names_for
+from mechbook.model.manifold import manifold_of
 from mechbook.numerics.simulate import FALLBACK_OFFSET, simulate
 
 
@@ -113,10 +114,13 @@ def _simulation(page, analysis, name: str, sys_, rows: list[dict]) -> dict | Non
             start = [_inside(sys_, q, analysis.problem.values()) for q in sys_.q]
             near, seconds = "q = 0 (no equilibrium known to the check)", min(seconds, 4.0)
         # unequal offsets, so that a uniform translation is not all that moves
-        init = {c: repr(x + FALLBACK_OFFSET * (1.0 if i == 0 else 0.5))
-                for i, (c, x) in enumerate(zip(sys_.coord_names, start, strict=True))}
+        q0 = [float(x) + FALLBACK_OFFSET * (1.0 if i == 0 else 0.5)
+              for i, x in enumerate(start)]
         source = (f"at rest, {FALLBACK_OFFSET:g} ({FALLBACK_OFFSET / 2:g} in the other "
                   f"coordinates) from {near}")
+        init, projected = _on_constraints(sys_, analysis.problem.values(), q0)
+        if projected:
+            source += ", moved onto the constraints as the checks move their states"
 
     def run():
         with np.errstate(all="ignore"):
@@ -147,6 +151,24 @@ def _simulation(page, analysis, name: str, sys_, rows: list[dict]) -> dict | Non
             "initial": ", ".join(f"{k} = {v:.4g}" for k, v in sim.initial.items()),
             "initial_source": source, "t_end": float(traj.t[-1]),
             "samples": len(traj.t), "notes": list(sim.notes)}
+
+
+def _on_constraints(sys_, values: dict, q0: list[float]) -> tuple[dict, bool]:
+    """The start {coordinate or rate: text} for the simulation: `q0` at rest, or, for a
+    system with constraints, the nearest state on its constraint manifold (coordinates and
+    rates, as the checks settle their sampled states: mechbook.model.manifold), and
+    whether it was moved there."""
+    names = list(sys_.coord_names)
+    manifold = manifold_of(sys_)
+    if manifold is None:
+        return {c: repr(x) for c, x in zip(names, q0, strict=True)}, False
+    settled = manifold.settle(values, np.array(q0), np.zeros(len(q0)))
+    if settled is None:  # the simulation says why it cannot start there
+        return {c: repr(x) for c, x in zip(names, q0, strict=True)}, False
+    q1, qd1 = settled
+    init = {c: repr(float(x)) for c, x in zip(names, q1, strict=True)}
+    init.update({f"{c}dot": repr(float(v)) for c, v in zip(names, qd1, strict=True)})
+    return init, True
 
 
 def settings_text(settings: dict) -> str:

@@ -25,7 +25,6 @@ import sympy as sp
 from mechbook.app.mathml import MINUS, NS, identifier_mathml, math
 from mechbook.app.report.derivation import StoredSystem
 from mechbook.app.report.syntax import syntax_math
-from mechbook.engine.periodic import time_dependent
 from mechbook.errors import MechbookError
 from mechbook.verify.context import Context, numbers, strip_const
 from mechbook.verify.registry import default_quantities
@@ -144,14 +143,10 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
     if shown == "equilibrium_points":
         return view.equilibria or None
     if shown == "sylvester_criterion":
-        lin = part_linear(ctx, view, values)
-        if lin is None or lin.first_order or lin.C.is_zero_matrix is False \
-                or time_dependent(lin):
-            return None  # velocity terms, first order, or K(t): not K's minors
-        K = lin.K
-        if K.rows > 3:
+        minors = stability_minors(ctx, view, values)
+        if minors is None:
             return None
-        return sp.And(*[K[:k, :k].det() > 0 for k in range(1, K.rows + 1)])
+        return sp.And(*[m > 0 for m in minors])
     if shown == "momenta_and_energy":
         out = {}
         cyclic = view.get("cyclic")
@@ -161,6 +156,43 @@ def engine_value(ctx: Context, view: StoredSystem | None, values: dict):
         if energy is not None:
             out[sp.Symbol("h")] = energy
         return out or None
+    return None
+
+
+def stability_minors(ctx: Context, view: StoredSystem | None, values: dict) -> list | None:
+    """K's leading principal minors at the part's point, where stability is K positive
+    definite (no velocity terms, not first order, K free of t, at most 3 coordinates);
+    else None."""
+    lin = part_linear(ctx, view, values)
+    if lin is None or lin.first_order or lin.C.is_zero_matrix is False:
+        return None  # velocity terms, or first order: not K's minors
+    t = ctx.system.t
+    if any(A.has(t) for A in (lin.M, lin.C, lin.K)) or lin.K.rows > 3:
+        return None  # K(t) (Floquet's, not Sylvester's), or too many coordinates to show
+    K = lin.K
+    return [sp.factor(K[:k, :k].det()) for k in range(1, K.rows + 1)]
+
+
+def stability_boundary(ctx: Context, view: StoredSystem | None, values: dict) -> dict | None:
+    """Where the engine's stability changes: det K = 0 solved for a parameter of the book's
+    relation (the first one it can be solved for), {symbol: [roots]}; None where there is
+    no such closed form (or no relation)."""
+    minors = stability_minors(ctx, view, values)
+    if not minors:
+        return None
+    try:
+        relation = ctx.parse(ctx.part.data.get("book"), ("book",), relation=True)
+    except (MechbookError, TypeError, ValueError):
+        return None
+    det = minors[-1]
+    text = str(ctx.part.data.get("book"))
+    # the book's own order: "omega < sqrt(g/b)" solves for omega
+    symbols = sorted((s for s in relation.free_symbols if det.has(s)),
+                     key=lambda s: (_first(text, s.name), s.name))
+    for sym in symbols:
+        roots = [r for r in sp.solve(det, sym) if r.is_real is not False]
+        if roots:
+            return {sym: roots}
     return None
 
 
@@ -232,6 +264,12 @@ def _numeric_pair(ctx: Context, view: StoredSystem | None, values: dict, pt: dic
     if shown == "period_list":
         eng = [2 * np.pi / w for w in eng if w > 1e-12]
     return numbers(exprs, pt), sorted(float(w) for w in eng)
+
+
+def _first(text: str, name: str) -> int:
+    """Where the name `name` first appears in `text` as a whole word (len(text) if not)."""
+    m = re.search(rf"(?<![A-Za-z0-9_]){re.escape(name)}(?![A-Za-z0-9_])", text)
+    return m.start() if m else len(text)
 
 
 def display_of(quantity: str) -> str | None:

@@ -15,6 +15,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
+from mechbook.core.words import plural
 from mechbook.engine.linear_grid import MARGINAL, STABLE, UNDEFINED, relations, truth
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.verify.context import Context
@@ -169,7 +170,8 @@ def _frequencies(out: dict, ctx, part, sweeper, result) -> None:
         worst = float(np.max(rel[ok])) if ok.any() else float("nan")
         out["max_rel_diff"] = worst
         out["lines"].append(f"{_who(out)} ({out['cite']}): largest relative difference from the "
-                            f"engine {worst:.2e} over {int(ok.sum())} points where both are "
+                            f"engine {worst:.2e} over {plural(int(ok.sum()), 'point')} where "
+                            f"both are "
                             "real")
     else:
         out["lines"].append(f"{_who(out)} ({out['cite']}): gives {vals.shape[1]} frequencies, the "

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.errors import MechbookError
+from mechbook.model.catalog import existing_problem_path
 
 if TYPE_CHECKING:
     from mechbook.engine.linear_grid import Axis
@@ -71,9 +72,8 @@ def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
     if quantity not in QUANTITIES:
         raise MechbookError(f"unknown quantity {quantity!r}; known: {', '.join(QUANTITIES)}")
     check_grid(axes)
+    existing_problem_path(pid, base)  # no such problem: the one message (and status)
     files = tree_files(pid, base)
-    if not files:
-        raise MechbookError(f"no problem {pid} under {base}")
     return SweepSpec(pid, tuple(sorted(files.items())), quantity, tuple(axes), system,
                      tuple((about or {}).items()), tuple((steady or {}).items()), part,
                      backend)

@@ -6,6 +6,7 @@ import numpy as np
 
 from mechbook.app.sweep.runner import SweepResult
 from mechbook.app.sweep.spec import AMPLITUDE
+from mechbook.core.words import plural
 from mechbook.engine.linear_grid import STABILITY_NAMES, UNDEFINED
 
 
@@ -15,7 +16,8 @@ def summary(result: SweepResult) -> list[str]:
     lines = [f"{a['problem']}: {a['title']}",
              f"{a['quantity']} about {a['point']} [system {a['system']}"
              + (", gyroscopic" if a["gyroscopic"] else "") + "]",
-             f"grid {a['axes']}: {a['points']} points in {a['blocks']} blocks on "
+             f"grid {a['axes']}: {plural(a['points'], 'point')} in "
+             f"{plural(a['blocks'], 'block')} on "
              f"{a['where']}; derived and compiled in {a['build_seconds']:.2f} s, evaluated "
              f"in {a['evaluate_seconds']:.2f} s ({a['points_per_second']:.3g} points/s)"]
     if a["fixed"]:
@@ -50,7 +52,7 @@ def summary(result: SweepResult) -> list[str]:
                    if acc.get("boundary_samples") else "")
                 + f": largest relative difference {acc['max_rel_diff']:.2e} ({what})")
         if acc["disagree"]:
-            line += f"; {acc['disagree']} points disagree: {acc['disagree_at']}"
+            line += f"; {plural(acc['disagree'], 'point')} disagree: {acc['disagree_at']}"
         lines.append(line)
     if a["ill_conditioned"]:
         lines.append(f"ill-conditioned points (float64 not trusted): {a['ill_conditioned']}, "

@@ -14,7 +14,10 @@ stays constant. Two checks (mechbook.engine.adiabatic):
               J: the slow change really keeps the action
 
 Both hold in the small-oscillation limit the book works in; a constant added to f, or a
-constant factor, is the same law.
+constant factor, is the same law. With `invariant: action` the book's f is the action
+itself, in the 1/2π convention of the `action` quantity: f must equal J/(2π) = √(MK)A²/2
+(= E/ω) at the same 6 points to 1e-20, so J and 2J, or the area ∮p dq = 2πJ, differ; the
+simulated change is checked as before.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import random
 
 import sympy as sp
 
+from mechbook.core.words import plural
 from mechbook.engine.adiabatic import frozen, simulate
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, value_and_scale
@@ -46,9 +50,10 @@ SLOW = {"type": "object", "minProperties": 1, "maxProperties": 1,
                'variable a free driven coordinate held fixed): f_A·J_r − f_r·J_A = 0 at 6 '
                'points to 1e-20, r anywhere in `slow: {r: [r0, r1]}`; and a simulation of '
                'the full equations with r moved from r0 to r1 over 200 periods keeps f and J '
-               'to 1e-3'),
+               'to 1e-3. With `invariant: action`, f must be the action itself, J/(2π) = '
+               '√(MK)A²/2 = E/ω (1/2π convention), at the 6 points to 1e-20'),
           keys={"coordinate": {"type": "string"}, "amplitude": {"type": "string"},
-                "slow": SLOW},
+                "slow": SLOW, "invariant": {"enum": ["function", "action"]}},
           equivalent=("shift", "scale"))
 def check_adiabatic_invariant(ctx: Context, val) -> Verdict:
     data, sys = ctx.part.data, ctx.system
@@ -78,6 +83,7 @@ def check_adiabatic_invariant(ctx: Context, val) -> Verdict:
     fa, fr, ja, jr = sp.diff(book, amp), sp.diff(book, slow), sp.diff(J, amp), sp.diff(J, slow)
     rng = random.Random(20261126)
     worst = 0.0
+    itself = data.get("invariant", "function") == "action"
     for k in range(1, POINTS + 1):
         pt = ctx.sampler.draw()
         r0, r1 = (value_and_scale(e, pt)[0].real for e in (r0_e, r1_e))
@@ -85,19 +91,31 @@ def check_adiabatic_invariant(ctx: Context, val) -> Verdict:
             raise ctx.part.error(("slow",), "the slow range's ends must be positive numbers")
         at = dict(pt)
         at[slow] = sp.Float(r0 + (r1 - r0) * rng.random(), 30)
+        if itself:  # the action itself, (1/2π)∮p dq: a value, not a function of it
+            got, s1 = value_and_scale(book, at)
+            want, s2 = value_and_scale(J / (2 * sp.pi), at)
+            rel = abs(got - want) / max(abs(want), s1, s2, 1e-300)
+            worst = max(worst, rel)
+            if not rel <= RTOL:
+                return Verdict(False, f"exact({k} points)",
+                               f"not the action J = {sp.sstr(J / (2 * sp.pi))} (1/2π∮p dq): "
+                               f"the book's {got.real:.12g}, the action {want.real:.12g} at "
+                               f"{slow} = {float(at[slow]):.6g}")
+            continue
         one, s1 = value_and_scale(fa * jr, at)
         two, s2 = value_and_scale(fr * ja, at)
         scale = max(abs(one) + abs(two), s1, s2, 1e-300)
         rel = abs(one - two) / scale
         worst = max(worst, rel)
         if not rel <= RTOL:
-            return Verdict(False, f"exact({k} points)",
+            return Verdict(False, f"exact({plural(k, 'point')})",
                            f"not a function of the action J = {sp.sstr(J)}: f_A·J_r − f_r·J_A "
                            f"is {rel:.2g} of its terms at {slow} = {float(at[slow]):.6g}")
-    return _simulated(ctx, book, J, amp, slow, r0_e, r1_e, worst)
+    return _simulated(ctx, book, J, amp, slow, r0_e, r1_e, worst, itself)
 
 
-def _simulated(ctx: Context, book, J, amp, slow, r0_e, r1_e, worst: float) -> Verdict:
+def _simulated(ctx: Context, book, J, amp, slow, r0_e, r1_e, worst: float,
+               itself: bool = False) -> Verdict:
     pt = ctx.sampler.default()
     r0, r1 = (value_and_scale(e, pt)[0].real for e in (r0_e, r1_e))
     a0 = value_and_scale(amp, pt)[0].real
@@ -123,6 +141,7 @@ def _simulated(ctx: Context, book, J, amp, slow, r0_e, r1_e, worst: float) -> Ve
               f"changed by {kept_f:.2g}, the action by {kept_j:.2g}")
     if not (abs(kept_f) <= SIM_RTOL and abs(kept_j) <= SIM_RTOL):
         return Verdict(False, "simulated", detail)
+    what = "the action itself" if itself else "a function of the action"
     return Verdict(True, f"exact({POINTS} points, 30 digits) and simulated", detail,
-                   power=f"a function of the action at {POINTS} points to {RTOL:g}; kept to "
+                   power=f"{what} at {POINTS} points to {RTOL:g}; kept to "
                          f"{abs(kept_f):.1g} (stated {SIM_RTOL:g}) by a simulated slow change")

@@ -31,6 +31,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_mp
+from mechbook.core.words import plural
 from mechbook.engine.extremum import Extremum, NoValue, locate, torus_maximum
 from mechbook.engine.linear import mp_matrix, state_matrix
 from mechbook.errors import UnsupportedError
@@ -287,21 +288,21 @@ def check_extremum(ctx: Context, val) -> Verdict:
         pt = ctx.sampler.draw()
         ext = engine(pt)
         if not ext.interior:
-            return Verdict(False, f"numeric({k} points)",
+            return Verdict(False, f"numeric({plural(k, 'point')})",
                            f"the engine's {kind} over [{_n(bounds_seen[0])}, "
                            f"{_n(bounds_seen[1])}] is at an end of the interval ({name} = "
                            f"{_n(ext.x)}, value {_n(ext.value)}): the "
                            "book's point is not the extremum there, or widen `over:`")
         sign_ok = ext.curvature < 0 if kind == "maximum" else ext.curvature > 0
         if not sign_ok:
-            return Verdict(False, f"numeric({k} points)", f"f'' = {_n(ext.curvature)} at "
+            return Verdict(False, f"numeric({plural(k, 'point')})", f"f'' = {_n(ext.curvature)} at "
                            f"{name} = {_n(ext.x)}: not a strict {kind}")
         e_at, e_val, msg = errors(pt, ext)
         worst_at, worst_val = max(worst_at, e_at), max(worst_val, e_val)
         if e_at > tol_at or e_val > tol_val:
             other = f"; other local {kind}s at {', '.join(_n(x) for x, _ in ext.others)}" \
                 if ext.others else ""
-            return Verdict(False, f"numeric({k} points)",
+            return Verdict(False, f"numeric({plural(k, 'point')})",
                            f"{kind} over {name}: {msg}: relative errors {e_at:.2g}, "
                            f"{e_val:.2g}{other}")
     what = " and ".join(w for w in ("at", "value") if w in book)
@@ -347,7 +348,8 @@ def _over_motion(ctx: Context, kind: str, spec: dict, book: dict) -> Verdict:
         err = error(pt)
         worst = max(worst, err)
         if not err <= RTOL:
-            return Verdict(False, f"numeric({k} points)", f"the {kind} of {spec['energy_of']}'s "
+            return Verdict(False, f"numeric({plural(k, 'point')})",
+                           f"the {kind} of {spec['energy_of']}'s "
                            f"energy over the motion: relative error {err:.2g}")
     return Verdict(True, f"numeric({POINTS} points, torus of phases, 40 digits)",
                    f"worst relative {worst:.2g}",

@@ -4,7 +4,7 @@ first integrals, the functional's value on it, and whether it is a minimum.
 
 A curve is written in a part as `{y: "c*cosh(x/c)"}` (explicit, y(x)) or `{parameter:
 theta, x: "a*(theta - sin(theta))", y: "a*(1 - cos(theta))"}` (parametric), with optional
-`multipliers: {length: expr}` (λ of an isoperimetric constraint). `constants: {a: 0.57,
+`multipliers: {length: expr}` (λ of an isoperimetric constraint). `solve_for: {a: 0.57,
 theta1: 2.4}` names the curve's constants fixed by the end conditions, each with a start
 for Gauss–Newton at the problem's default values; `range: [0, theta1]` the parameter's
 values at the two ends (default: the ends' x). At a sampled point the constants are
@@ -45,7 +45,7 @@ CONSTANTS = {"type": "object", "maxProperties": 8,
              "propertyNames": {"pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
              "additionalProperties": {"type": "number"}}
 SYMMETRY = {"type": "object", "minProperties": 1, "additionalProperties": EXPR}
-CURVE_KEYS = {"curve": CURVE, "range": RANGE, "constants": CONSTANTS}
+CURVE_KEYS = {"curve": CURVE, "range": RANGE, "solve_for": CONSTANTS}
 POINTS = 2  # parameter points a curve is checked at: the default values and a draw
 VANISH = 1e-18  # a residual at 30 digits, relative to what cancelled in it
 STATIONARY = 1e-9  # |J′(0)| relative to |J(0)| + |J″(0)| on the perturbed curves
@@ -149,11 +149,11 @@ class CurveSpec:
     def __init__(self, ctx: Context, spec, sub: tuple):
         self.fn = fn = functional(ctx)
         spec = ctx.as_map(spec, sub)
-        consts = ctx.as_map(ctx.part.data.get("constants") or {}, ("constants",))
+        consts = ctx.as_map(ctx.part.data.get("solve_for") or {}, ("solve_for",))
         names = dict(ctx.names)
         for k in consts:
             if k in names or k in fn.names():
-                raise ctx.part.error(("constants", k), f"{k!r} is already a name")
+                raise ctx.part.error(("solve_for", k), f"{k!r} is already a name")
             names[k] = sp.Symbol(k, real=True)
         self.constants = [names[k] for k in consts]
         self.start = {names[k]: v for k, v in consts.items()}
@@ -266,8 +266,8 @@ def _solved_points(spec: CurveSpec) -> list[dict]:
 @quantity('extremal',
           book='a curve: `{y: expr}` (y(x)) or `{parameter: s, x: expr, y: expr}`, with '
                '`multipliers:` if any, or `{implicit: G}` (G(x, y) = 0)',
-          how=('the curve\'s `constants:` (and the isoperimetric multipliers it does not '
-               'give) are solved by Gauss–Newton at 30 digits from the end conditions '
+          how=('the curve\'s constants `solve_for:` (and the isoperimetric multipliers it '
+               'does not give) are solved by Gauss–Newton at 30 digits from the end conditions '
                '(each end\'s x, the fixed values, ∂F̃/∂y′ = 0 at a free end), the '
                'constraints\' integrals, and the Euler–Lagrange residuals at six interior '
                'points; every residual must then vanish to 1e-18 of its scale, at the '
@@ -278,7 +278,7 @@ def _solved_points(spec: CurveSpec) -> list[dict]:
                '|J″|. An implicit curve (one function, no constraints): the ends on it, and '
                'Euler–Lagrange with y′, y″ by implicit differentiation at six points of it '
                '(y by Newton from the chord)'),
-          keys={"range": RANGE, "constants": CONSTANTS}, names=jet_names, needs_system=False)
+          keys={"range": RANGE, "solve_for": CONSTANTS}, names=jet_names, needs_system=False)
 def check_extremal(ctx: Context, val) -> Verdict:
     if isinstance(val, dict) and "implicit" in val:
         return _implicit_extremal(ctx, val)
@@ -322,11 +322,11 @@ def _implicit_extremal(ctx: Context, val: dict) -> Verdict:
     extra = sorted(set(val) - {"implicit"})
     if extra:
         raise ctx.part.error(("book", extra[0]), "an implicit curve is `{implicit: G}`")
-    consts = ctx.as_map(ctx.part.data.get("constants") or {}, ("constants",))
+    consts = ctx.as_map(ctx.part.data.get("solve_for") or {}, ("solve_for",))
     names = dict(ctx.names)
     for k in consts:
         if k in names or k in fn.names():
-            raise ctx.part.error(("constants", k), f"{k!r} is already a name")
+            raise ctx.part.error(("solve_for", k), f"{k!r} is already a name")
         names[k] = sp.Symbol(k, real=True)
     constants = [names[k] for k in consts]
     x, y = fn.x, fn.jets[0][0]

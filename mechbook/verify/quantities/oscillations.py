@@ -8,6 +8,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_mp
+from mechbook.core.words import plural
 from mechbook.engine import perturbation
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError, WrongAnswerError
@@ -49,12 +50,13 @@ def check_frequencies(ctx: Context, val) -> Verdict:
         ok, why = match_multiset(numbers(book, pt), list(lin.numeric_frequencies(pt)), partial)
         n += 1
         if not ok:
-            return Verdict(False, f"numeric({n} points)", why)
+            return Verdict(False, f"numeric({plural(n, 'point')})", why)
     precise = _precise_frequencies(ctx, book, lin, partial)
     if precise and not precise.ok:
         return precise
-    how = f"numeric({n} points, eigensolver" + (", 1 at 50 digits)" if precise else ")")
-    power = f"{n} points to 1e-8" + (f", 1 at 50 digits to {PRECISE_RTOL:g}" if precise else "")
+    how = f"numeric({plural(n, 'point')}, eigensolver" + (", 1 at 50 digits)" if precise else ")")
+    power = f"{plural(n, 'point')} to 1e-8" + (f", 1 at 50 digits to {PRECISE_RTOL:g}"
+                                                if precise else "")
     if partial:
         power += f"; partial: {len(book)} of {len(lin.q)} frequencies (the rest unchecked)"
     return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or how,

@@ -14,6 +14,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import evaluate_mp
+from mechbook.core.words import plural
 from mechbook.engine.part_energy import LinearMotion, quadratic_part_energy
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
@@ -123,7 +124,7 @@ def check_part_energy(ctx: Context, val) -> Verdict:
                 rel = float(abs(b - e) / scale)
                 worst = max(worst, rel)
                 if not rel <= RTOL:
-                    return Verdict(False, f"numeric({k + 1} points)",
+                    return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                    f"at t = {tv}: book {mpmath.nstr(b, 12)}, engine "
                                    f"{mpmath.nstr(e, 12)} (relative {rel:.2g})")
     return Verdict(True, f"numeric({POINTS} points x {len(TIMES)} times, 40 digits)",

@@ -7,6 +7,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.compile import compile_batch
+from mechbook.core.words import plural
 from mechbook.engine.phase import (
     PhaseFlow,  # scipy's integrator, only when a phase part is checked
     image_area,
@@ -110,7 +111,7 @@ def check_phase_area(ctx: Context, val) -> Verdict:
         b = value(book, env)
         rel = abs(b - area) / max(abs(area), 1e-300)
         if not (np.isfinite(rel) and abs(b.imag) <= 1e-12 * abs(b)) or rel > PHASE_RTOL:
-            return Verdict(False, f"numeric({k + 1} points)",
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                            f"book area {b.real:.12g}, image of the box {area:.12g} at t = "
                            f"{tv:.6g}, {_fmt_point(pt)}")
         worst = max(worst, rel)
@@ -197,11 +198,12 @@ def check_phase_region(ctx: Context, val) -> Verdict:
             j = wrong[0]
             where = ", ".join(f"{nm}={x:.8g}" for nm, x in zip(names, X[j], strict=True))
             back = ", ".join(f"{x:.8g}" for x in X0[j])
-            return Verdict(False, f"numeric({k + 1} points)",
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                            f"at {where}, t={tv:.6g}: the book puts the point "
                            f"{'inside' if claim[j] else 'outside'} the region, but the flow "
                            f"carries it back to ({back}), {'inside' if truth[j] else 'outside'}"
-                           f" the initial box ({wrong.size} of {judge.sum()} points disagree; "
+                           f" the initial box ({wrong.size} of "
+                           f"{plural(judge.sum(), 'point')} disagree; "
                            f"{_fmt_point(pt)})")
         inside += int(np.sum(judge & truth))
         judged += int(np.sum(judge))

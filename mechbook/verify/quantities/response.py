@@ -13,6 +13,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from mechbook.core.words import plural
 from mechbook.engine import response
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
@@ -140,7 +141,7 @@ def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
                       for r in roots]
         ok, why = match_complex(mapped, engine, partial=False, rtol=1e-7)
         if not ok:
-            return Verdict(False, f"numeric({k + 1} points)", why)
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})", why)
     return Verdict(True, f"numeric({POINTS} points, 40 digits)",
                    power=f"{POINTS} points: its roots are the exponents, to 1e-7, at 40 digits")
 
@@ -182,7 +183,7 @@ def _multiset_at_points(ctx: Context, val, engine) -> Verdict:
         pt = ctx.sampler.draw()
         ok, why = match_complex(complex_numbers(book, pt), engine(lin, pt), partial)
         if not ok:
-            return Verdict(False, f"numeric({k + 1} points)", why)
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})", why)
     return Verdict(True, f"numeric({POINTS} points, state-space eigenvalues)",
                    power=f"{POINTS} points: the multiset of exponents to 1e-8")
 
@@ -218,13 +219,13 @@ def check_complex_modes(ctx: Context, val) -> Verdict:
             pv = value(p, pt)
             ok, why = match_complex([pv], engine, partial=True)
             if not ok:
-                return Verdict(False, f"numeric({k + 1} points)", f"mode {i}: {why}")
+                return Verdict(False, f"numeric({plural(k + 1, 'point')})", f"mode {i}: {why}")
             u = np.array(complex_numbers(list(shape), pt))
             if not np.any(u) or not np.all(np.isfinite(u)):
                 return Verdict(False, "numeric", f"mode {i}: the shape is zero or undefined")
             res = _residual(M, C, K, pv, u)
             if res > 1e-8:
-                return Verdict(False, f"numeric({k + 1} points)",
+                return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"mode {i}: (Mp² + Cp + K)u relative residual {res:.3g}")
     return Verdict(True, f"numeric({POINTS} points)",
                    power=f"{POINTS} points: p an exponent to 1e-8, (Mp² + Cp + K)u to 1e-8")
@@ -286,7 +287,7 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
             got = value(e, pt)
             want = complex(np.array(complex_numbers(rows[c], pt)) @ X)
             if not abs(got - want) <= 1e-9 * max(abs(want), 1e-6 * scale):
-                return Verdict(False, f"numeric({k + 1} points)",
+                return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"{c}: book {_c(got)}, engine {_c(want)} (ω = {w:.6g})")
     return Verdict(True, f"numeric({POINTS} points, (K - w^2 M + i w C) X = F)",
                    power=f"{POINTS} points: each amplitude to 1e-9")
@@ -335,7 +336,7 @@ def check_resonances(ctx: Context, val) -> Verdict:
                 excited.append(complex(w))
         ok, why = match_complex(complex_numbers(book, pt), excited, partial=False)
         if not ok:
-            return Verdict(False, f"numeric({k + 1} points)", why)
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})", why)
     return Verdict(True, f"numeric({POINTS} points)",
                    power=f"{POINTS} points: the set of resonant frequencies to 1e-8")
 
@@ -407,15 +408,15 @@ def check_normal_transformation(ctx: Context, val) -> Verdict:
         off = V - np.diag(np.diag(V))
         scale = max(1e-300, float(np.max(np.abs(V))))
         if np.max(np.abs(T - np.eye(len(names)))) > 1e-9:
-            return Verdict(False, f"numeric({k + 1} points)",
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                            f"A^T M A is not the unit matrix: {np.round(T, 6).tolist()}")
         if np.max(np.abs(off)) > 1e-9 * scale:
-            return Verdict(False, f"numeric({k + 1} points)",
+            return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                            f"A^T K A is not diagonal: {np.round(V / scale, 6).tolist()}")
         for j, w in freqs.items():
             wv = value(w, pt)
             if abs(wv**2 - V[j, j]) > 1e-9 * scale:
-                return Verdict(False, f"numeric({k + 1} points)",
+                return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"{etas[j]}: omega**2 = {_c(wv**2)}, engine {V[j, j]:.10g}")
     return Verdict(True, f"numeric({POINTS} points)",
                    power=f"{POINTS} points in double precision: AᵀMA = 1 and AᵀKA diagonal to "

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechbook.core.words import plural
 from mechbook.engine import response, steady
 from mechbook.engine.certified_count import certified_count
 from mechbook.engine.steady_search import classify, classify_at, roots_in
@@ -57,7 +58,7 @@ def check_stability(ctx: Context, val) -> Verdict:
         if got != val:
             shown = ", ".join(f"{k}={float(v):.4g}" for k, v in sorted(
                 pt.items(), key=lambda kv: kv[0].name)[:8])
-            return Verdict(False, f"numeric({n + 1} points)",
+            return Verdict(False, f"numeric({plural(n + 1, 'point')})",
                            f"engine finds it {got} at {{{shown}}}")
     power = (f"60 points drawn widely (factors to e²), all {val}: a claim of no boundary, "
              "checked away from one")

@@ -16,6 +16,7 @@ import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate_resolved
 from mechbook.core.secalc import expand
+from mechbook.core.words import plural
 from mechbook.engine import steady
 from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial_roots
 from mechbook.errors import UndecidedError, UnsupportedError
@@ -163,14 +164,14 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
             abs(a - b) <= ROOT_RTOL * max(abs(a), abs(b), 1e-30) for a, b in zip(engine, book,
                                                                        strict=True))
         if not ok:
-            return Verdict(False, f"numeric({n} points)",
+            return Verdict(False, f"numeric({plural(n, 'point')})",
                            f"book's roots {[f'{b:.10g}' for b in book]}, engine's steady rates "
                            f"{[f'{e:.10g}' for e in engine]}")
     if not seen:  # two equations without real roots agree without saying anything
         raise UndecidedError(f"no steady motion exists at any of {n} sampled points: the "
                              "check cannot discriminate (`assume:` a region where one does)")
-    return Verdict(True, f"numeric({n} points, polynomial roots)",
-                   power=f"{n} points: the real roots, all of them, to {ROOT_RTOL:g}")
+    return Verdict(True, f"numeric({plural(n, 'point')}, polynomial roots)",
+                   power=f"{plural(n, 'point')}: the real roots, all of them, to {ROOT_RTOL:g}")
 
 
 
@@ -187,16 +188,17 @@ def _vanishes_at_rates(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
         for r in engine:
             v, scale = value_and_scale(eq, {**pt, fam.x: sp.Float(r, DIGITS)})
             if not abs(v) <= ROOT_RTOL * max(scale, 1e-300):
-                return Verdict(False, f"numeric({n} points)",
+                return Verdict(False, f"numeric({plural(n, 'point')})",
                                f"the book's equation does not vanish at the engine's steady "
                                f"rate {r:.10g} (residual {abs(v):.3g} of {scale:.3g})")
     if not seen:
         raise UndecidedError(f"no steady motion exists at any of {n} sampled points: the "
                              "check cannot discriminate (`assume:` a region where one does)")
-    return Verdict(True, f"numeric({n} points, at the engine's rates)",
+    return Verdict(True, f"numeric({plural(n, 'point')}, at the engine's rates)",
                    "the equation is not polynomial in the rate: it holds at every steady rate, "
                    "but its other roots are not counted",
-                   power=f"residual ≤ {ROOT_RTOL:g} at the engine's rates ({n} points); other "
+                   power=f"residual ≤ {ROOT_RTOL:g} at the engine's rates "
+                         f"({plural(n, 'point')}); other "
                          "roots of the book's equation not counted")
 
 

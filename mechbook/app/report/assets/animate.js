@@ -4,6 +4,7 @@
   "use strict";
   const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
   function setup(figure) {
+    figure.dataset.ready = "1";                  // set up once (a notebook runs this again)
     const data = JSON.parse(figure.querySelector("script.motion").textContent);
     const canvas = figure.querySelector("canvas");
     const button = figure.querySelector("button");
@@ -27,7 +28,10 @@
       }
       ctx.lineTo(bx, by); ctx.strokeStyle = "#888"; ctx.lineWidth = 1; ctx.stroke();
     }
-    function at(end) { return typeof end === "number" ? data.bodies[end].path[frame] : end; }
+    function at(end) {                         // a body, a point moving with one, or fixed
+      if (typeof end === "number") return data.bodies[end].path[frame];
+      return end.path ? end.path[frame] : end;
+    }
     function link(a, b) {                        // a rod: a thick dark line
       const [ax, ay] = px(a), [bx, by] = px(b);
       ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx, by);
@@ -99,5 +103,5 @@
     draw();
     window.requestAnimationFrame(tick);
   }
-  document.querySelectorAll("figure.animation").forEach(setup);
+  document.querySelectorAll("figure.animation:not([data-ready])").forEach(setup);
 })();

@@ -1,0 +1,243 @@
+"""`lyapunov`: the largest exponent by Benettin's method, against closed forms and
+well-known verdicts.
+
+- An overdamped oscillator ẍ + bẋ + kx = 0 (b² > 4k): every tangent vector ends along the
+  slower mode, so the exponent is the larger root of λ² + bλ + k, −b/2 + √(b²/4 − k), exactly
+  (the other mode's share dies like e^{−2√(b²/4 − k)·t}).
+- Two uncoupled oscillators (a linear centre): tangent vectors rotate, all exponents zero.
+- Hénon–Heiles, V = (x² + y²)/2 + x²y − y³/3: at E = 1/12 the orbits are regular (KAM tori
+  fill the section), at E = 1/6 the start (0, −0.1) on the y-axis lies in the chaotic sea
+  (Hénon & Heiles 1964; the exponent is about 0.14 there).
+- The driven damped pendulum θ̈ + θ̇/q + sin θ = g cos(ω t), ω = 2/3, q = 2 (Baker &
+  Gollub's values): chaotic at g = 1.5, a periodic attractor (a negative exponent) at 0.9.
+- A kicked rotor (rectangular kicks of width ε, the standard map as ε → 0): chaotic at
+  K = 6, regular next to the elliptic fixed point at K = 1.5.
+- An unbounded motion (an inverted oscillator) has no exponent: an error with its line.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+from ruamel.yaml import YAML
+from systems import load_analysis
+
+from mechbook.errors import UnsupportedError
+from mechbook.numerics.lyapunov import RESOLUTION, largest_exponent
+from mechbook.verify.answers import load_answers
+from mechbook.verify.checker import check_problem
+
+OVERDAMPED = """id: x
+source: a test
+title: an overdamped oscillator
+parameters:
+  b: {value: 3.0}
+  k: {value: 1.0}
+coordinates:
+  x: {}
+kinetic: xdot**2/2
+potential: k*x**2/2
+forces: {x: -b*xdot}
+"""
+
+CENTRE = """id: x
+source: a test
+title: two oscillators
+parameters:
+  w1: {value: 1.0}
+  w2: {value: 1.7}
+coordinates:
+  x: {}
+  y: {}
+kinetic: (xdot**2 + ydot**2)/2
+potential: (w1**2*x**2 + w2**2*y**2)/2
+"""
+
+HENON_HEILES = """id: x
+source: a test
+title: the Henon-Heiles system
+parameters: {}
+coordinates:
+  x: {}
+  y: {}
+kinetic: (xdot**2 + ydot**2)/2
+potential: (x**2 + y**2)/2 + x**2*y - y**3/3
+"""
+
+PENDULUM = """id: x
+source: a test
+title: a driven damped pendulum
+parameters:
+  q: {value: 2.0}
+  g: {value: 1.5}
+  w: {value: 0.6666666666666666}
+coordinates:
+  theta: {}
+kinetic: thetadot**2/2
+potential: -cos(theta)
+forces: {theta: -thetadot/q + g*cos(w*t)}
+"""
+
+ROTOR = """id: x
+source: a test
+title: a kicked rotor
+parameters:
+  K: {value: 6.0}
+  eps: {value: 0.02}
+coordinates:
+  theta: {}
+kinetic: thetadot**2/2
+potential: K*cos(theta)*(1 + sign(cos(2*pi*t) - cos(pi*eps)))/(2*eps)
+"""
+
+INVERTED = """id: x
+source: a test
+title: an inverted oscillator
+parameters:
+  k: {value: 1.0}
+coordinates:
+  x: {}
+kinetic: xdot**2/2
+potential: -k*x**2/2
+"""
+
+
+@pytest.fixture(scope="module")
+def tree(tmp_path_factory):
+    return tmp_path_factory.mktemp("lyapunov")
+
+
+def check(analysis, tmp_path, symbols=None, **part):
+    doc = {"problem": analysis.problem.id, "source": "test",
+           "parts": [{"part": "x", "cite": "test", "quantity": "lyapunov", **part}]}
+    if symbols:
+        doc["symbols"] = symbols
+    YAML().dump(copy.deepcopy(doc), (tmp_path / "key.yaml").open("w"))
+    out = check_problem(analysis, load_answers(tmp_path / "key.yaml"))[0]
+    return out.status, out.detail
+
+
+EXPONENT = "-b/2 + sqrt(b**2/4 - k)"
+
+
+@pytest.mark.parametrize("book, status", [
+    (EXPONENT, "pass"),
+    (f"({EXPONENT})*1.01", "fail"),
+    (f"({EXPONENT})*1.000001", "fail"),
+    ("-b/2 - sqrt(b**2/4 - k)", "fail"),      # the other (faster) exponent
+    ("negative", "pass"),
+    ("zero", "fail"),
+    ("positive", "fail"),
+])
+def test_overdamped_oscillator_exponent_in_closed_form(tree, tmp_path, book, status):
+    an = load_analysis(tree, OVERDAMPED, "9301")
+    got = check(an, tmp_path, initial={"x": 1, "xdot": 0}, time=40, book=book)
+    assert got[0] == status, got
+
+
+@pytest.mark.parametrize("book, status", [("zero", "pass"), ("positive", "fail"),
+                                          ("negative", "fail")])
+def test_a_linear_centre_has_zero_exponents(tree, tmp_path, book, status):
+    an = load_analysis(tree, CENTRE, "9302")
+    got = check(an, tmp_path, initial={"x": 0.3, "ydot": 0.2}, time=400, book=book)
+    assert got[0] == status, got
+
+
+def hh_start(energy: str, y: str) -> dict:
+    """(x, y, ẋ, ẏ) = (0, y, √(2E − y² + 2y³/3), 0): on the energy surface E."""
+    return {"y": y, "xdot": f"sqrt(2*{energy} - ({y})**2 + 2*({y})**3/3)"}
+
+
+@pytest.mark.parametrize("energy, y, book, status", [
+    ("1/12", "0.1", "zero", "pass"),
+    ("1/12", "0.1", "positive", "fail"),      # chaotic for a regular orbit
+    ("1/12", "-0.2", "zero", "pass"),
+    ("1/6", "-0.1", "positive", "pass"),
+    ("1/6", "-0.1", "zero", "fail"),           # regular for a chaotic orbit
+])
+def test_henon_heiles_regular_and_chaotic(tree, tmp_path, energy, y, book, status):
+    an = load_analysis(tree, HENON_HEILES, "9303")
+    got = check(an, tmp_path, initial=hh_start(energy, y), time=1000, book=book)
+    assert got[0] == status, got
+
+
+def test_a_value_the_run_cannot_resolve_is_unsupported(tree, tmp_path):
+    """The chaotic exponent's spread over the last quarters (~1e-2) exceeds ±1e-4."""
+    an = load_analysis(tree, HENON_HEILES, "9303")
+    got = check(an, tmp_path, initial=hh_start("1/6", "-0.1"), time=1000, book="0.14",
+                tolerance="1e-4")
+    assert got[0] == "unsupported" and "spread" in got[1], got
+
+
+def test_a_long_run_reports_its_progress(tree, tmp_path):
+    """The checker's stage is told how far the run has got (a run stopped by check's time
+    limit then says where it was), four times over the 64 windows."""
+    an = load_analysis(tree, HENON_HEILES, "9303")
+    doc = {"problem": an.problem.id, "source": "test",
+           "parts": [{"part": "x", "cite": "test", "quantity": "lyapunov", "time": 1000,
+                      "initial": hh_start("1/12", "0.1"), "book": "zero"}]}
+    YAML().dump(doc, (tmp_path / "key.yaml").open("w"))
+    told = []
+    out = check_problem(an, load_answers(tmp_path / "key.yaml"), stage=told.append)[0]
+    assert out.status == "pass"
+    assert told == ["part x (lyapunov)"] + [f"part x (lyapunov): t = {t} of 1000"
+                                           for t in (250, 500, 750, 1000)]
+    assert f"resolution {RESOLUTION / 1000:.2g}" in out.power
+
+
+@pytest.mark.parametrize("g, book, status", [
+    ("1.5", "positive", "pass"),
+    ("1.5", "negative", "fail"),
+    ("0.9", "negative", "pass"),
+    ("0.9", "positive", "fail"),
+])
+def test_baker_gollub_pendulum(tree, tmp_path, g, book, status):
+    """A turning pendulum is bounded (θ is an angle of the equations: only θ̇ counts)."""
+    an = load_analysis(tree, PENDULUM, "9304")
+    got = check(an, tmp_path, initial={"theta": 0.2}, time=1000, book=book,
+                estimate={"values": {"g": g}, "rtol": 0.01})
+    assert got[0] == status, got
+
+
+@pytest.mark.parametrize("k, start, book, status", [
+    ("6", {"theta": 1.0, "thetadot": 0.3}, "positive", "pass"),
+    ("6", {"theta": 1.0, "thetadot": 0.3}, "zero", "fail"),
+    ("1.5", {"theta": "pi + 0.05", "thetadot": 0}, "zero", "pass"),
+    ("1.5", {"theta": "pi + 0.05", "thetadot": 0}, "positive", "fail"),
+])
+def test_kicked_rotor(tree, tmp_path, k, start, book, status):
+    an = load_analysis(tree, ROTOR, "9305")
+    got = check(an, tmp_path, initial=start, time=200, max_step=0.005, book=book,
+                estimate={"values": {"K": k}, "rtol": 0.01})
+    assert got[0] == status, got
+
+
+def test_an_unbounded_motion_is_an_error_with_its_line(tree, tmp_path):
+    an = load_analysis(tree, INVERTED, "9306")
+    got = check(an, tmp_path, initial={"x": 0.1}, time=100, book="1")
+    assert got[0] == "error" and "key.yaml:" in got[1] and "unbounded" in got[1], got
+
+
+def test_the_standard_map_exponent_grows_like_log_k_over_2(tree, tmp_path):
+    """For large K the standard map's exponent approaches ln(K/2) (Chirikov): at K = 6,
+    1.1 within ±0.3 (the pulses' width adds ~0.1, the run's spread ~0.2) — a value claim
+    with its tolerance."""
+    an = load_analysis(tree, ROTOR, "9305")
+    got = check(an, tmp_path, initial={"theta": 1.0, "thetadot": 0.3}, time=400,
+                max_step=0.005, book="log(3)", tolerance="0.3")
+    assert got[0] == "pass", got
+    assert math.log(3) == pytest.approx(1.0986, abs=1e-4)
+
+
+def test_a_run_past_its_budget_stops_and_says_so(tree):
+    """After four windows the run projects its cost; past the budget it stops (check's time
+    limit is then never reached by a part that would not finish)."""
+    an = load_analysis(tree, HENON_HEILES, "9303")
+    y0 = np.array([0.0, 0.1, math.sqrt(2 / 12 - 0.01 + 2e-3 / 3), 0.0])
+    with pytest.raises(UnsupportedError, match="would take about"):
+        largest_exponent(an.system(), an.dynamics(), {}, y0, 1000.0, budget=1e-9)
+    run = largest_exponent(an.system(), an.dynamics(), {}, y0, 1000.0)
+    assert len(run.logs) == 64 and run.seconds < 60
