@@ -31,7 +31,7 @@ from mechbook.model.problem import load_problem
 from mechbook.model.tensorexpr import kind
 from mechbook.verify.answers import AnswerKey, Part, load_answers
 from mechbook.verify.checker import check_problem
-from mechbook.verify.context import Context, split_named
+from mechbook.verify.context import Context, split_named, strip_const
 
 ROOT = Path(__file__).resolve().parents[1]
 ANSWER_FILES = sorted((ROOT / "answers").glob("*/*.yaml"))
@@ -172,7 +172,9 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
     q = part.quantity
     root = ("erratum", "corrected") if "erratum" in part.data else ("book",)
     val = get(part.data, root)
-    if ctx.tensor_mode:
+    if q in FUNCTIONAL:
+        yield from functional_slots(q, val, root)
+    elif ctx.tensor_mode:
         yield from tensor_slots(part, val, root)
     elif q == "lagrangian":
         yield Slot(root, "lagrangian")
@@ -292,6 +294,56 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
             yield Slot(root + ("stable",), "flag")
     else:  # a quantity this test does not know yet: walk the value's structure
         yield from walk(val, root)
+
+
+FUNCTIONAL = ("euler_lagrange", "functional_integral", "extremal", "functional_value",
+              "minimum")
+
+
+def functional_slots(q: str, val, root: tuple) -> Iterator[Slot]:
+    """A functional's parts: its equations, a first integral, the curve's expressions (not
+    its parameter's name), a value, a verdict."""
+    if q == "euler_lagrange":
+        for i in range(len(val)):
+            yield Slot(root + (i,), "fn_equation")
+    elif q == "functional_integral":
+        yield Slot(root, "fn_integral")
+    elif q == "extremal":
+        for k, v in val.items():
+            if k == "multipliers":
+                for m in v:
+                    yield Slot(root + (k, m), "fn_curve")
+            elif k != "parameter":
+                yield Slot(root + (k,), "fn_curve")
+    elif q == "functional_value":
+        yield Slot(root, "fn_value")
+    else:
+        yield Slot(root, "fn_verdict")
+
+
+def functional_mutants(slot: Slot, value, names: list[str]) -> Iterator[tuple[str, object]]:
+    """Wrong versions of a functional part's value, none of which can mean the same."""
+    s = str(value)
+    if slot.kind == "fn_equation":
+        lhs, rhs = split_equation(s)
+        flipped = flip_first_sign(lhs)
+        if flipped:
+            yield "flip sign of a term", f"{flipped} = {rhs}"
+        doubled = double_first_term(lhs)
+        if doubled:
+            yield "double a term", f"{doubled} = {rhs}"
+        yield "add one", f"{lhs} + 1 = {rhs}"
+    elif slot.kind == "fn_integral":  # a multiple would be a function of the integral
+        body = strip_const(s)
+        yield "add x", f"({body}) + x"
+        yield "times (1 + x)", f"({body})*(1 + x)"
+    elif slot.kind == "fn_curve":
+        yield "double", f"2*({s})"
+        yield "add one", f"({s}) + 1"
+    elif slot.kind == "fn_value":
+        yield from expression_mutants(s, names)
+    else:
+        yield "the other verdict", "not a minimum" if s == "minimum" else "minimum"
 
 
 def walk(val, path: tuple) -> Iterator[Slot]:
@@ -761,7 +813,8 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, repo_analysis):
         for slot in part_slots:
             old = get(part.data, slot.path)
             count = 0
-            made = (tensor_mutants(ctx, slot, old, names) if ctx.tensor_mode else
+            made = (functional_mutants(slot, old, names) if slot.kind.startswith("fn_")
+                    else tensor_mutants(ctx, slot, old, names) if ctx.tensor_mode else
                     mutants(slot, old, names, coordinate))
             for label, new in made:
                 if count >= MAX_MUTANTS_PER_SLOT:
@@ -770,7 +823,8 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, repo_analysis):
                     continue  # a lower-order term does not change an asymptotic formula
                 if "estimate" in part.data and label in ("add one", "add the unit tensor"):
                     continue  # below the book's precision at its scale (moments ~ 1e37)
-                if (tensor_same_meaning(ctx, slot, old, new) if ctx.tensor_mode else
+                if (str(old) == str(new) if slot.kind.startswith("fn_") else
+                        tensor_same_meaning(ctx, slot, old, new) if ctx.tensor_mode else
                         same_meaning(ctx, slot, part.data, old, new)):
                     continue
                 count += 1

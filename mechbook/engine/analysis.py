@@ -24,6 +24,7 @@ from mechbook.engine.screen import screen
 from mechbook.errors import UnsupportedError
 from mechbook.model.built import Built
 from mechbook.model.declared import Declared
+from mechbook.model.functional import Functional
 from mechbook.model.problem import Problem
 from mechbook.model.system import System
 
@@ -59,6 +60,10 @@ class Analysis:
     def declared(self) -> Declared:
         """The problem's declared vectors, tensors and bodies (built once)."""
         return self.built.declared()
+
+    def functional(self) -> Functional | None:
+        """The problem's declared functional, or None (built once)."""
+        return self.built.functional()
 
     def derived(self) -> list[Derived]:
         """For each system built so far (in the problem's order), what was derived for it."""

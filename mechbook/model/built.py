@@ -1,5 +1,5 @@
-"""What is built from one problem, each thing once: its systems and its declared vectors,
-tensors and bodies.
+"""What is built from one problem, each thing once: its systems, its declared vectors,
+tensors and bodies, and its functional.
 
 The builder keeps what it built, not the Problem (plain data that anyone may hold): an
 engine Analysis owns one Built, so what a check built is what its Built holds, and a new
@@ -9,6 +9,7 @@ Analysis starts from nothing. `mechbook validate` uses one without the engine.
 from __future__ import annotations
 
 from mechbook.model.declared import Declared, declared
+from mechbook.model.functional import Functional, functional_of
 from mechbook.model.problem import Problem
 from mechbook.model.system import System, system_name, system_of
 
@@ -20,6 +21,7 @@ class Built:
         self.problem = problem
         self._systems: dict[str, System] = {}
         self._declared: Declared | None = None
+        self._functional: list[Functional | None] = []
 
     def system(self, name: str | None = None) -> System:
         """The system `name` (or the only one, or `main`), built once. NotFoundError (a
@@ -34,6 +36,12 @@ class Built:
         if self._declared is None:
             self._declared = declared(self.problem)
         return self._declared
+
+    def functional(self) -> Functional | None:
+        """The problem's declared functional (None if it has none), built once."""
+        if not self._functional:
+            self._functional.append(functional_of(self.problem.doc, self.problem.names()))
+        return self._functional[0]
 
     def systems_built(self) -> list[System]:
         """The systems built so far, in the problem's order."""

@@ -42,6 +42,7 @@ SYSTEM_COUNTS = {
     "coordinates": 16, "driven": 16, "particles": 32, "rigid_bodies": 32, "springs": 64,
     "constraints": 16, "velocity_constraints": 16, "rolling": 8, "forces": 16, "initial": 64,
 }
+FUNCTIONAL_COUNTS = {"functions": 6, "constraints": 8}  # a functional's (mechbook.model.functional)
 ANSWER_COUNTS = {"parts": 64, "abbreviations": 64, "symbols": 64}
 PART_COUNTS = {"assume": 32, "define": 32}
 
@@ -189,6 +190,8 @@ def check_counts(doc, data: dict, limits: dict[str, int], prefix: tuple = ()) ->
 def check_problem_counts(doc) -> None:
     data = doc.data
     check_counts(doc, data, PROBLEM_COUNTS)
+    if isinstance(data.get("functional"), dict):
+        check_counts(doc, data["functional"], FUNCTIONAL_COUNTS, ("functional",))
     check_counts(doc, data, SYSTEM_COUNTS)
     for name, system in (data.get("systems") or {}).items():
         if isinstance(system, dict):

@@ -18,6 +18,7 @@ import sympy as sp
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
 from mechbook.model.expr import CONSTANTS, DECLARABLE, FUNCTIONS, Operator, parse
+from mechbook.model.functional import functional_of
 from mechbook.model.input_limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
 from mechbook.model.yamlio import Document, loads
@@ -159,7 +160,7 @@ def load_problem(path: str | Path) -> Problem:
         systems = {n: SystemSpec(n, s, ("systems", n)) for n, s in data["systems"].items()}
     elif "coordinates" in data:
         systems = {"main": SystemSpec("main", {k: data[k] for k in SYSTEM_KEYS if k in data}, ())}
-    else:  # no system: a problem about declared vectors, tensors and bodies only
+    else:  # no system: declared vectors, tensors and bodies, or a functional, only
         stray = [k for k in SYSTEM_KEYS if k in data and k != "doc"]
         if stray:
             raise doc.error((stray[0],), "'coordinates' is required (or a 'systems' mapping) "
@@ -175,4 +176,5 @@ def load_problem(path: str | Path) -> Problem:
                           for i, c in enumerate(data.get("conditions", []))]
     if not all(bool(c.subs(problem.values())) for c in problem.conditions):
         raise doc.error(("conditions",), "the default parameter values violate the conditions")
+    functional_of(doc, problem.names())  # refused now, at its line (model.built keeps one)
     return problem

@@ -30,6 +30,7 @@ from mechbook.verify.quantities import (
     equilibria,
     expressions,
     extremum,
+    functional,
     hamilton_jacobi,
     motion,
     oscillations,
@@ -48,8 +49,9 @@ from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
 MODULES = (access, action, adiabatic, brackets, canonical, chaos, equations, equilibria,
-           expressions, extremum, hamilton_jacobi, motion, oscillations, parts, perturbation,
-           phase, response, rotation, stability, steady, tensors, trajectory, words)
+           expressions, extremum, functional, hamilton_jacobi, motion, oscillations, parts,
+           perturbation, phase, response, rotation, stability, steady, tensors, trajectory,
+           words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",
