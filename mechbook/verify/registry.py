@@ -33,6 +33,7 @@ from mechbook.verify.quantities import (
     phase,
     response,
     rotation,
+    scattering,
     stability,
     steady,
     tensors,
@@ -43,8 +44,8 @@ from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
 MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, motion,
-           oscillations, parts, perturbation, phase, response, rotation, stability, steady,
-           tensors, trajectory, words)
+           oscillations, parts, perturbation, phase, response, rotation, scattering, stability,
+           steady, tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",

@@ -1,0 +1,340 @@
+"""Scattering on an unbound orbit: deflection, closest approach, capture.
+
+A system whose coordinates are one radial coordinate r and one cyclic angle (a particle in
+a plane in a central potential, or anything the level-set reduction brings to that form,
+mechbook.engine.levelset) has, at angular momentum P and energy E,
+    E = m(r) ṙ²/2 + V_eff(r; P),   θ̇ = u(r; P).
+An orbit that comes in from r = ∞ with impact parameter b and energy E (V_eff → 0 there)
+has P = b·p∞, p∞ = √(2 m∞ E) the momentum at infinity (m∞ = m(∞)): the angular momentum
+about the centre of a straight line at distance b. It turns at r_min, the largest root
+of E = V_eff(r; P) (or on a hard core of radius a: V = ∞ for r < a, a specular
+reflection), and the deflection angle is
+    Θ = π − 2 ∫_{r_min}^∞ u(r) √(m/(2(E − V_eff))) dr,
+signed: positive away from the centre (repulsion), negative towards it. With
+r = r_min/(1 − w²) the turning point's 1/√ singularity is gone (dr ∝ w dw) and r = ∞ is
+w = 1: the integrand is bounded on [0, 1], integrated by tanh-sinh quadrature at two
+working precisions whose difference is the result's measured error.
+
+Capture: V_eff is increasing in P² (the centrifugal term), so at each r there is a largest
+b, B(r), for which E > V_eff(r); the particle falls to r → 0 exactly when b < b_c =
+inf_r B(r), the critical impact parameter (√(α/E) for V = −α/r²).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import mpmath
+import sympy as sp
+
+from mechbook.engine.lagrange import Dynamics
+from mechbook.engine.levelset import LevelSet
+from mechbook.errors import UnsupportedError
+
+DPS = 40  # the working precision of one evaluation (a second one at DPS + 15 checks it)
+DIGITS = 30  # digits a result must keep at both precisions
+FAR = 10 ** 8  # the inward search for r_min starts this many length scales out
+STEP = mpmath.mpf("0.98")  # its geometric step (a barrier narrower than 2 % of r is missed)
+MAX_STEPS = 6000
+
+
+class Unbound(Exception):
+    """The orbit is not a scattering orbit (bound, or the potential does not vanish far
+    out): the caller turns it into an error at the part's key."""
+
+
+@dataclass(frozen=True)
+class Turning:
+    """Where an orbit from infinity turns: `r` (None if it falls in), `on_core` (it turns
+    on the hard core, not at a root of E = V_eff)."""
+
+    r: object
+    on_core: bool = False
+
+    @property
+    def captured(self) -> bool:
+        return self.r is None
+
+
+class Scattering:
+    """The reduction of a system to its radial coordinate `radius` and one cyclic angle,
+    with an optional hard core (an expression in the parameters)."""
+
+    def __init__(self, dyn: Dynamics, radius: sp.Symbol, hard_core: sp.Expr | None = None):
+        self.level = LevelSet(dyn, radius)
+        if len(self.level.cyclic) != 1:
+            raise UnsupportedError("scattering needs one radial coordinate and one cyclic "
+                                   f"angle; this system has {len(self.level.cyclic) + 1} "
+                                   "coordinates")
+        self.angle = self.level.cyclic[0]
+        self.r = radius
+        self.hard_core = hard_core
+        mass, V, u = self.level.reduced
+        P = self.level.P[0]
+        if sp.diff(V, P, 3) != 0 or sp.diff(V, P).subs(P, 0) != 0:
+            raise UnsupportedError("scattering: the effective potential is not even and "
+                                   "quadratic in the angular momentum")
+        self.P = P
+
+    @cached_property
+    def functions(self):
+        mass, V, u = self.level.reduced
+        args = [self.r, self.P, *self.level.params]
+        core = [] if self.hard_core is None else [sp.lambdify(self.level.params,
+                                                              self.hard_core, "mpmath")]
+        return (sp.lambdify(args, mass, "mpmath"), sp.lambdify(args, V, "mpmath"),
+                sp.lambdify(args, u[0], "mpmath"), core)
+
+    @cached_property
+    def potential_is_zero(self) -> bool:
+        """Whether V_eff at P = 0 (the potential alone) vanishes identically: a finite range
+        is then the hard core's."""
+        _, V, _ = self.level.reduced
+        return sp.simplify(V.subs(self.P, 0)) == 0
+
+    def orbit(self, point: dict, b, E, dps: int = DPS) -> Orbit:
+        """The scattering orbit of impact parameter `b` and energy `E` (numbers) at the
+        parameter `point`, in `dps`-digit arithmetic; Unbound if it is not one."""
+        with mpmath.workdps(dps):
+            params = [mpmath.mpf(str(sp.N(point[p], dps))) for p in self.level.params]
+            return Orbit(self, params, mpmath.mpf(str(sp.N(b, dps))),
+                         mpmath.mpf(str(sp.N(E, dps))), dps)
+
+
+@dataclass
+class Orbit:
+    scattering: Scattering
+    params: list
+    b: object
+    E: object
+    dps: int
+
+    def _f(self, name: str):
+        m, V, u, core = self.scattering.functions
+        return {"m": m, "V": V, "u": u}[name]
+
+    def mass(self, r):
+        return self._f("m")(r, self.P, *self.params)
+
+    def veff(self, r, P=None):
+        return self._f("V")(r, self.P if P is None else P, *self.params)
+
+    def kinetic(self, r):
+        """E − V_eff(r): m ṙ²/2 (negative where the orbit cannot go)."""
+        try:
+            return self.E - self.veff(r)
+        except (ZeroDivisionError, ValueError):
+            return mpmath.mpf(-1)
+
+    @cached_property
+    def core(self):
+        _, _, _, core = self.scattering.functions
+        return core[0](*self.params) if core else None
+
+    @cached_property
+    def scale(self):
+        """A length to start from: the hard core, the impact parameter, or 1."""
+        return max(self.core or 0, abs(self.b), mpmath.mpf(1) if self.b == 0 else 0)
+
+    @cached_property
+    def m_inf(self):
+        with mpmath.workdps(self.dps):
+            far = self.scale * mpmath.mpf(10) ** (2 * DIGITS)
+            m = self._f("m")(far, 0, *self.params)
+            m2 = self._f("m")(far * 10 ** 5, 0, *self.params)
+            if not (mpmath.isfinite(m) and m > 0 and abs(m - m2) <= abs(m) *
+                    mpmath.mpf(10) ** (-DIGITS)):
+                raise Unbound("the radial mass has no positive limit far out")
+            return m
+
+    @cached_property
+    def P(self):
+        """The angular momentum b·√(2 m∞ E), after the checks that this is a scattering
+        orbit: the potential vanishes far out, and E > 0 above it."""
+        with mpmath.workdps(self.dps):
+            if not self.E > 0:
+                raise Unbound(f"E = {mpmath.nstr(self.E, 8)} is not above the potential at "
+                              "infinity (0): the orbit is bound, not a scattering one")
+            far1 = self.scale * mpmath.mpf(10) ** 20
+            far2 = self.scale * mpmath.mpf(10) ** 40
+            v1, v2 = (self._f("V")(r, 0, *self.params) for r in (far1, far2))
+            if not (abs(v2) <= abs(self.E) * mpmath.mpf(10) ** -15 and abs(v2) <= abs(v1)):
+                raise Unbound(f"the potential does not vanish at infinity (V = "
+                              f"{mpmath.nstr(v2, 8)} at r = 1e40 length scales): no "
+                              "scattering orbit")
+            return self.b * mpmath.sqrt(2 * self.m_inf * self.E)
+
+    @cached_property
+    def turning(self) -> Turning:
+        """The turning point of the orbit from infinity: an inward geometric search from
+        FAR length scales out, refined by bisection to the working precision."""
+        with mpmath.workdps(self.dps):
+            self.P  # noqa: B018 - the checks of an unbound orbit first
+            r = self.scale * FAR
+            for _ in range(3):
+                if self.kinetic(r) > 0:
+                    break
+                r *= FAR
+            else:
+                raise UnsupportedError("scattering: E − V_eff is not positive far out")
+            core = self.core
+            tiny = self.scale * mpmath.mpf(10) ** (-DIGITS)
+            for _ in range(MAX_STEPS):
+                nxt = r * STEP
+                if core is not None and nxt <= core:
+                    if self.kinetic(core) > 0:
+                        return Turning(core, on_core=True)
+                    return Turning(self._bisect(core, r))
+                if nxt < tiny:
+                    return Turning(None)
+                k = self.kinetic(nxt)
+                if not (mpmath.isfinite(k) and k > 0):
+                    return Turning(self._bisect(nxt, r))
+                r = nxt
+            raise UnsupportedError("scattering: no turning point found in the search")
+
+    def _bisect(self, lo, hi):
+        """The root of E − V_eff between `lo` (not allowed) and `hi` (allowed): bisection,
+        then the Illinois method at twice the working precision (an error δ in r_min moves
+        the deflection integral by ~√δ, so r_min needs twice the digits of Θ)."""
+        tol = mpmath.mpf(10) ** (-(self.dps // 2))
+        while hi - lo > hi * tol:
+            mid = (lo + hi) / 2
+            k = self.kinetic(mid)
+            if mpmath.isfinite(k) and k > 0:
+                hi = mid
+            else:
+                lo = mid
+        with mpmath.workdps(2 * self.dps + 10):
+            k_lo, k_hi = self.kinetic(lo), self.kinetic(hi)
+            if not (mpmath.isfinite(k_lo) and k_lo < 0):
+                return hi  # no value below the root (V_eff singular): the bisection's end
+            side = 0
+            for _ in range(200):
+                if hi - lo <= hi * mpmath.mpf(10) ** (-(2 * self.dps + 5)):
+                    break
+                mid = hi - k_hi * (hi - lo) / (k_hi - k_lo)
+                if not lo < mid < hi:
+                    mid = (lo + hi) / 2
+                k = self.kinetic(mid)
+                if k == 0:
+                    return mid
+                if mpmath.isfinite(k) and k > 0:
+                    hi, k_hi = mid, k
+                    if side == 1:
+                        k_lo /= 2
+                    side = 1
+                else:
+                    lo, k_lo = mid, k
+                    if side == -1:
+                        k_hi /= 2
+                    side = -1
+            return hi
+
+    @property
+    def r_min(self):
+        t = self.turning
+        if t.captured:
+            raise Captured("the particle falls to the centre (captured): there is no "
+                           "closest approach or deflection")
+        return t.r
+
+    @cached_property
+    def deflection(self):
+        """Θ = π − 2∫ u √(m/(2(E − V_eff))) dr from r_min to ∞ (signed)."""
+        with mpmath.workdps(self.dps):
+            rmin = self.r_min
+            t = self.turning
+            if not t.on_core:  # a simple root: E − V_eff has a nonzero slope there
+                h = rmin * mpmath.mpf(10) ** (-self.dps // 3)
+                slope = (self.kinetic(rmin + h) - self.kinetic(rmin)) / h
+                if not slope * rmin > abs(self.E) * mpmath.mpf(10) ** -12:
+                    raise UnsupportedError("scattering: orbiting (E − V_eff has a double "
+                                           "root at the turning point): the deflection "
+                                           "diverges")
+            # at a root the integrand is even in w: below w0 its value at w0 stands for it
+            # (an error of O(w0³)); on the core it is regular (∝ w) and needs no help
+            w0 = 0 if t.on_core else mpmath.mpf(10) ** (-self.dps // 4)
+
+            def integrand(w):
+                w = max(w, w0)
+                with mpmath.workdps(self.dps + 15):  # E − V_eff is small near r_min
+                    one = (1 - w) * (1 + w)
+                    r = rmin / one
+                    k = self.kinetic(r)
+                    if not k > 0:
+                        raise UnsupportedError("scattering: the orbit leaves the allowed "
+                                               "region beyond its turning point")
+                    u = self._f("u")(r, self.P, *self.params)
+                    return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rmin * w / one ** 2
+
+            total = mpmath.quad(integrand, [0, mpmath.mpf(1) / 2, 1])
+            return mpmath.pi - 2 * total
+
+
+class Captured(UnsupportedError):
+    """The orbit falls to the centre: the quantity asked for does not exist there."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+
+
+def checked(scattering: Scattering, point: dict, b, E, what) -> tuple:
+    """`what(orbit)` at DPS and at DPS + 15 digits; (value at the higher, their difference):
+    UnsupportedError if they differ by more than 10^-DIGITS of the value (the quadrature
+    did not reach its digits)."""
+    lo = what(scattering.orbit(point, b, E, DPS))
+    with mpmath.workdps(DPS + 15):
+        hi = what(scattering.orbit(point, b, E, DPS + 15))
+        diff = abs(hi - lo)
+        if diff > mpmath.mpf(10) ** (-DIGITS) * max(abs(hi), 1):
+            raise UnsupportedError(f"scattering: the quadrature did not reach {DIGITS} digits "
+                                   f"(two precisions differ by {mpmath.nstr(diff, 3)})")
+        return hi, diff
+
+
+def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int = DPS):
+    """b_c = inf_r B(r), B(r) the b at which E = V_eff(r; b·p∞) (0 where no b is captured,
+    a potential less singular than −1/r²): a log grid of r over 24 decades, then the
+    minimum refined by golden sections at `dps` digits."""
+    orbit = scattering.orbit(point, 1, E, dps)
+    if scattering.hard_core is not None:
+        raise UnsupportedError("capture with a hard core: the core reflects every orbit")
+    with mpmath.workdps(dps):
+        orbit.P  # noqa: B018 - an unbound orbit
+        p_inf = mpmath.sqrt(2 * orbit.m_inf * orbit.E)
+
+        def B(r):
+            v0 = orbit.veff(r, 0)
+            c2 = orbit.veff(r, 1) - v0  # V_eff = v0 + c2 P²
+            if not c2 > 0:
+                raise UnsupportedError("scattering: the centrifugal term is not positive")
+            room = orbit.E - v0
+            return mpmath.sqrt(room / c2) / p_inf if room > 0 else mpmath.mpf(0)
+
+        grid = [mpmath.mpf(10) ** (mpmath.mpf(k) / 10) for k in range(-120, 121)]
+        values = [B(r) for r in grid]
+        i = min(range(len(values)), key=lambda j: values[j])
+        if values[i] == 0:
+            return mpmath.mpf(0)
+        if i == 0:  # still falling towards r → 0: the infimum is the limit there
+            if values[0] < values[1] * mpmath.mpf("0.999"):
+                return mpmath.mpf(0)
+            return values[0]
+        if i == len(values) - 1:
+            raise UnsupportedError("scattering: B(r) keeps falling far out")
+        lo, hi = mpmath.log(grid[i - 1]), mpmath.log(grid[i + 1])
+        g = (mpmath.sqrt(5) - 1) / 2
+        a, c = hi - g * (hi - lo), lo + g * (hi - lo)
+        fa, fc = B(mpmath.exp(a)), B(mpmath.exp(c))
+        for _ in range(4 * dps):
+            if fa < fc:
+                hi, c, fc = c, a, fa
+                a = hi - g * (hi - lo)
+                fa = B(mpmath.exp(a))
+            else:
+                lo, a, fa = a, c, fc
+                c = lo + g * (hi - lo)
+                fc = B(mpmath.exp(c))
+        return min(fa, fc)
