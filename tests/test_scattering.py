@@ -226,3 +226,36 @@ def test_a_quadrature_short_of_its_digits_is_unsupported(systems, tmp_path, monk
     status, detail = check(systems["coulomb"], tmp_path,
                            {"quantity": "deflection_angle", "book": "3*atan(k/(2*E*b))"})
     assert status == "unsupported" and "did not reach" in detail, detail
+
+
+@pytest.mark.parametrize("book, partial, status", [
+    (["k/(2*E0) + sqrt(k**2/(4*E0**2) + l**2/(2*m*E0))"], True, "pass"),
+    (["1.01*(k/(2*E0) + sqrt(k**2/(4*E0**2) + l**2/(2*m*E0)))"], True, "fail"),
+    (["(1 + 1e-6)*(k/(2*E0) + sqrt(k**2/(4*E0**2) + l**2/(2*m*E0)))"], True, "fail"),
+])
+def test_turning_points_of_an_unbound_orbit(systems, tmp_path, book, partial, status):
+    """`turning_points` on a Coulomb orbit with E > 0 (it was refused: "no turning point (the
+    coordinate runs away)"): the closest approach is the one finite turning point, from
+    E0 = m(v² + w²)/2 + k and l = m·w at r = 1, rdot = -v, thetadot = w."""
+    symbols = {"v": {"value": 0.9, "positive": True}, "w": {"value": 0.6, "positive": True}}
+    doc = {"problem": "classic-coulomb", "source": "test", "symbols": symbols,
+           "abbreviations": {"E0": "m*(v**2 + w**2)/2 + k", "l": "m*w"},
+           "parts": [{"part": "x", "cite": "test", "quantity": "turning_points",
+                      "coordinate": "r", "initial": {"r": 1, "rdot": "-v", "thetadot": "w"},
+                      "partial": partial, "book": book}]}
+    path = tmp_path / "key.yaml"
+    YAML().dump(doc, path.open("w"))
+    out = check_problem(systems["coulomb"], load_answers(path))[0]
+    assert out.status.value == status, out.detail
+
+
+def test_an_unbound_orbit_has_no_period(systems, tmp_path):
+    symbols = {"v": {"value": 0.9, "positive": True}, "w": {"value": 0.6, "positive": True}}
+    doc = {"problem": "classic-coulomb", "source": "test", "symbols": symbols,
+           "parts": [{"part": "x", "cite": "test", "quantity": "motion_frequency",
+                      "coordinate": "r", "initial": {"r": 1, "rdot": "-v", "thetadot": "w"},
+                      "book": "1"}]}
+    path = tmp_path / "key.yaml"
+    YAML().dump(doc, path.open("w"))
+    out = check_problem(systems["coulomb"], load_answers(path))[0]
+    assert out.status.value == "unsupported" and "unbound" in out.detail, out.detail

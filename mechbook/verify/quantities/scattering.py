@@ -46,6 +46,7 @@ SINGULAR = 1e-10  # |dΘ/db|·b or |sin Θ| below this: a rainbow or a glory
 SCAN = 16  # impact parameters from b/100 to 100b on which one branch is confirmed
 ORBIT = {"coordinate": {"type": "string"}, "impact_parameter": EXPR, "energy": EXPR,
          "hard_core": EXPR}
+BEAM_ONLY = ("critical_impact_parameter", "total_cross_section")  # quantities of E alone
 BEAM = {"coordinate": {"type": "string"}, "energy": EXPR, "hard_core": EXPR,
         "impact_parameter": EXPR}
 
@@ -133,7 +134,7 @@ def _scattering(ctx: Context, radius, core) -> Scattering:
 def validate_orbit(ctx: Context) -> None:
     """The part's orbit at the default point is a scattering one: E above the potential
     at infinity, which vanishes (an error at the part's line otherwise)."""
-    beam = Beam(ctx, needs_b=ctx.part.quantity != "critical_impact_parameter")
+    beam = Beam(ctx, needs_b=ctx.part.quantity not in BEAM_ONLY)
     pt = ctx.sampler.default()
     b, E = beam.at(pt)
     try:
