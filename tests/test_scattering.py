@@ -259,3 +259,35 @@ def test_an_unbound_orbit_has_no_period(systems, tmp_path):
     YAML().dump(doc, path.open("w"))
     out = check_problem(systems["coulomb"], load_answers(path))[0]
     assert out.status.value == "unsupported" and "unbound" in out.detail, out.detail
+
+
+def _crosscheck(analysis, tmp_path, book: str, extra: dict | None = None):
+    from mechbook.crosscheck.problem import crosscheck_problem
+
+    doc = {"problem": analysis.problem.id, "source": "test", "symbols": SYMBOLS,
+           "parts": [{"part": "x", "cite": "test", "quantity": "deflection_angle",
+                      "impact_parameter": "b", "energy": "E", "book": book, **(extra or {})}]}
+    path = tmp_path / "key.yaml"
+    YAML().dump(doc, path.open("w"))
+    return [x for x in crosscheck_problem(analysis, load_answers(path))
+            if x.kind == "scattering"]
+
+
+@pytest.mark.parametrize("system, extra", [("coulomb", {}), ("coulomb-attractive", {}),
+                                           ("free", {"hard_core": "k"})])
+def test_the_asymptote_of_the_integrated_orbit_agrees(systems, tmp_path, system, extra):
+    (x,) = _crosscheck(systems[system], tmp_path, "1", extra)
+    assert x.status.value == "pass" and x.error < 1e-10, x.detail
+
+
+def test_the_asymptote_crosscheck_can_fail(systems, tmp_path, monkeypatch):
+    """An engine whose deflection is 7e-9 off is caught by the integrated orbit."""
+    real = engine.Orbit.deflection.func
+
+    def off(self):
+        with mpmath.workdps(self.dps):
+            return real(self) * (1 + mpmath.mpf(2) ** -27)  # 7e-9
+
+    monkeypatch.setattr(engine.Orbit, "deflection", property(off))
+    (x,) = _crosscheck(systems["coulomb"], tmp_path, "1")
+    assert x.status.value == "fail", x.detail

@@ -197,7 +197,7 @@ class _CapturedFail(Exception):
                'singularity: tanh-sinh quadrature at 40 and 55 digits, which must agree to '
                '1e-30; 6 points to 1e-20. An orbit that falls in fails a finite angle; '
                'orbiting (a double root) is unsupported'),
-          keys=ORBIT, validate=validate_orbit)
+          keys=ORBIT, validate=validate_orbit, crosschecks=("scattering",))
 def check_deflection_angle(ctx: Context, val) -> Verdict:
     book = ctx.parse(val, ("book",))
     try:
@@ -213,7 +213,7 @@ def check_deflection_angle(ctx: Context, val) -> Verdict:
                '`deflection_angle`), or the hard core\'s radius where the orbit reaches it: '
                'an inward search from 1e8 length scales, bisection and the Illinois method at '
                '90 digits; 6 points to 1e-20. An orbit that falls in fails'),
-          keys=ORBIT, validate=validate_orbit)
+          keys=ORBIT, validate=validate_orbit, crosschecks=("scattering",))
 def check_closest_approach(ctx: Context, val) -> Verdict:
     book = ctx.parse(val, ("book",))
 
@@ -256,7 +256,7 @@ def _observed(theta):
                '(sin Θ = 0, b ≠ 0), or several impact parameters scattering into one angle '
                '(χ(b) not monotone on 16 values from b/100 to 100b)'),
           keys={**ORBIT, "scattering_angle": NAME}, names=_angle_names,
-          validate=validate_orbit)
+          validate=validate_orbit, crosschecks=("scattering",))
 def check_cross_section(ctx: Context, val) -> Verdict:
     names = _angle_names(ctx)
     book = ctx.parse(val, ("book",), names=names)
