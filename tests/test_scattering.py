@@ -11,6 +11,11 @@
   b² < α/E, b_c = √(α/E), σ_capture = πα/E. Repulsive: with x = 1 − Θ/π, b = √(α/E)
   x/√(1 − x²), so dσ/dΩ = (α/E) x/(π sin Θ (1 − x²)²).
 - V = −α/r⁴: B(r)² = r² + α/(E r²) is least at r² = √(α/E): b_c² = 2√(α/E).
+- Time delay against the free line of the same b and E (v = √(2E/m)): the radial motion in
+  E·c²/r² is the free one of impact parameter c, which spends √(X² − c²)/v between r = c
+  and X. A hard sphere of radius a: τ = 2[(√(X² − b²) − √(a² − b²)) − √(X² − b²)]/v =
+  −2√(a² − b²)/v; with V = α/r² outside it (c² = b² + α/E < a²): τ = −2√(a² − c²)/v; for
+  V = ±α/r² alone the delay vanishes as X → ∞ (τ = 0).
 
 Each key wrong by 1 % and by 1e-6 fails; a wrong verdict fails; a bound orbit or a
 potential that does not vanish far out is an error with the file and line; a quadrature
@@ -103,6 +108,10 @@ CASES = [  # (system, quantity, book, extra keys)
     ("inverse-square-attractive", "total_cross_section", "pi*k/E", {"process": "capture"}),
     ("inverse-fourth-attractive", "critical_impact_parameter", "sqrt(2*sqrt(k/E))", {}),
     ("coulomb-attractive", "critical_impact_parameter", "0", {}),
+    ("free", "time_delay", "-2*sqrt(k**2 - b**2)/sqrt(2*E/m)",
+     {"hard_core": "k", "assume": ["b < k"]}),
+    ("inverse-square", "time_delay", "-2*sqrt(4*k - b**2 - k/E)/sqrt(2*E/m)",
+     {"hard_core": "2*sqrt(k)", "assume": ["b**2 + k/E < 4*k"]}),
 ]
 
 
@@ -172,6 +181,16 @@ def test_a_captured_orbit_fails_a_finite_deflection(systems, tmp_path):
                            {"quantity": "deflection_angle", "book": "pi",
                             "assume": ["b < 0.45"]}, symbols)
     assert status == "fail" and "captured" in detail
+
+
+@pytest.mark.parametrize("system, book, status", [
+    ("inverse-square", "0", "pass"),
+    ("inverse-square", "1e-6*b/sqrt(2*E/m)", "fail"),
+    ("coulomb", "0", "unsupported"),          # the delay grows like log R: no limit
+])
+def test_time_delay_without_a_core(systems, tmp_path, system, book, status):
+    got, detail = check(systems[system], tmp_path, {"quantity": "time_delay", "book": book})
+    assert got == status, detail
 
 
 def test_a_long_range_potential_fails_a_finite_total_cross_section(systems, tmp_path):

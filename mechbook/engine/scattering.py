@@ -51,6 +51,13 @@ class Turning:
 
     r: object
     on_core: bool = False
+    below: object = None  # on a core: the root of E = V_eff inside it (None if none)
+
+    @property
+    def singular(self):
+        """Where the integrands' 1/√ singularity is: the turning point, or on a core the
+        root inside it (near a grazing orbit, just below the core), or None."""
+        return self.below if self.on_core else self.r
 
     @property
     def captured(self) -> bool:
@@ -97,9 +104,17 @@ class Scattering:
         """The scattering orbit of impact parameter `b` and energy `E` (numbers) at the
         parameter `point`, in `dps`-digit arithmetic; Unbound if it is not one."""
         with mpmath.workdps(dps):
-            params = [mpmath.mpf(str(sp.N(point[p], dps))) for p in self.level.params]
-            return Orbit(self, params, mpmath.mpf(str(sp.N(b, dps))),
-                         mpmath.mpf(str(sp.N(E, dps))), dps)
+            params = [_mp(point[p], dps) for p in self.level.params]
+            return Orbit(self, params, _mp(b, dps), _mp(E, dps), dps)
+
+
+def _mp(value, dps: int):
+    """A number as an mpf: a SymPy Float exactly (its binary value, the same at every
+    precision above its own, so two precisions see the same orbit), else to `dps` digits."""
+    value = sp.sympify(value)
+    if isinstance(value, sp.Float) and value._prec <= mpmath.mp.prec:
+        return mpmath.mpf(value._mpf_)
+    return mpmath.mpf(str(sp.N(value, dps)))
 
 
 @dataclass
@@ -184,7 +199,7 @@ class Orbit:
                 nxt = r * STEP
                 if core is not None and nxt <= core:
                     if self.kinetic(core) > 0:
-                        return Turning(core, on_core=True)
+                        return Turning(core, True, self._root_inside(core, tiny))
                     return Turning(self._bisect(core, r))
                 if nxt < tiny:
                     return Turning(None)
@@ -193,6 +208,20 @@ class Orbit:
                     return Turning(self._bisect(nxt, r))
                 r = nxt
             raise UnsupportedError("scattering: no turning point found in the search")
+
+    def _root_inside(self, core, tiny):
+        """The largest root of E = V_eff below the core (the orbit never gets there, but
+        a grazing orbit's integrands are nearly singular at it), or None."""
+        r = core
+        for _ in range(MAX_STEPS):
+            nxt = r * STEP
+            if nxt < tiny:
+                return None
+            k = self.kinetic(nxt)
+            if not (mpmath.isfinite(k) and k > 0):
+                return self._bisect(nxt, r)
+            r = nxt
+        return None
 
     def _bisect(self, lo, hi):
         """The root of E − V_eff between `lo` (not allowed) and `hi` (allowed): bisection,
@@ -253,24 +282,95 @@ class Orbit:
                     raise UnsupportedError("scattering: orbiting (E − V_eff has a double "
                                            "root at the turning point): the deflection "
                                            "diverges")
+            # r = rs/(1 − w²) from the singular point rs (the turning point, or on a core
+            # the root inside it): the integral runs from w_lo (0 at a turning point) to 1;
             # at a root the integrand is even in w: below w0 its value at w0 stands for it
-            # (an error of O(w0³)); on the core it is regular (∝ w) and needs no help
-            w0 = 0 if t.on_core else mpmath.mpf(10) ** (-self.dps // 4)
+            # (an error of O(w0³)); on the core it is regular and needs no help
+            rs = t.singular if t.singular is not None else rmin
+            with mpmath.workdps(self.dps + 15):
+                w_lo = mpmath.sqrt(1 - rs / rmin) if t.on_core else mpmath.mpf(0)
+            w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
 
             def integrand(w):
                 w = max(w, w0)
                 with mpmath.workdps(self.dps + 15):  # E − V_eff is small near r_min
                     one = (1 - w) * (1 + w)
-                    r = rmin / one
+                    r = max(rs / one, rmin)
                     k = self.kinetic(r)
                     if not k > 0:
                         raise UnsupportedError("scattering: the orbit leaves the allowed "
                                                "region beyond its turning point")
                     u = self._f("u")(r, self.P, *self.params)
-                    return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rmin * w / one ** 2
+                    return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rs * w / one ** 2
 
-            total = mpmath.quad(integrand, [0, mpmath.mpf(1) / 2, 1])
+            total = mpmath.quad(integrand, [w_lo, (w_lo + 1) / 2, 1])
             return mpmath.pi - 2 * total
+
+
+    @cached_property
+    def speed(self):
+        """v∞ = √(2E/m∞)."""
+        with mpmath.workdps(self.dps):
+            return mpmath.sqrt(2 * self.E / self.m_inf)
+
+    @cached_property
+    def time_delay(self):
+        """τ = 2[∫_{r_min}^∞ √(m/(2(E − V_eff))) dr − ∫_b^∞ √(m∞/(2(E − Eb²/r²))) dr], the
+        time the orbit takes beyond the free straight line of the same b and E: split at
+        X = 2 max(r_min, b); the free part to X in closed form, √(X² − b²)/v∞; the orbit's
+        part to X after r = r_min + (X − r_min)w² (the turning point's singularity gone);
+        beyond X the difference of the two, after r = X/(1 − u). Defined where the
+        potential falls faster than 1/r (else the delay grows like log R): refused there."""
+        with mpmath.workdps(self.dps):
+            rmin = self.r_min
+            far = self.scale * mpmath.mpf(10) ** 20
+            if abs(far * self.veff(far, 0)) > abs(self.E) * self.scale * \
+                    mpmath.mpf(10) ** -10:
+                raise UnsupportedError("time delay: the potential falls like 1/r or slower, "
+                                       "so the delay grows like log R without a limit")
+            X = 2 * max(rmin, self.b)
+            m_inf, E, b = self.m_inf, self.E, self.b
+
+            def dt_dr(r):
+                with mpmath.workdps(self.dps + 15):
+                    k = self.kinetic(r)
+                    if not k > 0:
+                        raise UnsupportedError("time delay: the orbit leaves the allowed "
+                                               "region beyond its turning point")
+                    return mpmath.sqrt(self.mass(r) / (2 * k))
+
+            t = self.turning  # r = rs + (X − rs)w² from the singular point, as for Θ
+            rs = t.singular if t.singular is not None else rmin
+            with mpmath.workdps(self.dps + 15):
+                w_lo = mpmath.sqrt((rmin - rs) / (X - rs))
+            w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
+
+            def near(w):
+                w = max(w, w0)
+                with mpmath.workdps(self.dps + 15):
+                    return dt_dr(max(rs + (X - rs) * w * w, rmin)) * 2 * (X - rs) * w
+
+            def beyond(u):
+                # √(m/2k) − √(m∞/2k0) without the cancellation of two numbers near
+                # √(m∞/2E) far out: (m·k0 − m∞·k)/(2k·k0) over their sum, with
+                # k0 − k = V_eff − Eb²/r², a difference of two small numbers there
+                with mpmath.workdps(self.dps + 15):
+                    one = 1 - u
+                    r = X / one
+                    centrifugal = E * (b / r) ** 2
+                    v = self.veff(r)
+                    k, k0, m = E - v, E - centrifugal, self.mass(r)
+                    if not k > 0:
+                        raise UnsupportedError("time delay: the orbit leaves the allowed "
+                                               "region beyond its turning point")
+                    top = m * (v - centrifugal) + (m - m_inf) * k
+                    total = mpmath.sqrt(m / (2 * k)) + mpmath.sqrt(m_inf / (2 * k0))
+                    return top / (2 * k * k0) / total * X / one ** 2
+
+            inside = mpmath.quad(near, [w_lo, 1])
+            outside = mpmath.quad(beyond, [0, mpmath.mpf(1) / 2, 1])
+            free = mpmath.sqrt(X * X - b * b) / self.speed
+            return 2 * (inside + outside - free)
 
 
 class Captured(UnsupportedError):
