@@ -22,6 +22,7 @@ inf_r B(r), the critical impact parameter (√(α/E) for V = −α/r²).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -92,6 +93,15 @@ class Scattering:
                                                               self.hard_core, "mpmath")]
         return (sp.lambdify(args, mass, "mpmath"), sp.lambdify(args, V, "mpmath"),
                 sp.lambdify(args, u[0], "mpmath"), core)
+
+    @cached_property
+    def float_kinetic(self):
+        """V_eff(r, P, params) in double precision (None where it has no such form)."""
+        _, V, _ = self.level.reduced
+        try:
+            return sp.lambdify([self.r, self.P, *self.level.params], V, "math")
+        except Exception:  # noqa: BLE001 - a function math lacks: the search stays exact
+            return None
 
     @cached_property
     def potential_is_zero(self) -> bool:
@@ -195,6 +205,7 @@ class Orbit:
                 raise UnsupportedError("scattering: E − V_eff is not positive far out")
             core = self.core
             tiny = self.scale * mpmath.mpf(10) ** (-DIGITS)
+            r = self._descend(r, core, tiny)
             for _ in range(MAX_STEPS):
                 nxt = r * STEP
                 if core is not None and nxt <= core:
@@ -208,6 +219,32 @@ class Orbit:
                     return Turning(self._bisect(nxt, r))
                 r = nxt
             raise UnsupportedError("scattering: no turning point found in the search")
+
+    def _descend(self, r, core, tiny):
+        """The search's steps in double precision (a fiftieth of the cost): the last r
+        before E − V_eff is not positive, before the core or before `tiny`, from which the
+        search goes on at the working precision; a step the double-precision values
+        misjudged near the root is taken again there (r moved back out until allowed)."""
+        fn = self.scattering.float_kinetic
+        if fn is None:
+            return r
+        args = [float(self.P), *(float(p) for p in self.params)]
+        E, x, stop = float(self.E), float(r), float(max(core or 0, tiny))
+        for _ in range(MAX_STEPS):
+            nxt = x * float(STEP)
+            if nxt <= stop:
+                break
+            try:
+                k = E - fn(nxt, *args)
+            except (ZeroDivisionError, ValueError, OverflowError, TypeError):
+                break
+            if not (math.isfinite(k) and k > 0):
+                break
+            x = nxt
+        back = mpmath.mpf(x)
+        while back < r and not self.kinetic(back) > 0:
+            back = back / STEP
+        return min(back, r)
 
     def _root_inside(self, core, tiny):
         """The largest root of E = V_eff below the core (the orbit never gets there, but

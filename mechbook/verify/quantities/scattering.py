@@ -326,8 +326,9 @@ def _theta(beam: Beam, pt: dict, b, dps: int, E):
 
 
 def _differential(beam: Beam, pt: dict, b, E) -> tuple:
-    """(χ, dσ/dΩ) at the orbit (b, E); UnsupportedError where dσ/dΩ is singular."""
-    d = DPS + 15
+    """(χ, dσ/dΩ) at the orbit (b, E); UnsupportedError where dσ/dΩ is singular. The
+    stencils at DPS digits: Θ holds ~38 there, so a step of 1e-8·b leaves db/dΘ ~29."""
+    d = DPS
     theta = beam.value(pt, b, E, lambda o: o.deflection)
     with mpmath.workdps(d):
         bb = mpmath.mpf(str(b))
@@ -350,7 +351,7 @@ def _differential(beam: Beam, pt: dict, b, E) -> tuple:
             raise UnsupportedError(f"dσ/dΩ: a glory angle (sin Θ = 0 with b ≠ 0) at b = "
                                    f"{float(b):.6g}: the classical cross section is infinite")
     _one_branch(beam, pt, b, E)
-    with mpmath.workdps(d):
+    with mpmath.workdps(DPS + 15):
         return chi, bb / (abs(mpmath.sin(chi)) * abs(s1))
 
 
