@@ -15,6 +15,9 @@ r = r_min/(1 − w²) the turning point's 1/√ singularity is gone (dr ∝ w dw
 w = 1: the integrand is bounded on [0, 1], integrated by tanh-sinh quadrature at two
 working precisions whose difference is the result's measured error.
 
+The time delay against the free straight line of the same b and E is the difference of the
+two orbits' ∫ dt/dr, taken as one convergent integral far out (`Orbit.time_delay`).
+
 Capture: V_eff is increasing in P² (the centrifugal term), so at each r there is a largest
 b, B(r), for which E > V_eff(r); the particle falls to r → 0 exactly when b < b_c =
 inf_r B(r), the critical impact parameter (√(α/E) for V = −α/r²).
