@@ -241,7 +241,7 @@ def check_closest_approach(ctx: Context, val) -> Verdict:
                'integrals\' difference taken beyond 2 max(r_min, b), at 40 and 55 digits '
                'agreeing to 1e-30; 6 points to 1e-20 of max(|τ|, r_min/v∞). Unsupported where '
                'the potential falls like 1/r or slower (the delay grows like log R)'),
-          keys=ORBIT, validate=validate_orbit)
+          keys=ORBIT, validate=validate_orbit, crosschecks=("scattering",))
 def check_time_delay(ctx: Context, val) -> Verdict:
     book = ctx.parse(val, ("book",))
 
