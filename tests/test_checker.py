@@ -271,6 +271,8 @@ def slots(part: Part, ctx: Context, analysis: Analysis) -> Iterator[Slot]:
                 yield Slot(root + (group, k), "steady")
     elif q == "stability":
         yield Slot(root, "relation" if re.search(r"[<>]", str(val)) else "verdict")
+    elif q == "capture":
+        yield Slot(root, "relation" if re.search(r"[<>]", str(val)) else "capture_verdict")
     elif q == "equilibrium_count":
         yield Slot(root, "count")
         if "stable" in part.data:
@@ -432,6 +434,9 @@ def mutants(slot: Slot, value, names: list[str], coordinate: str) -> Iterator[tu
             if other != value:
                 yield f"say {other}", other
         return
+    if slot.kind == "capture_verdict":  # captured / scattered
+        yield "the other verdict", "scattered" if value == "captured" else "captured"
+        return
     s = str(value)
     if slot.kind in ("lagrangian", "value", "potential", "generating"):
         yield from expression_mutants(s, names)
@@ -547,7 +552,7 @@ def _free_of(expr, symbols) -> bool:
 def same_meaning(ctx: Context, slot: Slot, part_data: dict, old, new) -> bool:
     if str(old) == str(new):
         return True
-    if slot.kind in ("count", "flag", "verdict", "exponent_sign"):
+    if slot.kind in ("count", "flag", "verdict", "exponent_sign", "capture_verdict"):
         return False
     if slot.kind == "relation":  # the same condition once parsed (factors reordered), or
         # the same up to moving terms (e.g. a symmetric one with names swapped)

@@ -4,8 +4,9 @@ A cross-check vouches for a part at the part's own point, as the part's check re
 its system, the linear system about its `about:` (or `steady:`) point, its default
 parameter values (with `assume:` and the key's own symbols), its parser (names from
 `define:` included), and, for steady motions and trajectories, the family of steady rates
-or the level set its quantity derives. Only this module opens verify's `Context` and those
-quantity families; the rest of crosscheck/ asks a `PartView` and never sees their insides.
+or the level set its quantity derives (for scattering, the orbit from infinity). Only this
+module opens verify's `Context` and those quantity families; the rest of crosscheck/ asks a
+`PartView` and never sees their insides.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from mechbook.verify.context import Context
 from mechbook.verify.context import split_named as _split_named
 from mechbook.verify.quantities.brackets import bracket_claim
 from mechbook.verify.quantities.canonical import hamiltonian_claim
+from mechbook.verify.quantities.scattering import Beam
 from mechbook.verify.quantities.steady import family
 from mechbook.verify.quantities.trajectory import Motion
 
@@ -88,6 +90,11 @@ class PartView:
         """The trajectory a trajectory part derives (mechbook.verify.quantities.trajectory:
         `level`, `orbit(values)`, `measured(values)`)."""
         return Motion(self._ctx)
+
+    def beam(self) -> Beam:
+        """The orbit from infinity a scattering part names (mechbook.verify.quantities.
+        scattering: `engine` (the reduction), `at(values)` (b, E), `value(...)`)."""
+        return Beam(self._ctx)
 
 
 def split_named(text: object) -> tuple[str | None, object]:

@@ -27,6 +27,7 @@ from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.crosscheck.partview import PartView
 from mechbook.crosscheck.points import engine_linear_systems, numeric_key, point_label
 from mechbook.crosscheck.response import response_part
+from mechbook.crosscheck.scattering import scattering_crosscheck
 from mechbook.crosscheck.simulated_motion import steady_crosscheck, trajectory_crosscheck
 from mechbook.crosscheck.state_modes import state_frequency_crosscheck
 from mechbook.crosscheck.vouch import crosschecks_of
@@ -107,6 +108,13 @@ def _trajectory_question(part: Part, system: str | None) -> tuple:
             data.get("rate"))
 
 
+def _orbit_question(part: Part, system: str | None) -> tuple:
+    data = part.data
+    return (system, "orbit", repr(data.get("impact_parameter")), repr(data.get("energy")),
+            repr(data.get("hard_core")), data.get("coordinate"), repr(data.get("assume")),
+            repr(data.get("restrict")))
+
+
 _conserved = each_part(conserved_part, "conserved")
 
 # every name a registration's `crosschecks=` may hold, run for a part in this order (a check
@@ -136,6 +144,9 @@ CROSSCHECKS: dict[str, PartCheck] = {
     "new_hamiltonian": PartCheck("a canonical map's new variables moving by the book's K "
                                  "along a run, from Lagrange's equations (brackets.py)",
                                  each_part(new_hamiltonian_part, "new_hamiltonian")),
+    "scattering": PartCheck("the orbit from infinity integrated far out and its asymptote "
+                            "fitted: deflection and closest approach (scattering.py)",
+                            _shared_by(_orbit_question, "asymptote", scattering_crosscheck)),
 }
 
 

@@ -150,9 +150,33 @@ class Orbit:
                 inside = c
                 step = min(2 * step, cap)
             else:
-                raise UnsupportedError("level set: no turning point (the coordinate runs "
-                                       "away or goes round)")
+                far = self._runaway(inside, direction)
+                if far is None:
+                    return direction * mpmath.inf
+                inside, c, k = far
             return self._refine(inside, c, self.kinetic(inside), k)
+
+    def _runaway(self, inside, direction: int):
+        """After the search's steps: None if the coordinate runs away to infinity — E − V_eff
+        stays positive at points 10^3 to 10^60 times farther out (by factors of 10) and
+        V_eff settles to a limit there (its last values agree to 1e-20 of E): an unbound
+        orbit, whose turning point on this side is at infinity; else (inside, outside,
+        E − V_eff there), the bracket of a turning point farther out. UnsupportedError
+        where neither is seen (a coordinate that goes round, a potential without a limit)."""
+        span = 1 + abs(self.c0)
+        values = []
+        for k in range(3, 61):
+            c = self.c0 + direction * span * mpmath.mpf(10) ** k
+            e = self.kinetic(c)
+            if not (mpmath.isfinite(e) and e > 0):
+                return inside, c, e
+            inside = c
+            values.append(self.E - e)
+        size = abs(self.E) + abs(values[-1])
+        if all(abs(v - values[-1]) <= size * mpmath.mpf(10) ** -20 for v in values[-5:]):
+            return None
+        raise UnsupportedError("level set: no turning point (the coordinate goes round, or "
+                               "runs away without its potential settling to a limit)")
 
     def _refine(self, inside, outside, k_in, k_out):
         """The turning point between `inside` (E − V ≥ 0) and `outside` (E − V < 0, or no
@@ -212,6 +236,9 @@ class Orbit:
         one (mechbook.verify.quantities.trajectory)."""
         mass, _, _ = self.level.numeric_functions
         lo, hi = self.turning_points
+        if not (mpmath.isfinite(lo) and mpmath.isfinite(hi)):
+            raise UnsupportedError("level set: the orbit is unbound (the coordinate runs away "
+                                   "to infinity): it has no period")
         with mpmath.workdps(self.dps):  # mid, half at full precision: c − lo tiny near s = 0
             mid, half = (lo + hi) / 2, (hi - lo) / 2
 

@@ -22,7 +22,9 @@ from mechbook.model.expr import FUNCTIONS, split_single_equals
 from mechbook.verify.compare import value_and_scale
 from mechbook.verify.context import strip_const
 
-WORDS = ("stable", "unstable", "marginal")
+# verdicts given as words, each group the words one value may be instead of another
+WORD_GROUPS = (("stable", "unstable", "marginal"), ("captured", "scattered"))
+WORDS = tuple(w for group in WORD_GROUPS for w in group)
 COUNTS = ("equilibrium_count", "mode_count", "secular_growth")  # integers that are counts
 
 
@@ -172,7 +174,8 @@ def discrete(value) -> Iterator[tuple[str, object]]:
         if value > 0:
             yield "count - 1", value - 1
     elif isinstance(value, str) and value in WORDS:
-        for w in WORDS:
+        group = next(g for g in WORD_GROUPS if value in g)
+        for w in group:
             if w != value:
                 yield f"{value} -> {w}", w
 

@@ -46,6 +46,9 @@ class Quantity:
     crosschecks: tuple[str, ...] = ()
     display: str | None = None
     sweeps: tuple[str, ...] = ()
+    # ctx -> None: the quantity's own validation of a part before anything is judged (a
+    # scattering part's orbit is unbound), SpecError at the part's line otherwise
+    validate: Callable | None = None
 
 
 class Family:
@@ -64,8 +67,8 @@ class Family:
                  names: Callable | None = None, literals: tuple = (),
                  needs_system: bool = True, complex_values: bool = False,
                  equivalent: tuple | Callable = (), crosschecks: tuple[str, ...] = (),
-                 display: str | None = None,
-                 sweeps: tuple[str, ...] = ()) -> Callable[[Callable], Callable]:
+                 display: str | None = None, sweeps: tuple[str, ...] = (),
+                 validate: Callable | None = None) -> Callable[[Callable], Callable]:
         """Make the decorated function the check of quantity `name` (`names`: a function of
         the part's context giving the names its book value may use beyond the usual ones,
         e.g. a polynomial's variable; `mechbook validate` parses with them; `literals`:
@@ -75,14 +78,16 @@ class Family:
         hold constants such as sqrt(-1), which are refused elsewhere; `crosschecks`,
         `display`, `sweeps`: names of the cross-checks that vouch for it, of how the report
         shows the engine's value, of the sweeps that draw its book value — see
-        `Quantity`)."""
+        `Quantity`; `validate`: a function of the part's context that refuses a part whose
+        keys cannot describe what the quantity needs, SpecError at its line, run by
+        `mechbook validate` and before a check)."""
         def declare(fn: Callable) -> Callable:
             if name in self._entries:
                 raise ValueError(f"quantity {name!r} declared twice")
             self._entries[name] = Quantity(
                 name, fn, book, how, dict(keys or {}), names, tuple(literals), needs_system,
                 complex_values, equivalent if callable(equivalent) else tuple(equivalent),
-                tuple(crosschecks), display, tuple(sweeps))
+                tuple(crosschecks), display, tuple(sweeps), validate)
             return fn
 
         return declare

@@ -54,6 +54,8 @@ def validate_part(analysis: Analysis, part: Part,
             _parse_all(ctx, part.data[field], (field,), names if field == "book" else ctx.names)
     if "erratum" in part.data:
         _parse_all(ctx, part.data["erratum"]["corrected"], ("erratum", "corrected"), names)
+    if q.validate is not None and "unsupported" not in part.data:
+        q.validate(ctx)  # the quantity's own refusal (a scattering part on a bound orbit)
 
 
 def _parse_all(ctx: Context, value, sub: tuple, names: dict) -> None:

@@ -1,0 +1,480 @@
+"""Scattering on an unbound orbit: deflection, closest approach, capture.
+
+A system whose coordinates are one radial coordinate r and one cyclic angle (a particle in
+a plane in a central potential, or anything the level-set reduction brings to that form,
+mechbook.engine.levelset) has, at angular momentum P and energy E,
+    E = m(r) ṙ²/2 + V_eff(r; P),   θ̇ = u(r; P).
+An orbit that comes in from r = ∞ with impact parameter b and energy E (V_eff → 0 there)
+has P = b·p∞, p∞ = √(2 m∞ E) the momentum at infinity (m∞ = m(∞)): the angular momentum
+about the centre of a straight line at distance b. It turns at r_min, the largest root
+of E = V_eff(r; P) (or on a hard core of radius a: V = ∞ for r < a, a specular
+reflection), and the deflection angle is
+    Θ = π − 2 ∫_{r_min}^∞ u(r) √(m/(2(E − V_eff))) dr,
+signed: positive away from the centre (repulsion), negative towards it. With
+r = r_min/(1 − w²) the turning point's 1/√ singularity is gone (dr ∝ w dw) and r = ∞ is
+w = 1: the integrand is bounded on [0, 1], integrated by tanh-sinh quadrature at two
+working precisions whose difference is the result's measured error.
+
+The time delay against the free straight line of the same b and E is the difference of the
+two orbits' ∫ dt/dr, taken as one convergent integral far out (`Orbit.time_delay`).
+
+Capture: V_eff is increasing in P² (the centrifugal term), so at each r there is a largest
+b, B(r), for which E > V_eff(r); the particle falls to r → 0 exactly when b < b_c =
+inf_r B(r), the critical impact parameter (√(α/E) for V = −α/r²).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import mpmath
+import sympy as sp
+
+from mechbook.engine.lagrange import Dynamics
+from mechbook.engine.levelset import LevelSet
+from mechbook.errors import UnsupportedError
+
+DPS = 40  # the working precision of one evaluation (a second one at DPS + 15 checks it)
+DIGITS = 30  # digits a result must keep at both precisions
+FAR = 10 ** 8  # the inward search for r_min starts this many length scales out
+STEP = mpmath.mpf("0.98")  # its geometric step (a barrier narrower than 2 % of r is missed)
+MAX_STEPS = 6000
+
+
+class Unbound(Exception):
+    """The orbit is not a scattering orbit (bound, or the potential does not vanish far
+    out): the caller turns it into an error at the part's key."""
+
+
+@dataclass(frozen=True)
+class Turning:
+    """Where an orbit from infinity turns: `r` (None if it falls in), `on_core` (it turns
+    on the hard core, not at a root of E = V_eff)."""
+
+    r: object
+    on_core: bool = False
+    below: object = None  # on a core: the root of E = V_eff inside it (None if none)
+
+    @property
+    def singular(self):
+        """Where the integrands' 1/√ singularity is: the turning point, or on a core the
+        root inside it (near a grazing orbit, just below the core), or None."""
+        return self.below if self.on_core else self.r
+
+    @property
+    def captured(self) -> bool:
+        return self.r is None
+
+
+class Scattering:
+    """The reduction of a system to its radial coordinate `radius` and one cyclic angle,
+    with an optional hard core (an expression in the parameters)."""
+
+    def __init__(self, dyn: Dynamics, radius: sp.Symbol, hard_core: sp.Expr | None = None):
+        self.level = LevelSet(dyn, radius)
+        if len(self.level.cyclic) != 1:
+            raise UnsupportedError("scattering needs one radial coordinate and one cyclic "
+                                   f"angle; this system has {len(self.level.cyclic) + 1} "
+                                   "coordinates")
+        self.angle = self.level.cyclic[0]
+        self.r = radius
+        self.hard_core = hard_core
+        mass, V, u = self.level.reduced
+        P = self.level.P[0]
+        if sp.diff(V, P, 3) != 0 or sp.diff(V, P).subs(P, 0) != 0:
+            raise UnsupportedError("scattering: the effective potential is not even and "
+                                   "quadratic in the angular momentum")
+        self.P = P
+
+    @cached_property
+    def functions(self):
+        mass, V, u = self.level.reduced
+        args = [self.r, self.P, *self.level.params]
+        core = [] if self.hard_core is None else [sp.lambdify(self.level.params,
+                                                              self.hard_core, "mpmath")]
+        return (sp.lambdify(args, mass, "mpmath"), sp.lambdify(args, V, "mpmath"),
+                sp.lambdify(args, u[0], "mpmath"), core)
+
+    @cached_property
+    def float_kinetic(self):
+        """V_eff(r, P, params) in double precision (None where it has no such form)."""
+        _, V, _ = self.level.reduced
+        try:
+            return sp.lambdify([self.r, self.P, *self.level.params], V, "math")
+        except Exception:  # noqa: BLE001 - a function math lacks: the search stays exact
+            return None
+
+    @cached_property
+    def potential_is_zero(self) -> bool:
+        """Whether V_eff at P = 0 (the potential alone) vanishes identically: a finite range
+        is then the hard core's."""
+        _, V, _ = self.level.reduced
+        return sp.simplify(V.subs(self.P, 0)) == 0
+
+    def orbit(self, point: dict, b, E, dps: int = DPS) -> Orbit:
+        """The scattering orbit of impact parameter `b` and energy `E` (numbers) at the
+        parameter `point`, in `dps`-digit arithmetic; Unbound if it is not one."""
+        with mpmath.workdps(dps):
+            params = [_mp(point[p], dps) for p in self.level.params]
+            return Orbit(self, params, _mp(b, dps), _mp(E, dps), dps)
+
+
+def _mp(value, dps: int):
+    """A number as an mpf: a SymPy Float exactly (its binary value, the same at every
+    precision above its own, so two precisions see the same orbit), else to `dps` digits."""
+    value = sp.sympify(value)
+    if isinstance(value, sp.Float) and value._prec <= mpmath.mp.prec:
+        return mpmath.mpf(value._mpf_)
+    return mpmath.mpf(str(sp.N(value, dps)))
+
+
+@dataclass
+class Orbit:
+    scattering: Scattering
+    params: list
+    b: object
+    E: object
+    dps: int
+
+    def _f(self, name: str):
+        m, V, u, core = self.scattering.functions
+        return {"m": m, "V": V, "u": u}[name]
+
+    def mass(self, r):
+        return self._f("m")(r, self.P, *self.params)
+
+    def veff(self, r, P=None):
+        return self._f("V")(r, self.P if P is None else P, *self.params)
+
+    def kinetic(self, r):
+        """E − V_eff(r): m ṙ²/2 (negative where the orbit cannot go)."""
+        try:
+            return self.E - self.veff(r)
+        except (ZeroDivisionError, ValueError):
+            return mpmath.mpf(-1)
+
+    @cached_property
+    def core(self):
+        _, _, _, core = self.scattering.functions
+        return core[0](*self.params) if core else None
+
+    @cached_property
+    def scale(self):
+        """A length to start from: the hard core, the impact parameter, or 1."""
+        return max(self.core or 0, abs(self.b), mpmath.mpf(1) if self.b == 0 else 0)
+
+    @cached_property
+    def m_inf(self):
+        with mpmath.workdps(self.dps):
+            far = self.scale * mpmath.mpf(10) ** (2 * DIGITS)
+            m = self._f("m")(far, 0, *self.params)
+            m2 = self._f("m")(far * 10 ** 5, 0, *self.params)
+            if not (mpmath.isfinite(m) and m > 0 and abs(m - m2) <= abs(m) *
+                    mpmath.mpf(10) ** (-DIGITS)):
+                raise Unbound("the radial mass has no positive limit far out")
+            return m
+
+    @cached_property
+    def P(self):
+        """The angular momentum b·√(2 m∞ E), after the checks that this is a scattering
+        orbit: the potential vanishes far out, and E > 0 above it."""
+        with mpmath.workdps(self.dps):
+            if not self.E > 0:
+                raise Unbound(f"E = {mpmath.nstr(self.E, 8)} is not above the potential at "
+                              "infinity (0): the orbit is bound, not a scattering one")
+            far1 = self.scale * mpmath.mpf(10) ** 20
+            far2 = self.scale * mpmath.mpf(10) ** 40
+            v1, v2 = (self._f("V")(r, 0, *self.params) for r in (far1, far2))
+            if not (abs(v2) <= abs(self.E) * mpmath.mpf(10) ** -15 and abs(v2) <= abs(v1)):
+                raise Unbound(f"the potential does not vanish at infinity (V = "
+                              f"{mpmath.nstr(v2, 8)} at r = 1e40 length scales): no "
+                              "scattering orbit")
+            return self.b * mpmath.sqrt(2 * self.m_inf * self.E)
+
+    @cached_property
+    def turning(self) -> Turning:
+        """The turning point of the orbit from infinity: an inward geometric search from
+        FAR length scales out, refined by bisection to the working precision."""
+        with mpmath.workdps(self.dps):
+            self.P  # noqa: B018 - the checks of an unbound orbit first
+            r = self.scale * FAR
+            for _ in range(3):
+                if self.kinetic(r) > 0:
+                    break
+                r *= FAR
+            else:
+                raise UnsupportedError("scattering: E − V_eff is not positive far out")
+            core = self.core
+            tiny = self.scale * mpmath.mpf(10) ** (-DIGITS)
+            r = self._descend(r, core, tiny)
+            for _ in range(MAX_STEPS):
+                nxt = r * STEP
+                if core is not None and nxt <= core:
+                    if self.kinetic(core) > 0:
+                        return Turning(core, True, self._root_inside(core, tiny))
+                    return Turning(self._bisect(core, r))
+                if nxt < tiny:
+                    return Turning(None)
+                k = self.kinetic(nxt)
+                if not (mpmath.isfinite(k) and k > 0):
+                    return Turning(self._bisect(nxt, r))
+                r = nxt
+            raise UnsupportedError("scattering: no turning point found in the search")
+
+    def _descend(self, r, core, tiny):
+        """The search's steps in double precision (a fiftieth of the cost): the last r
+        before E − V_eff is not positive, before the core or before `tiny`, from which the
+        search goes on at the working precision; a step the double-precision values
+        misjudged near the root is taken again there (r moved back out until allowed)."""
+        fn = self.scattering.float_kinetic
+        if fn is None:
+            return r
+        args = [float(self.P), *(float(p) for p in self.params)]
+        E, x, stop = float(self.E), float(r), float(max(core or 0, tiny))
+        for _ in range(MAX_STEPS):
+            nxt = x * float(STEP)
+            if nxt <= stop:
+                break
+            try:
+                k = E - fn(nxt, *args)
+            except (ZeroDivisionError, ValueError, OverflowError, TypeError):
+                break
+            if not (math.isfinite(k) and k > 0):
+                break
+            x = nxt
+        back = mpmath.mpf(x)
+        while back < r and not self.kinetic(back) > 0:
+            back = back / STEP
+        return min(back, r)
+
+    def _root_inside(self, core, tiny):
+        """The largest root of E = V_eff below the core (the orbit never gets there, but
+        a grazing orbit's integrands are nearly singular at it), or None."""
+        r = core
+        for _ in range(MAX_STEPS):
+            nxt = r * STEP
+            if nxt < tiny:
+                return None
+            k = self.kinetic(nxt)
+            if not (mpmath.isfinite(k) and k > 0):
+                return self._bisect(nxt, r)
+            r = nxt
+        return None
+
+    def _bisect(self, lo, hi):
+        """The root of E − V_eff between `lo` (not allowed) and `hi` (allowed): bisection,
+        then the Illinois method at twice the working precision (an error δ in r_min moves
+        the deflection integral by ~√δ, so r_min needs twice the digits of Θ)."""
+        tol = mpmath.mpf(10) ** (-(self.dps // 2))
+        while hi - lo > hi * tol:
+            mid = (lo + hi) / 2
+            k = self.kinetic(mid)
+            if mpmath.isfinite(k) and k > 0:
+                hi = mid
+            else:
+                lo = mid
+        with mpmath.workdps(2 * self.dps + 10):
+            k_lo, k_hi = self.kinetic(lo), self.kinetic(hi)
+            if not (mpmath.isfinite(k_lo) and k_lo < 0):
+                return hi  # no value below the root (V_eff singular): the bisection's end
+            side = 0
+            for _ in range(200):
+                if hi - lo <= hi * mpmath.mpf(10) ** (-(2 * self.dps + 5)):
+                    break
+                mid = hi - k_hi * (hi - lo) / (k_hi - k_lo)
+                if not lo < mid < hi:
+                    mid = (lo + hi) / 2
+                k = self.kinetic(mid)
+                if k == 0:
+                    return mid
+                if mpmath.isfinite(k) and k > 0:
+                    hi, k_hi = mid, k
+                    if side == 1:
+                        k_lo /= 2
+                    side = 1
+                else:
+                    lo, k_lo = mid, k
+                    if side == -1:
+                        k_hi /= 2
+                    side = -1
+            return hi
+
+    @property
+    def r_min(self):
+        t = self.turning
+        if t.captured:
+            raise Captured("the particle falls to the centre (captured): there is no "
+                           "closest approach or deflection")
+        return t.r
+
+    @cached_property
+    def deflection(self):
+        """Θ = π − 2∫ u √(m/(2(E − V_eff))) dr from r_min to ∞ (signed)."""
+        with mpmath.workdps(self.dps):
+            rmin = self.r_min
+            t = self.turning
+            if not t.on_core:  # a simple root: E − V_eff has a nonzero slope there
+                h = rmin * mpmath.mpf(10) ** (-self.dps // 3)
+                slope = (self.kinetic(rmin + h) - self.kinetic(rmin)) / h
+                if not slope * rmin > abs(self.E) * mpmath.mpf(10) ** -12:
+                    raise UnsupportedError("scattering: orbiting (E − V_eff has a double "
+                                           "root at the turning point): the deflection "
+                                           "diverges")
+            # r = rs/(1 − w²) from the singular point rs (the turning point, or on a core
+            # the root inside it): the integral runs from w_lo (0 at a turning point) to 1;
+            # at a root the integrand is even in w: below w0 its value at w0 stands for it
+            # (an error of O(w0³)); on the core it is regular and needs no help
+            rs = t.singular if t.singular is not None else rmin
+            with mpmath.workdps(self.dps + 15):
+                w_lo = mpmath.sqrt(1 - rs / rmin) if t.on_core else mpmath.mpf(0)
+            w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
+
+            def integrand(w):
+                w = max(w, w0)
+                with mpmath.workdps(self.dps + 15):  # E − V_eff is small near r_min
+                    one = (1 - w) * (1 + w)
+                    r = max(rs / one, rmin)
+                    k = self.kinetic(r)
+                    if not k > 0:
+                        raise UnsupportedError("scattering: the orbit leaves the allowed "
+                                               "region beyond its turning point")
+                    u = self._f("u")(r, self.P, *self.params)
+                    return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rs * w / one ** 2
+
+            total = mpmath.quad(integrand, [w_lo, (w_lo + 1) / 2, 1])
+            return mpmath.pi - 2 * total
+
+
+    @cached_property
+    def speed(self):
+        """v∞ = √(2E/m∞)."""
+        with mpmath.workdps(self.dps):
+            return mpmath.sqrt(2 * self.E / self.m_inf)
+
+    @cached_property
+    def time_delay(self):
+        """τ = 2[∫_{r_min}^∞ √(m/(2(E − V_eff))) dr − ∫_b^∞ √(m∞/(2(E − Eb²/r²))) dr], the
+        time the orbit takes beyond the free straight line of the same b and E: split at
+        X = 2 max(r_min, b); the free part to X in closed form, √(X² − b²)/v∞; the orbit's
+        part to X after r = r_min + (X − r_min)w² (the turning point's singularity gone);
+        beyond X the difference of the two, after r = X/(1 − u). Defined where the
+        potential falls faster than 1/r (else the delay grows like log R): refused there."""
+        with mpmath.workdps(self.dps):
+            rmin = self.r_min
+            far = self.scale * mpmath.mpf(10) ** 20
+            if abs(far * self.veff(far, 0)) > abs(self.E) * self.scale * \
+                    mpmath.mpf(10) ** -10:
+                raise UnsupportedError("time delay: the potential falls like 1/r or slower, "
+                                       "so the delay grows like log R without a limit")
+            X = 2 * max(rmin, self.b)
+            m_inf, E, b = self.m_inf, self.E, self.b
+
+            def dt_dr(r):
+                with mpmath.workdps(self.dps + 15):
+                    k = self.kinetic(r)
+                    if not k > 0:
+                        raise UnsupportedError("time delay: the orbit leaves the allowed "
+                                               "region beyond its turning point")
+                    return mpmath.sqrt(self.mass(r) / (2 * k))
+
+            t = self.turning  # r = rs + (X − rs)w² from the singular point, as for Θ
+            rs = t.singular if t.singular is not None else rmin
+            with mpmath.workdps(self.dps + 15):
+                w_lo = mpmath.sqrt((rmin - rs) / (X - rs))
+            w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
+
+            def near(w):
+                w = max(w, w0)
+                with mpmath.workdps(self.dps + 15):
+                    return dt_dr(max(rs + (X - rs) * w * w, rmin)) * 2 * (X - rs) * w
+
+            def beyond(u):
+                # √(m/2k) − √(m∞/2k0) without the cancellation of two numbers near
+                # √(m∞/2E) far out: (m·k0 − m∞·k)/(2k·k0) over their sum, with
+                # k0 − k = V_eff − Eb²/r², a difference of two small numbers there
+                with mpmath.workdps(self.dps + 15):
+                    one = 1 - u
+                    r = X / one
+                    centrifugal = E * (b / r) ** 2
+                    v = self.veff(r)
+                    k, k0, m = E - v, E - centrifugal, self.mass(r)
+                    if not k > 0:
+                        raise UnsupportedError("time delay: the orbit leaves the allowed "
+                                               "region beyond its turning point")
+                    top = m * (v - centrifugal) + (m - m_inf) * k
+                    total = mpmath.sqrt(m / (2 * k)) + mpmath.sqrt(m_inf / (2 * k0))
+                    return top / (2 * k * k0) / total * X / one ** 2
+
+            inside = mpmath.quad(near, [w_lo, 1])
+            outside = mpmath.quad(beyond, [0, mpmath.mpf(1) / 2, 1])
+            free = mpmath.sqrt(X * X - b * b) / self.speed
+            return 2 * (inside + outside - free)
+
+
+class Captured(UnsupportedError):
+    """The orbit falls to the centre: the quantity asked for does not exist there."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+
+
+def checked(scattering: Scattering, point: dict, b, E, what) -> tuple:
+    """`what(orbit)` at DPS and at DPS + 15 digits; (value at the higher, their difference):
+    UnsupportedError if they differ by more than 10^-DIGITS of the value (the quadrature
+    did not reach its digits)."""
+    lo = what(scattering.orbit(point, b, E, DPS))
+    with mpmath.workdps(DPS + 15):
+        hi = what(scattering.orbit(point, b, E, DPS + 15))
+        diff = abs(hi - lo)
+        if diff > mpmath.mpf(10) ** (-DIGITS) * max(abs(hi), 1):
+            raise UnsupportedError(f"scattering: the quadrature did not reach {DIGITS} digits "
+                                   f"(two precisions differ by {mpmath.nstr(diff, 3)})")
+        return hi, diff
+
+
+def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int = DPS):
+    """b_c = inf_r B(r), B(r) the b at which E = V_eff(r; b·p∞) (0 where no b is captured,
+    a potential less singular than −1/r²): a log grid of r over 24 decades, then the
+    minimum refined by golden sections at `dps` digits."""
+    orbit = scattering.orbit(point, 1, E, dps)
+    if scattering.hard_core is not None:
+        raise UnsupportedError("capture with a hard core: the core reflects every orbit")
+    with mpmath.workdps(dps):
+        orbit.P  # noqa: B018 - an unbound orbit
+        p_inf = mpmath.sqrt(2 * orbit.m_inf * orbit.E)
+
+        def B(r):
+            v0 = orbit.veff(r, 0)
+            c2 = orbit.veff(r, 1) - v0  # V_eff = v0 + c2 P²
+            if not c2 > 0:
+                raise UnsupportedError("scattering: the centrifugal term is not positive")
+            room = orbit.E - v0
+            return mpmath.sqrt(room / c2) / p_inf if room > 0 else mpmath.mpf(0)
+
+        grid = [mpmath.mpf(10) ** (mpmath.mpf(k) / 10) for k in range(-120, 121)]
+        values = [B(r) for r in grid]
+        i = min(range(len(values)), key=lambda j: values[j])
+        if values[i] == 0:
+            return mpmath.mpf(0)
+        if i == 0:  # still falling towards r → 0: the infimum is the limit there
+            if values[0] < values[1] * mpmath.mpf("0.999"):
+                return mpmath.mpf(0)
+            return values[0]
+        if i == len(values) - 1:
+            raise UnsupportedError("scattering: B(r) keeps falling far out")
+        lo, hi = mpmath.log(grid[i - 1]), mpmath.log(grid[i + 1])
+        g = (mpmath.sqrt(5) - 1) / 2
+        a, c = hi - g * (hi - lo), lo + g * (hi - lo)
+        fa, fc = B(mpmath.exp(a)), B(mpmath.exp(c))
+        for _ in range(4 * dps):
+            if fa < fc:
+                hi, c, fc = c, a, fa
+                a = hi - g * (hi - lo)
+                fa = B(mpmath.exp(a))
+            else:
+                lo, a, fa = a, c, fc
+                c = lo + g * (hi - lo)
+                fc = B(mpmath.exp(c))
+        return min(fa, fc)
