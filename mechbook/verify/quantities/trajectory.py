@@ -26,7 +26,7 @@ from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
 from mechbook.numerics.rhs import build_model
 from mechbook.verify.asymptotic import asymptotic
-from mechbook.verify.compare import Verdict, match_multiset
+from mechbook.verify.compare import Verdict, at_point, match_multiset
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, Family
 
@@ -159,7 +159,7 @@ def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
         eng = engine_of(pt)
         ok, why = match_multiset(_at_start(motion.start, book, pt), eng, partial, rtol=motion.rtol)
         if not ok:
-            return Verdict(False, f"{how}({n} points)", f"{what}: {why}")
+            return Verdict(False, f"{how}({n} points)", f"{what}: {why}" + at_point(pt))
     return Verdict(True, f"{how}({motion.points()} points, rtol {motion.rtol:g})",
                    power=(f"within the stated {motion.rtol:g}" if "estimate" in ctx.part.data
                           else f"{motion.points()} points, each value to {motion.rtol:g} "
@@ -339,6 +339,6 @@ def check_event_time(ctx: Context, val) -> Verdict:
             engine = float(y[i] - q0[i])
         ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
         if not ok:
-            return Verdict(False, f"measured({n} points)", f"event: {why}")
+            return Verdict(False, f"measured({n} points)", f"event: {why}" + at_point(pt))
     return Verdict(True, f"measured({points} points, rtol {rtol:g})",
                    power=f"{points} points, measured by integration to {rtol:g}")
