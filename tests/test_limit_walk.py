@@ -2,7 +2,7 @@
 the error's resolution are judged (never a pass called exact above it), and a claim the
 arithmetic cannot resolve is unsupported, never a pass.
 
-Keys are derived in the docstrings. The walk's rule is tested on its own (`_judge`, on
+Keys are derived in the docstrings. The walk's rule is tested on its own (`judge_walk`, on
 errors written here as closed forms of ε) and on two driven systems whose boundaries are
 known in closed form to the order claimed: a spring with modulated stiffness (the first
 resonance tongue) and a pendulum balanced on a vibrating pivot (Kapitza's).
@@ -16,7 +16,7 @@ from systems import load_analysis
 
 from mechbook.errors import UnsupportedError
 from mechbook.verify.answers import load_answers
-from mechbook.verify.asymptotic import LIMIT_STEPS, MORE_STEPS, _judge
+from mechbook.verify.asymptotic import LIMIT_STEPS, MORE_STEPS, judge_walk
 from mechbook.verify.checker import check_problem
 
 STEPS = list(LIMIT_STEPS + MORE_STEPS)
@@ -32,7 +32,7 @@ def _walk(error, floor: float, order: int):
             break
         steps.append(eps)
         errors.append(max(error(eps), floor / 2))  # below the floor: reads as its noise
-    return _judge("h", 0, True, order, steps, errors, [floor] * len(errors))
+    return judge_walk("h", 0, True, order, steps, errors, [floor] * len(errors))
 
 
 def test_the_rule_judges_the_steps_above_the_floor():

@@ -93,7 +93,7 @@ def admissible(system, point: dict, values: dict) -> bool:
     positive r stays positive)? A cross-check samples only states the problem admits.
     Example: for a coordinate r declared positive, admissible(sys, {r: -0.62}, {}) is
     False."""
-    domains = getattr(system, "domains", {})
+    domains = system.domains
     params = {k: float(v) for k, v in values.items()
               if isinstance(v, int | float) or getattr(v, "is_number", False)}
     for q, x in point.items():
