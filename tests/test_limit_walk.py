@@ -118,6 +118,9 @@ def test_a_zone_written_with_or_is_decided(spring, tmp_path):
     out = _check(spring, tmp_path, "9601", **tongue, book=_zone("0"))
     assert out.status == "pass", out.detail
     assert "falls like h**2.0" in out.detail, out.detail
+    # an `and` around it (its other side, h < 1, never changes truth near the limit)
+    out = _check(spring, tmp_path, "9601", **tongue, book=f"({_zone('0')}) and h < 1")
+    assert out.status == "pass", out.detail
     out = _check(spring, tmp_path, "9601", **tongue,
                  book=f"gamma < 2*{W0}*(1 - 101*h/400) or gamma > 2*{W0}*(1 + 101*h/400)")
     assert out.status == "fail", out.detail
