@@ -21,7 +21,7 @@ from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.verify.compare import POINTS, Sampler, Verdict
 
 WORK = 40  # digits of the projection
-RTOL = 1e-18  # what may be left of the gradient, relative to the functions' gradients
+RTOL = 1e-24  # what may be left of the gradient, relative to the functions' gradients
 RANK_TOL = 1e-25  # a singular value below this fraction of the largest is zero
 
 
