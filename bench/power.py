@@ -163,7 +163,7 @@ def measure(tree: Path, files: list[str], out: Path, deltas: list[Fraction]) -> 
                             "token": getattr(m, "token", ""),
                             "status": status, "killed": killed and status != "timeout",
                             "detail": detail, "estimate": bool(est),
-                            "claim": delta == finer,
+                            "claim": delta == finer, "limit": "limit" in part.data,
                             "seconds": time.process_time() - start}, default=str) + "\n")
                         sink.flush()
                     seen_discrete = True
@@ -253,7 +253,7 @@ def table(mutants: list[dict], equiv: dict, title: str) -> str:
     rows = defaultdict(lambda: [0, 0, 0])  # mutants, equivalent, killed
     for r in mutants:
         cls = _class(r)
-        row = rows[(r["quantity"], cls)]
+        row = rows[(_quantity(r), cls)]
         row[0] += 1
         if r["killed"]:
             row[2] += 1
@@ -274,6 +274,11 @@ def table(mutants: list[dict], equiv: dict, title: str) -> str:
         rate = k / (n - e) if n > e else float("nan")
         lines.append(f"| **all** | {cls} | {n} | {e} | {k} | **{rate:.2%}** |")
     return "\n".join(lines)
+
+
+def _quantity(r: dict) -> str:
+    """The row's quantity: a part with `limit:` (an asymptotic claim) has its own."""
+    return f"{r['quantity']}` with `limit:" if r.get("limit") else r["quantity"]
 
 
 def _class(r: dict) -> str:

@@ -75,6 +75,8 @@ def engine_linear_systems(analysis: Analysis, name: str,
         if any(found.same(f.point, d) for d in done):
             continue
         point = {q: snap(x) for q, x in zip(sys.q, f.point, strict=True)}
+        if not admissible(sys, point, values):
+            continue  # outside a coordinate's domain (r > 0): not a state of the problem
         try:
             lin = analysis.linear(name, point)
             if lin.numeric_stability(values) != "stable" and not _marginal_ok(lin, values):
@@ -84,6 +86,26 @@ def engine_linear_systems(analysis: Analysis, name: str,
         done.append(tuple(f.point))
         out.append((lin, point_label(lin)))
     return out
+
+
+def admissible(system, point: dict, values: dict) -> bool:
+    """Is `point` (coordinates) inside every coordinate's declared domain and sign (a
+    positive r stays positive)? A cross-check samples only states the problem admits.
+    Example: for a coordinate r declared positive, admissible(sys, {r: -0.62}, {}) is
+    False."""
+    domains = system.domains
+    params = {k: float(v) for k, v in values.items()
+              if isinstance(v, int | float) or getattr(v, "is_number", False)}
+    for q, x in point.items():
+        try:
+            x = float(x)
+        except (TypeError, ValueError):
+            continue
+        if q.is_positive and x <= 0 or q.is_nonnegative and x < 0:
+            return False
+        if q in domains and not domains[q].contains(x, params):
+            return False
+    return True
 
 
 def _marginal_ok(lin: LinearSystem, values: dict) -> bool:

@@ -154,7 +154,8 @@ class LinearSystem:
         every symbol of the roots a number (a steady motion's rate or tilt named by an
         answer key is not among the system's parameters): UnsupportedError otherwise."""
         if not self.gyroscopic:
-            return [try_simplify(sp.sqrt(r), 5) for r in self.squared_frequencies]
+            return ascending([try_simplify(sp.sqrt(r), 5) for r in self.squared_frequencies],
+                             values)
         keep = []
         for r, mult in self._gyroscopic_roots.items():
             left = sorted(map(str, r.free_symbols - set(values)))
@@ -169,7 +170,7 @@ class LinearSystem:
                 keep += [try_simplify(r, 5)] * mult
         if len(keep) != len(self.q):
             raise UnsupportedError("closed-form frequencies of a gyroscopic system")
-        return keep
+        return ascending(keep, values)
 
     @cached_property
     def _gyroscopic_roots(self) -> dict:
@@ -457,6 +458,21 @@ def state_matrix(M, C, K):
         for j in range(n):
             A[n + i, j], A[n + i, n + j] = MK[i, j], MC[i, j]
     return A
+
+
+def ascending(exprs: list[sp.Expr], values: dict) -> list[sp.Expr]:
+    """Symbolic frequencies in the order the numeric ones come in (`numeric_frequencies`:
+    ascending), by their real values at `values` (30 digits); one that does not evaluate
+    there goes last, in its text's order, so the order is defined and kept."""
+    def key(e: sp.Expr):
+        try:
+            v = _entry(e, values, 30)
+        except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError,
+                MechbookError):
+            return (1, 0.0, str(e))
+        re = float(v.real) if isinstance(v, complex) else float(v)
+        return (0, re, str(e)) if re == re else (1, 0.0, str(e))
+    return sorted(exprs, key=key)
 
 
 def _entry(x: sp.Expr, values: dict, digits: int, exact: bool = False):

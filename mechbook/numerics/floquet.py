@@ -12,9 +12,12 @@ Deciding "on the unit circle" honestly:
   variable) and compared with det Φ: their relative difference is the measured resolution of
   Φ. A verdict needs it below RESOLVED; where it is not (and no multiplier is clearly off the
   circle) the point has no verdict (UnsupportedError with the numbers).
-- A multiplier within MARGINAL of ±1 is marginal (a tongue's edge, or a zero exponent of a
-  symmetry): rounding splits a double root there by the square root of the arithmetic's
-  precision (~1e-17), so nearer than 1e-13 nothing can be told.
+- A multiplier near ±1 is marginal (a tongue's edge, or a zero exponent of a symmetry):
+  rounding splits a double root there by the square root of Φ's error (its resolution, at
+  least the arithmetic's 1e-34, times the size of Φ: ~1e-17), so within 100 times that
+  (and at least MARGINAL, 1e-15) nothing can be told (`marginal_within`). Until issue 41 the
+  bound was a fixed 1e-13: 10⁴ times the split, it hid a boundary's last decades from the
+  walk toward a limit (mechbook.verify.boundary_limit).
 - Otherwise unstable iff some |μ| > 1 + ON_CIRCLE(resolution). Off the edges the multipliers
   of a stable conservative system sit on the circle to the arithmetic's precision, and an
   unstable one's leave it like the square root of the distance to the boundary: 1e-8 from
@@ -41,7 +44,15 @@ from mechbook.numerics.hyexpr import Translator, solve_spd
 
 DPS = 40  # mpmath digits for the period, the parameters and the eigenvalues of Φ
 RESOLVED = 1e-20  # the largest Liouville mismatch at which a verdict is given
-MARGINAL = 1e-13  # a multiplier this close to ±1 is marginal (no verdict)
+MARGINAL = 1e-15  # at least this close to ±1 a multiplier is marginal (no verdict)
+PRECISION = 1e-34  # 113-bit arithmetic's relative rounding
+
+
+def marginal_within(resolution: float, scale: float) -> float:
+    """How near ±1 a multiplier is marginal: 100 times the split rounding can give a
+    double root there, the square root of Φ's error (its measured resolution, at least the
+    arithmetic's, times the size of Φ's entries), and at least MARGINAL."""
+    return max(MARGINAL, 100 * (max(resolution, PRECISION) * max(scale, 1.0)) ** 0.5)
 CLEARLY = 1e-6  # |μ| beyond 1 + this is unstable whatever the resolution
 ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
 
@@ -59,6 +70,7 @@ class Multipliers:
     period: object  # mpf
     resolution: float  # |det Φ / exp(−∫tr M⁻¹C) − 1|
     seconds: float = 0.0
+    scale: float = 1.0  # the largest entry of Φ in magnitude
 
     def exponents(self) -> list:
         """Characteristic exponents log(μ)/T (real parts: growth rates)."""
@@ -71,7 +83,8 @@ class Multipliers:
     def verdict(self) -> str:
         """'stable', 'unstable' or 'marginal' (see the module's docstring)."""
         with mpmath.workdps(DPS):
-            edge = [m for m in self.values if min(abs(m - 1), abs(m + 1)) < MARGINAL]
+            near = marginal_within(self.resolution, self.scale)
+            edge = [m for m in self.values if min(abs(m - 1), abs(m + 1)) < near]
             off = [m for m in self.values if m not in edge]
             if any(abs(m) > 1 + CLEARLY for m in off):
                 return "unstable"
@@ -222,7 +235,8 @@ class Floquet:
         phi, T, mismatch = self.monodromy(values)
         with mpmath.workdps(DPS):
             mu = mpmath.eig(phi, left=False, right=False)
-        return Multipliers(list(mu), T, mismatch, time.perf_counter() - start)
+            scale = float(max(abs(x) for x in phi))
+        return Multipliers(list(mu), T, mismatch, time.perf_counter() - start, scale)
 
     def stability(self, values: dict) -> str:
         """'stable', 'unstable' or 'marginal' at `values` (see Multipliers.verdict)."""

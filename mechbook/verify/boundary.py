@@ -106,6 +106,102 @@ def atoms_of(cond: sp.Basic) -> list[sp.Expr]:
     return [r.lhs - r.rhs for r in rels]
 
 
+def atom_roots(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
+    """Every place along the ray where an atom of the relation goes through zero, as
+    (t, atom's index), sorted: a change of sign between grid points, and a dip through zero
+    and back between them (its minimum located by golden sections, each side's root
+    refined). A compound relation (`or`, `and`, a chained inequality, a piecewise form)
+    changes truth only at such places, and a zone narrower than the grid (a resonance
+    tongue as its width goes to 0) lies between two of them, of one atom or of two."""
+    out: list[tuple] = []
+    for i, f in enumerate(atoms):
+        vals = []
+        for t in ts:
+            pt = ray.point(t)
+            got = None if pt is None else value_at(f, pt)
+            vals.append(None if got is None else got[0])
+        for k in range(len(ts) - 1):
+            a, b = vals[k], vals[k + 1]
+            if a is not None and b is not None and (a > 0) != (b > 0):
+                out.append((refine([f], ray, float(ts[k]), float(ts[k + 1]))[0], i))
+        for k in range(1, len(ts) - 1):
+            a, b, c = vals[k - 1: k + 2]
+            if a is None or b is None or c is None or not (a > 0) == (b > 0) == (c > 0) \
+                    or abs(b) > abs(a) or abs(b) > abs(c):
+                continue
+            sign = 1 if b > 0 else -1
+            t_min, v = _signed_minimum(f, ray, sign, float(ts[k - 1]), float(ts[k + 1]))
+            if v is None or v * sign >= 0:
+                continue
+            out += [(refine([f], ray, float(ts[k - 1]), t_min)[0], i),
+                    (refine([f], ray, t_min, float(ts[k + 1]))[0], i)]
+    out.sort(key=lambda x: x[0])
+    return out
+
+
+def truth_changes(cond: sp.Basic, atoms: list[sp.Expr], ray: Ray,
+                  ts: np.ndarray) -> list[tuple]:
+    """(t, the book's truth just below, just above, the atom's index) at every atom root
+    along the ray where
+    the relation's truth changes (mechbook.verify.boundary.atom_roots), each side read a
+    quarter of the way to the next root (at most 1e-9 in ray units)."""
+    roots = atom_roots(atoms, ray, ts)
+    out = []
+    for k, (t0, i) in enumerate(roots):
+        gaps = [abs(t0 - roots[j][0]) for j in (k - 1, k + 1) if 0 <= j < len(roots)]
+        gaps = [g for g in gaps if g > mpmath.mpf(10) ** -(DIGITS - 2)]
+        with mpmath.workdps(DIGITS + 20):  # offsets below 1e-16 of t0 need the digits
+            d = min([mpmath.mpf(1e-9)] + [g / 4 for g in gaps])
+            lo, hi = ray.point(t0 - d), ray.point(t0 + d)
+        if lo is None or hi is None:
+            continue
+        below, above = holds(cond, lo), holds(cond, hi)
+        if below != above and all(abs(t0 - s[0]) > 1e-25 for s in out):
+            out.append((t0, below, above, i))
+    return out
+
+
+def _narrow_changes(cond, atoms, ray, ts, grid) -> list[tuple]:
+    """The truth changes (truth_changes) inside grid cells whose two ends the book's
+    relation gives the same truth: those the grid's own brackets miss."""
+    out = []
+    for change in truth_changes(cond, atoms, ray, ts):
+        k = int(np.searchsorted(ts, float(change[0]))) - 1
+        if 0 <= k < len(ts) - 1 and grid[k][0] is not None and grid[k][0] == grid[k + 1][0]:
+            out.append(change)
+    return out
+
+
+def _signed_minimum(f: sp.Expr, ray: Ray, sign: int, a: float, b: float):
+    """The minimum of sign·f on [a, b] by golden sections: (t, f there or None)."""
+    ratio = (math.sqrt(5) - 1) / 2
+
+    def f_at(t):
+        pt = ray.point(t)
+        got = None if pt is None else value_at(f, pt)
+        return None if got is None else got[0]
+
+    def g(t):
+        v = f_at(t)
+        return math.inf if v is None else sign * v
+
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    gc, gd = g(c), g(d)
+    for _ in range(100):
+        if gc <= gd:
+            b, d, gd = d, c, gc
+            c = b - ratio * (b - a)
+            gc = g(c)
+        else:
+            a, c, gc = c, d, gd
+            d = a + ratio * (b - a)
+            gd = g(d)
+        if b - a < BISECT_TOL:
+            break
+    t = c if gc <= gd else d
+    return t, f_at(t)
+
+
 def value_at(f: sp.Expr, pt: dict) -> tuple[float, float] | None:
     try:
         v, m = evaluate(f, pt, DIGITS)
@@ -354,6 +450,16 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
             if bad:
                 res.ok = False
                 res.detail = bad + _engine_crossing(judge, float(ts[k]), float(ts[k + 1]))
+                return res
+            res.crossings += 1
+        # a zone narrower than the grid (the book's truth the same at a cell's two ends,
+        # another inside): between two roots of the relation's atoms
+        for t_star, _, _, side in _narrow_changes(cond, atoms, ray, ts, grid):
+            crossed.add(side)
+            bad = _judge_crossing(judge, t_star, res, words)
+            if bad:
+                res.ok = False
+                res.detail = bad
                 return res
             res.crossings += 1
         for t_star, side in _tangencies(atoms, ray, ts):

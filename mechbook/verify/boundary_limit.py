@@ -36,6 +36,10 @@ from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
 
 FLOOR = 1e-14  # the smallest offset from the book's boundary that is tried
+# Floquet's verdicts (113-bit arithmetic): a multiplier leaves ±1 like the square root of the
+# distance to a tongue's edge and is marginal within 1e-13 of it, so offsets down to ~1e-26
+# have a verdict; 1e-24 leaves two decades of margin
+FLOQUET_FLOOR = 1e-24
 GRID = 40  # points along each probe's ray where the book's truth is read
 BRACKET = 1e-6  # the Boolean bisection's bracket before the atom's root is refined
 BISECTIONS = 10  # of the log offset between two decades: 10^(1/1024), 0.2 %
@@ -58,26 +62,29 @@ def probes(ctx: Context, cond: sp.Basic) -> list[sp.Symbol]:
     return out
 
 
-def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier) -> Verdict:
+def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier,
+          floor: float = FLOOR) -> Verdict:
     """The book's relation as an asymptotic claim: the distance between its boundary and
-    the engine's must fall at the order `limit:` states."""
+    the engine's must fall at the order `limit:` states. `floor`: the smallest offset the
+    engine's verdicts resolve (FLOOR; FLOQUET_FLOOR for Floquet's, in 113 bits)."""
     along = probes(ctx, cond)
     atoms = boundary.atoms_of(cond)
 
     last: dict = {}  # the probe along which the last step's error was largest
 
-    def error(pt: dict) -> float:
-        worst, found = 0.0, 0
+    def error(pt: dict) -> tuple[float, float]:
+        worst, found, resolution = 0.0, 0, floor
         for p in along:
             ray = _Ray(ctx.sampler, pt, np.array([1.0]), [p])
             for t_star, below, above, reach in _book_crossings(cond, atoms, ray):
                 found += 1
-                e = _engine_offset(classify, ray, t_star, below, above, reach)
+                e, r = _engine_offset(classify, ray, t_star, below, above, reach, floor)
+                resolution = max(resolution, r)
                 if e >= worst:
                     worst, last["probe"] = e, p.name
-        return worst if found else math.inf
+        return (worst if found else math.inf), resolution
 
-    got = asymptotic(ctx, error, floor=FLOOR)
+    got = asymptotic(ctx, error, floor=floor)
     names = ", ".join(s.name for s in along)
     where = f" (largest along {last['probe']} at the last step)" if len(along) > 1 and \
         "probe" in last else ""
@@ -86,7 +93,8 @@ def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier) -> Verdic
         return Verdict(False, got.method, detail)
     return Verdict(True, got.method, detail,
                    power=f"{got.power}; the distance between the book's boundary and the "
-                         f"engine's along {names}, resolved to {FLOOR:g}")
+                         f"engine's along {names}, from offsets of {floor:g} (or where "
+                         "the engine first gives verdicts on both sides)")
 
 
 class _Ray(boundary.Ray):
@@ -98,7 +106,8 @@ class _Ray(boundary.Ray):
         self._points: dict = {}
 
     def point(self, t) -> dict | None:
-        key = mpmath.mpf(t)
+        with mpmath.workdps(boundary.DIGITS + 20):  # at full precision: keyed in the default
+            key = mpmath.mpf(t)  # 15 digits, offsets below 1e-16 all met one cached point
         if key not in self._points:
             self._points[key] = super().point(t)
         return self._points[key]
@@ -106,38 +115,24 @@ class _Ray(boundary.Ray):
 
 def _book_crossings(cond: sp.Basic, atoms: list, ray: boundary.Ray) -> list[tuple]:
     """(t*, the book's truth below and above it, how far the engine's crossing may be
-    sought) for every place along the ray where the book's relation changes truth: where
-    the truth differs between grid points, and where an atom dips through zero and back
-    between them (a resonance tongue narrower than the grid: its minimum is located by
-    golden sections and each side bisected)."""
+    sought) for every place along the ray where the book's relation changes truth: at every
+    root of every atom of the relation where its truth changes (of a compound relation's
+    too: `or`, `and`, a chained inequality; a zone narrower than the grid, between two
+    roots, is found so: mechbook.verify.boundary.truth_changes), and, where the truth
+    differs between grid points with no such root between them, by bisection."""
     ts = np.linspace(-boundary.SPAN, boundary.SPAN, GRID)
 
     def book(t):
         pt = ray.point(t)
         return None if pt is None else holds(cond, pt)
 
+    found: list[tuple] = [c[:3] for c in boundary.truth_changes(cond, atoms, ray, ts)]
     truths = [book(t) for t in ts]
-    brackets = [(float(ts[k]), float(ts[k + 1]), truths[k]) for k in range(len(ts) - 1)
-                if truths[k] is not None and truths[k + 1] is not None
-                and truths[k] != truths[k + 1]]
-    for f in atoms:
-        vals = [_signed(f, ray, t) for t in ts]
-        for k in range(1, len(ts) - 1):
-            a, b, c = vals[k - 1: k + 2]
-            if a is None or b is None or c is None or not (a > 0) == (b > 0) == (c > 0) \
-                    or abs(b) > abs(a) or abs(b) > abs(c):
-                continue
-            sign = 1 if b > 0 else -1
-            t_min, v = _golden(lambda t, f=f, sign=sign: _signed(f, ray, t), sign,
-                               float(ts[k - 1]), float(ts[k + 1]))
-            inside = book(t_min)
-            if v is None or v * sign >= 0 or inside is None or inside == truths[k - 1] \
-                    or truths[k - 1] is None or truths[k + 1] != truths[k - 1]:
-                continue
-            brackets += [(float(ts[k - 1]), t_min, truths[k - 1]), (t_min, float(ts[k + 1]),
-                                                                     inside)]
-    found: list[tuple] = []
-    for a, b, fa in brackets:
+    for k in range(len(ts) - 1):
+        a, b, fa = float(ts[k]), float(ts[k + 1]), truths[k]
+        if fa is None or truths[k + 1] is None or fa == truths[k + 1] or \
+                any(a <= t <= b for t, _, _ in found):
+            continue
         while b - a > BRACKET:  # Boolean bisection to a bracket the root finder closes
             m = (a + b) / 2
             fm = book(m)
@@ -157,42 +152,19 @@ def _book_crossings(cond: sp.Basic, atoms: list, ray: boundary.Ray) -> list[tupl
     return out
 
 
-def _signed(f: sp.Expr, ray: boundary.Ray, t) -> float | None:
-    pt = ray.point(t)
-    got = None if pt is None else boundary.value_at(f, pt)
-    return None if got is None else got[0]
-
-
-def _golden(f, sign: int, a: float, b: float) -> tuple[float, float | None]:
-    """The minimum of sign·f on [a, b] by golden sections: (t, f there)."""
-    ratio = (math.sqrt(5) - 1) / 2
-
-    def g(t):
-        v = f(t)
-        return math.inf if v is None else sign * v
-
-    c, d = b - ratio * (b - a), a + ratio * (b - a)
-    gc, gd = g(c), g(d)
-    for _ in range(100):
-        if gc <= gd:
-            b, d, gd = d, c, gc
-            c = b - ratio * (b - a)
-            gc = g(c)
-        else:
-            a, c, gc = c, d, gd
-            d = a + ratio * (b - a)
-            gd = g(d)
-        if b - a < boundary.BISECT_TOL:
-            break
-    t = c if gc <= gd else d
-    return t, f(t)
-
-
 def _engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, below: bool,
-                   above: bool, reach: float) -> float:
-    """How far from t_star the engine's verdict changes the way the book's does there
-    (FLOOR where it already agrees at FLOOR; inf where it does not within `reach`)."""
-    def verdict(t) -> bool | None:
+                   above: bool, reach: float, floor: float = FLOOR) -> tuple[float, float]:
+    """(how far from t_star the engine's verdict changes the way the book's does there, the
+    resolution: `floor`, or the largest offset at which the engine gave no verdict).
+    Agreement on both sides is looked for at offsets growing by decades from `floor` (the
+    offset is `floor` where it agrees there; inf where it does not within `reach`), then
+    the engine's crossing is bisected in the logarithm of the offset. A verdict the engine
+    does not give (marginal: a Floquet multiplier within reach of ±1, as near an edge as the
+    drive's period is short) is no disagreement: the offsets up to the largest where one
+    was missing are the step's resolution, and an offset found among them says nothing."""
+    def verdict(side: int, offset: float) -> bool | None:
+        with mpmath.workdps(boundary.DIGITS + 20):  # t* ± 1e-24 at the default 15 digits
+            t = t_star + side * mpmath.mpf(offset)  # would be t* itself
         pt = ray.point(t)
         if pt is None:
             return None
@@ -201,22 +173,28 @@ def _engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, bel
         except MechbookError:
             return None
 
-    sigma, previous = FLOOR, None  # previous: (sigma, below agreed, above agreed)
+    missing = 0.0  # the largest offset at which a verdict was not given
+    sigma, previous = floor, None  # previous: (sigma, below agreed, above agreed)
     while sigma <= reach:
-        lo, hi = verdict(t_star - sigma), verdict(t_star + sigma)
+        lo, hi = verdict(-1, sigma), verdict(1, sigma)
+        if lo is None or hi is None:
+            missing = sigma
         if lo == below and hi == above:
             if previous is None:
-                return FLOOR
+                return floor, floor
             s_in, below_ok, _ = previous  # the engine's crossing: between s_in and sigma
             side, want = (-1, below) if not below_ok else (1, above)
             s_out = sigma
             for _ in range(BISECTIONS):
                 mid = math.sqrt(s_in * s_out)
-                if verdict(t_star + side * mid) == want:
+                got = verdict(side, mid)
+                if got is None:
+                    missing = max(missing, mid)
+                if got == want:
                     s_out = mid
                 else:
                     s_in = mid
-            return math.sqrt(s_in * s_out)
+            return math.sqrt(s_in * s_out), max(floor, missing)
         previous = (sigma, lo == below, hi == above)
         sigma *= 10
-    return math.inf
+    return math.inf, max(floor, missing)

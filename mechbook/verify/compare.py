@@ -332,6 +332,12 @@ def _num(z: complex) -> str:
     return f"{z.real:.10g}" if abs(z.imag) < 1e-14 * max(1, abs(z)) else f"{z:.6g}"
 
 
+def at_point(point: dict) -> str:
+    """Where a value was evaluated, for a failing verdict's message: " at {m=1.2, ...}"
+    (every fail names its point). Example: at_point({x: 0.5}) == " at {x=0.5}"."""
+    return " at " + _fmt(point)
+
+
 def _fmt(point: dict) -> str:
     items = sorted(point.items(), key=lambda kv: kv[0].name)[:8]
     return "{" + ", ".join(f"{k}={float(v):.4g}" for k, v in items) + "}"

@@ -8,6 +8,7 @@ import sympy as sp
 from mechbook.engine.lagrange import lagrange_expressions
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, linear_accelerations, split_named
+from mechbook.verify.manifold_constant import constant_on_manifold
 from mechbook.verify.registration import Family
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
@@ -91,12 +92,16 @@ def check_conserved(ctx: Context, val) -> Verdict:
             engine, up_to_constant, what = _named(ctx, name, sub)
             e = ctx.parse(text, sub)
             diff = e - engine
-            if up_to_constant:  # the energy: V (so h) is defined up to a constant
+            manifold = ctx.sampler.manifold
+            if up_to_constant and manifold is not None and not manifold.empty:
+                # constrained: equal up to a constant on the manifold, where the motion is
+                same = constant_on_manifold(e, engine, ctx.system, ctx.sampler)
+            elif up_to_constant:  # the energy: V (so h) is defined up to a constant
                 motion = list(ctx.system.q) + list(ctx.system.qd) + [ctx.system.t]
                 checks = [sp.diff(diff, x) for x in motion if diff.has(x)]
+                same = all_vanish(checks, ctx.sampler) if checks else None
             else:
-                checks = [diff]
-            same = all_vanish(checks, ctx.sampler) if checks else None
+                same = all_vanish([diff], ctx.sampler)
             if same is not None and not same.ok:
                 return Verdict(False, same.method, f"{name} is {what}: the book's "
                                f"expression differs from the engine's ({same.detail})")

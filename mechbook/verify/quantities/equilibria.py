@@ -108,7 +108,8 @@ def check_stability_condition(ctx: Context, val) -> Verdict:
             return None if got == "marginal" else got == "stable"
 
     if "limit" in ctx.part.data:
-        got = boundary_limit.check(ctx, cond, stable)
+        got = boundary_limit.check(ctx, cond, stable, boundary_limit.FLOOR if floquet is None
+                                   else boundary_limit.FLOQUET_FLOOR)
     else:
         got = boundary.verdict(boundary.compare(cond, stable, ctx.sampler,
                                                 ("stable", "unstable")))

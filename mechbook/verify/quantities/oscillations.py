@@ -14,7 +14,7 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError, WrongAnswerError
 from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
-from mechbook.verify.compare import Verdict, match_multiset, vanishes
+from mechbook.verify.compare import Verdict, at_point, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import EXPR, LIMIT, Family
 
@@ -50,7 +50,7 @@ def check_frequencies(ctx: Context, val) -> Verdict:
         ok, why = match_multiset(numbers(book, pt), list(lin.numeric_frequencies(pt)), partial)
         n += 1
         if not ok:
-            return Verdict(False, f"numeric({plural(n, 'point')})", why)
+            return Verdict(False, f"numeric({plural(n, 'point')})", why + at_point(pt))
     precise = _precise_frequencies(ctx, book, lin, partial)
     if precise and not precise.ok:
         return precise
@@ -98,7 +98,7 @@ def _precise_frequencies(ctx: Context, book, lin: LinearSystem, partial: bool):
         for v in sorted(values):
             if not free:
                 return Verdict(False, "numeric(50 digits)", "more book values than engine "
-                               "frequencies")
+                               "frequencies" + at_point(pt))
             j = min(range(len(free)), key=lambda i: abs(free[i] - v))
             rel = abs(free[j] - v) / max(abs(v), mpmath.mpf(10) ** -30)
             worst = max(worst, rel)
@@ -106,10 +106,11 @@ def _precise_frequencies(ctx: Context, book, lin: LinearSystem, partial: bool):
                 return Verdict(False, "numeric(50 digits)",
                                f"book value {mpmath.nstr(v, 25)} differs from the engine's "
                                f"{mpmath.nstr(free[j], 25)} by a relative {float(rel):.2g} at "
-                               f"50 digits (below double precision's reach)")
+                               f"50 digits (below double precision's reach)" + at_point(pt))
             free.pop(j)
         if free and not partial:
-            return Verdict(False, "numeric(50 digits)", "the engine has more frequencies")
+            return Verdict(False, "numeric(50 digits)",
+                           "the engine has more frequencies" + at_point(pt))
     return Verdict(True, "numeric(50 digits)", f"at 50 digits within {float(worst):.1g}",
                    power=f"at 50 digits to {PRECISE_RTOL:g}")
 
@@ -181,7 +182,7 @@ def check_period(ctx: Context, val) -> Verdict:
         freqs = [w for w in lin.numeric_frequencies(pt) if w > 0]
         if not any(abs(2 * np.pi / w - p) <= 1e-8 * p for w in freqs):
             return Verdict(False, "numeric", f"period {p:.10g} vs engine "
-                           f"{[2 * np.pi / w for w in freqs]}")
+                           f"{[2 * np.pi / w for w in freqs]}" + at_point(pt))
     try:
         if ctx.policy.prove and any(vanishes(period - 2 * sp.pi / w, ctx.sampler).method
                                     == "symbolic" for w in lin.frequencies if w != 0):
@@ -230,11 +231,12 @@ def check_normal_modes(ctx: Context, val) -> Verdict:
             shape = ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))
             if abs(numbers([freq], pt)[0]) not in _near(lin.numeric_frequencies(pt),
                                                          numbers([freq], pt)[0]):
-                return Verdict(False, "numeric", f"mode {i}: frequency not an engine frequency")
+                return Verdict(False, "numeric", f"mode {i}: frequency not an engine "
+                               "frequency" + at_point(pt))
             res = _mode_residual(lin, freq, shape, pt)
             if res > 1e-8:
                 return Verdict(False, "numeric", f"mode {i}: (K - w^2 M) u relative residual "
-                               f"{res:.3g}")
+                               f"{res:.3g}" + at_point(pt))
     return Verdict(True, "numeric(5 points)",
                    power="5 points: each (ω, shape) satisfies (K − ω²M)u = 0 to 1e-8 of its scale "
                    "(a shape up to its length)")

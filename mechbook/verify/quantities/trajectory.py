@@ -27,7 +27,7 @@ from mechbook.errors import UnsupportedError
 from mechbook.numerics.measure import MEASURE_RTOL, first_event, measure, signal_functions
 from mechbook.numerics.rhs import build_model
 from mechbook.verify.asymptotic import asymptotic
-from mechbook.verify.compare import Verdict, match_multiset
+from mechbook.verify.compare import Verdict, at_point, match_multiset
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import ESTIMATE, EXPR, LIMIT, POINT, Family
 
@@ -161,7 +161,7 @@ def _compare(ctx: Context, motion: Motion, book: list, engine_of, what: str,
         eng = engine_of(pt)
         ok, why = match_multiset(_at_start(motion.start, book, pt), eng, partial, rtol=motion.rtol)
         if not ok:
-            return Verdict(False, f"{how}({plural(n, 'point')})", f"{what}: {why}")
+            return Verdict(False, f"{how}({plural(n, 'point')})", f"{what}: {why}" + at_point(pt))
     return Verdict(True, f"{how}({plural(motion.points(), 'point')}, rtol {motion.rtol:g})",
                    power=(f"within the stated {motion.rtol:g}" if "estimate" in ctx.part.data
                           else f"{plural(motion.points(), 'point')}, each value to {motion.rtol:g} "
@@ -350,7 +350,7 @@ def check_event_time(ctx: Context, val) -> Verdict:
             engine = float(y[i] - q0[i])
         ok, why = match_multiset(_at_start(start, book, pt), [engine], rtol=rtol)
         if not ok:
-            return Verdict(False, f"measured({plural(n, 'point')})", f"event: {why}")
+            return Verdict(False, f"measured({plural(n, 'point')})", f"event: {why}" + at_point(pt))
     if exact is not None:
         return Verdict(True, f"{exact.method} and measured(1 point, rtol {rtol:g})",
                        exact.detail, power=exact.power)
