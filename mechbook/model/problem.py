@@ -17,6 +17,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
+from mechbook.model.continuum import field_of
 from mechbook.model.expr import CONSTANTS, DECLARABLE, FUNCTIONS, Operator, parse
 from mechbook.model.input_limits import check_problem_counts, decode, read_bytes
 from mechbook.model.schema import validate
@@ -175,4 +176,6 @@ def load_problem(path: str | Path) -> Problem:
                           for i, c in enumerate(data.get("conditions", []))]
     if not all(bool(c.subs(problem.values())) for c in problem.conditions):
         raise doc.error(("conditions",), "the default parameter values violate the conditions")
+    if "field" in data:  # checked now (file and line), built again by model.built.Built
+        field_of(doc, problem.names())
     return problem
