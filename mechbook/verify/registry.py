@@ -22,6 +22,7 @@ from mechbook.model.schema import bundled
 from mechbook.verify.quantities import (
     access,
     adiabatic,
+    continuum,
     equations,
     equilibria,
     expressions,
@@ -42,7 +43,7 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, adiabatic, equations, equilibria, expressions, extremum, motion,
+MODULES = (access, adiabatic, continuum, equations, equilibria, expressions, extremum, motion,
            oscillations, parts, perturbation, phase, response, rotation, stability, steady,
            tensors, trajectory, words)
 
