@@ -27,6 +27,7 @@ from mechbook.crosscheck.partview import PartView
 from mechbook.crosscheck.points import engine_linear_systems, numeric_key, point_label
 from mechbook.crosscheck.response import response_part
 from mechbook.crosscheck.simulated_motion import steady_crosscheck, trajectory_crosscheck
+from mechbook.crosscheck.spectral import spectral_part
 from mechbook.crosscheck.state_modes import state_frequency_crosscheck
 from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis
@@ -129,6 +130,8 @@ CROSSCHECKS: dict[str, PartCheck] = {
                        "(frequencies.py)", _modes),
     "response": PartCheck("with `modes`: the steady amplitude measured from the driven "
                           "motion (response.py)"),
+    "spectral": PartCheck("a field's frequencies by a spectral discretization that does "
+                          "not separate (spectral.py)", each_part(spectral_part, "spectral")),
 }
 
 

@@ -104,7 +104,7 @@ def edge_conditions(model: FieldModel, edge) -> list[sp.Expr]:
     return [natural[0] - edge.spring * u - edge.mass * utt] + natural[1:]
 
 
-def _modal(model: FieldModel, eq: sp.Expr) -> tuple:
+def modal_coefficients(model: FieldModel, eq: sp.Expr) -> tuple:
     """(−c_tt, the space coefficients) of the field equation; UnsupportedError where the
     modes do not separate so."""
     coeffs = linear_coefficients(model, eq)
@@ -120,7 +120,7 @@ def _modal(model: FieldModel, eq: sp.Expr) -> tuple:
     return weight, coeffs
 
 
-def _numbers(expr, point) -> mp.mpf:
+def as_number(expr, point) -> mp.mpf:
     v = sp.N(sp.S(expr).xreplace(point), DIGITS + 5)
     if not v.is_number:
         raise UnsupportedError(f"separation with coefficients that vary in space ({expr})")
@@ -136,7 +136,7 @@ def _bc_rows(model: FieldModel, edge, axis_orders: int, point: dict) -> list:
         row = [mp.mpf(0)] * axis_orders
         lam = mp.mpf(0)
         for o, c in coeffs.items():
-            c = _numbers(c.xreplace({model.coords[edge.axis]: edge.at}), point)
+            c = as_number(c.xreplace({model.coords[edge.axis]: edge.at}), point)
             space = o[1:]
             if o[0] == 2 and not any(space):
                 lam += c  # u_tt = −λ·u: K·u = λ·(c)·u
@@ -183,16 +183,16 @@ def segment_problem(model: FieldModel, coeffs: dict, weight, axis: int, edges: t
         space = o[1:]
         if not any(space):
             if with_constant:
-                ode[0] += _numbers(c, point)
+                ode[0] += as_number(c, point)
             continue
         if any(space[i] for i in range(dims) if i != axis):
             continue
-        ode[space[axis]] += _numbers(c, point)
+        ode[space[axis]] += as_number(c, point)
         n = max(n, space[axis])
     lo, hi = (e for e in edges if e.axis == axis)
-    length = _numbers(hi.at - lo.at, point)
+    length = as_number(hi.at - lo.at, point)
     rows = [_bc_rows(model, e, n, point) for e in (lo, hi)]
-    return ode[:n + 1], _numbers(weight, point), length, rows[0], rows[1]
+    return ode[:n + 1], as_number(weight, point), length, rows[0], rows[1]
 
 
 def _rigid_modes(problem: tuple) -> int:
@@ -255,7 +255,7 @@ def squared_frequencies(model: FieldModel, point: dict, count: int) -> list:
     """The lowest `count` values of ω² (degenerate ones repeated), at 30 digits, at the
     parameter point {symbol: value}."""
     eq = field_equation(model)
-    weight, coeffs = _modal(model, eq)
+    weight, coeffs = modal_coefficients(model, eq)
     if model.domain == "segment":
         return _segment_lambdas(model, coeffs, weight, 0, point, count, True)[:count]
     if model.domain == "rectangle":
@@ -267,7 +267,7 @@ def squared_frequencies(model: FieldModel, point: dict, count: int) -> list:
     return bessel_lambdas(model, weight, coeffs, point, count)
 
 
-def _isotropic(model: FieldModel, weight, coeffs: dict, point: dict) -> tuple:
+def isotropic_membrane(model: FieldModel, weight, coeffs: dict, point: dict) -> tuple:
     r = model.coords[0]
     rr, r1, th, c0 = (coeffs.pop(o, sp.S.Zero) for o in ((0, 2, 0), (0, 1, 0), (0, 0, 2),
                                                          (0, 0, 0)))
@@ -275,7 +275,7 @@ def _isotropic(model: FieldModel, weight, coeffs: dict, point: dict) -> tuple:
             or rr.has(r) or c0.has(r):
         raise UnsupportedError("separation on a disk or annulus of a density that is not "
                                "an isotropic membrane's (τ∇²u with constant τ)")
-    return _numbers(rr, point), _numbers(c0, point), _numbers(weight, point)
+    return as_number(rr, point), as_number(c0, point), as_number(weight, point)
 
 
 def _cross(n, k, a, b, da, db):
@@ -310,9 +310,9 @@ def _annulus_roots(n: int, sizes: list, deriv: list, count: int, kmax=None) -> l
 def bessel_lambdas(model: FieldModel, weight, coeffs: dict, point: dict, count: int) -> list:
     """ω² of an isotropic membrane on a disk or an annulus: (τk² − c0)/w over the radial
     wave numbers k of each n (zeros of J_n or J_n′; cross products of J_n and Y_n)."""
-    tau, c0, w = _isotropic(model, weight, dict(coeffs), point)
+    tau, c0, w = isotropic_membrane(model, weight, dict(coeffs), point)
     deriv = [0 if e.kind == "fixed" else 1 for e in model.edges]
-    sizes = [_numbers(e.at, point) for e in model.edges]
+    sizes = [as_number(e.at, point) for e in model.edges]
     out = []
     with mp.workdps(DIGITS + 5):
         for n in range(0, count + 2):

@@ -1,4 +1,5 @@
-"""The normal modes of a segment by Chebyshev collocation: a discretization independent of
+"""The normal modes of a segment, a rectangle and a Bessel radial problem by Chebyshev
+collocation: a discretization independent of
 separation, which converges to its eigenvalues spectrally (docs/answers.md gives figures).
 
 Σ a_k φ^(k) + λ·w·φ = 0 on [0, L] is collocated at the N + 1 Chebyshev–Lobatto points; the
@@ -51,7 +52,67 @@ def segment_eigenvalues(ode: list, weight: float, length: float, left: list, rig
         K[i] = sum(b * powers[k][end] for k, b in enumerate(coeffs))
         B[i] = 0.0
         B[i, end] = mass
+    return _pencil_eigenvalues(K, B, count)
+
+
+def _pencil_eigenvalues(K: np.ndarray, B: np.ndarray, count: int) -> list[float]:
     vals = scipy.linalg.eig(K, B, right=False)
     finite = vals[np.isfinite(vals)]
     finite = finite[np.abs(finite.imag) <= 1e-6 * np.maximum(1.0, np.abs(finite.real))]
     return sorted(float(v) for v in finite.real)[:count]
+
+
+def rectangle_eigenvalues(ops: dict, weight: float, sides: tuple, edges: dict, count: int,
+                          points: int = 20) -> list[float]:
+    """The lowest λ of Σ ops[(b, c)]·∂_x^b ∂_y^c φ + λ·w·φ = 0 on [0, a]×[0, b] by 2-D
+    Chebyshev collocation (no separation), a tensor grid of (points + 1)²; `edges`
+    {x0, x1, y0, y1: coefficients of the normal derivatives φ, φ_n} (second order only).
+
+    >>> rectangle_eigenvalues({(2, 0): 1, (0, 2): 1}, 1, (np.pi, np.pi),
+    ...     {e: [1, 0] for e in ("x0", "x1", "y0", "y1")}, 1)
+    [2.0...]
+    """
+    _, dx = chebyshev_matrix(points, float(sides[0]))
+    _, dy = chebyshev_matrix(points, float(sides[1]))
+    n = points + 1
+    eye = np.eye(n)
+    px = [eye, dx, dx @ dx]
+    py = [eye, dy, dy @ dy]
+    K = -sum(a * np.kron(px[b], py[c]) for (b, c), a in ops.items())
+    B = weight * np.eye(n * n)
+    rows = {}
+    for i in range(n):  # index i*n + j is (x_i, y_j); y edges first, x edges win corners
+        for j, name in ((0, "y0"), (points, "y1")):
+            c = edges[name]
+            rows[i * n + j] = c[0] * np.kron(eye[i], eye[j]) + c[1] * np.kron(eye[i], dy[j])
+        for k, name in ((0, "x0"), (points, "x1")):
+            c = edges[name]
+            rows[k * n + i] = c[0] * np.kron(eye[k], eye[i]) + c[1] * np.kron(dx[k], eye[i])
+    for idx, row in rows.items():
+        K[idx] = row
+        B[idx] = 0.0
+    return _pencil_eigenvalues(K, B, count)
+
+
+def radial_eigenvalues(order: int, inner: float, outer: float, kinds: tuple, count: int,
+                       points: int = POINTS) -> list[float]:
+    """The lowest k² of r²φ″ + rφ′ − n²φ + k²r²φ = 0 (Bessel's equation of order n) on
+    [inner, outer] by Chebyshev collocation; `kinds` (inner, outer): 0 for φ = 0, 1 for
+    φ′ = 0; a disk (inner = 0) is regular at the centre (φ = 0 there for n ≥ 1, φ′ = 0
+    for n = 0).
+
+    >>> radial_eigenvalues(0, 0.0, 1.0, (None, 0), 1)  # j_01 = 2.4048...
+    [5.78...]
+    """
+    r, d = chebyshev_matrix(points, outer - inner)
+    r = r + inner
+    size = points + 1
+    R = np.diag(r)
+    K = -(R @ R @ d @ d + R @ d - order**2 * np.eye(size))
+    B = R @ R
+    for idx, kind in ((0, kinds[0]), (points, kinds[1])):
+        if kind is None:  # the centre of a disk
+            kind = 1 if order == 0 else 0
+        K[idx] = np.eye(size)[idx] if kind == 0 else d[idx]
+        B[idx] = 0.0
+    return _pencil_eigenvalues(K, B, count)
