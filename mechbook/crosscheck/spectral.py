@@ -1,7 +1,7 @@
 """The field frequencies by a spectral discretization that does not separate: the check
 of a `field_frequencies` part by other means (never reading the book's values).
 
-A segment by Chebyshev collocation at 96 points (the separated roots were bracketed at
+A segment by Chebyshev collocation at 48 points (the separated roots were bracketed at
 64), a rectangle by a 2-D tensor-product collocation of the whole operator (no
 separation), a disk or an annulus by collocation of Bessel's radial equation for each n.
 At the part's default parameters the separated frequencies (engine.continuum) and these
@@ -30,7 +30,7 @@ from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import Part
 
 RTOL = 1e-8
-SEGMENT_POINTS = 96
+SEGMENT_POINTS = 48
 
 
 def spectral_part(analysis: Analysis, part: Part, models: dict) -> CrossCheck | None:
