@@ -13,6 +13,8 @@ cross products of J_n and Y_n), each n ≥ 1 twice (cos nθ and sin nθ).
 
 from __future__ import annotations
 
+from weakref import WeakKeyDictionary
+
 import mpmath as mp
 import sympy as sp
 
@@ -21,6 +23,7 @@ from mechbook.errors import UnsupportedError
 from mechbook.model.continuum import FieldModel, T
 
 DIGITS = 30
+_EQUATIONS: WeakKeyDictionary = WeakKeyDictionary()  # a model's field equation, derived once
 
 
 def _to_function(model: FieldModel) -> tuple:
@@ -52,6 +55,8 @@ def field_equation(model: FieldModel) -> sp.Expr:
 
     >>> # ℒ = ρu_t²/2 − τu_x²/2 gives −ρ·u_tt + τ·u_xx
     """
+    if model in _EQUATIONS:
+        return _EQUATIONS[model]
     U, variables, sub = _to_function(model)
     weight = model.coords[0] if model.polar else sp.S.One
     lag = model.density * weight
@@ -65,7 +70,9 @@ def field_equation(model: FieldModel) -> sp.Expr:
             if k:
                 term = sp.diff(term, v, k)
         out += (-1) ** sum(orders) * term
-    return sp.expand(sp.simplify(_to_jets(model, out, U, variables) / weight))
+    eq = sp.expand(_to_jets(model, out, U, variables) / weight)
+    _EQUATIONS[model] = eq
+    return eq
 
 
 def linear_coefficients(model: FieldModel, expr: sp.Expr) -> dict:
@@ -226,14 +233,17 @@ def _polish(problem: tuple, guesses: list) -> list:
             def f(lam):
                 return mp.det(_boundary_matrix(ode, w, length, left, right, lam))
             lo, hi = mp.mpf(g) - delta, mp.mpf(g) + delta
-            try:
-                if mp.sign(f(lo)) != mp.sign(f(hi)):
-                    root = mp.findroot(f, (lo, hi), solver="anderson")
-                else:
-                    root = mp.findroot(f, mp.mpf(g), solver="secant")
+            try:  # the secant from the collocation's value (it is close), else the bracket
+                root = mp.findroot(f, (mp.mpf(g), mp.mpf(g) + delta * mp.mpf("1e-4")),
+                                   solver="secant")
+                if abs(root - g) > delta:
+                    raise ValueError("left the bracket")
             except (ValueError, ZeroDivisionError):
-                raise UnsupportedError("no root of the boundary determinant near the "
-                                       f"discretization's eigenvalue {g:.8g}") from None
+                try:
+                    root = mp.findroot(f, (lo, hi), solver="anderson")
+                except (ValueError, ZeroDivisionError):
+                    raise UnsupportedError("no root of the boundary determinant near the "
+                                           f"discretization's eigenvalue {g:.8g}") from None
             if abs(root - g) > delta:
                 raise UnsupportedError("the boundary determinant's root left the bracket of "
                                        f"the discretization's eigenvalue {g:.8g}")

@@ -44,7 +44,7 @@ class Edge:
     spring: sp.Expr = sp.S.Zero
 
 
-@dataclass
+@dataclass(eq=False)
 class FieldModel:
     """A field's density, names and boundary, parsed: what the engine derives from."""
 
