@@ -284,3 +284,50 @@ def test_bad_fields(tmp_path, density, boundary, match):
     bad = (density, "{rectangle: [a, b]}", boundary, MEMBRANE[3])
     with pytest.raises(SpecError, match=rf"9701\.yaml:\d+: .*{match}"):
         load_problem(write_problem(tmp_path, bad))
+
+
+# ---- mode shapes ---------------------------------------------------------------------------
+@pytest.mark.parametrize("frequency, shape, status", [
+    ("4*(pi/L)**2*sqrt(EI/rhoA)", "sin(2*pi*x/L)", Status.PASS),
+    ("1.01*4*(pi/L)**2*sqrt(EI/rhoA)", "sin(2*pi*x/L)", Status.FAIL),
+    ("(1 + 1e-6)*4*(pi/L)**2*sqrt(EI/rhoA)", "sin(2*pi*x/L)", Status.FAIL),
+    ("4*(pi/L)**2*sqrt(EI/rhoA)", "sin(2*pi*x/L) + 1e-6*x", Status.FAIL),  # not hinged
+    ("4*(pi/L)**2*sqrt(EI/rhoA)", "cos(2*pi*x/L)", Status.FAIL)])  # u(0) = 1
+def test_hinged_beam_mode(tmp_path, frequency, shape, status):
+    """sin(nπx/L): u = u_xx = 0 at both ends, EI·(nπ/L)⁴ = ρA·ω²."""
+    book = f'{{frequency: "{frequency}", shape: "{shape}"}}'
+    assert check(tmp_path, HINGED, "field_mode", book).status == status
+
+
+def test_membrane_mode_and_a_free_edge(tmp_path):
+    """sin(πx/a)·sin(2πy/b) at c·π·sqrt(1/a² + 4/b²) on a fixed rectangle; with the x
+    edges free, cos(πx/a)·sin(πy/b) (u_x = 0 at x = 0, a) and sin does not."""
+    w = "pi*sqrt(tau/sigma)*sqrt(1/a**2 + 4/b**2)"
+    assert check(tmp_path, MEMBRANE, "field_mode",
+                 f'{{frequency: "{w}", shape: "sin(pi*x/a)*sin(2*pi*y/b)"}}'
+                 ).status == Status.PASS
+    free = (MEMBRANE[0], MEMBRANE[1], "{x0: free, x1: free, y0: fixed, y1: fixed}",
+            MEMBRANE[3])
+    w = "pi*sqrt(tau/sigma)*sqrt(1/a**2 + 1/b**2)"
+    assert check(tmp_path, free, "field_mode",
+                 f'{{frequency: "{w}", shape: "cos(pi*x/a)*sin(pi*y/b)"}}'
+                 ).status == Status.PASS
+    assert check(tmp_path, free, "field_mode",
+                 f'{{frequency: "{w}", shape: "sin(pi*x/a)*sin(pi*y/b)"}}'
+                 ).status == Status.FAIL
+
+
+def test_string_end_mass_mode(tmp_path):
+    """sin(kx) with ω = ck solves the string; at x = L the mass's M·u_tt = −τ·u_x holds
+    only where τk·cos kL = Mω²·sin kL (a k off that root fails)."""
+    p = END_MASS[3]
+    rho, M, L = (mp.mpf(p[k]) for k in ("rho", "M", "L"))
+    k = mp.findroot(lambda k: mp.tan(k * L) - rho / (M * k), 0.9 / L)
+    # with M = rho*L (the key's `restrict:`) the root z = kL of tan z = 1/z is universal
+    z = mp.findroot(lambda z: mp.tan(z) - 1 / z, 0.86)  # tan z = 1/z when M = rho*L
+    assert abs(k * L - mp.findroot(lambda z: mp.tan(z) - rho * L / (M * z), 0.9)) < 1e-25
+    book = f'{{frequency: "{mp.nstr(z, 28)}*sqrt(tau/rho)/L", shape: "sin({mp.nstr(z, 28)}*x/L)"}}'
+    restrict = "    restrict: {M: rho*L}\n"
+    assert check(tmp_path, END_MASS, "field_mode", book, restrict).status == Status.PASS
+    wrong = book.replace(mp.nstr(z, 28), mp.nstr(z * 1.01, 28))
+    assert check(tmp_path, END_MASS, "field_mode", wrong, restrict).status == Status.FAIL

@@ -1,5 +1,5 @@
 """A continuous field's quantities (`field:`): `field_equation`, `field_frequencies`,
-`field_current`.
+`field_mode`, `field_current`.
 
 The book's expressions use the field's jet names (u, u_t, u_tt, u_x, u_xxxx, u_r, u_theta,
 …; mechbook.model.continuum), the coordinates and the parameters.
@@ -10,7 +10,12 @@ from __future__ import annotations
 import mpmath as mp
 import sympy as sp
 
-from mechbook.engine.continuum import field_equation, squared_frequencies, total_derivative
+from mechbook.engine.continuum import (
+    edge_conditions,
+    field_equation,
+    squared_frequencies,
+    total_derivative,
+)
 from mechbook.model.continuum import FieldModel
 from mechbook.verify.compare import EXACT_RTOL, RTOL, Verdict, equal, vanishes
 from mechbook.verify.context import Context
@@ -213,3 +218,63 @@ def check_field_current(ctx: Context, val) -> Verdict:
         return minus
     return Verdict(False, plus.method, f"ρ is not ±{sp.sstr(canonical)}, the canonical "
                    f"density of the translation in {which}: {plus.detail}")
+
+
+def mode_jets(model: FieldModel, shape: sp.Expr, omega: sp.Expr) -> dict:
+    """The jet of u = φ·cos(ωt) at t = 0: ∂_t^a ∂^β u = (−ω²)^(a/2)·∂^β φ for even a, 0
+    for odd a."""
+    sub = {}
+    for orders, sym in list(model.jets.items()):
+        if orders[0] % 2:
+            sub[sym] = sp.S.Zero
+            continue
+        d = shape
+        for c, k in zip(model.coords, orders[1:], strict=True):
+            if k:
+                d = sp.diff(d, c, k)
+        sub[sym] = (-omega**2) ** (orders[0] // 2) * d
+    return sub
+
+
+@quantity('field_mode',
+          book='`{frequency: ω, shape: φ}`: a normal mode u = φ(coordinates)·cos ωt',
+          how=('the field equation with u = φ·cos ωt vanishes identically in the coordinates '
+               '(6 random points of coordinates and parameters, 30 digits, 1e-20 of what '
+               'cancels), each edge\'s conditions vanish on the edge (6 points each), and φ '
+               'is not zero; a shape the coordinates\' functions cannot write (a Bessel '
+               'function on main) is not checkable this way'),
+          names=field_names, needs_system=False)
+def check_field_mode(ctx: Context, val) -> Verdict:
+    """The book's (ω, φ) solves the field equation and the boundary conditions."""
+    model = _field(ctx)
+    names = field_names(ctx)
+    val = ctx.as_map(val, ("book",))
+    if "frequency" not in val or "shape" not in val:
+        raise ctx.part.error(("book",), "a mode gives `frequency:` and `shape:`")
+    omega = ctx.parse(val["frequency"], ("book", "frequency"), names=names)
+    shape = ctx.parse(val["shape"], ("book", "shape"), names=names)
+    jets = set(model.jets.values()) | {model.names["t"]}
+    for key, expr in (("frequency", omega), ("shape", shape)):
+        if expr.free_symbols & jets or (key == "frequency" and expr.free_symbols
+                                        & set(model.coords)):
+            raise ctx.part.error(("book", key), "a mode's frequency is a constant and its "
+                                 "shape a function of the coordinates, without the field's "
+                                 "derivatives or t")
+    if ctx.validate_only:
+        return Verdict(True, "validated")
+    if shape == 0 or vanishes(shape, ctx.sampler, symbolic=False).ok:
+        return Verdict(False, "numeric", "the shape is zero: no mode")
+    sub = mode_jets(model, shape, omega)
+    got = vanishes(sp.expand(field_equation(model).xreplace(sub)), ctx.sampler)
+    if not got.ok:
+        got.detail = f"φ·cos ωt does not solve the field equation: {got.detail}"
+        return got
+    for edge in model.edges:
+        for cond in edge_conditions(model, edge):
+            on_edge = cond.xreplace(sub).xreplace({model.coords[edge.axis]: edge.at})
+            edge_got = vanishes(sp.expand(on_edge), ctx.sampler)
+            if not edge_got.ok:
+                edge_got.detail = (f"the condition {sp.sstr(cond)} = 0 fails on the edge "
+                                   f"{edge.name}: {edge_got.detail}")
+                return edge_got
+    return got
