@@ -331,3 +331,18 @@ def test_string_end_mass_mode(tmp_path):
     assert check(tmp_path, END_MASS, "field_mode", book, restrict).status == Status.PASS
     wrong = book.replace(mp.nstr(z, 28), mp.nstr(z * 1.01, 28))
     assert check(tmp_path, END_MASS, "field_mode", wrong, restrict).status == Status.FAIL
+
+
+def test_angular_momentum_current_of_the_disk(tmp_path):
+    """Rotation θ → θ + ε: with the action density r·ℒ, Noether gives
+    ∂_t(σu_t·u_θ) + (1/r)∂_r(r·(−τu_r·u_θ)) + (1/r)∂_θ(−τu_θ²/r − r·ℒ) = 0 on solutions,
+    ρ = u_θ·∂ℒ/∂u_t the canonical density of the translation in θ; the flux without its
+    −r·ℒ term fails."""
+    lag = "(sigma*u_t**2/2 - tau*(u_r**2 + u_theta**2/r**2)/2)"
+    flux = f'["-tau*u_r*u_theta", "-tau*u_theta**2/r - r*{lag}"]'
+    assert check(tmp_path, DISK, "field_current",
+                 f'{{density: "sigma*u_t*u_theta", flux: {flux}}}',
+                 "    noether: theta\n").status == Status.PASS
+    assert check(tmp_path, DISK, "field_current",
+                 '{density: "sigma*u_t*u_theta", flux: ["-tau*u_r*u_theta", '
+                 '"-tau*u_theta**2/r"]}', "    noether: theta\n").status == Status.FAIL
