@@ -346,3 +346,50 @@ def test_angular_momentum_current_of_the_disk(tmp_path):
     assert check(tmp_path, DISK, "field_current",
                  '{density: "sigma*u_t*u_theta", flux: ["-tau*u_r*u_theta", '
                  '"-tau*u_theta**2/r"]}', "    noether: theta\n").status == Status.FAIL
+
+
+def test_annulus_and_free_disk(tmp_path):
+    """An annulus fixed at r = a and b: R = J_n(kr)Y_n(ka) − J_n(ka)Y_n(kr) vanishes at a,
+    and at b where J_n(ka)Y_n(kb) = J_n(kb)Y_n(ka); the lowest (n = 0) found here by
+    findroot near the estimate π/(b − a). A disk with a free rim: J_n′(kR) = 0, so after
+    the rigid mode (ω = 0) come c·j′_{1,1}/R twice and c·j′_{2,1}/R twice."""
+    annulus = ("sigma*u_t**2/2 - tau*(u_r**2 + u_theta**2/r**2)/2", "{annulus: [R1, R2]}",
+               "{all: fixed}", {"sigma": 1.0, "tau": 1.0, "R1": 1.0, "R2": 2.0})
+    k = mp.findroot(lambda k: mp.besselj(0, k) * mp.bessely(0, 2 * k)
+                    - mp.besselj(0, 2 * k) * mp.bessely(0, k), mp.pi)
+    got = engine_frequencies(tmp_path, annulus, 3)
+    assert abs(got[0] - k) < mp.mpf(10)**-25 * k
+    assert abs(got[1] - got[2]) < mp.mpf(10)**-25  # n = 1, cos and sin
+    free = (DISK[0], DISK[1], "{edge: free}", DISK[3])
+    c = mp.sqrt(mp.mpf(12.0) / mp.mpf(0.3)) / mp.mpf(0.25)
+    got = engine_frequencies(tmp_path, free, 5)
+    want = [0, *[c * mp.besseljzero(1, 1, derivative=1)] * 2,
+            *[c * mp.besseljzero(2, 1, derivative=1)] * 2]
+    assert all(abs(g - w) < mp.mpf(10)**-25 * c for g, w in zip(got, want, strict=True))
+
+
+def test_disk_pair_listed_once_fails(tmp_path):
+    """j_01, j_11, j_21: the (1, cos)/(1, sin) pair counted once is not the lowest three."""
+    c = "sqrt(tau/sigma)/R"
+    z = [mp.nstr(mp.besseljzero(n, 1), 30) for n in (0, 1, 2)]
+    assert check(tmp_path, DISK, "field_frequencies",
+                 f'["{z[0]}*{c}", "{z[1]}*{c}", "{z[1]}*{c}"]').status == Status.PASS
+    assert check(tmp_path, DISK, "field_frequencies",
+                 f'["{z[0]}*{c}", "{z[1]}*{c}", "{z[2]}*{c}"]').status == Status.FAIL
+
+
+@pytest.mark.parametrize("system", [MEMBRANE, DISK, BEAM, HINGED, KLEIN_GORDON, END_MASS,
+                                    (DISK[0], "{annulus: [R, 2*R]}", "{inner: free, "
+                                     "outer: fixed}", DISK[3])],
+                         ids=["membrane", "disk", "beam", "hinged", "klein-gordon",
+                              "end-mass", "annulus"])
+def test_collocation_agrees_with_separation(tmp_path, system):
+    """The spectral cross-check's discretization (no separation) within 1e-9 of the
+    separated ω² for every kind of domain and edge."""
+    from mechbook.crosscheck.spectral import discretized
+
+    analysis = Analysis(load_problem(write_problem(tmp_path, system)))
+    model = analysis.built.field()
+    point = {p.symbol: sp.Float(p.value, 30) for p in analysis.problem.parameters.values()}
+    separated = [float(v) for v in squared_frequencies(model, point, 5)]
+    assert discretized(model, point, 5) == pytest.approx(separated, rel=1e-9, abs=1e-9)
