@@ -393,3 +393,9 @@ def test_collocation_agrees_with_separation(tmp_path, system):
     point = {p.symbol: sp.Float(p.value, 30) for p in analysis.problem.parameters.values()}
     separated = [float(v) for v in squared_frequencies(model, point, 5)]
     assert discretized(model, point, 5) == pytest.approx(separated, rel=1e-9, abs=1e-9)
+
+
+def test_a_negative_mode_frequency_fails(tmp_path):
+    """Only ω² enters u = φ·cos ωt's equations: the sign is checked on its own."""
+    book = '{frequency: "-4*(pi/L)**2*sqrt(EI/rhoA)", shape: "sin(2*pi*x/L)"}'
+    assert check(tmp_path, HINGED, "field_mode", book).status == Status.FAIL

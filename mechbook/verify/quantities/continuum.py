@@ -264,6 +264,12 @@ def check_field_mode(ctx: Context, val) -> Verdict:
         return Verdict(True, "validated")
     if shape == 0 or vanishes(shape, ctx.sampler, symbolic=False).ok:
         return Verdict(False, "numeric", "the shape is zero: no mode")
+    for _ in range(3):  # ω² alone enters the equations: the sign is the book's claim
+        pt = ctx.sampler.draw()
+        w = sp.N(omega.xreplace(pt), DIGITS)
+        if not w.is_real or w < 0:
+            return Verdict(False, "numeric", f"the frequency {sp.sstr(omega)} is {w}, not a "
+                           "nonnegative number, here")
     sub = mode_jets(model, shape, omega)
     got = vanishes(sp.expand(field_equation(model).xreplace(sub)), ctx.sampler)
     if not got.ok:
