@@ -240,9 +240,9 @@ def mode_jets(model: FieldModel, shape: sp.Expr, omega: sp.Expr) -> dict:
           book='`{frequency: ω, shape: φ}`: a normal mode u = φ(coordinates)·cos ωt',
           how=('the field equation with u = φ·cos ωt vanishes identically in the coordinates '
                '(6 random points of coordinates and parameters, 30 digits, 1e-20 of what '
-               'cancels), each edge\'s conditions vanish on the edge (6 points each), and φ '
-               'is not zero; a shape the coordinates\' functions cannot write (a Bessel '
-               'function on main) is not checkable this way'),
+               'cancels), each edge\'s conditions vanish on the edge (6 points each), φ is '
+               'not zero and ω ≥ 0 (3 points); a shape the coordinates\' functions cannot '
+               'write (a Bessel function on main) is not checkable this way'),
           names=field_names, needs_system=False)
 def check_field_mode(ctx: Context, val) -> Verdict:
     """The book's (ω, φ) solves the field equation and the boundary conditions."""
