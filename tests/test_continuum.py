@@ -399,3 +399,18 @@ def test_a_negative_mode_frequency_fails(tmp_path):
     """Only ω² enters u = φ·cos ωt's equations: the sign is checked on its own."""
     book = '{frequency: "-4*(pi/L)**2*sqrt(EI/rhoA)", shape: "sin(2*pi*x/L)"}'
     assert check(tmp_path, HINGED, "field_mode", book).status == Status.FAIL
+
+
+def test_string_with_an_end_spring(tmp_path):
+    """A spring K at x = L: −τ·u_x − K·u = 0 there, so with u = sin(kx):
+    τk·cos kL + K·sin kL = 0, tan kL = −τk/K; ω = ck (roots past π/2, 3π/2, ...)."""
+    spring = (END_MASS[0], END_MASS[1], "{left: fixed, right: {spring: K}}",
+              {"rho": 0.5, "tau": 3.0, "L": 1.2, "K": 4.0})
+    tau, K, L = mp.mpf(3.0), mp.mpf(4.0), mp.mpf(1.2)
+    c = mp.sqrt(tau / mp.mpf(0.5))
+    ks = [mp.findroot(lambda k: tau * k * mp.cos(k * L) + K * mp.sin(k * L),
+                      ((2 * n - 1) * mp.pi / 2 / L + 1e-9, n * mp.pi / L), solver="anderson")
+          for n in (1, 2, 3)]
+    got = engine_frequencies(tmp_path, spring, 3)
+    for g, k in zip(got, ks, strict=True):
+        assert abs(g - c * k) < mp.mpf(10)**-24 * g
