@@ -16,6 +16,7 @@ from mechbook.engine.continuum import (
     squared_frequencies,
     total_derivative,
 )
+from mechbook.errors import UnsupportedError
 from mechbook.model.continuum import FieldModel
 from mechbook.verify.compare import EXACT_RTOL, RTOL, Verdict, equal, vanishes
 from mechbook.verify.context import Context
@@ -112,6 +113,9 @@ def check_field_frequencies(ctx: Context, val) -> Verdict:
         pt = ctx.sampler.default() if k == 0 else ctx.sampler.draw()
         with mp.workdps(DIGITS):
             engine = [mp.sqrt(x) for x in squared_frequencies(model, pt, count)]
+            if len(engine) < count:
+                raise UnsupportedError(f"only {len(engine)} of the {count} lowest "
+                                       "frequencies found")
             values = [mp.mpf(str(sp.N(b.xreplace(pt), DIGITS + 5))) for b in book]
             free = list(engine)
             scale0 = max(abs(e) for e in engine) * mp.mpf("1e-3")
