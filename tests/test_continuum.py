@@ -414,3 +414,21 @@ def test_string_with_an_end_spring(tmp_path):
     got = engine_frequencies(tmp_path, spring, 3)
     for g, k in zip(got, ks, strict=True):
         assert abs(g - c * k) < mp.mpf(10)**-24 * g
+
+
+def test_the_spectral_crosscheck_can_fail(tmp_path, monkeypatch):
+    """The cross-check passes the membrane's separated values and fails them 1e-6 off
+    (as a wrong separation would be)."""
+    import mechbook.crosscheck.spectral as spectral
+
+    analysis = Analysis(load_problem(write_problem(tmp_path, MEMBRANE)))
+    key = tmp_path / "key.yaml"
+    key.write_text("problem: lim-9701\nsource: test\nparts:\n  - part: a\n    cite: c\n"
+                   "    quantity: field_frequencies\n    book: [1, 2, 3]\n")
+    part = load_answers(key).parts[0]
+    assert spectral.spectral_part(analysis, part, {}).status == Status.PASS
+    real = spectral.squared_frequencies
+    monkeypatch.setattr(spectral, "squared_frequencies",
+                        lambda *a: [v * (1 + mp.mpf("1e-6")) for v in real(*a)])
+    got = spectral.spectral_part(analysis, part, {})
+    assert got.status == Status.FAIL and got.error > 1e-7, got.detail
