@@ -29,6 +29,7 @@ from mechbook.crosscheck.points import engine_linear_systems, numeric_key, point
 from mechbook.crosscheck.response import response_part
 from mechbook.crosscheck.scattering import scattering_crosscheck
 from mechbook.crosscheck.simulated_motion import steady_crosscheck, trajectory_crosscheck
+from mechbook.crosscheck.spectral import spectral_part
 from mechbook.crosscheck.state_modes import state_frequency_crosscheck
 from mechbook.crosscheck.vouch import crosschecks_of
 from mechbook.engine.analysis import Analysis
@@ -147,6 +148,8 @@ CROSSCHECKS: dict[str, PartCheck] = {
     "scattering": PartCheck("the orbit from infinity integrated far out and its asymptote "
                             "fitted: deflection and closest approach (scattering.py)",
                             _shared_by(_orbit_question, "asymptote", scattering_crosscheck)),
+    "spectral": PartCheck("a field's frequencies by a spectral discretization that does "
+                          "not separate (spectral.py)", each_part(spectral_part, "spectral")),
 }
 
 

@@ -8,6 +8,7 @@ Analysis starts from nothing. `mechbook validate` uses one without the engine.
 
 from __future__ import annotations
 
+from mechbook.model.continuum import FieldModel, field_of
 from mechbook.model.declared import Declared, declared
 from mechbook.model.functional import Functional, functional_of
 from mechbook.model.problem import Problem
@@ -22,6 +23,7 @@ class Built:
         self._systems: dict[str, System] = {}
         self._declared: Declared | None = None
         self._functional: list[Functional | None] = []
+        self._field: FieldModel | None = None
 
     def system(self, name: str | None = None) -> System:
         """The system `name` (or the only one, or `main`), built once. NotFoundError (a
@@ -42,6 +44,12 @@ class Built:
         if not self._functional:
             self._functional.append(functional_of(self.problem.doc, self.problem.names()))
         return self._functional[0]
+
+    def field(self) -> FieldModel | None:
+        """The problem's continuous field (`field:`), built once, or None if it has none."""
+        if self._field is None and "field" in self.problem.doc.data:
+            self._field = field_of(self.problem.doc, self.problem.names())
+        return self._field
 
     def systems_built(self) -> list[System]:
         """The systems built so far, in the problem's order."""

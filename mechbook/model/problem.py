@@ -17,6 +17,7 @@ import sympy as sp
 
 from mechbook.errors import ExpressionError
 from mechbook.model.books import file_id_error
+from mechbook.model.continuum import field_of
 from mechbook.model.expr import CONSTANTS, DECLARABLE, FUNCTIONS, Operator, parse
 from mechbook.model.functional import functional_of
 from mechbook.model.input_limits import check_problem_counts, decode, read_bytes
@@ -177,4 +178,6 @@ def load_problem(path: str | Path) -> Problem:
     if not all(bool(c.subs(problem.values())) for c in problem.conditions):
         raise doc.error(("conditions",), "the default parameter values violate the conditions")
     functional_of(doc, problem.names())  # refused now, at its line (model.built keeps one)
+    if "field" in data:  # checked now (file and line), built again by model.built.Built
+        field_of(doc, problem.names())
     return problem

@@ -26,6 +26,7 @@ from mechbook.verify.quantities import (
     brackets,
     canonical,
     chaos,
+    continuum,
     equations,
     equilibria,
     expressions,
@@ -49,10 +50,10 @@ from mechbook.verify.quantities import (
 from mechbook.verify.registration import QuantityTable
 
 # the modules whose families make up the built-in table, one per family of quantities
-MODULES = (access, action, adiabatic, brackets, canonical, chaos, equations, equilibria,
-           expressions, extremum, functional, hamilton_jacobi, motion, oscillations, parts,
-           perturbation, phase, response, rotation, scattering, stability, steady, tensors,
-           trajectory, words)
+MODULES = (access, action, adiabatic, brackets, canonical, chaos, continuum, equations,
+           equilibria, expressions, extremum, functional, hamilton_jacobi, motion,
+           oscillations, parts, perturbation, phase, response, rotation, scattering,
+           stability, steady, tensors, trajectory, words)
 
 # part keys every quantity accepts (their schemas are in the bundled answers.json)
 COMMON_KEYS = ("part", "cite", "quantity", "system", "book", "about", "steady", "reduce",

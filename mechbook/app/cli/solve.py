@@ -18,6 +18,7 @@ def command(ctx: click.Context, problem_id: str, system: str | None, no_simplify
     """Derive and print a problem's results (what its `compute:` asks for), simplified."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.api import load
+    from mechbook.engine.continuum import field_equation, squared_frequencies
     from mechbook.engine.derive import declared_results, derive
 
     base = resolve_root(ctx)
@@ -37,8 +38,19 @@ def command(ctx: click.Context, problem_id: str, system: str | None, no_simplify
                                f"{numeric_text(key, arr, res.arrays)}")
             for key, text in res.notes.items():
                 click.echo(f"{key}: {text}")
-        if not names or any(k in problem.model.doc.data for k in ("vectors", "tensors",
-                                                                 "bodies")):
+        field = problem.analysis.built.field()
+        if field is not None:  # a continuous field: its equation and lowest frequencies
+            click.echo(f"\n== field {field.name} on a {field.domain}")
+            click.echo(f"field equation:\n    {field_equation(field)} = 0")
+            point = problem.analysis.problem.values()
+            try:
+                lams = squared_frequencies(field, point, 6)
+                click.echo("frequencies (numeric, default parameters):\n    " +
+                           ", ".join(f"{float(v) ** 0.5:.10g}" for v in lams))
+            except MechbookError as exc:
+                click.echo(f"frequencies: {exc}")
+        if (not names and field is None) or any(k in problem.model.doc.data
+                                                for k in ("vectors", "tensors", "bodies")):
             problem.analysis.declared()  # a problem's own vectors, tensors and bodies
             res = declared_results(problem.analysis)
             click.echo("\n== declared vectors, tensors and bodies")
