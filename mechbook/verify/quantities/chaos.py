@@ -402,12 +402,17 @@ def check_lyapunov(ctx: Context, val) -> Verdict:
             ok, bad = abs(lam) + s <= b, abs(lam) - s > b
         else:
             ok, bad = lam + s < -b, lam - s >= -b
+        if ok and val == "zero":
+            # A zero pass bounds |λ|; it cannot tell zero from an exponent below b.
+            return Verdict(True, method, power=f"zero to the run's resolution {b:.2g}: |λ| + "
+                                                f"spread ≤ {b:.2g} (an exponent below it is "
+                                                "not excluded; a longer `time:` resolves more)")
         if ok:
             return Verdict(True, method, power=f"{val} beyond the run's resolution {b:.2g} and "
                                                 f"spread {s:.2g}")
         if bad:
-            return Verdict(False, method, f"the exponent is not {val}: λ = {lam:.6g} (spread "
-                                          f"{s:.2g}, resolution {b:.2g})")
+            return Verdict(False, method, f"the exponent is not {val} at the run's resolution "
+                                          f"{b:.2g}: λ = {lam:.6g} (spread {s:.2g})")
         raise UnsupportedError(f"the run cannot resolve the claim {val!r}: λ = {lam:.4g} with "
                                f"spread {s:.2g} against the resolution {b:.2g} (a longer "
                                "`time:` resolves more)")
