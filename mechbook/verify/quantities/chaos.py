@@ -224,7 +224,7 @@ def _point_error(ctx: Context, rm: ReturnMap, book: dict, points: list, pt: dict
                'with `energy:` holding a conserved energy) from the guess `initial:`, '
                '`order:` n (default 1), at the problem\'s values (or `estimate:`\'s; where '
                'that orbit misses the book\'s point, Newton again from the book\'s point, '
-               'which fails only if it goes elsewhere): the '
+               'which fails only where it finds no orbit or another): the '
                'orbit passes the book\'s point, its multipliers (eigenvalues of DPⁿ from '
                'the variational equations, on a surface without the energy\'s 1) are the '
                'book\'s, to 1e-8 (an estimate\'s rtol; a point also to Newton\'s '
@@ -279,23 +279,21 @@ def _orbit_from_book(ctx: Context, rm: ReturnMap, at, order: int, pt: dict, rtol
                      why: str):
     """(orbit, its monodromy gap, "") for the orbit Newton finds from the book's point (the
     coordinates it leaves out taken from `initial:`), where the orbit from `initial:` missed
-    it; (None, None, why) where Newton from the book's point goes to another orbit: the
-    book's point is none. Newton failing from there is unsupported (nothing refuted)."""
+    it; (None, None, why) where the book's point is no orbit: Newton from it finds none
+    (Newton started on an orbit stops there at once) or goes to another one."""
     guess = _start(ctx, pt)
     for k, v in ctx.as_map(at, ("book", "at")).items():
         guess[_state_index(ctx, k, ("book", "at", k))] = _number(ctx, v, ("book", "at", k), pt)
     try:
-        found, gap = _orbit(ctx, rm, guess, order)
-    except NoCrossing:
-        raise UnsupportedError(f"{why}; from the book's point the orbit does not reach the "
-                               "section") from None
-    except UnsupportedError as exc:
-        raise UnsupportedError(f"{why}; from the book's point: {exc}") from None
+        found = rm.orbit(guess, order)
+    except (NoCrossing, UnsupportedError) as exc:
+        return None, None, f"{why}, and Newton from the book's point finds no orbit ({exc})"
     again = _point_error(ctx, rm, at, found.points, pt, rtol)
     if again:
         return None, None, (f"{why}, and Newton from the book's point finds the orbit at "
                             f"{_where(ctx, at, found.points)}")
-    return found, gap, ""
+    orbit, gap = _orbit(ctx, rm, found.points[0], order)  # its monodromy cross-checked
+    return orbit, gap, ""
 
 
 def _where(ctx: Context, at, points: list) -> str:
