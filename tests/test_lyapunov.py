@@ -151,6 +151,20 @@ def hh_start(energy: str, y: str) -> dict:
     return {"y": y, "xdot": f"sqrt(2*{energy} - ({y})**2 + 2*({y})**3/3)"}
 
 
+def test_a_zero_pass_states_the_bound_it_proves(tree, tmp_path):
+    """`zero` passes on |λ| + s ≤ b = 8/T: the power line must say that an exponent below b
+    is not excluded, never that zero is resolved "beyond" the resolution."""
+    an = load_analysis(tree, CENTRE, "9302")
+    doc = {"problem": an.problem.id, "source": "test",
+           "parts": [{"part": "x", "cite": "test", "quantity": "lyapunov", "time": 400,
+                      "initial": {"x": 0.3, "ydot": 0.2}, "book": "zero"}]}
+    YAML().dump(doc, (tmp_path / "key.yaml").open("w"))
+    out = check_problem(an, load_answers(tmp_path / "key.yaml"))[0]
+    assert out.status == "pass", out.detail
+    assert f"≤ {RESOLUTION / 400:.2g}" in out.power and "not excluded" in out.power, out.power
+    assert "beyond" not in out.power, out.power
+
+
 @pytest.mark.parametrize("energy, y, book, status", [
     ("1/12", "0.1", "zero", "pass"),
     ("1/12", "0.1", "positive", "fail"),      # chaotic for a regular orbit

@@ -195,6 +195,23 @@ def test_kicked_rotor_fixed_points_and_multipliers(tree, tmp_path, theta, stable
     assert check(an, tmp_path, **base, book={"multipliers": wrong})[0] == "fail"
 
 
+@pytest.mark.parametrize("at, stable, status", [
+    ({"theta": "pi", "thetadot": 0}, True, "pass"),     # a fixed point, not the guess's
+    ({"theta": "pi", "thetadot": 0}, False, "fail"),    # judged on the book's orbit
+    ({"theta": "1", "thetadot": 0}, None, "fail"),      # no orbit: Newton from it goes on
+    ({"theta": "pi*1.000001", "thetadot": 0}, None, "fail"),
+])
+def test_a_book_point_away_from_newtons_guess(tree, tmp_path, at, stable, status):
+    """`initial:` is Newton's guess only: the rotor has fixed points at 0 and π, and the
+    book's π is an orbit although Newton from near 0 finds 0. Only Newton from the book's
+    point can refute it (the kicks leave θ = π at rest: the torque K sin θ vanishes)."""
+    an = rotor(tree, 1.5, "9102")
+    book = {"at": at} if stable is None else {"at": at, "stable": stable}
+    got = check(an, tmp_path, quantity="poincare", section=ROTOR_SECTION,
+                initial={"theta": 0.1, "thetadot": 0.05}, book=book)
+    assert got[0] == status, got
+
+
 def test_kicked_rotor_tends_to_the_standard_map(tree):
     """Narrow kicks: the multipliers approach the standard map's, to O(Kε)."""
     k = 1.5

@@ -222,7 +222,9 @@ def _point_error(ctx: Context, rm: ReturnMap, book: dict, points: list, pt: dict
           how=('Newton\'s method on the return map Pⁿ of `section:` (`{period: T, phase}`: '
                'stroboscopic; `{coordinate: q, value: c, direction: up|down}`: a surface, '
                'with `energy:` holding a conserved energy) from the guess `initial:`, '
-               '`order:` n (default 1), at the problem\'s values (or `estimate:`\'s): the '
+               '`order:` n (default 1), at the problem\'s values (or `estimate:`\'s; where '
+               'that orbit misses the book\'s point, Newton again from the book\'s point, '
+               'which fails only where it finds no orbit or another): the '
                'orbit passes the book\'s point, its multipliers (eigenvalues of DPⁿ from '
                'the variational equations, on a surface without the energy\'s 1) are the '
                'book\'s, to 1e-8 (an estimate\'s rtol; a point also to Newton\'s '
@@ -243,7 +245,15 @@ def check_poincare(ctx: Context, val) -> Verdict:
     if "at" in book:
         why = _point_error(ctx, rm, book["at"], orbit.points, pt, rtol)
         if why:
-            return Verdict(False, method, why)
+            # `initial:` is only Newton's guess: the map may have other orbits, and the
+            # book's point may be one of them. Only Newton from the book's point itself
+            # can contradict it.
+            found, found_gap, refuted = _orbit_from_book(ctx, rm, book["at"], order, pt,
+                                                         rtol, why)
+            if refuted:
+                return Verdict(False, method, refuted)
+            orbit, gap = found, found_gap
+            method += "; again from the book's point"
     if order > 1 and _has_shorter_period(rm, orbit, order):
         return Verdict(False, method, f"the orbit found has a period shorter than {order}")
     if "multipliers" in book:
@@ -263,6 +273,33 @@ def check_poincare(ctx: Context, val) -> Verdict:
     return Verdict(True, method, power=(
         f"one point (the problem's values); orbit and multipliers to {rtol:g}; monodromy "
         f"confirmed by finite differences to {gap:.1g}"))
+
+
+def _orbit_from_book(ctx: Context, rm: ReturnMap, at, order: int, pt: dict, rtol: float,
+                     why: str):
+    """(orbit, its monodromy gap, "") for the orbit Newton finds from the book's point (the
+    coordinates it leaves out taken from `initial:`), where the orbit from `initial:` missed
+    it; (None, None, why) where the book's point is no orbit: Newton from it finds none
+    (Newton started on an orbit stops there at once) or goes to another one."""
+    guess = _start(ctx, pt)
+    for k, v in ctx.as_map(at, ("book", "at")).items():
+        guess[_state_index(ctx, k, ("book", "at", k))] = _number(ctx, v, ("book", "at", k), pt)
+    try:
+        found = rm.orbit(guess, order)
+    except (NoCrossing, UnsupportedError) as exc:
+        return None, None, f"{why}, and Newton from the book's point finds no orbit ({exc})"
+    again = _point_error(ctx, rm, at, found.points, pt, rtol)
+    if again:
+        return None, None, (f"{why}, and Newton from the book's point finds the orbit at "
+                            f"{_where(ctx, at, found.points)}")
+    orbit, gap = _orbit(ctx, rm, found.points[0], order)  # its monodromy cross-checked
+    return orbit, gap, ""
+
+
+def _where(ctx: Context, at, points: list) -> str:
+    names = ctx.system.coord_names + [c + "dot" for c in ctx.system.coord_names]
+    idx = [_state_index(ctx, k, ("book", "at", k)) for k in ctx.as_map(at, ("book", "at"))]
+    return "; ".join(", ".join(f"{names[i]} = {p[i]:.10g}" for i in idx) for p in points)
 
 
 def _has_shorter_period(rm: ReturnMap, orbit, order: int) -> bool:
@@ -402,12 +439,17 @@ def check_lyapunov(ctx: Context, val) -> Verdict:
             ok, bad = abs(lam) + s <= b, abs(lam) - s > b
         else:
             ok, bad = lam + s < -b, lam - s >= -b
+        if ok and val == "zero":
+            # A zero pass bounds |λ|; it cannot tell zero from an exponent below b.
+            return Verdict(True, method, power=f"zero to the run's resolution {b:.2g}: |λ| + "
+                                                f"spread ≤ {b:.2g} (an exponent below it is "
+                                                "not excluded; a longer `time:` resolves more)")
         if ok:
             return Verdict(True, method, power=f"{val} beyond the run's resolution {b:.2g} and "
                                                 f"spread {s:.2g}")
         if bad:
-            return Verdict(False, method, f"the exponent is not {val}: λ = {lam:.6g} (spread "
-                                          f"{s:.2g}, resolution {b:.2g})")
+            return Verdict(False, method, f"the exponent is not {val} at the run's resolution "
+                                          f"{b:.2g}: λ = {lam:.6g} (spread {s:.2g})")
         raise UnsupportedError(f"the run cannot resolve the claim {val!r}: λ = {lam:.4g} with "
                                f"spread {s:.2g} against the resolution {b:.2g} (a longer "
                                "`time:` resolves more)")
