@@ -10,10 +10,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-
 from hostile import can_mount, check, mechbook, pendulum_tree, run, tmpfs
-
-SCHEMAS = ("problem.json", "answers.json", "books.json", "check-result.json")
 
 
 def _digest(path: Path) -> str:
