@@ -7,6 +7,7 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from mechbook.app import api_args as args
 from mechbook.app.store import write_simulation
 from mechbook.core.optional import require
 from mechbook.numerics.plot import plot_simulation
@@ -153,7 +154,7 @@ class Simulation:
         --------
         >>> mechbook.load("lim-2031").simulate(t_end=5).plot("run.png")   # doctest: +SKIP
         """
-        return plot_simulation(self.run, path)
+        return plot_simulation(self.run, args.path("path", path))
 
     def store(self, path: str | Path, name: str | None = None) -> str:
         """Write the run into an HDF5 store, as `mechbook simulate` does.
@@ -177,7 +178,8 @@ class Simulation:
         '/problems/lim-2031/simulations/main-DOP853'
         """
         run = self.run
-        name = name or f"{run.system}-{run.trajectory.method}"
+        path = args.path("path", path)
+        name = args.text("name", name) or f"{run.system}-{run.trajectory.method}"
         write_simulation(run.problem_id, name, run.arrays(), run.settings(),
                          {f"monitors/{d.name}": d.attrs() for d in run.drifts}, path)
         return f"/problems/{run.problem_id}/simulations/{name}"
