@@ -104,5 +104,5 @@ def test_good_arguments_still_work(tree):
     assert done.returncode == 0, done.stderr[-2000:]
     got = json.loads(done.stdout.strip().splitlines()[-1])
     assert got["n"] == 11
-    # the pendulum's small-oscillation frequency sqrt(g/l), g = 9.81 (the default of `g: {}`), l = 0.25
+    # the small-oscillation frequency sqrt(g/l): g = 9.81 (the default of `g: {}`), l = 0.25
     assert got["w"] == pytest.approx([(9.81 / 0.25) ** 0.5], rel=1e-9)
