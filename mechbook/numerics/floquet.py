@@ -26,6 +26,7 @@ unsupported, with that reason.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -41,6 +42,8 @@ from mechbook.numerics.hyexpr import Translator, solve_spd
 
 DPS = 40  # mpmath digits for the period, the parameters and the eigenvalues of Φ
 RESOLVED = 1e-20  # the largest Liouville mismatch at which a verdict is given
+SHORTEST = 1e-9  # T·rate below this: Φ = I + O(T·rate) leaves every multiplier within
+# MARGINAL's reach of 1 after the integration's rounding, and nothing can be told
 MARGINAL = 1e-13  # a multiplier this close to ±1 is marginal (no verdict)
 CLEARLY = 1e-6  # |μ| beyond 1 + this is unstable whatever the resolution
 ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
@@ -179,7 +182,32 @@ class Floquet:
             if not mpmath.isfinite(T) or T == 0:
                 raise MechbookError(f"the period {self.period} is not a finite positive "
                                     "number here")
+            rate = self._rate(values)
+            if T * rate < SHORTEST:
+                raise MechbookError(
+                    f"the period {self.period} = {mpmath.nstr(T, 3)} is too short to be "
+                    f"resolved here: over it the state moves by about "
+                    f"{mpmath.nstr(T * rate, 2)} of itself (the system's rates are "
+                    f"~{mpmath.nstr(rate, 3)} per unit time), so every multiplier is 1 to "
+                    f"within the integration's resolution; give the coefficients' period")
             return T
+
+    def _rate(self, values: dict) -> mpmath.mpf:
+        """The largest rate of the linearized motion at t = 0 (1 + the largest entry of
+        M⁻¹K and M⁻¹C there): a period T with T·rate below SHORTEST leaves Φ = I to the
+        integration's resolution, and its multipliers tell nothing."""
+        lin = self.lin
+        at = {s: sp.Float(mpmath.nstr(_mp(v), 30), 30) for s, v in values.items()
+              if isinstance(s, sp.Symbol)}
+        at[lin.dyn.sys.t] = 0
+        try:
+            M = lin.M.xreplace(at).evalf(30)
+            rows = [M.LUsolve(X.xreplace(at).evalf(30)) for X in (lin.K, lin.C)]
+            big = max([abs(complex(x)) for R in rows for x in R] + [0.0])
+        except (TypeError, ValueError, ZeroDivisionError, sp.matrices.exceptions.
+                NonInvertibleMatrixError):
+            return mpmath.mpf(1)
+        return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
 
     def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, float]:
         """(Φ at DPS digits, T, the Liouville mismatch |det Φ·exp(∫tr M⁻¹C) − 1|)."""
