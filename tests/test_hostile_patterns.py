@@ -31,3 +31,17 @@ def test_a_pattern_as_long_as_an_id_still_matches(tmp_path):
                     "[l][i][m]-210[1]", cwd=tree, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "lim-2101" in done.stdout and "lim-2102" not in done.stdout
+
+
+def test_exitfirst_with_two_workers_says_it_stopped(tmp_path):
+    """Issue 44, item 5: `check -x -j 2` says that it stopped at the first failure, and
+    which problems it did not check."""
+    tree = pendulum_tree(tmp_path / "tree", nums=("2101", "2102", "2103", "2104", "2105"))
+    key = tree / "answers" / "lim" / "2101.yaml"
+    key.write_text(key.read_text(encoding="utf-8").replace("l*thetaddot", "2*l*thetaddot"),
+                   encoding="utf-8")  # a wrong key: lim-2101 fails
+    done = mechbook("--root", tree, "check", "-x", "-j", "2", "--no-store", "--no-crosscheck",
+                    cwd=tree, timeout=300)
+    assert done.returncode == 1, done.stderr
+    assert "stopped at the first failure (-x)" in done.stderr, done.stderr
+    assert "not checked: " in done.stderr and "lim-2105" in done.stderr, done.stderr

@@ -44,6 +44,14 @@ class _Group(click.Group):
     a traceback or click's "Aborted!" with status 1 (the workers ignore SIGINT: the run
     stops them, mechbook.app.batch); a MechbookError no command caught is its message."""
 
+    def make_context(self, info_name, args, parent=None, **extra):
+        # Ctrl-C while the arguments are read (click would say "Aborted!", status 1)
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except KeyboardInterrupt:
+            say("\ninterrupted", err=True)
+            raise click.exceptions.Exit(INTERRUPTED) from None
+
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
