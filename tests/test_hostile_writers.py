@@ -130,3 +130,25 @@ def test_watch_writes_nothing_through_a_key_replaced_by_a_link(tmp_path):
     assert "outside" in done.stdout + done.stderr, done.stdout + done.stderr
     assert _digest(outside) == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["outside.yaml", "tree"]
+
+
+@pytest.mark.parametrize("plant", ["link", "dangling", "fifo"])
+def test_the_side_file_is_never_written_through_a_link_or_into_a_fifo(tmp_path, plant):
+    """The side file's name is guessable (<store>.unsaved-<time>-<pid>.jsonl): a link or a
+    FIFO planted there is refused (OSError: the next place is tried), never followed or
+    waited on."""
+    from mechbook.app.unsaved import _append
+
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me\n", encoding="utf-8")
+    path = tmp_path / "mechbook.h5.unsaved-x.jsonl"
+    if plant == "link":
+        path.symlink_to(victim)
+    elif plant == "dangling":
+        path.symlink_to(tmp_path / "made-here")
+    else:
+        os.mkfifo(path)
+    with pytest.raises(OSError):
+        _append(path, '{"a": 1}\n')  # a FIFO without a reader: no block (O_NONBLOCK)
+    assert victim.read_text(encoding="utf-8") == "keep me\n"
+    assert not (tmp_path / "made-here").exists()
