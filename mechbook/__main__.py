@@ -9,7 +9,7 @@ import sys
 
 def run() -> None:
     """The entry point: the command line, with an interrupt at any moment ending in 130."""
-    try:
+    try:  # imported here, inside the handler: a Ctrl-C during the imports is caught too
         from mechbook.app.cli import main
 
         main(prog_name="mechbook")

@@ -137,7 +137,7 @@ def test_the_side_file_is_never_written_through_a_link_or_into_a_fifo(tmp_path, 
     """The side file's name is guessable (<store>.unsaved-<time>-<pid>.jsonl): a link or a
     FIFO planted there is refused (OSError: the next place is tried), never followed or
     waited on."""
-    from mechbook.app.unsaved import _append
+    from mechbook.app.unsaved import append_line
 
     victim = tmp_path / "victim.txt"
     victim.write_text("keep me\n", encoding="utf-8")
@@ -149,6 +149,6 @@ def test_the_side_file_is_never_written_through_a_link_or_into_a_fifo(tmp_path, 
     else:
         os.mkfifo(path)
     with pytest.raises(OSError):
-        _append(path, '{"a": 1}\n')  # a FIFO without a reader: no block (O_NONBLOCK)
+        append_line(path, '{"a": 1}\n')  # a FIFO without a reader: no block (O_NONBLOCK)
     assert victim.read_text(encoding="utf-8") == "keep me\n"
     assert not (tmp_path / "made-here").exists()

@@ -67,7 +67,7 @@ class SideFile:
                                          f"{datetime.now(UTC):%Y%m%dT%H%M%SZ}-{os.getpid()}"
                                          ".jsonl")
             try:
-                _append(path, line)
+                append_line(path, line)
             except OSError as exc:
                 self.failures.append(f"{path}: {exc.strerror or exc}")
                 continue
@@ -77,7 +77,7 @@ class SideFile:
         return None
 
 
-def _append(path: Path, line: str) -> None:
+def append_line(path: Path, line: str) -> None:
     """Append one line, synced; on failure (a full disk) the file is as it was before. A
     link at the path is never followed and a FIFO or device never written (nor waited on:
     O_NONBLOCK): OSError, and the next place is tried."""
