@@ -246,10 +246,11 @@ def run_schema(where: Path, spec: dict) -> tuple[str, str]:
         target.parent.mkdir(parents=True, exist_ok=True)
         if target != tree:
             target.write_text("a file where the folder goes")
-    elif plant == "dir-is-link":
-        if target != tree:
+    elif plant == "dir-is-link":  # DIR a link the user named: followed, as init's DIR is,
+        if target != tree:  # so it points inside the tree (a linked folder below DIR is not)
+            (tree / "real").mkdir()
             target.parent.mkdir(parents=True, exist_ok=True)
-            target.symlink_to(guard.outside, target_is_directory=True)
+            target.symlink_to(tree / "real", target_is_directory=True)
     elif plant in ("dir-is-dangling", "dir-is-fifo"):
         if target != tree:
             target.parent.mkdir(parents=True, exist_ok=True)
