@@ -152,3 +152,36 @@ def test_the_side_file_is_never_written_through_a_link_or_into_a_fifo(tmp_path, 
         append_line(path, '{"a": 1}\n')  # a FIFO without a reader: no block (O_NONBLOCK)
     assert victim.read_text(encoding="utf-8") == "keep me\n"
     assert not (tmp_path / "made-here").exists()
+
+
+def test_schema_write_past_the_file_size_limit_leaves_no_empty_file(tmp_path):
+    """The full disk without a mount: RLIMIT_FSIZE of 8 KiB (the answers schema is ~44 KB),
+    SIGXFSZ ignored so that the write fails with EFBIG as on a full disk."""
+    import resource
+    import signal
+    import sys
+
+    from hostile import ROOT
+
+    old = tmp_path / "schemas"
+    old.mkdir()
+    (old / "answers.json").write_text('{"old": 1}\n', encoding="utf-8")
+
+    def small_files() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    done = subprocess.run([sys.executable, "-m", "mechbook", "schema", "--write", str(old)],
+                          capture_output=True, text=True, timeout=120, env=env,
+                          preexec_fn=small_files)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "File too large" in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr
+    import json
+
+    for path in old.iterdir():  # nothing empty, nothing half-written: whole JSON or absent
+        json.loads(path.read_text(encoding="utf-8"))
+    assert (old / "answers.json").read_text(encoding="utf-8") == '{"old": 1}\n'
