@@ -226,3 +226,53 @@ def test_the_hdf5_kind_reports_a_leak_through_an_external_link(tmp_path, monkeyp
         monkeypatch.setattr(module, "member", lambda group, name: group[name])
     (tmp_path / "case-2").mkdir()
     assert surfaces.run_hdf5(tmp_path / "case-2", spec)[0] == "leak"
+
+
+# ---- the kinds of issue 44 can fail ------------------------------------------------------------
+def test_the_schema_kind_reports_a_write_through_a_link(tmp_path, monkeypatch):
+    """9a86c12's `schema --write` (write_text through whatever is there): 'outside'."""
+    import fuzz_surfaces44 as surfaces44
+
+    from mechbook.app import editor
+
+    spec = {"plant": "outside-link", "name": "problem.json", "dir": "schemas"}
+    (tmp_path / "case-1").mkdir()
+    assert surfaces44.run_schema(tmp_path / "case-1", spec)[0] == "refused"
+
+    def naive(directory):
+        directory.mkdir(parents=True, exist_ok=True)
+        for name in editor.NAMES:
+            (directory / f"{name}.json").write_text(editor.text(name), encoding="utf-8")
+        return []
+
+    monkeypatch.setattr(editor, "write_schemas", naive)
+    (tmp_path / "case-2").mkdir()
+    assert surfaces44.run_schema(tmp_path / "case-2", spec)[0] == "outside"
+
+
+def test_the_api_kind_reports_a_raw_exception(tmp_path, monkeypatch):
+    """An argument that reaches the engine unchecked (9a86c12's `params=[...]`): 'crash'."""
+    import fuzz_surfaces44 as surfaces44
+
+    from mechbook.app import api_args
+
+    spec = {"call": "p.frequencies(numeric=True, params={v})", "value": "[('m', 2)]"}
+    (tmp_path / "case-1").mkdir()
+    assert surfaces44.run_api(tmp_path / "case-1", spec)[0] == "refused"
+    monkeypatch.setattr(api_args, "mapping", lambda name, value: value)
+    (tmp_path / "case-2").mkdir()
+    assert surfaces44.run_api(tmp_path / "case-2", spec)[0] == "crash"
+
+
+def test_the_velocity_kind_refuses_what_is_not_linear(tmp_path):
+    import fuzz_surfaces44 as surfaces44
+
+    (tmp_path / "case-1").mkdir()
+    status, message = surfaces44.run_velocity(tmp_path / "case-1",
+                                              {"kind": "constraint", "expr": "1*(Abs(xdot))"})
+    assert status == "refused" and "not linear in the velocities" in message, message
+    (tmp_path / "case-2").mkdir()
+    status, message = surfaces44.run_velocity(
+        tmp_path / "case-2", {"kind": "constraint",
+                              "expr": "-1e-12*(xdot*sin(theta)) + 1e-12*(ydot*cos(theta))"})
+    assert status == "ok", message

@@ -588,3 +588,16 @@ def test_an_orbit_on_a_circle_averages_as_a_trig_polynomial(monkeypatch):
         problem = load_problem(ROOT / f"problems/symon/{pid}.yaml")
         system = system_of(problem, next(iter(problem.systems)))
         assert not any(s.name.startswith("alpha") for s in system.lagrangian.free_symbols)
+
+
+def test_unary_minuses_in_a_tensor_expression_are_an_expression_error():
+    """Issue 44's full fuzz run, case 3598: 500 unary minuses in a problem's `tensors:` entry
+    passed the parser's depth limit, and the tensor builder (two frames a level) raised a
+    raw RecursionError from `validate`."""
+    import sympy as sp
+
+    from mechbook.errors import ExpressionError
+    from mechbook.model.tensorexpr import parse_tensor
+
+    with pytest.raises(ExpressionError, match="nested too deeply"):
+        parse_tensor("-" * 500 + "x", {"x": sp.Symbol("x")})

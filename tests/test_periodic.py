@@ -438,3 +438,14 @@ def test_a_declared_period_is_verified(mathieu_fixed, tmp_path):
     assert out.status == "unsupported" and "not a period" in out.detail, out.detail
     out = _check(mathieu_fixed, tmp_path, "lim-9402", **part, period="2*pi/omegaa")
     assert out.status == "error" and "unknown name 'omegaa'" in out.detail, out.detail
+
+
+@pytest.mark.parametrize("period", ["1e-30", "1e-12", "pi*1e-15"])
+def test_a_period_too_short_to_resolve_is_refused(mathieu_fixed, tmp_path, period):
+    """Issue 44: `period: 1e-30` passed the range check and gave "marginal" (Φ = I to the
+    integration's resolution: every multiplier 1). Any period over which the state cannot
+    move measurably is an error naming it, never a verdict."""
+    out = _check(mathieu_fixed, tmp_path, "lim-9402", quantity="stability",
+                 about={"x": 0}, book="stable", period=period)
+    assert out.status == "error", (out.status, out.detail)
+    assert "too short to be resolved" in out.detail, out.detail

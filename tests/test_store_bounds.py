@@ -220,3 +220,29 @@ def test_a_damaged_simulation_costs_only_itself(tree):
         in res.stderr, res.stderr
     rec = store.read("lim-2101", path)
     assert rec["checked"] and rec["simulations"] == ["main-DOP853"]
+
+
+def _twelve_under_the_bound(path: Path) -> None:
+    """Twelve datasets under one record, each of 33 * 10^6 float64 (264 MB, just under the
+    per-dataset bound), chunked with a fill value and never written: the file stays small,
+    reading them all takes 3.2 GB (issue 44)."""
+    with h5py.File(path, "a") as f:
+        for i in range(12):
+            f.create_dataset(f"problems/lim-2101/systems/main/numeric/big{i:02d}",
+                             shape=(33_000_000,), dtype="f8", chunks=(1 << 20,),
+                             fillvalue=1.0)
+
+
+@pytest.mark.parametrize("command", ["show", "report"])
+def test_a_record_is_bounded_in_total_not_only_per_dataset(tree, command):
+    path = _store(tree)
+    _twelve_under_the_bound(path)
+    assert path.stat().st_size < 1_000_000
+    args = ["show", "lim-2101"] if command == "show" else ["report", "lim-2101"]
+    res = mechbook("--root", tree, *args, cwd=tree)
+    _clean(res)
+    text = res.stdout + res.stderr
+    assert "holds more than 536.9 MB of data in its datasets together" in text, text
+    if command == "show":
+        assert res.returncode == 1
+    assert mechbook("--root", tree, "show", "lim-2102", cwd=tree).returncode == 0

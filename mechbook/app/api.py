@@ -27,6 +27,7 @@ import functools
 import html
 from pathlib import Path
 
+from mechbook.app import api_args as args
 from mechbook.app.api_params import Parameters
 from mechbook.app.api_results import CheckResult, Simulation
 from mechbook.app.api_system import SystemView
@@ -34,7 +35,7 @@ from mechbook.app.mathml import math
 from mechbook.app.run import RunOptions
 from mechbook.app.service import check_loaded
 from mechbook.engine.analysis import Analysis
-from mechbook.errors import NotFoundError
+from mechbook.errors import InputError, NotFoundError
 from mechbook.model.books import Book, book_of
 from mechbook.model.catalog import existing_problem_path, root
 from mechbook.model.problem import Problem as Model
@@ -68,7 +69,8 @@ def load(problem_id: str, root_dir: str | Path | None = None,
     >>> p.title
     'Bead on a hoop spinning about a vertical diameter'
     """
-    base = Path(root_dir) if root_dir is not None else root()
+    args.text("problem_id", problem_id, optional=False)
+    base = args.path("root_dir", root_dir) if root_dir is not None else root()
     return Problem(load_problem(existing_problem_path(problem_id, base)), base, simplify)
 
 
@@ -145,6 +147,7 @@ class Problem:
         --------
         >>> mechbook.load("lim-2043").system("main").lagrangian   # doctest: +SKIP
         """
+        args.text("name", name)
         if name is None:
             if len(self.model.systems) == 1:
                 name = self.systems[0]
@@ -196,6 +199,9 @@ class Problem:
         >>> mechbook.load("lim-2031").check().ok       # doctest: +SKIP
         True
         """
+        if not isinstance(crosscheck, bool):
+            raise InputError(f"crosscheck: {crosscheck!r:.60} is not True or False")
+        store = args.path("store", store) if store is not None else None
         run = check_loaded(self.model, self.base, RunOptions(crosscheck=crosscheck), store)
         return CheckResult(self.id, run.outcomes, run.crosschecks, run.error, run.seconds)
 

@@ -145,7 +145,8 @@ class OdeFunction:
         """The state `simulate` starts from with the same `init` ({coordinate or
         coordinate + 'dot': number or text}; the problem's `initial:` and then zeros for
         what it leaves out)."""
-        q0, qd0, _ = initial_state(self._analysis, self._system, texts(init), self._values)
+        q0, qd0, _ = initial_state(self._analysis, self._system, texts(init, "init"),
+                                   self._values)
         return np.concatenate((q0, qd0))
 
     def __repr__(self) -> str:

@@ -10,12 +10,14 @@ may use the other parameters' defaults), as `mechbook simulate --param` reads th
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping
 from numbers import Real
 
 import numpy as np
 import sympy as sp
 
+from mechbook.app import api_args as args
 from mechbook.errors import InputError, NotFoundError
 from mechbook.model.hints import did_you_mean
 
@@ -60,7 +62,7 @@ class Parameters(Mapping):
 def parameter_values(model, params: Mapping | None) -> dict[sp.Symbol, float]:
     """The default values with `params` ({name or symbol: number or text}) applied."""
     values = dict(model.values())
-    for key, given in (params or {}).items():
+    for key, given in args.mapping("params", params).items():
         name = str(key)
         if name not in model.parameters:
             hint = did_you_mean(name, model.parameters)
@@ -77,7 +79,7 @@ def parameter_values(model, params: Mapping | None) -> dict[sp.Symbol, float]:
 
 def _number(model, name: str, given) -> float:
     if isinstance(given, Real) and not isinstance(given, bool):
-        value = float(given)
+        value = args.number(f"params[{name!r}]", given, -math.inf, math.inf)
     elif isinstance(given, str | sp.Basic):
         expr = model.parse(given, ()) if isinstance(given, str) else given  # a SymPy object
         try:
@@ -92,10 +94,20 @@ def _number(model, name: str, given) -> float:
     return value
 
 
-def texts(params: Mapping | None) -> dict[str, str]:
-    """{name or symbol: number or text} as {name: text}, for the simulation's reader."""
-    return {str(k): (repr(float(v)) if isinstance(v, Real) and not isinstance(v, bool)
-                     else str(v)) for k, v in (params or {}).items()}
+def texts(params: Mapping | None, what: str = "params") -> dict[str, str]:
+    """{name or symbol: number or text} as {name: text}, for the simulation's reader
+    (InputError naming `what` for anything else: a list, a number too large for a float,
+    NaN, infinities)."""
+    out = {}
+    for k, v in args.mapping(what, params).items():
+        if isinstance(v, Real) and not isinstance(v, bool):
+            out[str(k)] = repr(args.number(f"{what}[{str(k)!r}]", v, -math.inf, math.inf))
+        elif isinstance(v, str | sp.Basic):
+            out[str(k)] = str(v)
+        else:
+            raise InputError(f"{what}[{str(k)!r}]: {v!r:.60} is not a number (a number, or "
+                             "text such as '2*pi')")
+    return out
 
 
 def refuse_unknown(method: str, given: Mapping, known: tuple[str, ...]) -> None:

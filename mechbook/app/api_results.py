@@ -7,6 +7,7 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from mechbook.app import api_args as args
 from mechbook.app.api_animation import Animation, Picture
 from mechbook.app.report import animation
 from mechbook.app.store import write_simulation
@@ -162,7 +163,7 @@ class Simulation:
         """
         if path is None:
             return Picture(simulation_png(self.run), self._title())
-        return plot_simulation(self.run, path)
+        return plot_simulation(self.run, args.path("path", path))
 
     def animate(self, frames: int = animation.MAX_FRAMES) -> Animation:
         """The bodies moving as simulated, for a notebook (Jupyter shows it: a canvas and
@@ -225,7 +226,8 @@ class Simulation:
         '/problems/lim-2031/simulations/main-DOP853'
         """
         run = self.run
-        name = name or f"{run.system}-{run.trajectory.method}"
+        path = args.path("path", path)
+        name = args.text("name", name) or f"{run.system}-{run.trajectory.method}"
         write_simulation(run.problem_id, name, run.arrays(), run.settings(),
                          {f"monitors/{d.name}": d.attrs() for d in run.drifts}, path)
         return f"/problems/{run.problem_id}/simulations/{name}"

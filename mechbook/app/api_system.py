@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import sympy as sp
 
+from mechbook.app import api_args as args
 from mechbook.app.api_ode import OdeFunction
 from mechbook.app.api_params import parameter_values, refuse_unknown, texts
 from mechbook.app.api_results import Simulation
@@ -127,7 +128,7 @@ class SystemView:
             return self._an.default_point(self.name)
         sys = self._sys
         out = {}
-        for name, val in about.items():
+        for name, val in args.mapping("about", about).items():
             key = str(name)
             if key not in sys.coord_names:
                 raise NotFoundError(f"{key!r} is not a coordinate of {self.problem.id} "
@@ -137,6 +138,8 @@ class SystemView:
                     val = self.problem.model.parse(val, (), dict(sys.names))
                 except SpecError as exc:
                     raise InputError(f"{what}={{{key!r}: {val!r}}}: {exc.bare}") from None
+            elif not isinstance(val, sp.Basic):
+                val = args.number(f"about[{key!r}]", val, -1e100, 1e100)
             out[sys.q[sys.coord_names.index(key)]] = as_expr(val)
         return out
 
@@ -289,7 +292,8 @@ class SystemView:
         {'energy_function': 1.2e-10}
         """
         refuse_unknown("simulate", options, SIMULATE_OPTIONS)
-        options["init"] = texts(options.get("init"))
+        t_end = args.simulate_options(t_end, options)
+        options["init"] = texts(options.get("init"), "init")
         options["parameters"] = texts(options.pop("params", None))
         if options.get("backend") is None:
             options.pop("backend", None)

@@ -12,8 +12,10 @@ mechbook, `mechbook schema --write schemas` refreshes a tree's copies.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
+from mechbook.app.outputs import OutputError, refuse_special, write_file
 from mechbook.errors import MechbookError
 
 NAMES = ("problem", "answers", "books", "check-result")
@@ -46,20 +48,25 @@ def text(name: str) -> str:
 
 
 def write_schemas(directory: Path) -> list[Path]:
-    """Every schema as `<directory>/<name>.json`; the files written."""
-    directory.mkdir(parents=True, exist_ok=True)
-    out = []
-    for name in NAMES:
-        path = directory / f"{name}.json"
-        path.write_text(text(name), encoding="utf-8")
-        out.append(path)
-    return out
+    """Every schema as `<directory>/<name>.json` (made if missing), each by the link-safe
+    writer (mechbook.app.outputs.write_file): a link, FIFO or directory at any of the paths is
+    refused before anything is written. The files written; OutputError names a failure."""
+    directory = Path(directory)
+    if os.path.lexists(directory) and not os.path.isdir(directory):
+        raise OutputError(directory, "it exists and is not a directory", "schema directory")
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(directory, exc.strerror or str(exc), "schema directory") from None
+    paths = {name: directory / f"{name}.json" for name in NAMES}
+    for path in paths.values():  # all refused before any is written
+        refuse_special(path, "schema")
+    return [write_file(path, text(name).encode("utf-8"), "schema")
+            for name, path in paths.items()]
 
 
 def modeline(yaml_file: Path, schema_file: Path) -> str:
     """The comment that hands `schema_file` to the editor of `yaml_file` (a relative
     path, so that the tree can move)."""
-    import os
-
     rel = os.path.relpath(schema_file, yaml_file.parent)
     return MODELINE + Path(rel).as_posix()

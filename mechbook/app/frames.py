@@ -6,10 +6,12 @@ need it, and importing this module does not import it until `results` is called.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
-from mechbook.app.store import problems, read, vet
+from mechbook.app import api_args as args
+from mechbook.app.store import problems, read, regular_store, vet
 from mechbook.core.optional import require
 from mechbook.model.catalog import DEFAULT_STORE
 
@@ -52,9 +54,10 @@ def results(store: str | Path = DEFAULT_STORE) -> Frames:
     """
     pd = require("pandas", "data", "mechbook.results()")
 
-    path = Path(store)
-    if not path.exists():
+    path = args.path("store", store)
+    if not os.path.lexists(path):
         raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
+    regular_store(path)  # a FIFO would block the read: refused by its kind, never opened
     vet(path)  # once for the whole file, not a child per record
     checks, cross, timings = [], [], []
     for pid in problems(path):

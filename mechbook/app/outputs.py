@@ -10,6 +10,12 @@ sees the old file or the new one. The new version is an anonymous file (Linux `O
 that gets a name only an instant before the rename: a process killed while it writes leaves
 nothing behind (where `O_TMPFILE` is missing, a named temporary file is used and removed on
 every error; `remove_stale` clears what a killed writer left).
+
+`write_file` is the one writer of the files mechbook makes beside a tree's sources (the
+schemas of `schema --write`, the report's pages): it refuses a link (even a dangling one), a
+FIFO, a device or a directory at the path before anything is opened, writes the new version
+beside it and renames it into place, so nothing is written through a link, nothing blocks on
+a FIFO, and a full disk leaves the old file (or none), never an empty or half one.
 """
 
 from __future__ import annotations
@@ -72,6 +78,40 @@ def output_file(path: str | Path, what: str = "output") -> Path:
         raise OutputError(path, f"it is a {_kind(info.st_mode)}, not a regular file (results "
                           "are written only to regular files): give another path", what)
     return real
+
+
+def refuse_special(path: str | Path, what: str = "file") -> None:
+    """OutputError unless `path` is nothing yet or a regular file that is no link: judged by
+    `lstat`, so neither a link nor a FIFO is followed or opened."""
+    path = Path(path)
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise OutputError(path, exc.strerror or str(exc), what) from None
+    if stat.S_ISLNK(info.st_mode):
+        raise OutputError(path, f"it is a symbolic link (to {os.readlink(path)}): nothing "
+                          "is written through a link (remove it, or give another path)", what)
+    if not stat.S_ISREG(info.st_mode):
+        raise OutputError(path, f"it is a {_kind(info.st_mode)}, not a regular file: "
+                          "remove it, or give another path", what)
+
+
+def write_file(path: str | Path, data: bytes, what: str = "file") -> Path:
+    """Write `data` as the file `path`, never through a link: `refuse_special`, then a new
+    file beside it renamed into place (`replaced`). OutputError names the path and why;
+    on any failure the old file (or nothing) is left. Returns `path`.
+
+    Example: ``write_file(Path("schemas/problem.json"), b"{}", "schema")``."""
+    path = Path(path)
+    refuse_special(path, what)
+    try:
+        with replaced(path) as fh:
+            fh.write(data)
+    except OSError as exc:
+        raise OutputError(path, exc.strerror or str(exc), what) from None
+    return path
 
 
 def _mode_for(path: Path) -> int:

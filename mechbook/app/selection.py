@@ -21,11 +21,14 @@ from pathlib import Path
 
 from mechbook.app.bounded import Unreadable, json_value, read_regular
 from mechbook.app.outputs import replaced
-from mechbook.errors import NothingSelectedError
+from mechbook.errors import InputError, NothingSelectedError
 from mechbook.model.catalog import all_ids
 from mechbook.model.ids import BOOK, ID, split_id
 
 GLOB = set("*?[")
+MAX_PATTERN = 512  # characters of one id pattern: an id has at most 121, and fnmatch's
+# translation into a regular expression takes time quadratic in the pattern (30,000 '['
+# took 35 s before this bound), so a longer pattern is refused before it is compiled
 _BOOK = re.compile(BOOK)
 
 
@@ -46,6 +49,9 @@ def select(args: Sequence[str], base: Path) -> list[str]:
 
 
 def _matching(arg: str, tree: list[str], base: Path) -> list[str]:
+    if len(arg) > MAX_PATTERN:
+        raise InputError(f"the id pattern {arg[:40]!r}... is {len(arg)} characters long (at "
+                         f"most {MAX_PATTERN}; a problem id has at most 121)")
     if GLOB & set(arg):
         found = [pid for pid in tree if fnmatch.fnmatchcase(pid, arg)]
         what = f"no problem id matches {arg!r}"

@@ -13,9 +13,11 @@ because a reader can see what it holds.
 
 from __future__ import annotations
 
+import errno
 import json
 import logging
 import os
+import stat
 import tempfile
 from dataclasses import asdict
 from datetime import UTC, datetime
@@ -65,7 +67,7 @@ class SideFile:
                                          f"{datetime.now(UTC):%Y%m%dT%H%M%SZ}-{os.getpid()}"
                                          ".jsonl")
             try:
-                _append(path, line)
+                append_line(path, line)
             except OSError as exc:
                 self.failures.append(f"{path}: {exc.strerror or exc}")
                 continue
@@ -75,11 +77,18 @@ class SideFile:
         return None
 
 
-def _append(path: Path, line: str) -> None:
-    """Append one line, synced; on failure (a full disk) the file is as it was before."""
-    fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+def append_line(path: Path, line: str) -> None:
+    """Append one line, synced; on failure (a full disk) the file is as it was before. A
+    link at the path is never followed and a FIFO or device never written (nor waited on:
+    O_NONBLOCK): OSError, and the next place is tried."""
+    flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) \
+        | getattr(os, "O_NONBLOCK", 0)
+    fd = os.open(path, flags, 0o644)
     try:
-        size = os.fstat(fd).st_size
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise OSError(errno.EINVAL, "not a regular file", str(path))
+        size = info.st_size
         try:
             data = memoryview(line.encode("utf-8"))
             while data:  # a full disk may take part of it: the rest raises, then undone

@@ -119,7 +119,8 @@ def report_lines(run, seconds: float, cpu: float | None) -> list[str]:
 def watch(pid: str, base: Path, say: Callable[[str], None],
           options: WatchOptions = WatchOptions()) -> int:
     """Check `pid` now and after every change of its files; returns the number of checks
-    run (when `options.runs` stops it, or the user interrupts)."""
+    run when `options.runs` stops it. Ctrl-C says "stopped watching" and is raised again
+    (KeyboardInterrupt), so that the command ends with 130 as every command does."""
     book, number = split_id(pid)
     paths = [base / "problems" / book / f"{number}.yaml",
              base / "answers" / book / f"{number}.yaml", base / "books.yaml"]
@@ -159,4 +160,5 @@ def watch(pid: str, base: Path, say: Callable[[str], None],
                 say("waiting for a change ...")
     except KeyboardInterrupt:
         say("stopped watching")
+        raise  # the command line's status for an interrupt, 130 (mechbook.app.cli)
     return done

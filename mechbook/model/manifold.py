@@ -159,6 +159,7 @@ class StateManifold:
         cols = [j for j, v in enumerate(self.qd) if v in free]
         A = self._matrix(A_expr, env)
         b = mpmath.matrix([evaluate_mp(x, env, WORK) for x in b_expr])
+        _unit_rows(A, b)  # a constraint's scale (1e-12·(ẏ − ẋ)) is the author's, no rank
         v = mpmath.matrix([env[x] for x in self.qd])
         r = A * v + b
         if cols:
@@ -233,8 +234,23 @@ class StateManifold:
         with mpmath.workdps(WORK):
             A_expr, _ = self._rows
             holonomic = _rank(self._matrix(self._jacobian, env)) if self.position else 0
-            both = _rank(self._matrix(A_expr, env)) if A_expr else 0
+            both = _rank(_unit_rows(self._matrix(A_expr, env))) if A_expr else 0
         return Freedoms(n - holonomic, n - both)
+
+
+def _unit_rows(A, b=None):
+    """A (and b) with every row of A scaled to unit length, in place (a zero row is left):
+    a constraint multiplied by 1e-12 is the same constraint, and must weigh the same in a
+    least-norm step, a residual's test and a rank. Returns A."""
+    for i in range(A.rows):
+        size = mpmath.sqrt(sum(abs(A[i, j]) ** 2 for j in range(A.cols)))
+        if size == 0:
+            continue
+        for j in range(A.cols):
+            A[i, j] /= size
+        if b is not None:
+            b[i] /= size
+    return A
 
 
 def _least_norm(G, r):

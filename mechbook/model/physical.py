@@ -95,7 +95,9 @@ def _mass_matrix(system, values: dict) -> None:
         m, j = at
         full = m
         if j.size:  # the velocities the constraints allow: the null space of J
-            _, sv, vt = np.linalg.svd(j)
+            norms = np.linalg.norm(j, axis=1)  # each row to unit length: a constraint's
+            j = j[norms > 0] / norms[norms > 0, None]  # scale (1e-12·(ẏ − ẋ)) is no rank
+            _, sv, vt = np.linalg.svd(j) if j.size else (None, np.zeros(0), np.eye(len(m)))
             rank = int(np.sum(sv > 1e-10 * max(sv.max(initial=0.0), 1e-300)))
             basis = vt[rank:].T
             if basis.shape[1] == 0:

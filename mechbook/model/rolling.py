@@ -76,14 +76,47 @@ def _linear_in_velocities(sys, name: str, c: sp.Expr, sub: tuple) -> None:
     if not c.free_symbols & set(sys.qd):
         raise sys.error(sub, f"velocity constraint {name!r} holds no velocity: a relation "
                          "among the coordinates is a holonomic constraint (`constraints:`)")
-    for v in sys.qd:
-        for w in sys.qd:
-            second = sp.diff(c, v, w)
-            if second != 0 and not _vanishes(second):
-                raise sys.error(sub, f"velocity constraint {name!r} is not linear in the "
-                                 f"velocities (its second derivative in {v} and {w} is "
-                                 f"{sp.sstr(second)[:80]}): it must read A(q, t)·q̇ + b(q, t) "
-                                 "= 0")
+    # linear means a polynomial of degree one in the velocities: a velocity inside a
+    # function or a non-integer power (Abs(xdot), sign(xdot)*xdot, sqrt(xdot**2)) is not,
+    # though its second derivatives vanish wherever they are defined
+    inside = _velocity_inside(c, set(sys.qd))
+    poly = None if inside is not None else _poly(c, sys.qd)
+    if poly is None:
+        where = f" ({sp.sstr(inside)[:80]})" if inside is not None else ""
+        raise sys.error(sub, f"velocity constraint {name!r} is not linear in the velocities: "
+                         f"a velocity appears inside a function or a power{where}; it must "
+                         "read A(q, t)·q̇ + b(q, t) = 0")
+    for powers, coeff in poly.terms():
+        if sum(powers) > 1 and not _vanishes(coeff.as_expr() if hasattr(coeff, "as_expr")
+                                             else sp.sympify(coeff)):
+            term = sp.Mul(*[v**k for v, k in zip(sys.qd, powers, strict=True)])
+            raise sys.error(sub, f"velocity constraint {name!r} is not linear in the "
+                             f"velocities (it holds {sp.sstr(term)} times "
+                             f"{sp.sstr(coeff)[:80]}): it must read A(q, t)·q̇ + b(q, t) = 0")
+
+
+_NOT_SMOOTH = (sp.Abs, sp.sign, sp.Piecewise, sp.Heaviside, sp.Min, sp.Max, sp.floor,
+               sp.ceiling, sp.re, sp.im, sp.DiracDelta)
+
+
+def _velocity_inside(c: sp.Expr, velocities: set) -> sp.Expr | None:
+    """The first node of `c` that holds a velocity inside something no linear expression
+    has: a function (Abs, sign, sin, ...) or a power other than a positive integer."""
+    for node in sp.preorder_traversal(c):
+        if not (isinstance(node, sp.Basic) and node.free_symbols & velocities):
+            continue
+        if isinstance(node, sp.Pow) and not (node.exp.is_Integer and node.exp > 0):
+            return node
+        if isinstance(node, (sp.Function, *_NOT_SMOOTH)):
+            return node
+    return None
+
+
+def _poly(c: sp.Expr, velocities: list):
+    try:
+        return sp.Poly(sp.expand(c), *velocities)
+    except (sp.PolynomialError, sp.GeneratorsNeeded, ValueError, TypeError):
+        return None
 
 
 def _vanishes(expr: sp.Expr) -> bool:

@@ -137,7 +137,11 @@ def parse_tensor(text, names: Mapping[str, sp.Basic] | None = None,
     names = names or {}
     text, tree = syntax_tree(text)
     with dotprodsimp(False):
-        return _TensorBuilder(text, names, objects or {}).build(tree)
+        try:
+            return _TensorBuilder(text, names, objects or {}).build(tree)
+        except RecursionError:  # two frames a level here (500 unary minuses): as `parse`
+            raise ExpressionError(f"expression {text[:60]!r} nested too deeply",
+                                  text) from None
 
 
 def parse_tensor_equation(text, names: Mapping[str, sp.Basic] | None = None,

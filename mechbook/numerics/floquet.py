@@ -29,6 +29,7 @@ unsupported, with that reason.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -53,6 +54,10 @@ def marginal_within(resolution: float, scale: float) -> float:
     double root there, the square root of Φ's error (its measured resolution, at least the
     arithmetic's, times the size of Φ's entries), and at least MARGINAL."""
     return max(MARGINAL, 100 * (max(resolution, PRECISION) * max(scale, 1.0)) ** 0.5)
+
+
+SHORTEST = 1e-9  # T·rate below this: Φ = I + O(T·rate) puts every multiplier within 1e-9
+# of 1, where the integration's rounding decides its side: nothing can be told (an error)
 CLEARLY = 1e-6  # |μ| beyond 1 + this is unstable whatever the resolution
 ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
 
@@ -192,7 +197,32 @@ class Floquet:
             if not mpmath.isfinite(T) or T == 0:
                 raise MechbookError(f"the period {self.period} is not a finite positive "
                                     "number here")
+            rate = self._rate(values)
+            if T * rate < SHORTEST:
+                raise MechbookError(
+                    f"the period {self.period} = {mpmath.nstr(T, 3)} is too short to be "
+                    f"resolved here: over it the state moves by about "
+                    f"{mpmath.nstr(T * rate, 2)} of itself (the system's rates are "
+                    f"~{mpmath.nstr(rate, 3)} per unit time), so every multiplier is 1 to "
+                    f"within the integration's resolution; give the coefficients' period")
             return T
+
+    def _rate(self, values: dict) -> mpmath.mpf:
+        """The largest rate of the linearized motion at t = 0 (1 + the largest entry of
+        M⁻¹K and M⁻¹C there): a period T with T·rate below SHORTEST leaves Φ = I to the
+        integration's resolution, and its multipliers tell nothing."""
+        lin = self.lin
+        at = {s: sp.Float(mpmath.nstr(_mp(v), 30), 30) for s, v in values.items()
+              if isinstance(s, sp.Symbol)}
+        at[lin.dyn.sys.t] = 0
+        try:
+            M = lin.M.xreplace(at).evalf(30)
+            rows = [M.LUsolve(X.xreplace(at).evalf(30)) for X in (lin.K, lin.C)]
+            big = max([abs(complex(x)) for R in rows for x in R] + [0.0])
+        except (TypeError, ValueError, ZeroDivisionError, sp.matrices.exceptions.
+                NonInvertibleMatrixError):
+            return mpmath.mpf(1)
+        return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
 
     def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, float]:
         """(Φ at DPS digits, T, the Liouville mismatch |det Φ·exp(∫tr M⁻¹C) − 1|)."""

@@ -43,12 +43,17 @@ class _Group(click.Group):
     stops them, mechbook.app.batch); a MechbookError no command caught is its message; a
     usage error (the group's or a command's) exits 4, as pytest's (statuses.TABLE)."""
 
-    def make_context(self, *args, **kwargs) -> click.Context:
+    def make_context(self, info_name, args, parent=None, **extra) -> click.Context:
+        # a usage error exits 4; Ctrl-C while the arguments are read ends with 130 (click
+        # would say "Aborted!", status 1)
         try:
-            return super().make_context(*args, **kwargs)
+            return super().make_context(info_name, args, parent, **extra)
         except click.UsageError as exc:
             exc.exit_code = USAGE
             raise
+        except KeyboardInterrupt:
+            say("\ninterrupted", err=True)
+            raise click.exceptions.Exit(INTERRUPTED) from None
 
     def invoke(self, ctx: click.Context):
         try:

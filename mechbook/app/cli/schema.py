@@ -14,7 +14,7 @@ NAMES = ("problem", "answers", "books", "check-result")  # mechbook.app.editor.N
 
 @click.command("schema")
 @click.argument("name", required=False, type=click.Choice(NAMES))
-@click.option("--write", "directory", type=click.Path(file_okay=False, path_type=Path),
+@click.option("--write", "directory", type=click.Path(path_type=Path),
               default=None, help="Write every schema to DIRECTORY (as NAME.json) instead.")
 def command(name: str | None, directory: Path | None) -> None:
     """Print the JSON Schema NAME (problem, answers, books or check-result), or write them
@@ -34,9 +34,6 @@ def command(name: str | None, directory: Path | None) -> None:
     if name is not None:
         click.echo(editor.text(name), nl=False)
         return
-    try:
-        written = editor.write_schemas(directory)
-    except OSError as exc:
-        raise click.ClickException(f"cannot write to {directory}: {exc.strerror}") from None
+    written = editor.write_schemas(directory)  # an OutputError is the command's message
     for path in written:
         say(f"wrote {path}")

@@ -20,6 +20,8 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import os
+import stat
 from dataclasses import asdict
 from pathlib import Path
 
@@ -122,7 +124,14 @@ def save(out: Path, pages: dict[str, dict]) -> None:
 
 
 def still_good(out: Path, pid: str, key: str, pages: dict[str, dict]) -> bool:
-    """Whether the page of `pid` on disk was built from `key`."""
+    """Whether the page of `pid` on disk was built from `key`: a regular file, no link (a
+    link or anything else in a page's place is built again, and the new page renamed over
+    it, never written through it)."""
     entry = pages.get(pid)
-    return (isinstance(entry, dict) and entry.get("key") == key
-            and (out / "problems" / f"{pid}.html").exists())
+    if not (isinstance(entry, dict) and entry.get("key") == key):
+        return False
+    try:
+        info = os.lstat(out / "problems" / f"{pid}.html")
+    except OSError:
+        return False
+    return stat.S_ISREG(info.st_mode)

@@ -24,6 +24,7 @@ from mechbook.app.store.reader import (
     problems,
     read,
     read_simulation,
+    regular_store,
     there,
     vet,
 )
@@ -45,7 +46,7 @@ __all__ = [
     "ProblemRecord", "write", "write_simulation", "compact_store", "check_run_name",
     # reading
     "DEFAULT_PATH", "FORMAT", "StoreError", "StoreHang", "hang_reason", "read",
-    "read_simulation", "problems", "vet", "there", "damage", "refusal", "DAMAGED",
+    "read_simulation", "problems", "regular_store", "vet", "there", "damage", "refusal", "DAMAGED",
     # the warm-run cache
     "Cached", "cached", "durations",
     # for the store's other entries (a sweep's: mechbook.app.sweep.storage)

@@ -15,6 +15,9 @@ everything read from a store goes through this module:
 - only the types mechbook writes (numbers, booleans, strings); a dataset whose data lies in
   other files (HDF5's external storage, a virtual dataset) or a soft or external link is
   refused, so nothing outside the store is ever read through it;
+- one record (a problem's, a simulation's, a sweep's) is bounded in total too
+  (`MAX_RECORD_BYTES`, counted by `record`): a dozen datasets each just under their own
+  bound would otherwise take gigabytes together;
 - walks are bounded in depth, in members per group (counted before the group is listed)
   and in the number of objects (a group may hold itself).
 
@@ -24,6 +27,8 @@ Every refusal is an `Oversized` (a ValueError): to a reader it is damage, descri
 from __future__ import annotations
 
 from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any
 
 import h5py
@@ -31,6 +36,8 @@ import numpy as np
 
 MAX_DATASET_BYTES = 256 * 2**20  # one dataset in memory; the largest mechbook writes is a
 # simulation's q or q̇: 16 coordinates × 10^6 samples × 8 bytes = 128 MB
+MAX_RECORD_BYTES = 2 * MAX_DATASET_BYTES  # the datasets of one record together: a
+# simulation's q and q̇ at their largest, and its times
 MAX_ATTRIBUTE_BYTES = 2**20  # one attribute; HDF5 keeps mechbook's under 64 KiB
 MAX_STRINGS = 4096  # strings in one dataset or attribute (mechbook writes one, or a
 # simulation's coordinate names)
@@ -48,6 +55,30 @@ _NUMERIC = "fiub"  # float, signed and unsigned integers, booleans (an HDF5 enum
 class Oversized(ValueError):
     """Something in the store that is not read: too large, of a type mechbook never
     writes, or reaching outside the file."""
+
+
+_RECORD: ContextVar[list | None] = ContextVar("mechbook_store_record", default=None)
+
+
+@contextmanager
+def record(name: str) -> Iterator[None]:
+    """Within it, the datasets read (`dataset`) count against one record's bound,
+    MAX_RECORD_BYTES, by their declared sizes before they are read: Oversized past it."""
+    token = _RECORD.set([MAX_RECORD_BYTES, name])
+    try:
+        yield
+    finally:
+        _RECORD.reset(token)
+
+
+def _spend_bytes(n: int) -> None:
+    left = _RECORD.get()
+    if left is None:
+        return
+    left[0] -= n
+    if left[0] < 0:
+        raise Oversized(f"the record {left[1]} holds more than {_size_text(MAX_RECORD_BYTES)} "
+                        "of data in its datasets together (at most that is read)")
 
 
 def _size_text(n: float) -> str:
@@ -89,13 +120,19 @@ def dataset(d: h5py.Dataset) -> Value:
         raise Oversized(f"{what()} keeps its data in other files (external or virtual "
                         "storage): not read")
     if not _check(what, d.shape, d.dtype, MAX_DATASET_BYTES):
+        _spend_bytes(int(np.prod(d.shape, dtype=object)) * d.dtype.itemsize if d.shape
+                     else d.dtype.itemsize)
         return d[()]
     if d.shape == ():
-        return _text(what, d[()])
+        value = _text(what, d[()])
+        _spend_bytes(len(value) if isinstance(value, bytes | str) else 0)
+        return value
     out, total = [], 0
     for index in np.ndindex(*d.shape):
         value = d[index]
-        total += len(value) if isinstance(value, bytes | str) else 0
+        size = len(value) if isinstance(value, bytes | str) else 0
+        total += size
+        _spend_bytes(size)
         if total > MAX_TEXT_BYTES:
             raise Oversized(f"{what()} holds more than {_size_text(MAX_TEXT_BYTES)} of text")
         out.append(value)

@@ -12,6 +12,7 @@ damaged is what the next write moves aside, and nothing else.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import h5py
@@ -26,6 +27,7 @@ from mechbook.app.store.bounds import (
     member,
     members,
     new_budget,
+    record,
     walk,
 )
 from mechbook.records import CrossCheck, Status
@@ -44,6 +46,17 @@ _GROUPS = ("systems", "checks", "crosschecks", "simulations")
 
 class Damaged(ValueError):
     """A record that is not what a check writes (a missing attribute, an unknown outcome)."""
+
+
+def _one_record(read):
+    """`read(g, budget)` with the datasets it reads counted against one record's bound
+    (mechbook.app.store.bounds.record): every reader of a record goes through it."""
+    @functools.wraps(read)
+    def bounded(g, budget: list[int] | None = None) -> dict:
+        with record(getattr(g, "name", "?")):
+            return read(g, budget)
+
+    return bounded
 
 
 def reason_of(exc: BaseException) -> str:
@@ -96,6 +109,7 @@ def _typed(attrs: dict, wanted: dict, where: str) -> None:
             raise Damaged(f"{where}: the attribute {key!r} is {attrs[key]!r}")
 
 
+@_one_record
 def read_problem_entry(g, budget: list[int] | None = None) -> dict:
     """A problem's record, read whole (every attribute and dataset of it, within the
     bounds; its simulations only by name: each is read on its own) and checked to be what
@@ -185,6 +199,7 @@ def read_crosschecks(g: h5py.Group, budget: list[int] | None = None) -> list[dic
     return [e for _, e in sorted(out, key=lambda x: x[0])]
 
 
+@_one_record
 def read_simulation_entry(s, budget: list[int] | None = None) -> dict:
     """A stored simulation, read whole within the bounds: its float arrays and their
     attributes (every other dataset and attribute read too, so damage anywhere shows)."""
@@ -288,6 +303,7 @@ def plain_value(v: object) -> object:
     return v
 
 
+@_one_record
 def read_sweep_entry(g, budget: list[int] | None = None) -> dict:
     """A stored sweep, read whole within the store's bounds (mechbook.app.store.bounds);
     raises on damage."""

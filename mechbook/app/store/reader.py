@@ -80,9 +80,7 @@ def opened(path: str | Path) -> Iterator[h5py.File]:
     be; FileNotFoundError if there is none."""
     if not os.path.lexists(path):
         raise FileNotFoundError(f"no store at {path}; run `mechbook check` first")
-    if not Path(path).is_file():  # a FIFO would block the open; a directory, a dead link
-        raise StoreError(path, "it is not a regular file (a directory, a FIFO, a device or "
-                         "a broken link): give the path of a store", "read")
+    regular_store(path)
     try:
         f = h5py.File(path, "r")
     except Exception as exc:  # noqa: BLE001 - truncated, not HDF5, a directory, unreadable
@@ -94,6 +92,14 @@ def opened(path: str | Path) -> Iterator[h5py.File]:
         if why is not None:
             raise StoreError(path, why, "read")
         yield f
+
+
+def regular_store(path: str | Path) -> None:
+    """StoreError unless `path` is a regular file (or a link to one), judged by `stat`
+    before any open: a FIFO would block the open, a device be read without end."""
+    if not Path(path).is_file():  # a FIFO would block the open; a directory, a dead link
+        raise StoreError(path, "it is not a regular file (a directory, a FIFO, a device or "
+                         "a broken link): give the path of a store", "read")
 
 
 def _damaged(path: str | Path, what: str, exc: BaseException) -> StoreError:
@@ -117,8 +123,8 @@ def vet(path: str | Path = DEFAULT_PATH) -> None:
     a reader of many records (the report, a DataFrame of every problem) then reads them in
     this process, not one child each. A store that is not sound is left to each read to
     describe."""
-    if is_sound(path) or signature(path) is None:
-        return
+    if is_sound(path) or signature(path) is None or not Path(path).is_file():
+        return  # not a regular file: each read says so (a FIFO is never opened)
     try:
         if in_child(path, damage, path) is None:
             mark_sound(path)
