@@ -189,17 +189,17 @@ def test_a_sign_claim_against_the_resolution(lam, s, status):
     """`positive` at T = 400 (b = 0.02), in closed form: passes where λ − s > b, fails only
     where λ + s < −b; in between the reason names the `time:` beyond 8/(λ − s) that would
     resolve a λ − s > 0."""
-    from mechbook.verify.quantities.chaos import _judge_sign
+    from mechbook.verify.quantities.chaos import judge_exponent_sign
     b = RESOLUTION / 400
     try:
-        verdict = _judge_sign("positive", lam, s, b, 400.0, "m")
+        verdict = judge_exponent_sign("positive", lam, s, b, 400.0, "m")
     except UnsupportedError as exc:
         assert status == "unsupported", exc
         if lam - s > 0:
             assert "`time:` beyond 1000 would resolve it" in str(exc), exc
         return
     assert ("pass" if verdict.ok else "fail") == status
-    mirrored = _judge_sign("negative", -lam, s, b, 400.0, "m")
+    mirrored = judge_exponent_sign("negative", -lam, s, b, 400.0, "m")
     assert mirrored.ok == verdict.ok
 
 

@@ -436,7 +436,7 @@ def check_lyapunov(ctx: Context, val) -> Verdict:
     lam, s, b = run.estimate, run.spread, run.resolution
     method = f"Benettin (T = {span:g}: λ = {lam:.6g}, spread {s:.2g}, resolution {b:.2g})"
     if val in CLAIMS:
-        return _judge_sign(val, lam, s, b, span, method)
+        return judge_exponent_sign(val, lam, s, b, span, method)
     claimed = _number(ctx, val, ("book",), pt)
     tol = (_number(ctx, data["tolerance"], ("tolerance",), pt) if "tolerance" in data
            else (ctx.sampler.rtol if "estimate" in data else RTOL) * max(abs(claimed), b))
@@ -452,11 +452,18 @@ def check_lyapunov(ctx: Context, val) -> Verdict:
                            "longer `time:` converges further)")
 
 
-def _judge_sign(val: str, lam: float, s: float, b: float, span: float,
-                method: str) -> Verdict:
+def judge_exponent_sign(val: str, lam: float, s: float, b: float, span: float,
+                        method: str) -> Verdict:
     """A sign claim judged against the run's resolution b = 8/T: `fail` only where the run
     resolves the opposite (a run of length T cannot tell zero from an exponent below b, so
-    a weakly chaotic orbit claimed positive is unresolved, not contradicted)."""
+    a weakly chaotic or sticky orbit claimed positive is unresolved, not contradicted).
+
+    val: "positive", "zero" or "negative"; lam, s, b: the run's estimate, spread and
+    resolution; span: its length T; method: the verdict's method text. Returns the
+    Verdict; raises UnsupportedError (with b, λ, s, T and the `time:` that would resolve
+    the claim) where the run can tell neither. Example:
+    judge_exponent_sign("positive", -0.03, 0.002, 0.02, 400.0, "m").ok is False.
+    """
     figures = f"λ = {lam:.4g}, spread {s:.2g}, T = {span:g}"
     if val == "zero":
         if abs(lam) + s <= b:
