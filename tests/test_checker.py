@@ -832,6 +832,20 @@ def tensor_same_meaning(ctx: Context, slot: Slot, old, new) -> bool:
 
 
 # ---- (b) the mutation test ------------------------------------------------------------------
+RESOLVED_BY = "resolution b = "  # how a `lyapunov` sign claim's unsupported names its run
+
+
+def rejected(slot: Slot, got) -> bool:
+    """Whether a mutant was rejected: it failed. A Lyapunov sign claim the run cannot
+    resolve (an exponent below its resolution b = 8/T is neither shown nor excluded) ends
+    `unsupported`, never `fail`: that counts only where the detail states the resolution it
+    was judged at. A mutant never passes."""
+    if got.status == "fail":
+        return True
+    return (slot.kind == "exponent_sign" and got.status == "unsupported"
+            and RESOLVED_BY in got.detail)
+
+
 # A sample of six keys runs in every tier (the quick one too); every other key is `slow` and
 # `mutation` (tests/mutation_keys.py: `make test-mutation`).
 @pytest.mark.parametrize("answer_file", per_key(ANSWER_FILES))
@@ -888,7 +902,7 @@ def test_mutated_answers_fail(answer_file: Path, tmp_path: Path, repo_analysis):
                 got = check_problem(analysis, mutant_key)[0]
                 if VERBOSE:
                     print(f"{part.name} {slot.path} {label}: {new!r} -> {got.status}")
-                ok = got.status != "erratum" if erratum else got.status == "fail"
+                ok = got.status != "erratum" if erratum else rejected(slot, got)
                 if not ok:
                     where = "/".join(str(p) for p in slot.path)
                     survivors.append(f"{part.name} [{part.quantity}] {where}: {label}: "
@@ -1053,3 +1067,19 @@ def test_text_surgery_helpers():
     assert [(sl.path, sl.kind) for sl in leaves] == [
         (("book", "x", 0), "equation"), (("book", "x", 1), "relation"),
         (("book", "x", 2), "value"), (("book", "y"), "value")]
+
+
+def test_a_mutant_counts_as_rejected_only_where_it_failed_or_its_claim_is_unresolved():
+    """The harness's rule: `fail` rejects; `unsupported` rejects only an `exponent_sign`
+    mutant whose detail states the resolution it was judged at; a pass never does."""
+    from types import SimpleNamespace as Outcome
+    sign, value = Slot(("book",), "exponent_sign"), Slot(("book",), "value")
+    unresolved = ("the run resolves no exponent above the resolution b = 0.008 (λ = 0.001, "
+                  "spread 0.0009, T = 1000); a positive exponent ... is not excluded")
+    assert rejected(sign, Outcome(status="fail", detail=""))
+    assert rejected(value, Outcome(status="fail", detail=""))
+    assert rejected(sign, Outcome(status="unsupported", detail=unresolved))
+    assert not rejected(sign, Outcome(status="unsupported", detail="the integration failed"))
+    assert not rejected(value, Outcome(status="unsupported", detail=unresolved))
+    for slot in (sign, value):
+        assert not rejected(slot, Outcome(status="pass", detail=unresolved))

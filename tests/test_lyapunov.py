@@ -7,7 +7,7 @@ well-known verdicts.
 - Two uncoupled oscillators (a linear centre): tangent vectors rotate, all exponents zero.
 - Hénon–Heiles, V = (x² + y²)/2 + x²y − y³/3: at E = 1/12 the orbits are regular (KAM tori
   fill the section), at E = 1/6 the start (0, −0.1) on the y-axis lies in the chaotic sea
-  (Hénon & Heiles 1964; the exponent is about 0.14 there).
+  (Hénon & Heiles 1964; its exponent is positive, of order 0.1 or below).
 - The driven damped pendulum θ̈ + θ̇/q + sin θ = g cos(ω t), ω = 2/3, q = 2 (Baker &
   Gollub's values): chaotic at g = 1.5, a periodic attractor (a negative exponent) at 0.9.
 - A kicked rotor (rectangular kicks of width ε, the standard map as ε → 0): chaotic at
@@ -130,7 +130,7 @@ EXPONENT = "-b/2 + sqrt(b**2/4 - k)"
     ("-b/2 - sqrt(b**2/4 - k)", "fail"),      # the other (faster) exponent
     ("negative", "pass"),
     ("zero", "fail"),
-    ("positive", "fail"),
+    ("positive", "fail"),                     # resolved negative: λ + s < −b
 ])
 def test_overdamped_oscillator_exponent_in_closed_form(tree, tmp_path, book, status):
     an = load_analysis(tree, OVERDAMPED, "9301")
@@ -138,8 +138,8 @@ def test_overdamped_oscillator_exponent_in_closed_form(tree, tmp_path, book, sta
     assert got[0] == status, got
 
 
-@pytest.mark.parametrize("book, status", [("zero", "pass"), ("positive", "fail"),
-                                          ("negative", "fail")])
+@pytest.mark.parametrize("book, status", [("zero", "pass"), ("positive", "unsupported"),
+                                          ("negative", "unsupported")])
 def test_a_linear_centre_has_zero_exponents(tree, tmp_path, book, status):
     an = load_analysis(tree, CENTRE, "9302")
     got = check(an, tmp_path, initial={"x": 0.3, "ydot": 0.2}, time=400, book=book)
@@ -165,12 +165,51 @@ def test_a_zero_pass_states_the_bound_it_proves(tree, tmp_path):
     assert "beyond" not in out.power, out.power
 
 
+def test_a_regular_orbit_claimed_positive_is_unsupported_with_the_reason(tree, tmp_path):
+    """A run of length T cannot tell zero from a positive exponent below b = 8/T (a weakly
+    chaotic or sticky orbit): nothing contradicts `positive`, so the claim is `unsupported`,
+    never `fail`, and the reason gives b, λ, the spread, T and the run that would resolve
+    it (b = 8/T: T = 4000 resolves 8/4000 = 0.002)."""
+    an = load_analysis(tree, CENTRE, "9302")
+    got = check(an, tmp_path, initial={"x": 0.3, "ydot": 0.2}, time=400, book="positive")
+    assert got[0] == "unsupported", got
+    b = RESOLUTION / 400
+    assert f"resolution b = {b:.2g}" in got[1] and "not excluded" in got[1], got
+    assert "λ = " in got[1] and "spread" in got[1] and "T = 400" in got[1], got
+    assert "`time: 4000` resolves 0.002" in got[1], got
+
+
+@pytest.mark.parametrize("lam, s, status", [
+    (0.01, 0.002, "unsupported"),   # 0.008 > 0: T > 8/0.008 = 1000 would resolve it
+    (0.03, 0.002, "pass"),          # λ − s = 0.028 > b = 0.02
+    (-0.03, 0.002, "fail"),         # λ + s = −0.028 < −b
+    (-0.01, 0.002, "unsupported"),  # a negative λ within b: a positive one not excluded
+])
+def test_a_sign_claim_against_the_resolution(lam, s, status):
+    """`positive` at T = 400 (b = 0.02), in closed form: passes where λ − s > b, fails only
+    where λ + s < −b; in between the reason names the `time:` beyond 8/(λ − s) that would
+    resolve a λ − s > 0."""
+    from mechbook.verify.quantities.chaos import judge_exponent_sign
+    b = RESOLUTION / 400
+    try:
+        verdict = judge_exponent_sign("positive", lam, s, b, 400.0, "m")
+    except UnsupportedError as exc:
+        assert status == "unsupported", exc
+        if lam - s > 0:
+            assert "`time:` beyond 1000 would resolve it" in str(exc), exc
+        return
+    assert ("pass" if verdict.ok else "fail") == status
+    mirrored = judge_exponent_sign("negative", -lam, s, b, 400.0, "m")
+    assert mirrored.ok == verdict.ok
+
+
 @pytest.mark.parametrize("energy, y, book, status", [
     ("1/12", "0.1", "zero", "pass"),
-    ("1/12", "0.1", "positive", "fail"),      # chaotic for a regular orbit
+    ("1/12", "0.1", "positive", "unsupported"),  # below b: not excluded, not contradicted
     ("1/12", "-0.2", "zero", "pass"),
     ("1/6", "-0.1", "positive", "pass"),
     ("1/6", "-0.1", "zero", "fail"),           # regular for a chaotic orbit
+    ("1/6", "-0.1", "negative", "fail"),       # resolved positive: λ − s > b
 ])
 def test_henon_heiles_regular_and_chaotic(tree, tmp_path, energy, y, book, status):
     an = load_analysis(tree, HENON_HEILES, "9303")
@@ -178,12 +217,35 @@ def test_henon_heiles_regular_and_chaotic(tree, tmp_path, energy, y, book, statu
     assert got[0] == status, got
 
 
-def test_a_value_the_run_cannot_resolve_is_unsupported(tree, tmp_path):
-    """The chaotic exponent's spread over the last quarters (~1e-2) exceeds ±1e-4."""
+@pytest.mark.parametrize("claim, status", [
+    ((0.5, 0.25), "unsupported"),  # v = λ + s/2 ± s/4 overlaps [λ − s, λ + s], not around it
+    ((3.0, 1.0), "fail"),          # v = λ + 3s ± s: [λ − s, λ + s] wholly outside
+    ((0.0, 2.0), "pass"),          # v = λ ± 2s: [λ − s, λ + s] wholly inside
+])
+def test_a_value_is_judged_by_the_runs_interval(tree, tmp_path, claim, status):
+    """A value claim against the run's interval [λ − s, λ + s]: pass only inside v ± tol,
+    fail only outside it, else unsupported. The claims are placed from the run's own λ and
+    s (computed here, with the checker's start on E = 1/6), so each lands where it is said to."""
     an = load_analysis(tree, HENON_HEILES, "9303")
-    got = check(an, tmp_path, initial=hh_start("1/6", "-0.1"), time=1000, book="0.14",
-                tolerance="1e-4")
-    assert got[0] == "unsupported" and "spread" in got[1], got
+    y0 = np.array([0.0, -0.1, math.sqrt(2 / 6 - 0.01 - 2e-3 / 3), 0.0])
+    run = largest_exponent(an.system(), an.dynamics(), {}, y0, 1000.0)
+    lam, s = run.estimate, run.spread
+    assert s > 0
+    shift, width = claim  # in units of the spread
+    got = check(an, tmp_path, initial=hh_start("1/6", "-0.1"), time=1000,
+                book=repr(lam + shift * s), tolerance=repr(width * s))
+    assert got[0] == status, got
+    if status == "unsupported":
+        assert "neither lies within nor outside" in got[1] and "spread" in got[1], got
+
+
+def test_a_wrong_value_fails(tree, tmp_path):
+    """The chaotic exponent at E = 1/6 is of order 0.1 (Hénon & Heiles' orbits separate
+    over tens of time units), so 1 ± 0.1 is contradicted."""
+    an = load_analysis(tree, HENON_HEILES, "9303")
+    got = check(an, tmp_path, initial=hh_start("1/6", "-0.1"), time=1000, book="1",
+                tolerance="0.1")
+    assert got[0] == "fail" and "lies outside" in got[1], got
 
 
 def test_a_long_run_reports_its_progress(tree, tmp_path):
@@ -205,8 +267,9 @@ def test_a_long_run_reports_its_progress(tree, tmp_path):
 @pytest.mark.parametrize("g, book, status", [
     ("1.5", "positive", "pass"),
     ("1.5", "negative", "fail"),
+    ("1.5", "zero", "fail"),
     ("0.9", "negative", "pass"),
-    ("0.9", "positive", "fail"),
+    ("0.9", "positive", "fail"),               # a periodic attractor: resolved negative
 ])
 def test_baker_gollub_pendulum(tree, tmp_path, g, book, status):
     """A turning pendulum is bounded (θ is an angle of the equations: only θ̇ counts)."""
@@ -219,8 +282,9 @@ def test_baker_gollub_pendulum(tree, tmp_path, g, book, status):
 @pytest.mark.parametrize("k, start, book, status", [
     ("6", {"theta": 1.0, "thetadot": 0.3}, "positive", "pass"),
     ("6", {"theta": 1.0, "thetadot": 0.3}, "zero", "fail"),
+    ("6", {"theta": 1.0, "thetadot": 0.3}, "negative", "fail"),
     ("1.5", {"theta": "pi + 0.05", "thetadot": 0}, "zero", "pass"),
-    ("1.5", {"theta": "pi + 0.05", "thetadot": 0}, "positive", "fail"),
+    ("1.5", {"theta": "pi + 0.05", "thetadot": 0}, "positive", "unsupported"),
 ])
 def test_kicked_rotor(tree, tmp_path, k, start, book, status):
     an = load_analysis(tree, ROTOR, "9305")

@@ -19,7 +19,7 @@ import sympy as sp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.errors import UnsupportedError
-from mechbook.numerics.lyapunov import UnboundedMotion, largest_exponent
+from mechbook.numerics.lyapunov import RESOLUTION, UnboundedMotion, largest_exponent
 from mechbook.numerics.poincare import NEWTON_TOL, NoCrossing, ReturnMap, Section, stability
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
@@ -404,9 +404,12 @@ CLAIMS = ("positive", "zero", "negative")
                'the variational equations renormalized in 64 windows; λ the growth over the '
                'second half per unit time, its spread s the difference of the last two '
                'quarters\' estimates, its resolution b = 8/T (a regular motion stays below). '
-               'positive: λ − s > b (fails where λ + s ≤ b); zero: |λ| + s ≤ b (fails where '
-               '|λ| − s > b); negative: λ + s < −b; a value: |λ − v| ≤ tolerance with s ≤ '
-               'tolerance; otherwise unsupported. An unbounded motion (a non-angle coordinate '
+               'positive: passes where λ − s > b, fails only where the exponent is resolved '
+               'negative (λ + s < −b); negative mirrors it; zero: |λ| + s ≤ b (fails where '
+               '|λ| − s > b); a value v: passes where [λ − s, λ + s] lies within v ± '
+               'tolerance, fails where it lies outside; otherwise unsupported, with the '
+               '`time:` that would resolve it (a run of length T cannot tell zero from an '
+               'exponent below b). An unbounded motion (a non-angle coordinate '
                'or a velocity past 1e4 times the start) is an error. `max_step:` bounds the '
                'steps (a drive in pulses shorter than the steps would be missed)'),
           literals=CLAIMS,
@@ -433,35 +436,67 @@ def check_lyapunov(ctx: Context, val) -> Verdict:
     lam, s, b = run.estimate, run.spread, run.resolution
     method = f"Benettin (T = {span:g}: λ = {lam:.6g}, spread {s:.2g}, resolution {b:.2g})"
     if val in CLAIMS:
-        if val == "positive":
-            ok, bad = lam - s > b, lam + s <= b
-        elif val == "zero":
-            ok, bad = abs(lam) + s <= b, abs(lam) - s > b
-        else:
-            ok, bad = lam + s < -b, lam - s >= -b
-        if ok and val == "zero":
+        return judge_exponent_sign(val, lam, s, b, span, method)
+    claimed = _number(ctx, val, ("book",), pt)
+    tol = (_number(ctx, data["tolerance"], ("tolerance",), pt) if "tolerance" in data
+           else (ctx.sampler.rtol if "estimate" in data else RTOL) * max(abs(claimed), b))
+    off = abs(lam - claimed)
+    if off + s <= tol:  # all of [λ − s, λ + s] within the book's value ± tolerance
+        return Verdict(True, method, power=f"the exponent to {tol:.2g}: |λ − v| + spread "
+                                            f"{s:.2g} ≤ {tol:.2g}")
+    if off - s > tol:  # all of [λ − s, λ + s] outside it
+        return Verdict(False, method, f"λ = {lam:.10g} ± {s:.2g} (spread) lies outside "
+                                      f"{claimed:.10g} ± {tol:.2g}")
+    raise UnsupportedError(f"λ = {lam:.6g} with spread {s:.2g} neither lies within nor "
+                           f"outside the claim {claimed:.6g} ± {tol:.2g} (T = {span:g}; a "
+                           "longer `time:` converges further)")
+
+
+def judge_exponent_sign(val: str, lam: float, s: float, b: float, span: float,
+                        method: str) -> Verdict:
+    """A sign claim judged against the run's resolution b = 8/T: `fail` only where the run
+    resolves the opposite (a run of length T cannot tell zero from an exponent below b, so
+    a weakly chaotic or sticky orbit claimed positive is unresolved, not contradicted).
+
+    val: "positive", "zero" or "negative"; lam, s, b: the run's estimate, spread and
+    resolution; span: its length T; method: the verdict's method text. Returns the
+    Verdict; raises UnsupportedError (with b, λ, s, T and the `time:` that would resolve
+    the claim) where the run can tell neither. Example:
+    judge_exponent_sign("positive", -0.03, 0.002, 0.02, 400.0, "m").ok is False.
+    """
+    figures = f"λ = {lam:.4g}, spread {s:.2g}, T = {span:g}"
+    if val == "zero":
+        if abs(lam) + s <= b:
             # A zero pass bounds |λ|; it cannot tell zero from an exponent below b.
             return Verdict(True, method, power=f"zero to the run's resolution {b:.2g}: |λ| + "
                                                 f"spread ≤ {b:.2g} (an exponent below it is "
                                                 "not excluded; a longer `time:` resolves more)")
-        if ok:
-            return Verdict(True, method, power=f"{val} beyond the run's resolution {b:.2g} and "
-                                                f"spread {s:.2g}")
-        if bad:
-            return Verdict(False, method, f"the exponent is not {val} at the run's resolution "
+        if abs(lam) - s > b:
+            return Verdict(False, method, f"the exponent is not zero at the run's resolution "
                                           f"{b:.2g}: λ = {lam:.6g} (spread {s:.2g})")
-        raise UnsupportedError(f"the run cannot resolve the claim {val!r}: λ = {lam:.4g} with "
-                               f"spread {s:.2g} against the resolution {b:.2g} (a longer "
-                               "`time:` resolves more)")
-    claimed = _number(ctx, val, ("book",), pt)
-    tol = (_number(ctx, data["tolerance"], ("tolerance",), pt) if "tolerance" in data
-           else (ctx.sampler.rtol if "estimate" in data else RTOL) * max(abs(claimed), b))
-    if s > tol:
-        raise UnsupportedError(f"the run's spread {s:.2g} exceeds the claim's tolerance "
-                               f"{tol:.2g} (a longer `time:` converges further)")
-    if abs(lam - claimed) <= tol:
-        return Verdict(True, method, power=f"the exponent to {tol:.2g} (spread {s:.2g})")
-    if abs(lam - claimed) > tol + s:
-        return Verdict(False, method, f"λ = {lam:.10g}, not {claimed:.10g} ± {tol:.2g}")
-    raise UnsupportedError(f"λ = {lam:.6g} is within the spread {s:.2g} of the claim's "
-                           f"tolerance")
+        raise UnsupportedError(f"the run cannot resolve the claim 'zero' at its resolution "
+                               f"b = {b:.2g} ({figures}): {_longer(abs(lam) - s, b, span)}")
+    sign = 1.0 if val == "positive" else -1.0
+    if sign * lam - s > b:
+        return Verdict(True, method, power=f"{val} beyond the run's resolution {b:.2g} and "
+                                            f"spread {s:.2g}")
+    if sign * lam + s < -b:
+        other = "negative" if val == "positive" else "positive"
+        return Verdict(False, method, f"the exponent is resolved {other}, not {val}: λ = "
+                                      f"{lam:.6g} (spread {s:.2g}) beyond the run's "
+                                      f"resolution {b:.2g}")
+    side = "above" if val == "positive" else "below"
+    bound = f"{b:.2g}" if val == "positive" else f"−{b:.2g}"
+    raise UnsupportedError(f"the run resolves no exponent {side} the resolution b = {bound} "
+                           f"({figures}); a {val} exponent of size below {b:.2g} is not "
+                           f"excluded: {_longer(sign * lam - s, b, span)}")
+
+
+def _longer(margin: float, b: float, span: float) -> str:
+    """What run would resolve the claim: b = 8/T, so an exponent of size ε needs T > 8/ε."""
+    if margin > 0:  # the run's own figures, if they hold, are resolved by T > 8/margin
+        need = RESOLUTION / margin
+        return (f"`time:` beyond {need:.4g} would resolve it if λ and its spread hold "
+                f"(b = 8/T)")
+    return (f"an exponent of size ε needs `time:` beyond 8/ε (b = 8/T; `time: {10 * span:g}` "
+            f"resolves {b / 10:.2g})")
