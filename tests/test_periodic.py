@@ -438,3 +438,48 @@ def test_a_declared_period_is_verified(mathieu_fixed, tmp_path):
     assert out.status == "unsupported" and "not a period" in out.detail, out.detail
     out = _check(mathieu_fixed, tmp_path, "lim-9402", **part, period="2*pi/omegaa")
     assert out.status == "error" and "unknown name 'omegaa'" in out.detail, out.detail
+
+
+def test_a_verdict_only_where_the_monodromy_is_resolved(tmp_path):
+    """Below the window (Ω² < k) the turning saddle throws the particle off: c < 0, so one
+    z = λ² is positive and |μ| = e^{√z T} > 1 (the closed form of
+    `test_rotating_saddle_closed_form`). At Ω = 0.2 that multiplier is ~1e19 and its
+    partner ~1e-19: det Φ = 1 is a difference of terms ~1e38, so the raw Liouville mismatch
+    (5.8e3 until issue 41, read at 40 digits) is the determinant's condition, not Φ's error.
+    Over κ(Φ) it must be below 1e-20, and the verdict unstable. At Ω = 0.05 (|μ| ~ 1e77)
+    113 bits cannot hold the partner: no verdict. And no verdict is given where the
+    resolution fails, however far a multiplier lies off the circle."""
+    import mpmath
+
+    from mechbook.numerics.floquet import RESOLVED, Multipliers
+    analysis = load_analysis(tmp_path, SADDLE, "9406")
+    q = analysis.system(None).q
+    flo = Floquet.of(analysis.linear(None, {q[0]: 0, q[1]: 0}))
+    values = {"m": 1, "k": 1, "kappa": 2}
+
+    def at(omega):
+        return flo.multipliers({s: sp.Float(values.get(s.name, omega), 30)
+                                for s in flo.symbols})
+
+    got = at(0.2)
+    growth = math.sqrt((-(1 - 2 + 2 * 0.04) + math.sqrt((1 - 2 + 2 * 0.04) ** 2
+                                                         - 4 * (0.04 - 1) * (0.04 + 2))) / 2)
+    T = 2 * math.pi / 0.2  # the period read off the coefficients: a turn of the axes
+    assert got.resolution < RESOLVED, (got.resolution, got.mismatch, got.condition)
+    assert got.verdict() == "unstable"
+    assert abs(got.largest() / math.exp(growth * T) - 1) < 1e-9, got.largest()
+    with pytest.raises(UnsupportedError, match="not resolved"):
+        at(0.05).verdict()
+    forged = Multipliers([mpmath.mpf(1e10), mpmath.mpf(1e-10), mpmath.mpc(0, 1),
+                          mpmath.mpc(0, -1)], mpmath.mpf(1), 1e-10, scale=1e10,
+                         mismatch=1.0, condition=1e10)
+    with pytest.raises(UnsupportedError, match="not resolved"):
+        forged.verdict()
+    out = _check(analysis, tmp_path, "lim-9406", quantity="stability",
+                 about={"x": 0, "y": 0}, assume=["kappa < 3*k", "Omega**2 < k"],
+                 book="unstable")
+    if out.status == "pass":
+        assert "Φ resolved to" in out.power, out.power
+        assert float(out.power.split("Φ resolved to ")[1].split()[0]) <= RESOLVED
+    else:
+        assert out.status == "unsupported" and "not resolved" in out.detail, out.detail
