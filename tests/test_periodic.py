@@ -307,10 +307,16 @@ def modulated(tmp_path_factory):
 def test_the_tongue_width_holds_to_first_order(modulated, tmp_path):
     """With τ = γt/2: α = 4ω0²/γ², q = 2ω0²h/γ² (sign immaterial); the tongue's edges
     α = 1 ± q − q²/8 ∓ … give γ = 2ω0(1 ∓ h/4 − h²/64 + …): the book's
-    |γ − 2ω0| < hω0/2 (unstable inside) is right to first order, off by h²/64 relative."""
+    |γ − 2ω0| < hω0/2 (unstable inside) is right to first order, off by h²/64 relative.
+    Its h coefficient is 1/4 of the value at h = 0.2, 0.05 per unit ε: a pass must resolve
+    a term of order 1 wrong by 5e-8 (1e-6 of it, issue 41's second pass). The walk ends at
+    h = 2e-6, where the tongue (4e-7 wide) has one edge left on the grid, having resolved
+    6e-8: unsupported, saying so (it passed, measured against the value, until then)."""
     out = _check(modulated, tmp_path, "lim-9405", **TONGUE,
                  book="(gamma - 2*omega0)**2 > (h*omega0/2)**2")
-    assert out.status == "pass", out.detail
+    assert out.status == "pass" or (out.status == "unsupported" and "not resolved" in
+                                    out.detail and "falls like h**2.0" in out.detail), \
+        out.detail
     first = float(out.detail.split("relative error ")[1].split(",")[0])
     assert abs(first / (0.02**2 / 64) - 1) < 0.05, out.detail  # h = 0.02: h²/64
     wrong = _check(modulated, tmp_path, "lim-9405", **TONGUE,
