@@ -9,16 +9,24 @@ eigenvalues μ (the multipliers; exponents log μ / T) decide stability: every |
 
 Deciding "on the unit circle" honestly:
 - Liouville's formula det Φ = exp(−∫₀ᵀ tr(M⁻¹C) dt) is integrated alongside (one more
-  variable) and compared with det Φ: their relative difference is the measured resolution of
-  Φ. A verdict needs it below RESOLVED; where it is not (and no multiplier is clearly off the
-  circle) the point has no verdict (UnsupportedError with the numbers).
+  variable) and compared with det Φ. An error E of Φ moves det Φ by det Φ·tr(Φ⁻¹E), so the
+  relative mismatch measures Φ's relative error times the determinant's condition
+  κ(Φ) = ‖Φ‖‖Φ⁻¹‖: the mismatch over κ(Φ) is the measured resolution of Φ (its relative
+  error as Liouville sees it). For a well-conditioned Φ the two agree; for a strongly
+  unstable one (|μ| ~ 1e19 and 1e-19) κ(Φ) is ~1e38 and the raw mismatch says nothing of Φ
+  itself. det Φ, Φ⁻¹ and the multipliers are taken with the digits that condition needs
+  (`digits_for`), so the mismatch is Φ's, never the determinant's rounding. A verdict, any
+  verdict, needs the resolution below RESOLVED; where it is not the point has no verdict
+  (UnsupportedError with the numbers). Until issue 41 a multiplier 1e-6 off the circle
+  gave "unstable" whatever the mismatch: a verdict whose own accuracy test had failed.
 - A multiplier near ±1 is marginal (a tongue's edge, or a zero exponent of a symmetry):
   rounding splits a double root there by the square root of Φ's error (its resolution, at
   least the arithmetic's 1e-34, times the size of Φ: ~1e-17), so within 100 times that
   (and at least MARGINAL, 1e-15) nothing can be told (`marginal_within`). Until issue 41 the
   bound was a fixed 1e-13: 10⁴ times the split, it hid a boundary's last decades from the
   walk toward a limit (mechbook.verify.boundary_limit).
-- Otherwise unstable iff some |μ| > 1 + ON_CIRCLE(resolution). Off the edges the multipliers
+- Otherwise unstable iff some |μ| > 1 + ON_CIRCLE(Φ's absolute error, the resolution times
+  the size of Φ). Off the edges the multipliers
   of a stable conservative system sit on the circle to the arithmetic's precision, and an
   unstable one's leave it like the square root of the distance to the boundary: 1e-8 from
   a tongue's edge they are ~1e-5 off it, far above the resolution.
@@ -58,13 +66,20 @@ def marginal_within(resolution: float, scale: float) -> float:
 
 SHORTEST = 1e-9  # T·rate below this: Φ = I + O(T·rate) puts every multiplier within 1e-9
 # of 1, where the integration's rounding decides its side: nothing can be told (an error)
-CLEARLY = 1e-6  # |μ| beyond 1 + this is unstable whatever the resolution
 ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
 
 
-def on_circle(resolution: float) -> float:
-    """How far |μ| may exceed 1 and still count as on the circle."""
-    return max(1e-24, 1e3 * resolution)
+def on_circle(resolution: float, scale: float = 1.0) -> float:
+    """How far |μ| may exceed 1 and still count as on the circle: a thousand times Φ's
+    absolute error (its resolution times the size of its entries), and at least 1e-24."""
+    return max(1e-24, 1e3 * resolution * max(scale, 1.0))
+
+
+def digits_for(scale: float, n: int) -> int:
+    """Decimal digits with which det Φ, Φ⁻¹ and Φ's eigenvalues lose nothing of Φ's own
+    accuracy: an n×n determinant of entries up to `scale` that is ~1 cancels about
+    n·log10(scale) digits."""
+    return DPS + 5 + int(n * max(0.0, mpmath.log10(max(scale, 1.0))))
 
 
 @dataclass
@@ -73,9 +88,11 @@ class Multipliers:
 
     values: list  # mpmath complex numbers
     period: object  # mpf
-    resolution: float  # |det Φ / exp(−∫tr M⁻¹C) − 1|
+    resolution: float  # |det Φ / exp(−∫tr M⁻¹C) − 1| / κ(Φ): Φ's relative error
     seconds: float = 0.0
     scale: float = 1.0  # the largest entry of Φ in magnitude
+    mismatch: float = 0.0  # |det Φ / exp(−∫tr M⁻¹C) − 1| itself
+    condition: float = 1.0  # κ(Φ) = ‖Φ‖‖Φ⁻¹‖ (infinity norm), the determinant's condition
 
     def exponents(self) -> list:
         """Characteristic exponents log(μ)/T (real parts: growth rates)."""
@@ -87,18 +104,18 @@ class Multipliers:
 
     def verdict(self) -> str:
         """'stable', 'unstable' or 'marginal' (see the module's docstring)."""
+        if not self.resolution <= RESOLVED:
+            raise UnsupportedError(
+                f"Floquet multipliers not resolved: det Φ differs from Liouville's "
+                f"exp(−∫tr M⁻¹C dt) by a relative {self.mismatch:.2g}, which over the "
+                f"determinant's condition κ(Φ) = {self.condition:.2g} leaves Φ known to "
+                f"{self.resolution:.2g} (needs {RESOLVED:g}; the largest |μ| is "
+                f"{self.largest():.3g})")
         with mpmath.workdps(DPS):
             near = marginal_within(self.resolution, self.scale)
             edge = [m for m in self.values if min(abs(m - 1), abs(m + 1)) < near]
             off = [m for m in self.values if m not in edge]
-            if any(abs(m) > 1 + CLEARLY for m in off):
-                return "unstable"
-            if self.resolution > RESOLVED:
-                raise UnsupportedError(
-                    f"Floquet multipliers not resolved: det Φ differs from Liouville's "
-                    f"exp(−∫tr M⁻¹C dt) by {self.resolution:.2g} (needs {RESOLVED:g}), and "
-                    f"the largest |μ| = {self.largest():.17g} is too near 1 to decide")
-            if any(abs(m) - 1 > on_circle(self.resolution) for m in off):
+            if any(abs(m) - 1 > on_circle(self.resolution, self.scale) for m in off):
                 return "unstable"
             return "marginal" if edge else "stable"
 
@@ -224,8 +241,8 @@ class Floquet:
             return mpmath.mpf(1)
         return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
 
-    def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, float]:
-        """(Φ at DPS digits, T, the Liouville mismatch |det Φ·exp(∫tr M⁻¹C) − 1|)."""
+    def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, object]:
+        """(Φ, its entries exact as integrated; T; the Liouville exponent ∫tr M⁻¹C dt)."""
         import heyoka as hy
 
         ta = self._integrator()
@@ -250,23 +267,33 @@ class Floquet:
             if out[0] != hy.taylor_outcome.time_limit:
                 raise MechbookError(f"Floquet: the integration over one period stopped "
                                     f"({out[0]})")
+        with mpmath.workdps(60):  # a real128 printed to 36 digits, read back exactly
             y = [mpmath.mpf(str(v)) for v in ta.state]
             phi = mpmath.matrix(n2, n2)
             for j in range(n2):
                 for i in range(n2):
                     phi[i, j] = y[n2 * j + i]
-            det = mpmath.det(phi)
-            liouville = mpmath.exp(-y[-1])
-            mismatch = abs(det / liouville - 1) if liouville != 0 else mpmath.inf
-            return phi, T, float(mismatch)
+            return phi, T, y[-1]
 
     def multipliers(self, values: dict) -> Multipliers:
         start = time.perf_counter()
-        phi, T, mismatch = self.monodromy(values)
-        with mpmath.workdps(DPS):
+        phi, T, exponent = self.monodromy(values)
+        scale = float(max(abs(x) for x in phi))
+        with mpmath.workdps(digits_for(scale, phi.rows)):
+            liouville = mpmath.exp(-exponent)
+            det = mpmath.det(phi)
+            mismatch = abs(det / liouville - 1) if liouville != 0 else mpmath.inf
+            try:
+                condition = mpmath.mnorm(phi, 1) * mpmath.mnorm(mpmath.inverse(phi), 1)
+            except ZeroDivisionError:
+                condition = mpmath.inf
             mu = mpmath.eig(phi, left=False, right=False)
-            scale = float(max(abs(x) for x in phi))
-        return Multipliers(list(mu), T, mismatch, time.perf_counter() - start, scale)
+        resolution = float(mismatch / condition) if mpmath.isfinite(condition) else \
+            float("inf")
+        with mpmath.workdps(DPS):
+            mu = [+m for m in mu]
+        return Multipliers(mu, T, resolution, time.perf_counter() - start, scale,
+                           float(mismatch), float(condition))
 
     def stability(self, values: dict) -> str:
         """'stable', 'unstable' or 'marginal' at `values` (see Multipliers.verdict)."""

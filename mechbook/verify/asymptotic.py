@@ -4,6 +4,7 @@ parameter is walked toward its limit. Shared by every quantity that takes `limit
 
 from __future__ import annotations
 
+import mpmath
 import numpy as np
 import sympy as sp
 
@@ -49,17 +50,25 @@ def asymptotic(ctx: Context, error, floor: float | None = None) -> Verdict:
     errors: list[float] = []
     resolutions: list[float] = []  # nan: unknown
     steps: list[float] = []
+    books: list = []  # the book's values at each step, where the error function gives them
+    coefficient: list = [None]  # the book's own order-k coefficient, once measured
 
     def measure(pt) -> tuple[float, float]:
         if pt is None:
+            books.append(None)
             return float("nan"), float("nan")
         got = error(pt)
-        e, r = got if isinstance(got, tuple) else (got, floor)
+        got = got if isinstance(got, tuple) else (got, floor)
+        e, r = got[:2]
+        books.append(got[2] if len(got) > 2 else None)
         return float(e), float("nan") if r is None else max(float(r), floor or 0.0)
 
     for eps in LIMIT_STEPS + MORE_STEPS:
+        if eps == MORE_STEPS[0]:
+            coefficient[0] = book_coefficient(steps, books, order)
+        small = SMALL_ENOUGH * min(1.0, coefficient[0] or 1.0)
         if eps in MORE_STEPS and not (np.isfinite(resolutions[-1])
-                                      and errors[-1] / steps[-1] ** order >= SMALL_ENOUGH
+                                      and errors[-1] / steps[-1] ** order >= small
                                       and errors[-1] >= 10 * resolutions[-1]):
             break  # small enough against the claimed order's term, at the resolution, or
             # no resolution known to walk on with
@@ -78,11 +87,47 @@ def asymptotic(ctx: Context, error, floor: float | None = None) -> Verdict:
         errors.append(e)
         resolutions.append(r)
         steps.append(eps)
-    return judge_walk(name, spec["to"], to_zero, order, steps, errors, resolutions)
+    if coefficient[0] is None and len(steps) <= len(LIMIT_STEPS):
+        coefficient[0] = book_coefficient(steps, books, order)
+    return judge_walk(name, spec["to"], to_zero, order, steps, errors, resolutions,
+                      coefficient[0])
+
+
+FIT_STEPS = 5  # the book's values at the walk's steps 1e-2 … 1e-4 fix its coefficients
+ZERO_COEFFICIENT = 1e-12  # a fitted coefficient below this is the book's zero (fit noise)
+
+
+def book_coefficient(steps: list, books: list, order: int) -> float | None:
+    """The book's own coefficient of ε^order, relative to its value in the limit: the
+    polynomial of degree FIT_STEPS − 1 through the book's values at the walk's steps 1e-2 …
+    1e-4 (30 digits each), its ε^order coefficient over its constant; the smallest over the
+    values a step reports (a relation's boundary at each of its crossings). None where the
+    error function reports no values, a step has none, their number changes, or every
+    coefficient is the book's zero (below ZERO_COEFFICIENT). Example: values
+    2ω0(1 + ε/20 − 6.25e-4 ε²), order 2: 6.25e-4."""
+    if order < 1:
+        return None
+    idx = [k for k, e in enumerate(steps) if 1e-4 * 0.9 <= e <= 1e-2 * 1.1][:FIT_STEPS]
+    if len(idx) < FIT_STEPS or any(not books[k] or None in books[k] for k in idx) or \
+            len({len(books[k]) for k in idx}) != 1:
+        return None
+    found = []
+    with mpmath.workdps(50):
+        xs = [mpmath.mpf(steps[k]) for k in idx]
+        V = mpmath.matrix([[x ** j for j in range(FIT_STEPS)] for x in xs])
+        for j in range(len(books[idx[0]])):
+            ys = mpmath.matrix([mpmath.mpf(sp.Float(books[k][j], 30)._mpf_) for k in idx])
+            a = mpmath.lu_solve(V, ys)
+            if a[0] == 0 or order >= FIT_STEPS:
+                return None
+            c = abs(a[order] / a[0])
+            if c >= ZERO_COEFFICIENT:
+                found.append(float(c))
+    return min(found) if found else None
 
 
 def judge_walk(name: str, to, to_zero: bool, order: int, steps: list, errors: list,
-               resolutions: list) -> Verdict:
+               resolutions: list, coefficient: float | None = None) -> Verdict:
     """The verdict on a walk (see `asymptotic`): the steps above the error's resolution are
     judged, the steps at it only bound what a wrong term could have hidden.
 
@@ -90,7 +135,12 @@ def judge_walk(name: str, to, to_zero: bool, order: int, steps: list, errors: li
     claimed order, and per step ε, the relative error and its resolution (nan: unknown).
     Returns the Verdict; raises UnsupportedError where the order or the claimed order's
     coefficient is not resolved. Example: errors 0.3ε³ at ε = 1e-1 … 1e-4 with a
-    resolution of 1e-40, order 2: a pass, "error falls like ε^3.00"."""
+    resolution of 1e-40, order 2: a pass, "error falls like ε^3.00".
+
+    `coefficient`: the book's own coefficient of the claimed order, relative to its value
+    (`book_coefficient`); a pass then needs δ ≤ 1e-6 of it (of the value where it is 1 or
+    more, or unknown): a claimed coefficient moved by 1e-6 of itself must show."""
+    needed = RESOLVE * min(1.0, coefficient or 1.0)
     shown = ", ".join(f"{e:.2g}" for e in errors)
     at_floor = [bool(np.isfinite(r) and e < 10 * r) for e, r in
                 zip(errors, resolutions, strict=True)]
@@ -112,7 +162,7 @@ def judge_walk(name: str, to, to_zero: bool, order: int, steps: list, errors: li
                   f"({max(resolutions):.0e}) at every step")
         power = (f"exact toward the limit to the resolution: {below} at every step (a term "
                  f"of order {order} wrong by more than ~{shows:.0e} of the value would show)")
-        return _resolved(shows, detail, power, order)
+        return _resolved(shows, detail, power, order, needed, coefficient)
     if min(errors[k] for k in judged[-3:]) <= 0:
         return Verdict(False, "numeric(asymptotic)", f"relative error {shown}: zero with no "
                        "resolution stated, nothing can be told from it")
@@ -152,17 +202,26 @@ def judge_walk(name: str, to, to_zero: bool, order: int, steps: list, errors: li
     power = (f"error falls like ε^{slope:.2f} toward the limit, to {errors[judged[-1]]:.1g} "
              f"(order {order} claimed{resolution}): a term of order {order} wrong by more "
              f"than ~{shows:.0e} of the value would show")
+    if coefficient:
+        power += (f" ({shows / coefficient:.0e} of the book's own order-{order} coefficient, "
+                  f"{coefficient:.2g} of the value)")
     if not known:  # no resolution (a simulation's error): the walk stops at 1e-4
         return Verdict(True, "numeric(asymptotic)", detail, power=power)
-    return _resolved(shows, detail, power, order)
+    return _resolved(shows, detail, power, order, needed, coefficient)
 
 
-def _resolved(shows: float, detail: str, power: str, order: int) -> Verdict:
-    """A pass where the walk resolved a term of the claimed order to RESOLVE; unsupported,
-    with the resolution reached, where the arithmetic's floor came first."""
-    if shows > RESOLVE:
+def _resolved(shows: float, detail: str, power: str, order: int, needed: float = RESOLVE,
+              coefficient: float | None = None) -> Verdict:
+    """A pass where the walk resolved a term of the claimed order to `needed` (RESOLVE of
+    the value, or of the book's own coefficient where that is smaller); unsupported, with
+    the resolution reached, where the arithmetic's floor came first."""
+    if shows > needed:
+        own = (f" ({shows / coefficient:.0e} of the book's own order-{order} coefficient, "
+               f"{coefficient:.2g})" if coefficient else "")
         raise UnsupportedError(
             f"the claimed order's coefficient is not resolved: {detail}; a term of order "
-            f"{order} wrong by less than ~{shows:.0e} of the value would not show before the "
-            f"error reached its arithmetic's resolution (a pass needs {RESOLVE:g})")
+            f"{order} wrong by less than ~{shows:.0e} of the value{own} would not show "
+            f"before the error reached its arithmetic's resolution (a pass needs "
+            f"{needed:.0e}: {RESOLVE:g} of "
+            f"{'that coefficient' if needed < RESOLVE else 'the value'})")
     return Verdict(True, "numeric(asymptotic)", detail, power=power)

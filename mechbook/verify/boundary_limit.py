@@ -37,9 +37,11 @@ from mechbook.verify.context import Context
 
 FLOOR = 1e-14  # the smallest offset from the book's boundary that is tried
 # Floquet's verdicts (113-bit arithmetic): a multiplier leaves ±1 like the square root of the
-# distance to a tongue's edge and is marginal within 1e-13 of it, so offsets down to ~1e-26
-# have a verdict; 1e-24 leaves two decades of margin
-FLOQUET_FLOOR = 1e-24
+# distance to a tongue's edge and is marginal within ~1e-15 of it, so offsets down to ~1e-30
+# have a verdict; 1e-28 (1e-24 until issue 41's second pass) reaches the depth a claimed
+# coefficient of 6e-4 needs at 1e-6 of itself (a second-order Mathieu zone), and offsets
+# without a verdict are measured as the step's resolution, never judged
+FLOQUET_FLOOR = 1e-28
 GRID = 40  # points along each probe's ray where the book's truth is read
 BRACKET = 1e-6  # the Boolean bisection's bracket before the atom's root is refined
 BISECTIONS = 10  # of the log offset between two decades: 10^(1/1024), 0.2 %
@@ -72,17 +74,19 @@ def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier,
 
     last: dict = {}  # the probe along which the last step's error was largest
 
-    def error(pt: dict) -> tuple[float, float]:
-        worst, found, resolution = 0.0, 0, floor
+    def error(pt: dict) -> tuple[float, float, list]:
+        worst, found, resolution, book = 0.0, 0, floor, []
         for p in along:
             ray = _Ray(ctx.sampler, pt, np.array([1.0]), [p])
             for t_star, below, above, reach in _book_crossings(cond, atoms, ray):
                 found += 1
+                at = ray.point(t_star)  # the book's boundary value of p at this step
+                book.append(None if at is None else at[p])
                 e, r = _engine_offset(classify, ray, t_star, below, above, reach, floor)
                 resolution = max(resolution, r)
                 if e >= worst:
                     worst, last["probe"] = e, p.name
-        return (worst if found else math.inf), resolution
+        return (worst if found else math.inf), resolution, book
 
     got = asymptotic(ctx, error, floor=floor)
     names = ", ".join(s.name for s in along)

@@ -11,10 +11,11 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+import mpmath
 import numpy as np
 import sympy as sp
 
-from mechbook.core.numeval import NotNumeric, evaluate, evaluate_resolved, holds
+from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, evaluate_resolved, holds
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.core.words import plural
 from mechbook.records import NUMERIC, ProofPolicy
@@ -37,6 +38,24 @@ class Verdict:
     # what a pass is worth: the smallest wrong answer it would have rejected, in words
     # ("6 points at 30 digits, residual ≤ 1e-20 of its scale"); '' where the method says it
     power: str = ""
+
+
+def _derived_value(expr: sp.Basic, point: dict) -> tuple:
+    """(real part, imaginary part) of a derived symbol's expression at `point`: compiled
+    once and run in mpmath at 15 digits beyond DIGITS (the walk toward a limit asks for it
+    at thousands of points: SymPy's subs and N cost 4 ms each there), SymPy's own
+    evaluation where the compiled program has no number for a part; (None, None) where
+    the value is not a number."""
+    try:
+        with mpmath.workdps(DIGITS + 15):
+            v = evaluate_mp(expr, point, DIGITS + 15)
+            return sp.Float(mpmath.re(v), DIGITS + 15), sp.Float(mpmath.im(v), DIGITS + 15)
+    except NotNumeric:
+        v = sp.N(expr.subs(point), DIGITS)
+        re, im = v.as_real_imag()
+        if not (re.is_number and im.is_number):
+            return None, None
+        return re, im
 
 
 class Sampler:
@@ -65,11 +84,10 @@ class Sampler:
         """The point with its derived symbols computed (None where one is not real)."""
         for sym, expr in self.derived.items():
             try:  # all 30 digits: a point exactly on a surface (a double root) stays on it
-                v = sp.N(expr.subs(point), DIGITS)
-                re, im = v.as_real_imag()
-                if not (re.is_number and im.is_number):
-                    return None
+                re, im = _derived_value(expr, point)
             except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+                return None
+            if re is None:
                 return None
             if not (math.isfinite(float(re)) and abs(im) <= 1e-20 * max(1.0, abs(re))):
                 return None

@@ -52,6 +52,6 @@ class FloquetVerdicts:
 
     def power(self) -> str:
         return (f"the engine's verdicts from Floquet multipliers (the monodromy over one "
-                f"period T = {self.floquet.period}, {ARITHMETIC}; Liouville's determinant "
-                f"agreed to {max(self.worst, 1e-36):.0e} at {plural(self.points, 'point')}, "
-                f"{RESOLVED:g} needed)")
+                f"period T = {self.floquet.period}, {ARITHMETIC}; Φ resolved to "
+                f"{max(self.worst, 1e-36):.0e} by Liouville's determinant over its "
+                f"condition at {plural(self.points, 'point')}, {RESOLVED:g} needed)")
