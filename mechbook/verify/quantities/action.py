@@ -174,14 +174,16 @@ class Actions:
         """(J, its resolution): the quadrature at DPS digits and its distance from CHECK_DPS."""
         if c not in self.librating():
             return self.momentum(c, pt), mpmath.mpf(0)
+        unbound = self.ctx.part.error(("coordinate",), f"{c} does not librate (it runs away "
+                                      "or goes round): an unbound motion has no action")
         try:
             one, two = (self.orbit(c, pt, d) for d in (DPS, CHECK_DPS))
+            if not all(mpmath.isfinite(x) for x in one.turning_points):
+                raise unbound  # a turning point at infinity: the orbit of a scattering
             J1, J2 = one.action, two.action
         except UnsupportedError as exc:
             if "no turning point" in exc.capability:
-                raise self.ctx.part.error(("coordinate",), f"{c} does not librate (it runs "
-                                          "away or goes round): an unbound motion has no "
-                                          "action") from None
+                raise unbound from None
             raise
         with mpmath.workdps(CHECK_DPS):
             err = abs(J1 - J2) / max(abs(J2), mpmath.mpf(10) ** -40)
