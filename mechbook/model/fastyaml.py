@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import re
 from functools import cache
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 try:  # PyYAML is a dependency; libyaml is in its wheels, but a source build may lack it
     import yaml
@@ -27,9 +27,7 @@ except ImportError:  # pragma: no cover - then every file takes the round-trip p
     _Loader = None
 
 from mechbook.errors import SpecError
-
-if TYPE_CHECKING:
-    from mechbook.model.yamlio import Data
+from mechbook.model.data import Data
 
 # the scalars resolved here; ruamel.yaml's YAML 1.2 resolvers give the same values for them
 _INT = re.compile(r"[-+]?(?:0|[1-9][0-9]*)")

@@ -16,10 +16,9 @@ from typing import TYPE_CHECKING, Protocol
 if TYPE_CHECKING:
     import sympy as sp
 
+    from mechbook.model.data import Data
     from mechbook.model.domains import Domain
     from mechbook.model.problem import Problem
-    from mechbook.model.system import System
-    from mechbook.model.yamlio import Data
 
 
 class SystemLike(Protocol):
@@ -49,8 +48,9 @@ class SystemLike(Protocol):
         ...
 
     @property
-    def full(self) -> System:
-        """The system built from the file: this one, or the one that was reduced."""
+    def full(self) -> SystemLike:
+        """The system built from the file (a `System`, whose `reduced` is False): this one, or
+        the one that was reduced."""
         ...
 
     @property

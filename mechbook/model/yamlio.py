@@ -18,6 +18,7 @@ from ruamel.yaml.constructor import DuplicateKeyError
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from mechbook.errors import SpecError
+from mechbook.model.data import Data  # what `Document.data` holds (named here for its readers)
 from mechbook.model.fastyaml import fast_data
 from mechbook.model.hints import yaml_hint
 from mechbook.model.input_limits import (
@@ -29,8 +30,6 @@ from mechbook.model.input_limits import (
 )
 
 Path_ = tuple[str | int, ...]
-# a YAML file's plain data: mappings, lists and scalars (what `Document.data` holds)
-Data = dict[str, "Data"] | list["Data"] | str | int | float | bool | None
 
 
 class Document:
