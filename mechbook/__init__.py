@@ -12,15 +12,15 @@ from mechbook.version import __version__
 
 __all__ = ["Problem", "load", "results", "__version__"]
 
-_LAZY = {"load": "mechbook.app.api", "Problem": "mechbook.app.api",
+_LAZY = {"load": "mechbook.app.api.problem", "Problem": "mechbook.app.api.problem",
          "results": "mechbook.app.frames"}
 
 
 def __getattr__(name: str):
     if name in _LAZY:
-        if _LAZY[name] == "mechbook.app.api":
+        if _LAZY[name] == "mechbook.app.api.problem":
             # on first use (PEP 562): `import mechbook` stays light
-            from mechbook.app import api as module
+            from mechbook.app.api import problem as module
         else:
             # on first use (PEP 562): `import mechbook` stays light
             from mechbook.app import frames as module

@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 
 import mechbook
 from mechbook.app.api import Problem
-from mechbook.app.api_system import SystemView
+from mechbook.app.api.system import SystemView
 from mechbook.errors import InputError, NotFoundError
 
 FORCED = """\
@@ -165,3 +165,14 @@ def test_animate_and_plot_show_inline(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []  # inline: nothing written
     written = run.plot(tmp_path / "run.png")
     assert written.read_bytes().startswith(b"\x89PNG")
+
+
+def test_a_loaded_problem_keeps_the_contract_its_systems_read():
+    """api.system names the problem's type through api.loaded (below both: no import cycle,
+    not even for a hint); a `Problem` keeps that contract, with each attribute a system reads."""
+    from mechbook.app.api.loaded import LoadedProblem
+
+    p = mechbook.load("lim-2031")
+    assert isinstance(p, LoadedProblem)
+    assert not isinstance(object(), LoadedProblem)
+    assert p.system(p.systems[0]).problem is p

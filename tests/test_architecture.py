@@ -137,13 +137,28 @@ def test_no_import_cycles_even_inside_functions():
     assert not cycles, "import cycles:\n" + "\n".join(shown)
 
 
+def test_no_import_cycles_even_for_type_hints():
+    """Imports under `if TYPE_CHECKING:` count too: a module that needs another's type for a
+    hint, while that one imports it, shares the type through a module below both (issue 43:
+    mechbook.model.data below yamlio and fastyaml; mechbook.app.api.loaded below the API's
+    problem and its systems; the system contract without the System it describes)."""
+    graph = {m: imports(p) - {m} for m, p in modules().items()}
+    typed = {m: (imports(p) - imports(p, runtime_only=True)) - {m}
+             for m, p in modules().items()}
+    cycles = [c for c in import_cycles(graph) if any(typed[m] & set(c) for m in c)]
+    shown = ["; ".join(f"{m} -> {sorted(typed[m] & set(c))} (for type hints)" for m in c
+                       if typed[m] & set(c)) for c in cycles]
+    assert not cycles, "import cycles through TYPE_CHECKING imports:\n" + "\n".join(shown)
+
+
 def test_the_cycle_test_can_fail():
     assert import_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
     assert import_cycles({"a": {"b"}, "b": set()}) == []
 
 
 def test_every_package_says_what_it_owns_and_may_import():
-    for init in PACKAGE.glob("*/__init__.py"):
+    """Each stage, and each package of mechbook.app (issue 43: the folder shows the parts)."""
+    for init in [*PACKAGE.glob("*/__init__.py"), *(PACKAGE / "app").glob("*/__init__.py")]:
         doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))) or ""
         assert "May import" in doc, f"{init}: the docstring states no import rule"
 
@@ -465,6 +480,19 @@ def test_the_sweep_package_names_resolve_to_their_modules():
         assert getattr(sweep, name) is getattr(importlib.import_module(home), name), name
     with pytest.raises(AttributeError):
         sweep.no_such_name  # noqa: B018
+
+
+def test_the_api_package_names_resolve_to_their_modules():
+    """mechbook.app.api loads its names on first use, as mechbook.load does."""
+    import importlib
+
+    import mechbook.app.api as api
+
+    assert sorted(api.__all__) == sorted(api._HOME)
+    for name, home in api._HOME.items():
+        assert getattr(api, name) is getattr(importlib.import_module(home), name), name
+    with pytest.raises(AttributeError):
+        api.no_such_name  # noqa: B018
 
 
 def test_the_store_package_exports_what_it_lists():

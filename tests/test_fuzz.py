@@ -254,7 +254,7 @@ def test_the_api_kind_reports_a_raw_exception(tmp_path, monkeypatch):
     """An argument that reaches the engine unchecked (9a86c12's `params=[...]`): 'crash'."""
     import fuzz_surfaces44 as surfaces44
 
-    from mechbook.app import api_args
+    from mechbook.app.api import args as api_args
 
     spec = {"call": "p.frequencies(numeric=True, params={v})", "value": "[('m', 2)]"}
     (tmp_path / "case-1").mkdir()

@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
-from mechbook.app import api_args as args
+from mechbook.app.api import args
 from mechbook.app.store import problems, read, regular_store, vet
 from mechbook.core.optional import require
 from mechbook.model.catalog import DEFAULT_STORE

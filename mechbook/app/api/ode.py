@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from mechbook.app.api_params import texts
+from mechbook.app.api.params import texts
 from mechbook.core.backends import DEFAULT_BACKEND
 from mechbook.core.compile import compile_exprs
 from mechbook.errors import InputError, NotFoundError

@@ -17,7 +17,7 @@ from numbers import Real
 import numpy as np
 import sympy as sp
 
-from mechbook.app import api_args as args
+from mechbook.app.api import args
 from mechbook.errors import InputError, NotFoundError
 from mechbook.model.hints import did_you_mean
 

@@ -17,7 +17,7 @@ on `p` itself need a problem with one system (or take `system=`). Text given to 
 Results are simplified for reading (`simplify=True`, as `mechbook solve`; each
 simplification has a time limit); checks and simulations use the unsimplified engine, as
 `mechbook check` does. Objects show themselves in a notebook (`_repr_latex_`,
-`_repr_html_`). The system's methods live in mechbook.app.api_system, parameter values and
+`_repr_html_`). The system's methods live in mechbook.app.api.system, parameter values and
 the ODE function in api_params, the results in api_results.
 """
 
@@ -27,10 +27,10 @@ import functools
 import html
 from pathlib import Path
 
-from mechbook.app import api_args as args
-from mechbook.app.api_params import Parameters
-from mechbook.app.api_results import CheckResult, Simulation
-from mechbook.app.api_system import SystemView
+from mechbook.app.api import args
+from mechbook.app.api.params import Parameters
+from mechbook.app.api.results import CheckResult, Simulation
+from mechbook.app.api.system import SystemView
 from mechbook.app.mathml import math
 from mechbook.app.run import RunOptions
 from mechbook.app.service import check_loaded

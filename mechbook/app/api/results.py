@@ -7,8 +7,8 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from mechbook.app import api_args as args
-from mechbook.app.api_animation import Animation, Picture
+from mechbook.app.api import args
+from mechbook.app.api.animation import Animation, Picture
 from mechbook.app.report import animation
 from mechbook.app.store import write_simulation
 from mechbook.core.optional import require

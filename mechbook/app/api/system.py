@@ -1,6 +1,6 @@
 """One system of a loaded problem, as the Python API hands it out (`p.system(name)`, or `p`
 itself for a problem with one system): derived results as SymPy objects, numbers at the
-default parameter values or at `params=` (mechbook.app.api_params)."""
+default parameter values or at `params=` (mechbook.app.api.params)."""
 
 from __future__ import annotations
 
@@ -10,12 +10,13 @@ from typing import TYPE_CHECKING
 
 import sympy as sp
 
-from mechbook.app import api_args as args
-from mechbook.app.api_ode import OdeFunction
-from mechbook.app.api_params import parameter_values, refuse_unknown, texts
-from mechbook.app.api_results import Simulation
-from mechbook.app.display import MathDict, MathList
-from mechbook.app.linearization import Linearization, linearization
+from mechbook.app.api import args
+from mechbook.app.api.display import MathDict, MathList
+from mechbook.app.api.linearization import Linearization, linearization
+from mechbook.app.api.loaded import LoadedProblem
+from mechbook.app.api.ode import OdeFunction
+from mechbook.app.api.params import parameter_values, refuse_unknown, texts
+from mechbook.app.api.results import Simulation
 from mechbook.app.mathml import math
 from mechbook.core.compile import as_expr
 from mechbook.core.timeout import try_simplify
@@ -26,8 +27,6 @@ from mechbook.numerics.simulate import simulate
 if TYPE_CHECKING:
     import numpy as np
 
-    from mechbook.app.api import Problem
-
 SIMULATE_OPTIONS = ("init", "params", "method", "accuracy", "rtol", "atol", "max_step",
                     "step", "points", "backend")
 
@@ -35,7 +34,7 @@ SIMULATE_OPTIONS = ("init", "params", "method", "accuracy", "rtol", "atol", "max
 class SystemView:
     """One system's derived results as SymPy objects (computed on first use, cached)."""
 
-    def __init__(self, problem: Problem, name: str):
+    def __init__(self, problem: LoadedProblem, name: str):
         self.problem, self.name = problem, name
         self._an = problem.analysis
 

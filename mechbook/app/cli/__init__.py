@@ -7,6 +7,9 @@ Only click and a few small modules are imported at the top of every module here:
 list, shell completion and argument errors answer without loading SymPy, NumPy or the
 engine, which each command imports when it runs (a test keeps it so; docs/performance.md
 has the timing). The entry point is `mechbook.app.cli:main`.
+
+May import: every package of mechbook.app (the command line is the top), at start-up only
+what --help needs (the rest inside each command).
 """
 
 from __future__ import annotations

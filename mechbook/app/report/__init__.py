@@ -8,4 +8,7 @@
 
 Mathematics is SymPy's presentation MathML (mechbook.app.mathml), which browsers render
 natively: the report needs no script from elsewhere and no network.
+
+May import: the stages below mechbook.app, its shared modules, store/, running/ and
+output/ (MathML, safe text).
 """

@@ -10,6 +10,9 @@ its parts:
     repair       a damaged store found before an edit, moved aside and rebuilt
     compaction   a store written anew with only what it holds
     child_read   a store not yet found sound read in a child under a CPU limit
+
+May import: the stages below mechbook.app and its shared modules (text, outputs, bounded,
+fingerprint); never the command line, the running of checks or the report.
 """
 
 from mechbook.app.store.bounds import attributes, member

@@ -13,6 +13,9 @@ parts:
 The names below load their module on first use (PEP 562): the command line reads `spec`'s
 QUANTITIES for its option choices at start-up, and importing this package must not load
 NumPy and SymPy for that.
+
+May import: the stages below mechbook.app, its shared modules, store/ and running/ (the
+batch's limits, a cluster); spec only the standard library and the engine's names.
 """
 
 from __future__ import annotations
