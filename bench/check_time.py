@@ -54,9 +54,9 @@ PER_PROBLEM = ONLY_THIS_TREE + """
 import json, time
 from pathlib import Path
 tree = Path(sys.argv[1]); sys.path.insert(0, str(tree))
-from mechbook.app.run import RunOptions, run_problem
+from mechbook.app.running.run import RunOptions, run_problem
 try:  # as the tree's own check processes run (a tree that has it: its collector settled)
-    from mechbook.app.batch import settle
+    from mechbook.app.running.batch import settle
     settle(preload=True)
 except ImportError:
     pass
@@ -78,7 +78,7 @@ PROFILE = ONLY_THIS_TREE + """
 import cProfile, json, pstats, time
 from pathlib import Path
 tree = Path(sys.argv[1]); sys.path.insert(0, str(tree))
-from mechbook.app.run import RunOptions, run_problem
+from mechbook.app.running.run import RunOptions, run_problem
 import mechbook.verify.checker, mechbook.verify.registry, mechbook.crosscheck  # noqa
 pr = cProfile.Profile()
 start = time.process_time()

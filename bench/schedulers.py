@@ -23,8 +23,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mechbook.app.batch import Batch, BatchOptions  # noqa: E402
-from mechbook.app.distributed import check_task, limited, tree_files  # noqa: E402
+from mechbook.app.running.batch import Batch, BatchOptions  # noqa: E402
+from mechbook.app.running.distributed import check_task, limited, tree_files  # noqa: E402
 
 PROBLEMS = ["lim-2031", "lim-2036", "lim-2043", "symon-09-11"]
 
@@ -79,7 +79,7 @@ def _limited_sleep(seconds, limit):
 def bench_dask(workers: int, problems: list[str], options: BatchOptions) -> dict:
     from dask.distributed import Client
 
-    from mechbook.app.distributed import local_cluster
+    from mechbook.app.running.distributed import local_cluster
 
     row = {"scheduler": "dask"}
     t = time.perf_counter()

@@ -3,14 +3,14 @@
 Every input must end in success or a MechbookError-class message: never a traceback, never a
 hang past the time limit, never memory past the bound. Inputs are generated from the real
 problem and answer files (problems/, answers/) by six kinds of mutation (see KINDS), written
-into a small tree per case, and run on the batch machinery (mechbook.app.batch) so a hang or
+into a small tree per case, and run on the batch machinery (mechbook.app.running.batch) so a hang or
 a memory bomb is stopped and reported, not waited for:
 
     python tests/fuzz.py --cases 10000 --seed 1      # `make fuzz`; a table of outcomes
     tests/test_fuzz.py runs a sample of it in `make test`.
 
 Most cases run what `mechbook validate` runs (schema, systems built, every expression
-parsed); the `check` kind runs the full check of a mutated problem (mechbook.app.run), where
+parsed); the `check` kind runs the full check of a mutated problem (mechbook.app.running.run), where
 an engine fault shows as a traceback in the run's debug log (the details carry messages
 only). The kinds of issue 21 (store faults, strings through every output, numeric options,
 symbolic links) are generated and judged by tests/fuzz_faults.py, which adds the failures
@@ -601,7 +601,7 @@ def _classify(item: str, stage) -> tuple[str, str]:
 
             stage("validating")
             return "ok", validate_file(rest)[:300]
-        from mechbook.app.run import RunOptions, run_problem
+        from mechbook.app.running.run import RunOptions, run_problem
 
         root, _, pid = rest.rpartition(":")
         run = run_problem(pid, Path(root), RunOptions(crosscheck=False), stage)
@@ -639,7 +639,7 @@ def stopped(item: str, why: str, seconds: float, stage: str) -> tuple[str, str, 
 def run_cases(cases: list[Case], workdir: Path, jobs: int = 2, keep: Path | None = None,
               on_result=None) -> list[Result]:
     """Write the cases, run them on the batch machinery, classify, keep failures' files."""
-    from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.app.running.batch import Batch, BatchOptions
 
     items, by_item = [], {}
     for case in cases:

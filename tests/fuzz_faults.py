@@ -277,7 +277,7 @@ def outputs_take(strings: list[str], where: Path) -> tuple[str, str]:
     """Every string through HDF5, JSON, JUnit XML and the terminal; 'unsafe' if one breaks."""
     import mechbook.app.store as store
     from mechbook.app.formats import junit_xml, to_json
-    from mechbook.app.run import ProblemRun
+    from mechbook.app.running.run import ProblemRun
     from mechbook.app.text import for_terminal, json_safe
     from mechbook.records import Outcome
 

@@ -385,7 +385,7 @@ def run_watch(where: Path, spec: dict) -> tuple[str, str]:
     """What `watch` does on a save: poll its three files (their signature) and check the
     problem (the task its worker runs), with one of them replaced by what an editor or a
     user can leave behind. Neither may block, read without bound, or end in a traceback."""
-    from mechbook.app.run import RunOptions
+    from mechbook.app.running.run import RunOptions
     from mechbook.app.watch import check_in_worker, files_signature, report_lines
 
     tree = _tree(where)

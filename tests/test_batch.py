@@ -201,7 +201,7 @@ GC_STATE = """\
 import sys
 sys.path.insert(0, {tests!r})
 from pathlib import Path
-from mechbook.app.batch import Batch, BatchOptions
+from mechbook.app.running.batch import Batch, BatchOptions
 import json
 import test_batch
 print(json.dumps(Batch(Path("."), BatchOptions(jobs=2, timeout=600, memory_mb=0),
@@ -217,12 +217,12 @@ def gc_state(item, base, options, stage):
 
 
 def test_workers_start_with_the_imported_engine_frozen_out_of_the_collector(tmp_path):
-    """batch.settle: the fork server freezes what it imported (mechbook.app.frozen), so
+    """batch.settle: the fork server freezes what it imported (mechbook.app.running.frozen), so
     each worker starts with ~10⁵ objects the collector never walks again, and young
     collections rarer; the process that runs the batch keeps its own collector as it was."""
     import gc
 
-    from mechbook.app.batch import GC_THRESHOLDS
+    from mechbook.app.running.batch import GC_THRESHOLDS
 
     before = (gc.get_freeze_count(), gc.get_threshold())
     out = subprocess.run([sys.executable, "-c", GC_STATE.format(tests=str(ROOT / "tests"))],

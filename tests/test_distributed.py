@@ -17,7 +17,7 @@ from dask.distributed import Client  # noqa: E402
 
 import mechbook.app.sweep.runner as sweep_mod  # noqa: E402
 from mechbook.app.cli import main  # noqa: E402
-from mechbook.app.distributed import ENV, limited, local_cluster  # noqa: E402
+from mechbook.app.running.distributed import ENV, limited, local_cluster  # noqa: E402
 from mechbook.app.sweep import make_spec, run_sweep  # noqa: E402
 from mechbook.engine.linear_grid import parse_axis  # noqa: E402
 from mechbook.errors import MechbookError  # noqa: E402

@@ -46,7 +46,7 @@ def test_the_harness_reports_a_hang_and_a_crash(tmp_path, monkeypatch):
     import fuzz as harness
 
     import mechbook.app.validate as validate
-    from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.app.running.batch import Batch, BatchOptions
     from mechbook.errors import SpecError
 
     batch = Batch(tmp_path, BatchOptions(jobs=1, timeout=2, memory_mb=0),

@@ -15,7 +15,7 @@ from hostile import check, pendulum_tree, run
 
 import mechbook.app.store as store
 from mechbook.app.formats import junit_xml, to_json
-from mechbook.app.run import ProblemRun
+from mechbook.app.running.run import ProblemRun
 from mechbook.app.text import for_terminal, for_xml, json_safe, storable
 from mechbook.records import Outcome, Results
 

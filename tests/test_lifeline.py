@@ -80,7 +80,7 @@ SPINNER = textwrap.dedent("""\
     import sys
     sys.path.insert(0, {tests!r})
     from pathlib import Path
-    from mechbook.app.batch import Batch, BatchOptions
+    from mechbook.app.running.batch import Batch, BatchOptions
     import test_lifeline
     Batch(Path("."), BatchOptions(jobs=2, timeout=600, memory_mb=0),
           task=test_lifeline.spin).run(["a", "b", "c"])
@@ -109,7 +109,7 @@ def test_a_worker_started_after_its_run_died_does_not_run(tmp_path):
     """die_with on a process already gone kills the caller at once."""
     script = textwrap.dedent("""\
         import os, subprocess, sys, time
-        from mechbook.app.lifeline import die_with
+        from mechbook.app.running.lifeline import die_with
         gone = subprocess.Popen([sys.executable, "-c", "pass"]); gone.wait()
         die_with(gone.pid)
         time.sleep(30)

@@ -391,7 +391,7 @@ def test_a_coordinate_without_inertia_is_a_clear_error_not_a_traceback(tmp_path)
     path = tree(tmp_path, text, KEY.replace("quantity: frequencies\n    about: {theta: 0}\n"
                                             "    book: [\"sqrt(g/l)\"]",
                                             'quantity: eom\n    book: ["thetaddot = 0"]'))
-    from mechbook.app.run import run_problem
+    from mechbook.app.running.run import run_problem
 
     run_ = run_problem("lim-2099", path.parents[2])
     assert run_.outcomes == [] and run_.record is None

@@ -14,7 +14,7 @@ import pytest
 from hostile import ROOT, check, pendulum_tree, run
 
 import mechbook.app.validate as validate
-from mechbook.app.run import run_problem
+from mechbook.app.running.run import run_problem
 from mechbook.errors import MechbookError, SpecError, describe
 
 UNPHYSICAL = [

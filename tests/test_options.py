@@ -10,7 +10,7 @@ import time
 import pytest
 from hostile import ROOT, pendulum_tree, run
 
-import mechbook.app.simrun as simrun
+import mechbook.app.running.simrun as simrun
 import mechbook.app.sweep as sweep
 
 PID = "lim-2031"
@@ -135,7 +135,7 @@ def test_simulate_nan_in_parameters_and_initial_values_is_a_clear_error(tmp_path
 def test_the_batch_itself_refuses_nan_limits(timeout, memory):
     """Past the command line (the Python API, the fuzzer): a NaN limit is refused, not
     taken as no limit."""
-    from mechbook.app.batch import BatchOptions
+    from mechbook.app.running.batch import BatchOptions
     from mechbook.errors import MechbookError
 
     with pytest.raises(MechbookError, match="batch limits must be numbers"):

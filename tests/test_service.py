@@ -1,4 +1,4 @@
-"""The check service below the command line (mechbook.app.service): ids resolved once, the
+"""The check service below the command line (mechbook.app.running.service): ids resolved once, the
 store's valid outcomes reused, the runs back in the order of the ids; the Python API checks
 the model it loaded; options that would be dropped silently are refused."""
 
@@ -8,11 +8,11 @@ import pytest
 from hostile import ROOT, pendulum_tree, run
 
 import mechbook
-import mechbook.app.simrun as simrun
+import mechbook.app.running.simrun as simrun
 import mechbook.app.sweep as sweep
-from mechbook.app.batch import BatchOptions
-from mechbook.app.run import RunOptions
-from mechbook.app.service import CheckOptions, CheckService, resolve_ids
+from mechbook.app.running.batch import BatchOptions
+from mechbook.app.running.run import RunOptions
+from mechbook.app.running.service import CheckOptions, CheckService, resolve_ids
 from mechbook.errors import MechbookError
 
 

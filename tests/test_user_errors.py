@@ -153,7 +153,7 @@ def test_show_of_a_problem_not_in_the_store_is_a_clean_message(tmp_path):
 
 
 def test_check_of_a_problem_with_no_file_is_not_found(tmp_path):
-    from mechbook.app.service import resolve_ids
+    from mechbook.app.running.service import resolve_ids
 
     with pytest.raises(NotFoundError, match=r"^no problem lim-2013 \(no file .*2013\.yaml; "
                        r"`mechbook list` shows the problems there are\)$"):

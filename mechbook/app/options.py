@@ -4,7 +4,7 @@ click's FloatRange lets NaN through (every comparison with NaN is false), so `--
 removed the time limit; an option without a maximum let `--points 10**20` reach NumPy. Every
 numeric option of the command line is one of these, with the bounds below: far above any
 real use, low enough that a run stays bounded (each run also has its time limit and memory
-bound). Importing this module loads only click.
+bound), and a batch's default limits. Importing this module loads only click.
 """
 
 from __future__ import annotations
@@ -12,6 +12,11 @@ from __future__ import annotations
 import math
 
 import click
+
+# a batch's default limits (here, so that --help shows them without loading the batch
+# machinery, h5py and NumPy)
+DEFAULT_TIMEOUT = 600.0  # seconds per problem; the slowest takes well under a minute
+DEFAULT_MEMORY_MB = 8000  # resident memory per worker
 
 MAX_SECONDS = 1e6  # wall-clock limits: about 11.6 days
 MAX_MEMORY_MB = 1e7  # 10 TB: more than any machine this runs on

@@ -2,7 +2,7 @@
 
 Writing a problem is a loop of edit, save, check. A fresh `mechbook check` process spends
 most of its second importing SymPy, SciPy and the engine; here a worker process of the batch
-machinery (mechbook.app.batch), forked from a server that imported them once, checks every
+machinery (mechbook.app.running.batch), forked from a server that imported them once, checks every
 save and stays for the next one, so a save is answered in about the time the check itself
 takes (a few tenths of a second for a problem with one degree of freedom). Each check has
 the limits of `mechbook check`: a wall-clock time limit and a memory bound, enforced from
@@ -28,11 +28,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from mechbook.app.batch import Batch, BatchOptions
-from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.bounded import Unreadable, read_regular
 from mechbook.app.console import STATUS_ORDER
-from mechbook.app.run import ProblemRun, RunOptions, run_problem
+from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.running.batch import Batch, BatchOptions
+from mechbook.app.running.run import ProblemRun, RunOptions, run_problem
 from mechbook.errors import MechbookError
 from mechbook.model.ids import split_id
 from mechbook.model.input_limits import MAX_FILE_BYTES
@@ -84,7 +84,7 @@ def _changed(old: tuple, new: tuple) -> bool:
 
 
 def check_in_worker(pid: str, base: Path, options, stage) -> tuple:
-    """The batch task: one check (mechbook.app.run), and the CPU time it took here."""
+    """The batch task: one check (mechbook.app.running.run), and the CPU time it took here."""
     cpu = _cpu()
     run = run_problem(pid, base, options, stage=stage)
     return run, _cpu() - cpu

@@ -32,8 +32,8 @@ from mechbook.app.api.params import Parameters
 from mechbook.app.api.results import CheckResult, Simulation
 from mechbook.app.api.system import SystemView
 from mechbook.app.mathml import math
-from mechbook.app.run import RunOptions
-from mechbook.app.service import check_loaded
+from mechbook.app.running.run import RunOptions
+from mechbook.app.running.service import check_loaded
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import InputError, NotFoundError
 from mechbook.model.books import Book, book_of

@@ -43,7 +43,7 @@ from mechbook.version import __version__
 class _Group(click.Group):
     """The command group; Ctrl-C ends any command with one line and exit status 130, never
     a traceback or click's "Aborted!" with status 1 (the workers ignore SIGINT: the run
-    stops them, mechbook.app.batch); a MechbookError no command caught is its message; a
+    stops them, mechbook.app.running.batch); a MechbookError no command caught is its message; a
     usage error (the group's or a command's) exits 4, as pytest's (statuses.TABLE)."""
 
     def make_context(self, info_name, args, parent=None, **extra) -> click.Context:
@@ -88,7 +88,7 @@ def main(ctx: click.Context, root_dir: Path | None) -> None:
     ctx.obj["root_opt"] = root_dir
     set_logging()
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.quiet import install
+    from mechbook.app.running.quiet import install
 
     install(lambda text: say(text, err=True))  # warnings as one-line notes, no traceback
 

@@ -1,4 +1,4 @@
-"""`mechbook check`: options in, the check service (mechbook.app.service) runs the problems
+"""`mechbook check`: options in, the check service (mechbook.app.running.service) runs the problems
 and writes the store, the outcomes out (a table, JSON, JUnit XML) and the exit status."""
 
 from __future__ import annotations
@@ -84,9 +84,9 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     every mode, and each system's Lagrange equations against Newton's law
     (docs/numerics.md); a cross-check fail also exits 1."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.batch import BatchOptions, settle
-    from mechbook.app.run import RunOptions
-    from mechbook.app.service import CheckOptions, CheckService
+    from mechbook.app.running.batch import BatchOptions, settle
+    from mechbook.app.running.run import RunOptions
+    from mechbook.app.running.service import CheckOptions, CheckService
     from mechbook.records import ProofPolicy
 
     _refuse_serial_limits(ctx, serial)

@@ -17,7 +17,7 @@ from typing import Any
 import click
 
 from mechbook.app import options as opt
-from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.text import for_terminal
 from mechbook.core.backends import BACKENDS
 from mechbook.errors import MechbookError

@@ -54,7 +54,7 @@ def command(ctx: click.Context, problem_ids: tuple[str, ...], store_path: Path,
     # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.report.build import ReportOptions, build_report
     from mechbook.app.report.page import PageOptions
-    from mechbook.app.service import resolve_ids
+    from mechbook.app.running.service import resolve_ids
 
     base = resolve_root(ctx)
     try:  # named ones must exist; of all, a bad file gets a page saying so

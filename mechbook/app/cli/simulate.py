@@ -93,7 +93,7 @@ def command(ctx: click.Context, problem_id: str, system: str | None, method: str
     time limit and a memory bound (a worker process stopped from outside when it exceeds
     either); exceeding one is reported with the stage the run was in, exit status 1."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.simrun import SimRequest, run_simulation
+    from mechbook.app.running.simrun import SimRequest, run_simulation
     from mechbook.app.store import check_run_name
 
     _refuse_what_does_not_apply(ctx, method, accuracy, serial)

@@ -81,7 +81,7 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
     in stacked batches; the float64 result is checked against 30 digits at sampled points
     and the book's answer at the same point is drawn over (and compared)."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.distributed import scheduler_address
+    from mechbook.app.running.distributed import scheduler_address
     from mechbook.app.sweep import make_spec, run_sweep
 
     base = resolve_root(ctx)

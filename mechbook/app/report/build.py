@@ -3,7 +3,7 @@ filters by book and status) and one page per problem, under one directory that w
 offline (`results/report/index.html` by default).
 
 It is built like `mechbook check`: the pages run on the batch machinery's worker processes
-(mechbook.app.batch: a time limit and a memory bound per page, a dead worker replaced), the
+(mechbook.app.running.batch: a time limit and a memory bound per page, a dead worker replaced), the
 slowest first; each worker writes its page the moment it is done, and `.pages.json` records
 the content hash each page was built from (mechbook.app.report.cache), so an interrupted
 report keeps what it finished and a rerun rebuilds only the pages whose problem, answer key,
@@ -21,13 +21,13 @@ from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
 
-from mechbook.app.batch import Batch, BatchOptions
 from mechbook.app.outputs import replaced
-from mechbook.app.quiet import warnings_as_notes
 from mechbook.app.report import cache
 from mechbook.app.report.page import PageOptions, build_page
 from mechbook.app.report.progress import Progress
 from mechbook.app.report.simplified import DIRECTORY as SIMPLIFIED
+from mechbook.app.running.batch import Batch, BatchOptions
+from mechbook.app.running.quiet import warnings_as_notes
 from mechbook.app.store import StoreError, problems, read, vet
 from mechbook.app.text import unicode_safe
 from mechbook.core.words import duration, plural

@@ -4,7 +4,7 @@ The problem is derived once and its linear system (about `--about`, a steady mot
 `--steady`, an answer part's point `--part`, or the stable equilibrium) compiled once with
 the parameters as arguments (mechbook.engine.linear_grid); the grid is cut into blocks, evaluated
 in this process, on a local process pool (`-j`), or on a Dask cluster (`--scheduler`,
-mechbook.app.distributed), and put back together in grid order. Quantities:
+mechbook.app.running.distributed), and put back together in grid order. Quantities:
 
     frequencies  the normal angular frequencies at every point (ascending; NaN: unstable)
     stability    stable / marginal / unstable / undefined at every point, and the largest
@@ -31,9 +31,15 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from mechbook.app.batch import deferred_interrupt, kill_pool, pool_context, start_server
-from mechbook.app.distributed import connect, dask_distributed, limited, materialize, use_scratch
 from mechbook.app.options import SWEEP_SAMPLES
+from mechbook.app.running.batch import deferred_interrupt, kill_pool, pool_context, start_server
+from mechbook.app.running.distributed import (
+    connect,
+    dask_distributed,
+    limited,
+    materialize,
+    use_scratch,
+)
 from mechbook.app.sweep.book_answer import book_overlay
 from mechbook.app.sweep.precision import sample_accuracy
 from mechbook.app.sweep.spec import (

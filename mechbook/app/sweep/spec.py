@@ -67,7 +67,7 @@ def make_spec(pid: str, base: Path, quantity: str, axes: list[Axis], *,
               steady: dict | None = None, part: str | None = None,
               backend: str = DEFAULT_BACKEND) -> SweepSpec:
     # at call time: the command line reads this module at start-up (distributed: NumPy)
-    from mechbook.app.distributed import tree_files
+    from mechbook.app.running.distributed import tree_files
 
     if quantity not in QUANTITIES:
         raise MechbookError(f"unknown quantity {quantity!r}; known: {', '.join(QUANTITIES)}")

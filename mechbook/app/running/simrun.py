@@ -1,6 +1,6 @@
 """`mechbook simulate` under a time limit and a memory bound.
 
-A simulation runs in a worker process of the batch machinery (mechbook.app.batch): a run
+A simulation runs in a worker process of the batch machinery (mechbook.app.running.batch): a run
 past its wall-clock limit or its resident-memory bound is stopped from outside and reported
 with the stage it was in, like a problem of `mechbook check`. The worker returns plain data
 (the lines to print, the arrays and settings to store); the parent prints them and writes
@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mechbook.app.batch import Batch, BatchOptions
-from mechbook.app.run import Stage
+from mechbook.app.running.batch import Batch, BatchOptions
+from mechbook.app.running.run import Stage
 from mechbook.app.validate import build_limit, build_systems
 from mechbook.core.compile import DEFAULT_BACKEND
 from mechbook.engine.analysis import Analysis

@@ -4,7 +4,7 @@ Python API call this, and only print or return what it gives back.
     ids ──resolve──▶ files in the tree (one id grammar; a bad file among all is an error run)
         ──cache────▶ outcomes still valid in the store (problem, answers, engine unchanged)
         ──order────▶ the rest, the longest first by their stored durations
-        ──batch────▶ the local pool (mechbook.app.batch) or a Dask cluster (distributed)
+        ──batch────▶ the local pool (mechbook.app.running.batch) or a Dask cluster (distributed)
         ──store────▶ each finished problem written at once (mechbook.app.unsaved.Saver)
         ──report───▶ the runs in the order of the ids, and what became of the store
 
@@ -20,11 +20,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mechbook.app.batch import Batch, BatchOptions
-from mechbook.app.distributed import ClusterBatch, scheduler_address
 from mechbook.app.formats import failures
 from mechbook.app.outputs import OutputError, output_file, resolve_path
-from mechbook.app.run import ProblemRun, RunOptions, cached_runs, run_problem
+from mechbook.app.running.batch import Batch, BatchOptions
+from mechbook.app.running.distributed import ClusterBatch, scheduler_address
+from mechbook.app.running.run import ProblemRun, RunOptions, cached_runs, run_problem
 from mechbook.app.selection import select
 from mechbook.app.store import durations, write
 from mechbook.app.unsaved import Saver

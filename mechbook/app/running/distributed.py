@@ -8,7 +8,7 @@ lower per-task overhead (about 1 ms against 2-5 ms) does not count for tasks of 
 and what Ray offers beyond Dask (killing a running task) does not spare us our own limits:
 a check must be stopped with the stage it was in, and the memory bound read from /proc,
 exactly as the local pool does. So the limits stay ours on every scheduler: each task runs
-its work in a child process of the Dask worker (the local pool's code, `mechbook.app.batch`,
+its work in a child process of the Dask worker (the local pool's code, `mechbook.app.running.batch`,
 for a check; `Sidecar` below for a sweep block), killed and replaced when it passes the
 time or memory bound.
 
@@ -35,9 +35,9 @@ from dataclasses import replace
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
-from mechbook.app.batch import POLL, Batch, BatchOptions, pool_context, rss_mb, start_server
-from mechbook.app.lifeline import die_with
-from mechbook.app.run import ProblemRun
+from mechbook.app.running.batch import POLL, Batch, BatchOptions, pool_context, rss_mb, start_server
+from mechbook.app.running.lifeline import die_with
+from mechbook.app.running.run import ProblemRun
 from mechbook.core.optional import require
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import answer_path, problem_path
@@ -63,7 +63,7 @@ def tree_files(pid: str, base: Path) -> dict[str, bytes]:
 _TREES: dict[str, Path] = {}  # per worker process: content hash -> scratch tree
 # where the scratch trees go: the temporary directory on a Dask worker; in a local pool's
 # worker, the run's own multiprocessing folder (set by `use_scratch`), which goes with the
-# run even when it is killed (mechbook.app.lifeline): a pool's workers end by os._exit,
+# run even when it is killed (mechbook.app.running.lifeline): a pool's workers end by os._exit,
 # and their atexit never runs
 SCRATCH: str | None = None
 

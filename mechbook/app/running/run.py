@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mechbook.app.fingerprint import file_sha256
-from mechbook.app.quiet import warnings_as_notes
+from mechbook.app.running.quiet import warnings_as_notes
 from mechbook.app.store import ProblemRecord, cached
 from mechbook.errors import FAULTS, MechbookError, describe
 from mechbook.model.catalog import answer_path, problem_path

@@ -35,10 +35,10 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Generic, TypeVar
 
-from mechbook.app.batch_limits import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
-from mechbook.app.lifeline import die_with, sweep_stale_folders
-from mechbook.app.quiet import install
-from mechbook.app.run import ProblemRun, RunOptions, Stage, run_problem
+from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.running.lifeline import die_with, sweep_stale_folders
+from mechbook.app.running.quiet import install
+from mechbook.app.running.run import ProblemRun, RunOptions, Stage, run_problem
 from mechbook.errors import MechbookError, describe
 
 ItemT = TypeVar("ItemT", bound=Hashable)  # what one task is given: a problem id, a request
@@ -73,7 +73,7 @@ class BatchOptions(Generic[OptionsT]):
 
 
 def problem_task(pid: str, base: Path, options: RunOptions, stage: Stage) -> ProblemRun:
-    """The default task: check one problem (mechbook.app.run)."""
+    """The default task: check one problem (mechbook.app.running.run)."""
     return run_problem(pid, base, options, stage=stage)
 
 
@@ -84,7 +84,7 @@ def problem_failed(pid: str, why: str, seconds: float, stage: str) -> ProblemRun
 
 def _worker(conn: Connection, base: Path, options: object, task: Task, run_pid: int) -> None:
     """A worker's loop: receive an item, run the task on it, send stages and the result.
-    It dies with the run (mechbook.app.lifeline), even one killed with -9."""
+    It dies with the run (mechbook.app.running.lifeline), even one killed with -9."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
     for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
         signal.signal(ends, signal.SIG_DFL)
@@ -123,7 +123,7 @@ class _Slot:
 
 
 # the engine, imported once by the fork server the workers fork from (or by a serial run)
-PRELOAD = ("mechbook.app.run", "mechbook.verify.checker", "mechbook.verify.quantities",
+PRELOAD = ("mechbook.app.running.run", "mechbook.verify.checker", "mechbook.verify.quantities",
            "mechbook.crosscheck")
 GC_THRESHOLDS = (10_000, 20, 100)  # young collections ~14 times rarer than Python's default
 
@@ -132,10 +132,11 @@ def pool_context():
     """The workers' context: a fork server that imported the engine once and settled."""
     sweep_stale_folders()  # what runs killed with their fork server left
     ctx = mp.get_context("forkserver")
-    # ... and settles there (mechbook.app.frozen): the workers fork from a frozen heap;
-    # mechbook.app.forkstart first: the server ignores Ctrl-C and removes its socket's
+    # ... and settles there (mechbook.app.running.frozen): the workers fork from a frozen heap;
+    # mechbook.app.running.forkstart first: the server ignores Ctrl-C and removes its socket's
     # folder when it ends (even after its run was killed)
-    ctx.set_forkserver_preload(["mechbook.app.forkstart", *PRELOAD, "mechbook.app.frozen"])
+    ctx.set_forkserver_preload(["mechbook.app.running.forkstart", *PRELOAD,
+                                "mechbook.app.running.frozen"])
     return ctx
 
 
@@ -175,7 +176,7 @@ def start_server() -> None:
     """Start the fork server (and multiprocessing's resource tracker) if it is not running,
     with SIGINT ignored from the new processes' first instruction: a signal's disposition
     SIG_IGN survives exec, so a Ctrl-C while their interpreters start up (before
-    mechbook.app.forkstart is imported) cannot kill them with a "Fatal Python error" on
+    mechbook.app.running.forkstart is imported) cannot kill them with a "Fatal Python error" on
     the terminal. This process ignores SIGINT only for the instant of the spawn."""
     import threading
     from multiprocessing import forkserver

@@ -1,4 +1,4 @@
-"""Imported first by the batch's fork server (mechbook.app.batch), before the engine.
+"""Imported first by the batch's fork server (mechbook.app.running.batch), before the engine.
 
 Two things only the server itself can do:
 - Ctrl-C is the run's business. The terminal sends SIGINT to every process of its group,
@@ -11,7 +11,7 @@ Two things only the server itself can do:
   closes, removes it on its way out, once the run that marked the folder is gone; a
   SIGTERM or SIGHUP to the server itself (a whole process group ended) ends it the same
   way. Only a SIGKILL of the server as well leaves the folder: the next run removes it
-  (mechbook.app.lifeline.sweep_stale_folders).
+  (mechbook.app.running.lifeline.sweep_stale_folders).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import atexit
 import os
 import signal
 
-from mechbook.app.lifeline import remove_if_abandoned
+from mechbook.app.running.lifeline import remove_if_abandoned
 
 _SERVER = os.getpid()  # the fork server; its workers inherit this module, and never end by
 # way of atexit (they leave with os._exit), but a removal is the server's alone all the same
