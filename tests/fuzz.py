@@ -597,7 +597,7 @@ def _classify(item: str, stage) -> tuple[str, str]:
             root, _, pid = rest.rpartition(":")
             return faults.run_symlink(Path(root), pid)
         if mode == "validate":
-            from mechbook.app.validate import validate_file
+            from mechbook.app.authoring.validate import validate_file
 
             stage("validating")
             return "ok", validate_file(rest)[:300]

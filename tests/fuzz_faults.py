@@ -246,7 +246,7 @@ PLACEHOLDER = "FUZZSTRINGPLACEHOLDER"
 
 def run_strings(path: Path) -> tuple[str, str]:
     """Validate; a refusal must name the file; what passes must go through every output."""
-    from mechbook.app.validate import validate_file
+    from mechbook.app.authoring.validate import validate_file
     from mechbook.errors import MechbookError
     from mechbook.model.yamlio import load
 
@@ -429,7 +429,7 @@ def _marked(text: str) -> str:
 
 def run_symlink(base: Path, pid: str) -> tuple[str, str]:
     """What `list` and `check` read of a problem: its file and its answer key by id."""
-    from mechbook.app.validate import build_systems
+    from mechbook.app.authoring.validate import build_systems
     from mechbook.errors import MechbookError
     from mechbook.model.catalog import answer_path, problem_path
     from mechbook.model.problem import load_problem

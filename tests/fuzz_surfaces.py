@@ -297,8 +297,8 @@ def run_init(where: Path, spec: dict) -> tuple[str, str]:
     NAME first: nothing may be written outside NAME, and what it writes is regular files."""
     from click.testing import CliRunner
 
+    from mechbook.app.authoring.init import FILES
     from mechbook.app.cli import main
-    from mechbook.app.init import FILES
 
     guard = Guard(where)
     root = where / "tree"
@@ -385,8 +385,8 @@ def run_watch(where: Path, spec: dict) -> tuple[str, str]:
     """What `watch` does on a save: poll its three files (their signature) and check the
     problem (the task its worker runs), with one of them replaced by what an editor or a
     user can leave behind. Neither may block, read without bound, or end in a traceback."""
+    from mechbook.app.authoring.watch import check_in_worker, files_signature, report_lines
     from mechbook.app.running.run import RunOptions
-    from mechbook.app.watch import check_in_worker, files_signature, report_lines
 
     tree = _tree(where)
     guard = Guard(where)

@@ -30,8 +30,8 @@ def _write(tree: Path, pid: str, problem: str, key: str) -> Path:
 def _validate_then_check(tree: Path, pid: str, ppath: Path) -> tuple[str, str]:
     """validate the problem; if it is valid, check it (no cross-checks): a traceback in the
     run's log or an error detail is a crash."""
+    from mechbook.app.authoring.validate import validate_file
     from mechbook.app.running.run import RunOptions, run_problem
-    from mechbook.app.validate import validate_file
     from mechbook.errors import MechbookError
 
     try:

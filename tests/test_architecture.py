@@ -539,7 +539,7 @@ def test_the_private_import_test_can_fail(tmp_path):
 # `validate` (run, validate); each such import says why
 LAZY_IMPORTS = ("mechbook/__init__.py", "mechbook/__main__.py", "mechbook/app/cli/",
                 "mechbook/app/running/run.py",
-                "mechbook/app/validate.py", "mechbook/app/editor.py",
+                "mechbook/app/authoring/validate.py", "mechbook/app/authoring/editor.py",
                 "mechbook/app/sweep/spec.py", "mechbook/model/books.py")
 
 

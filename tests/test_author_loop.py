@@ -118,7 +118,7 @@ def test_validate_refuses_a_name_the_problem_does_not_declare(tmp_path):
 
 @pytest.mark.slow
 def test_every_committed_answer_key_resolves_its_names():
-    from mechbook.app.validate import validate_file
+    from mechbook.app.authoring.validate import validate_file
 
     for key in sorted(ROOT.glob("answers/*/*.yaml")):
         assert "is valid" in validate_file(key), key

@@ -45,7 +45,7 @@ def test_the_harness_reports_a_hang_and_a_crash(tmp_path, monkeypatch):
     is refused."""
     import fuzz as harness
 
-    import mechbook.app.validate as validate
+    import mechbook.app.authoring.validate as validate
     from mechbook.app.running.batch import Batch, BatchOptions
     from mechbook.errors import SpecError
 
@@ -194,7 +194,7 @@ def test_the_init_kind_reports_a_write_through_a_link(tmp_path, monkeypatch):
     """Files written by following what is there (0834a76's init): 'outside'."""
     import fuzz_surfaces as surfaces
 
-    from mechbook.app import init
+    from mechbook.app.authoring import init
 
     spec = {"plant": "linked-folder", "seed": 1, "name": "tree"}
     (tmp_path / "case-1").mkdir()
@@ -233,7 +233,7 @@ def test_the_schema_kind_reports_a_write_through_a_link(tmp_path, monkeypatch):
     """9a86c12's `schema --write` (write_text through whatever is there): 'outside'."""
     import fuzz_surfaces44 as surfaces44
 
-    from mechbook.app import editor
+    from mechbook.app.authoring import editor
 
     spec = {"plant": "outside-link", "name": "problem.json", "dir": "schemas"}
     (tmp_path / "case-1").mkdir()

@@ -33,8 +33,8 @@ def test_init_and_check_from_a_wheel_in_a_fresh_venv(tmp_path):
     assert built.returncode == 0, built.stdout + built.stderr
     (wheel,) = wheels.glob("mechbook-*.whl")
     names = zipfile.ZipFile(wheel).namelist()
-    for needed in ("mechbook/py.typed", "mechbook/app/starter/problem.yaml",
-                   "mechbook/app/starter/Makefile", "mechbook/model/schemas/problem.json",
+    for needed in ("mechbook/py.typed", "mechbook/app/authoring/starter/problem.yaml",
+                   "mechbook/app/authoring/starter/Makefile", "mechbook/model/schemas/problem.json",
                    "mechbook/app/report/assets/animate.js",
                    "mechbook/app/report/templates/problem.html",
                    "mechbook/docs/schema.md", "mechbook/docs/answers.md",

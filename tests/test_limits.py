@@ -14,7 +14,7 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
-import mechbook.app.validate  # noqa: F401 - imported here, so the timings below are the refusals
+import mechbook.app.authoring.validate  # noqa: F401 - imported here, so the timings below are the refusals
 from mechbook.app.cli import main
 from mechbook.errors import MechbookError, SpecError
 from mechbook.model import input_limits
@@ -550,7 +550,7 @@ def _ringed_planet_off_its_circle(tmp_path: Path) -> Path:
 
 @pytest.mark.slow
 def test_an_average_that_is_not_a_trig_polynomial_is_refused_within_seconds(tmp_path):
-    from mechbook.app.validate import validate_file
+    from mechbook.app.authoring.validate import validate_file
 
     path = _ringed_planet_off_its_circle(tmp_path)
     start = time.process_time()
@@ -562,7 +562,7 @@ def test_an_average_that_is_not_a_trig_polynomial_is_refused_within_seconds(tmp_
 
 @pytest.mark.slow
 def test_validate_bounds_its_own_cpu_time(tmp_path, monkeypatch):
-    from mechbook.app import validate
+    from mechbook.app.authoring import validate
 
     path = _ringed_planet_off_its_circle(tmp_path)
     monkeypatch.setattr(validate, "BUILD_SECONDS", 0.5)

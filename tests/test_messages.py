@@ -13,7 +13,7 @@ from dataclasses import replace
 import pytest
 from hostile import ROOT, check, pendulum_tree, run
 
-import mechbook.app.validate as validate
+import mechbook.app.authoring.validate as validate
 from mechbook.app.running.run import run_problem
 from mechbook.errors import MechbookError, SpecError, describe
 

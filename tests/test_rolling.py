@@ -17,7 +17,7 @@ from constrained_systems import (
     write_tree,
 )
 
-from mechbook.app.validate import build_systems
+from mechbook.app.authoring.validate import build_systems
 from mechbook.crosscheck.newton import newton_crosscheck
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from mechbook.app import editor
+from mechbook.app.authoring import editor
 from mechbook.model.yamlio import load
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,6 +1,6 @@
 """Every name an answer key uses, resolved against its problem before anything is checked.
 
-Expressions are parsed in their part's context (mechbook.app.validate), but several keys
+Expressions are parsed in their part's context (mechbook.app.authoring.validate), but several keys
 hold *names*, not expressions: the coordinates of an `about:` point or a `steady:` motion,
 the coordinate `unknown:` a steady rate is for, the parameter a `limit:` takes to zero, the
 names a `define:` introduces. A wrong one used to pass `mechbook validate` and fail only in

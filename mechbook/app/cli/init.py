@@ -1,4 +1,4 @@
-"""`mechbook init`: a tree of one's own to start from (mechbook.app.init)."""
+"""`mechbook init`: a tree of one's own to start from (mechbook.app.authoring.init)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def command(directory: str) -> None:
     """Start a tree of your own in DIRECTORY: books.yaml, an example problem and its answer
     key (which `mechbook check` passes), and a Makefile. Nothing is overwritten."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.init import init_tree
+    from mechbook.app.authoring.init import init_tree
 
     try:
         if not directory.strip():  # '' would be the current directory: never implied

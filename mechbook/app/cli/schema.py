@@ -1,5 +1,5 @@
 """`mechbook schema`: the JSON Schemas of problem, answer, books and check-result files, for
-an editor's YAML language server (mechbook.app.editor)."""
+an editor's YAML language server (mechbook.app.authoring.editor)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import click
 
 from mechbook.app.cli.common import say
 
-NAMES = ("problem", "answers", "books", "check-result")  # mechbook.app.editor.NAMES
+NAMES = ("problem", "answers", "books", "check-result")  # mechbook.app.authoring.editor.NAMES
 
 
 @click.command("schema")
@@ -26,7 +26,7 @@ def command(name: str | None, directory: Path | None) -> None:
     on the first line of problems/<book>/<n>.yaml (answers.json for answer keys,
     books.json for books.yaml); `mechbook init` does both for a new tree."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app import editor
+    from mechbook.app.authoring import editor
 
     if (name is None) == (directory is None):
         raise click.UsageError("name one schema (problem, answers, books, check-result) or "

@@ -17,7 +17,7 @@ from mechbook.errors import MechbookError
 def command(files: tuple[Path, ...]) -> None:
     """Validate problem or answer files (schema and every expression); nothing runs."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.validate import validate_file
+    from mechbook.app.authoring.validate import validate_file
 
     bad = 0
     refused: set[Path] = set()  # problem files already reported invalid

@@ -38,8 +38,8 @@ def command(ctx: click.Context, problem_id: str, no_crosscheck: bool, timeout: f
     tenths of a second for a small problem). Each check runs in a worker process under the
     limits of `mechbook check` (--timeout, --memory). Ctrl-C stops; nothing is stored."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.watch import WatchOptions
-    from mechbook.app.watch import watch as watch_problem
+    from mechbook.app.authoring.watch import WatchOptions
+    from mechbook.app.authoring.watch import watch as watch_problem
 
     base = resolve_root(ctx)
     try:

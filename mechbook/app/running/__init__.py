@@ -16,6 +16,7 @@ Import each part from its module (`from mechbook.app.running.batch import Batch`
 `__init__` imports nothing, because the fork server imports forkstart through it before
 anything else, and the command line's start-up must stay light.
 
-May import: the stages below mechbook.app, its shared modules, store/ and output/ (the
-check's formats, safe text); never the command line, the API or the report.
+May import: the stages below mechbook.app, its shared modules, store/, output/ (the check's
+formats, safe text) and authoring's validate (the bounded build every check starts with);
+never the command line, the API or the report.
 """

@@ -114,7 +114,7 @@ def _check(run: ProblemRun, pid: str, base: Path, options: RunOptions, stage: St
            start: float, loaded: Problem | None = None) -> None:
     # the engine and the checks, imported here only: a warm `mechbook check` answers from
     # the store (cached_runs) without loading them (docs/performance.md, warm check)
-    from mechbook.app.validate import validated_parts
+    from mechbook.app.authoring.validate import validated_parts
     from mechbook.crosscheck import crosscheck_problem
     from mechbook.engine.analysis import Analysis
     from mechbook.engine.derive import computed

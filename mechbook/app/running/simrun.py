@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mechbook.app.authoring.validate import build_limit, build_systems
 from mechbook.app.running.batch import Batch, BatchOptions
 from mechbook.app.running.run import Stage
-from mechbook.app.validate import build_limit, build_systems
 from mechbook.core.compile import DEFAULT_BACKEND
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, describe, message

@@ -1,11 +1,11 @@
 """`mechbook init DIR`: a tree of one's own to start from, which `mechbook check` passes.
 
-The starter tree (mechbook/app/starter, shipped in the package) holds books.yaml with one
+The starter tree (mechbook/app/authoring/starter, shipped in the package) holds books.yaml with one
 book, one example problem (a pendulum on a spring, its radius declared positive) with its
 answer key, a Makefile with the usual targets, a README that says what is where and how to
 go on, a .gitignore for what mechbook writes (results/); and the JSON Schemas of those files
 under schemas/, which the first line of each names for an editor's YAML language server
-(mechbook.app.editor). Nothing is overwritten: a file that
+(mechbook.app.authoring.editor). Nothing is overwritten: a file that
 exists already is refused, naming it.
 
 Nothing is written outside DIR either. DIR itself may be a link to a directory (the user
@@ -22,8 +22,8 @@ import stat
 from importlib import resources
 from pathlib import Path
 
-from mechbook.app.editor import DIRECTORY, NAMES
-from mechbook.app.editor import text as schema_text
+from mechbook.app.authoring.editor import DIRECTORY, NAMES
+from mechbook.app.authoring.editor import text as schema_text
 from mechbook.errors import MechbookError
 
 # starter file -> where it goes (`gitignore`: a package's data files are not dot files)
@@ -121,7 +121,7 @@ def init_tree(target: str | Path) -> list[Path]:
     _names_fit(target)
     contents = {f"{DIRECTORY}/{name}.json": schema_text(name).encode("utf-8")
                 for name in NAMES}  # first: the files' modelines name these
-    source = resources.files("mechbook.app").joinpath("starter")
+    source = resources.files("mechbook.app.authoring").joinpath("starter")
     contents.update((dest, source.joinpath(name).read_bytes()) for name, dest in FILES.items())
     top = _top(target)
     try:
