@@ -13,7 +13,7 @@ from mechbook.version import __version__
 __all__ = ["Problem", "load", "results", "__version__"]
 
 _LAZY = {"load": "mechbook.app.api.problem", "Problem": "mechbook.app.api.problem",
-         "results": "mechbook.app.frames"}
+         "results": "mechbook.app.api.frames"}
 
 
 def __getattr__(name: str):
@@ -23,7 +23,7 @@ def __getattr__(name: str):
             from mechbook.app.api import problem as module
         else:
             # on first use (PEP 562): `import mechbook` stays light
-            from mechbook.app import frames as module
+            from mechbook.app.api import frames as module
         return getattr(module, name)
     raise AttributeError(f"module 'mechbook' has no attribute {name!r}")
 

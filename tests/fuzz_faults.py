@@ -174,11 +174,11 @@ def _same(a: dict, b: dict) -> bool:
 
 def run_store(where: Path, spec: dict) -> tuple[str, str]:
     """Write records, damage the store, read it every way, then save one more record the
-    way `check` does (mechbook.app.unsaved.Saver): it must be in the store or in the side
+    way `check` does (mechbook.app.store.unsaved.Saver): it must be in the store or in the side
     file named, and every record readable before must still be readable."""
     import mechbook.app.store as store
-    from mechbook.app.restore import restore
-    from mechbook.app.unsaved import Saver
+    from mechbook.app.store.restore import restore
+    from mechbook.app.store.unsaved import Saver
 
     rng = random.Random(spec["seed"])
     path = where / "results" / "mechbook.h5"
@@ -276,9 +276,9 @@ def run_strings(path: Path) -> tuple[str, str]:
 def outputs_take(strings: list[str], where: Path) -> tuple[str, str]:
     """Every string through HDF5, JSON, JUnit XML and the terminal; 'unsafe' if one breaks."""
     import mechbook.app.store as store
-    from mechbook.app.formats import junit_xml, to_json
+    from mechbook.app.output.formats import junit_xml, to_json
+    from mechbook.app.output.text import for_terminal, json_safe
     from mechbook.app.running.run import ProblemRun
-    from mechbook.app.text import for_terminal, json_safe
     from mechbook.records import Outcome
 
     rng = random.Random(len(strings))

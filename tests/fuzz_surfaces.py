@@ -189,8 +189,8 @@ def _side_line(rng: random.Random, pid: str, store: object, spec: dict) -> str:
     import fuzz
     from fuzz_faults import HOSTILE_STRINGS, _record
 
-    from mechbook.app.text import json_safe
-    from mechbook.app.unsaved import json_default
+    from mechbook.app.output.text import json_safe
+    from mechbook.app.store.unsaved import json_default
 
     record = json.loads(json.dumps(json_safe(asdict(_record(pid, rng.sample(HOSTILE_STRINGS,
                                                                             4), rng))),
@@ -237,8 +237,8 @@ def _side_line(rng: random.Random, pid: str, store: object, spec: dict) -> str:
 def run_restore(where: Path, spec: dict) -> tuple[str, str]:
     """Write a side file (good and hostile lines), restore it as `mechbook restore` does
     from inside the tree; nothing outside may change; what it says it stored reads back."""
-    from mechbook.app.restore import restore
     from mechbook.app.store.reader import read
+    from mechbook.app.store.restore import restore
     from mechbook.errors import MechbookError
 
     rng = random.Random(spec["seed"])
@@ -609,8 +609,8 @@ def run_hdf5(where: Path, spec: dict) -> tuple[str, str]:
     from fuzz_faults import HOSTILE_STRINGS, _readable, _record
 
     import mechbook.app.store as store
+    from mechbook.app.store.unsaved import Saver
     from mechbook.app.sweep.storage import stored_sweeps
-    from mechbook.app.unsaved import Saver
     from mechbook.errors import MechbookError
 
     rng = random.Random(spec["seed"])

@@ -136,7 +136,7 @@ def test_results_as_dataframes(store):
 
 
 def test_mathml_dots_velocities_and_accelerations():
-    from mechbook.app.mathml import DOT_STYLE, math
+    from mechbook.app.output.mathml import DOT_STYLE, math
 
     out = math(sp.Symbol("thetadot") + sp.Symbol("x1ddot") + sp.Symbol("omega"))
     dot = f'<mo style="{DOT_STYLE}">'  # drawn large enough to read (issue 23)

@@ -11,10 +11,10 @@ import re
 import pytest
 
 from mechbook.app.api import Problem, load
+from mechbook.app.api.frames import results
 from mechbook.app.api.linearization import Linearization
 from mechbook.app.api.results import CheckResult, Simulation
 from mechbook.app.api.system import SIMULATE_OPTIONS, SystemView
-from mechbook.app.frames import results
 
 PUBLIC = [load, results, Problem.system, Problem.check, SystemView.frequencies,
           SystemView.modes, SystemView.simulate, SystemView.linearize,

@@ -16,7 +16,7 @@ import pytest
 from click.testing import CliRunner
 
 from mechbook.app.cli import main
-from mechbook.app.formats import schema
+from mechbook.app.output.formats import schema
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("sympy", "scipy", "numpy", "h5py", "matplotlib", "pandas", "mechbook.engine",

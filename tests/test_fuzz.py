@@ -132,7 +132,7 @@ def test_the_store_kind_reports_silent_data_loss(tmp_path, monkeypatch):
     the case is 'lost', not 'refused'."""
     import fuzz_faults as faults
 
-    import mechbook.app.unsaved as unsaved
+    import mechbook.app.store.unsaved as unsaved
 
     spec = {"records": 2, "strings": ["x"], "file": "none", "inject": "readonly", "seed": 3}
     assert faults.run_store(tmp_path / "a", spec)[0] == "refused"
@@ -178,7 +178,7 @@ def test_the_restore_kind_reports_a_write_outside_the_tree(tmp_path, monkeypatch
     file says: 'outside'."""
     import fuzz_surfaces as surfaces
 
-    from mechbook.app import restore
+    from mechbook.app.store import restore
 
     spec = {"lines": 1, "seed": 7, "special": None, "store": "absolute-outside",
             "mutate": "none"}

@@ -14,9 +14,9 @@ import pytest
 from hostile import check, pendulum_tree, run
 
 import mechbook.app.store as store
-from mechbook.app.formats import junit_xml, to_json
+from mechbook.app.output.formats import junit_xml, to_json
+from mechbook.app.output.text import for_terminal, for_xml, json_safe, storable
 from mechbook.app.running.run import ProblemRun
-from mechbook.app.text import for_terminal, for_xml, json_safe, storable
 from mechbook.records import Outcome, Results
 
 # (what the YAML file holds, in a double-quoted string; what the message names)

@@ -137,7 +137,7 @@ def test_the_side_file_is_never_written_through_a_link_or_into_a_fifo(tmp_path, 
     """The side file's name is guessable (<store>.unsaved-<time>-<pid>.jsonl): a link or a
     FIFO planted there is refused (OSError: the next place is tried), never followed or
     waited on."""
-    from mechbook.app.unsaved import append_line
+    from mechbook.app.store.unsaved import append_line
 
     victim = tmp_path / "victim.txt"
     victim.write_text("keep me\n", encoding="utf-8")

@@ -18,7 +18,7 @@ from hostile import check, mechbook, pendulum_tree
 
 import mechbook.app.store as store
 import mechbook.app.store.writer as store_writer
-from mechbook.app.unsaved import FORMAT
+from mechbook.app.store.unsaved import FORMAT
 
 
 def _line(pid: str = "lim-2101", store_path: str = "results/mechbook.h5", **extra) -> str:
@@ -175,7 +175,7 @@ def test_what_check_kept_is_restored_into_the_tree_store(tree, monkeypatch):
 def test_many_lines_are_written_in_few_edits(tree, monkeypatch):
     """A side file of 250 kept problems is written in three edits of the store (batches
     of 100), not 250: each edit copies the whole store."""
-    from mechbook.app import restore as restore_module
+    from mechbook.app.store import restore as restore_module
 
     edits = []
     real = restore_module.write

@@ -24,10 +24,10 @@ from hostile import ROOT, can_mount, check, pendulum_tree, run, tmpfs
 import mechbook.app.outputs as outputs
 import mechbook.app.store as store
 import mechbook.app.store.repair as store_repair
+import mechbook.app.store.unsaved as unsaved
 import mechbook.app.store.writer as store_writer
-import mechbook.app.unsaved as unsaved
-from mechbook.app.restore import restore
 from mechbook.app.selection import lastfailed_path
+from mechbook.app.store.restore import restore
 
 
 def _side_file(text: str) -> Path:

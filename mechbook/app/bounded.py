@@ -1,7 +1,7 @@
 """Reading the files mechbook writes for itself, which anyone can replace: bounded, regular
 files only, JSON of bounded depth.
 
-The side file of results that could not be stored (mechbook.app.unsaved), the report's page
+The side file of results that could not be stored (mechbook.app.store.unsaved), the report's page
 manifest (mechbook.app.report.cache) and the files `watch` polls are read back later, and in
 the meantime they may have become a FIFO (reading waits for a writer that never comes), a
 link to /dev/zero (reading never ends), a file of gigabytes, or JSON nested a hundred

@@ -3,7 +3,7 @@
 `p.eom` is a list of equations and `p.momenta` a dict: Jupyter printed them as text (only a
 lone SymPy object has its own LaTeX). `MathList` and `MathDict` are a list and a dict in
 every way (equality, indexing, JSON of their items) that also give Jupyter LaTeX (one item
-per row, aligned) and MathML (mechbook.app.mathml, the report's printer). A `MathDict`
+per row, aligned) and MathML (mechbook.app.output.mathml, the report's printer). A `MathDict`
 keyed by symbols is indexed by their names too (`p.equilibria[0]["theta"]`), as `about=`
 takes them.
 """
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from mechbook.app.mathml import math
+from mechbook.app.output.mathml import math
 
 
 def _latex(item) -> str:

@@ -31,7 +31,7 @@ from mechbook.app.api import args
 from mechbook.app.api.params import Parameters
 from mechbook.app.api.results import CheckResult, Simulation
 from mechbook.app.api.system import SystemView
-from mechbook.app.mathml import math
+from mechbook.app.output.mathml import math
 from mechbook.app.running.run import RunOptions
 from mechbook.app.running.service import check_loaded
 from mechbook.engine.analysis import Analysis

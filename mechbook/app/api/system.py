@@ -17,7 +17,7 @@ from mechbook.app.api.loaded import LoadedProblem
 from mechbook.app.api.ode import OdeFunction
 from mechbook.app.api.params import parameter_values, refuse_unknown, texts
 from mechbook.app.api.results import Simulation
-from mechbook.app.mathml import math
+from mechbook.app.output.mathml import math
 from mechbook.core.compile import as_expr
 from mechbook.core.timeout import try_simplify
 from mechbook.engine.existence import existing

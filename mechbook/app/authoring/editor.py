@@ -37,7 +37,7 @@ def schema(name: str) -> dict:
         return answers_schema()
     if name == "check-result":
         # at call time: `mechbook schema NAME` loads only the schema it prints (verify: SymPy)
-        from mechbook.app.formats import schema as check_result
+        from mechbook.app.output.formats import schema as check_result
 
         return check_result()
     raise MechbookError(f"no schema {name!r} (schemas: {', '.join(NAMES)})")

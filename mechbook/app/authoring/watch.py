@@ -29,8 +29,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mechbook.app.bounded import Unreadable, read_regular
-from mechbook.app.console import STATUS_ORDER
 from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
+from mechbook.app.output.console import STATUS_ORDER
 from mechbook.app.running.batch import Batch, BatchOptions
 from mechbook.app.running.run import ProblemRun, RunOptions, run_problem
 from mechbook.errors import MechbookError

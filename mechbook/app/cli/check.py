@@ -25,7 +25,7 @@ from mechbook.app.cli.common import (
     timeout_option,
 )
 from mechbook.app.cli.statuses import epilog, failure
-from mechbook.app.text import json_safe
+from mechbook.app.output.text import json_safe
 from mechbook.errors import MechbookError
 
 
@@ -130,7 +130,7 @@ def _last_failed(store: Path, ids: list[str]) -> list[str]:
 def _remember(report) -> None:
     """Record which problems failed now, for `--lf` (a note if it cannot be written)."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.formats import failures
+    from mechbook.app.output.formats import failures
     from mechbook.app.selection import lastfailed_path, record
 
     try:
@@ -157,7 +157,7 @@ def _run(service, ids: list[str], verbose: bool):
     """The service's run with the progress on stderr (and, with -v, each problem's debug
     lines); a batch that cannot run at all is the command's error."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.console import Progress
+    from mechbook.app.output.console import Progress
 
     progress = Progress(len(ids), 0)
 
@@ -181,8 +181,8 @@ def _print(report, base: Path, fmt: str, verbose: bool, junit_path: Path | None)
     import json
 
     # at call time, not at the top: `mechbook --help` and `list` start without it
-    from mechbook.app.console import print_table
-    from mechbook.app.formats import failures, to_json, write_junit
+    from mechbook.app.output.console import print_table
+    from mechbook.app.output.formats import failures, to_json, write_junit
 
     ordered = report.runs
     if fmt == "json":

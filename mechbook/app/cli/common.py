@@ -18,7 +18,7 @@ import click
 
 from mechbook.app import options as opt
 from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
-from mechbook.app.text import for_terminal
+from mechbook.app.output.text import for_terminal
 from mechbook.core.backends import BACKENDS
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, root

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from mechbook.app.cli.common import say
-from mechbook.app.text import for_terminal
+from mechbook.app.output.text import for_terminal
 from mechbook.errors import MechbookError
 
 

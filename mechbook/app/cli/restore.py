@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from mechbook.app.cli.common import say, store_option
-from mechbook.app.text import for_terminal
+from mechbook.app.output.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import root
 
@@ -24,7 +24,7 @@ def command(ctx: click.Context, files: tuple[Path, ...], store_path: Path | None
     inside the tree; the whole file is checked before anything is written."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.outputs import resolve_path
-    from mechbook.app.restore import restore as restore_file
+    from mechbook.app.store.restore import restore as restore_file
 
     given = ctx.obj.get("root_opt")
     try:

@@ -28,7 +28,7 @@ from mechbook.app.cli.common import (
     timeout_option,
 )
 from mechbook.app.cli.statuses import failure
-from mechbook.app.text import for_terminal
+from mechbook.app.output.text import for_terminal
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import existing_problem_path
 
@@ -156,7 +156,7 @@ def _store(report, name: str | None, path: Path) -> bool:
     """Write the run to the store; on failure keep it in a side file and say where."""
     # at call time, not at the top: `mechbook --help` and `list` start without it
     from mechbook.app.store import StoreError, write_simulation
-    from mechbook.app.unsaved import SideFile
+    from mechbook.app.store.unsaved import SideFile
 
     run_name = name or f"{report.system}-{report.method}"
     try:

@@ -14,7 +14,7 @@ import textwrap
 
 import click
 
-from mechbook.app.text import for_terminal
+from mechbook.app.output.text import for_terminal
 from mechbook.errors import MalformedIdError, NothingSelectedError
 
 OK = 0

@@ -6,7 +6,7 @@
     svg        the charts (inline SVG); animation the bodies' motion as frames for a canvas
     templates/ the pages (Jinja2, autoescaped); assets/ the style sheet and the filter script
 
-Mathematics is SymPy's presentation MathML (mechbook.app.mathml), which browsers render
+Mathematics is SymPy's presentation MathML (mechbook.app.output.mathml), which browsers render
 natively: the report needs no script from elsewhere and no network.
 
 May import: the stages below mechbook.app, its shared modules, store/, running/ and

@@ -21,6 +21,7 @@ from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
 
+from mechbook.app.output.text import unicode_safe
 from mechbook.app.outputs import replaced
 from mechbook.app.report import cache
 from mechbook.app.report.page import PageOptions, build_page
@@ -29,7 +30,6 @@ from mechbook.app.report.simplified import DIRECTORY as SIMPLIFIED
 from mechbook.app.running.batch import Batch, BatchOptions
 from mechbook.app.running.quiet import warnings_as_notes
 from mechbook.app.store import StoreError, problems, read, vet
-from mechbook.app.text import unicode_safe
 from mechbook.core.words import duration, plural
 from mechbook.errors import MechbookError, describe
 from mechbook.model.books import books, split_id

@@ -27,8 +27,8 @@ from pathlib import Path
 
 from mechbook.app.bounded import Unreadable, json_value, read_regular
 from mechbook.app.fingerprint import engine_sha256, file_sha256
+from mechbook.app.output.text import json_safe
 from mechbook.app.outputs import replaced
-from mechbook.app.text import json_safe
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import answer_path, problem_path
 

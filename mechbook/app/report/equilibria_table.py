@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
-from mechbook.app.mathml import math
+from mechbook.app.output.mathml import math
 from mechbook.app.report.derivation import StoredSystem, same_point
 from mechbook.core.numeval import NotNumeric, evaluate
 from mechbook.engine.existence import existing

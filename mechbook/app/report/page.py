@@ -27,7 +27,7 @@ from pathlib import Path
 
 import sympy as sp
 
-from mechbook.app.mathml import math
+from mechbook.app.output.mathml import math
 from mechbook.app.report import svg
 from mechbook.app.report.answer_parts import parts
 from mechbook.app.report.derivation import StoredSystem

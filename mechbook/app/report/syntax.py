@@ -14,7 +14,7 @@ from __future__ import annotations
 import ast
 import html
 
-from mechbook.app.mathml import NS, identifier_mathml
+from mechbook.app.output.mathml import NS, identifier_mathml
 
 _PREC = {ast.Add: 1, ast.Sub: 1, ast.Mult: 2, ast.Div: 2, ast.Pow: 4}
 _REL = {ast.Lt: "&lt;", ast.LtE: "≤", ast.Gt: "&gt;", ast.GtE: "≥", ast.NotEq: "≠",

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
-from mechbook.app.mathml import MINUS, NS, identifier_mathml, math
+from mechbook.app.output.mathml import MINUS, NS, identifier_mathml, math
 from mechbook.app.report.derivation import StoredSystem
 from mechbook.app.report.syntax import syntax_math
 from mechbook.errors import MechbookError

@@ -5,7 +5,7 @@ Python API call this, and only print or return what it gives back.
         ──cache────▶ outcomes still valid in the store (problem, answers, engine unchanged)
         ──order────▶ the rest, the longest first by their stored durations
         ──batch────▶ the local pool (mechbook.app.running.batch) or a Dask cluster (distributed)
-        ──store────▶ each finished problem written at once (mechbook.app.unsaved.Saver)
+        ──store────▶ each finished problem written at once (mechbook.app.store.unsaved.Saver)
         ──report───▶ the runs in the order of the ids, and what became of the store
 
 A check is two steps, so that a caller can refuse its own bad options between them in the
@@ -20,19 +20,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mechbook.app.formats import failures
+from mechbook.app.output.formats import failures
 from mechbook.app.outputs import OutputError, output_file, resolve_path
 from mechbook.app.running.batch import Batch, BatchOptions
 from mechbook.app.running.distributed import ClusterBatch, scheduler_address
 from mechbook.app.running.run import ProblemRun, RunOptions, cached_runs, run_problem
 from mechbook.app.selection import select
 from mechbook.app.store import durations, write
-from mechbook.app.unsaved import Saver
+from mechbook.app.store.unsaved import Saver
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import DEFAULT_STORE, all_ids, existing_problem_path
 
 if TYPE_CHECKING:
-    from mechbook.app.unsaved import Saver
+    from mechbook.app.store.unsaved import Saver
     from mechbook.model.problem import Problem
 
 OnDone = Callable[[ProblemRun], None]

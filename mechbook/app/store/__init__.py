@@ -10,9 +10,13 @@ its parts:
     repair       a damaged store found before an edit, moved aside and rebuilt
     compaction   a store written anew with only what it holds
     child_read   a store not yet found sound read in a child under a CPU limit
+    unsaved      results the store could not take, kept in a side file (import it from
+                 its module: it is not loaded with the store)
+    restore      `mechbook restore`: a side file read back, checked, written into a store
 
-May import: the stages below mechbook.app and its shared modules (text, outputs, bounded,
-fingerprint); never the command line, the running of checks or the report.
+May import: the stages below mechbook.app, its shared modules (outputs, bounded,
+fingerprint) and output/'s text (strings made safe for HDF5 and JSON); never the command
+line, the running of checks or the report.
 """
 
 from mechbook.app.store.bounds import attributes, member

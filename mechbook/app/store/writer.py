@@ -32,7 +32,7 @@ stored simulations; storing a simulation replaces only that simulation.
 
 Nothing fails quietly. A write that cannot be made (a read-only or full file system, a
 directory or device at the path) raises StoreError with the path and the reason; the command
-line then keeps the results in a side file (mechbook.app.unsaved) and exits non-zero. A
+line then keeps the results in a side file (mechbook.app.store.unsaved) and exits non-zero. A
 damaged store (truncated, bytes flipped, not HDF5 at all) is detected before it is edited:
 it is moved aside to `<name>.damaged-<time>`, rebuilt from every problem, simulation and
 sweep that can still be read whole, and a warning says what was kept and what was lost.
@@ -64,6 +64,7 @@ import h5py
 import numpy as np
 
 from mechbook.app.fingerprint import engine_sha256
+from mechbook.app.output.text import storable
 from mechbook.app.outputs import OutputError, output_file, remove_stale, replaced
 from mechbook.app.store.bounds import MAX_ATTRIBUTE_BYTES, MAX_TEXT_BYTES
 from mechbook.app.store.child_read import mark_sound
@@ -71,7 +72,6 @@ from mechbook.app.store.compaction import compact
 from mechbook.app.store.entries import FORMAT, reason_of
 from mechbook.app.store.reader import DEFAULT_PATH, StoreError
 from mechbook.app.store.repair import ensure_sound
-from mechbook.app.text import storable
 from mechbook.errors import MechbookError
 from mechbook.records import Outcome, Results
 from mechbook.version import __version__
@@ -288,7 +288,7 @@ def attribute_value(v: object) -> object:
 
 
 def bounded_text(text: str, limit: int = MAX_ATTRIBUTE_BYTES, cut: bool = True) -> str:
-    """`text` as the store holds it (mechbook.app.text.storable) and as its readers will
+    """`text` as the store holds it (mechbook.app.output.text.storable) and as its readers will
     read it back: no longer than their bound (mechbook.app.store.bounds), cut with a note
     if it is longer (a title or an error's detail of megabytes), or, for JSON that cutting
     would break (`cut` False), a ValueError."""

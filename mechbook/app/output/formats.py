@@ -18,8 +18,8 @@ from collections import Counter
 from importlib import resources
 from pathlib import Path
 
+from mechbook.app.output.text import for_xml
 from mechbook.app.outputs import OutputError, output_file, replaced
-from mechbook.app.text import for_xml
 from mechbook.records import CROSSCHECK_STATUSES, FAILING, STATUSES, Status
 from mechbook.version import __version__
 

@@ -16,7 +16,7 @@ from collections.abc import Iterable
 import sympy as sp
 from sympy.printing.mathml import MathMLPresentationPrinter
 
-from mechbook.app.linebreak import rows as linebreak_rows
+from mechbook.app.output.linebreak import rows as linebreak_rows
 from mechbook.core.compile import as_expr
 
 NS = "http://www.w3.org/1998/Math/MathML"
@@ -109,7 +109,7 @@ def _rows(items: Iterable, width: int | None = None) -> str:
 
 
 def _lines(expr, width: int) -> str | None:
-    """A formula too long for a line as rows (mechbook.app.linebreak), or None."""
+    """A formula too long for a line as rows (mechbook.app.output.linebreak), or None."""
     if not isinstance(expr, sp.Basic):
         return None
     rows = linebreak_rows(expr, width, inner)

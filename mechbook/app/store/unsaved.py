@@ -25,8 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbook.app.store import ProblemRecord, StoreError, compact_store, write
-from mechbook.app.text import json_safe
+from mechbook.app.output.text import json_safe
+from mechbook.app.store.reader import StoreError
+from mechbook.app.store.writer import ProblemRecord, compact_store, write
 
 log = logging.getLogger("mechbook.store")
 

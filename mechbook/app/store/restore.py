@@ -1,4 +1,4 @@
-"""`mechbook restore FILE`: the results a side file kept (mechbook.app.unsaved) written into a
+"""`mechbook restore FILE`: the results a side file kept (mechbook.app.store.unsaved) written into a
 store, once the cause of the failed write is fixed.
 
 A side file is a file like any other by the time it is read back: it may have been edited,
@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from mechbook.app.bounded import Unreadable, json_value, regular_file
-from mechbook.app.store import ProblemRecord, check_run_name, write, write_simulation
-from mechbook.app.unsaved import FORMAT
+from mechbook.app.store.unsaved import FORMAT
+from mechbook.app.store.writer import ProblemRecord, check_run_name, write, write_simulation
 from mechbook.errors import MechbookError
 from mechbook.model.ids import check_id
 from mechbook.records import CrossCheck, Outcome, Results, Status
