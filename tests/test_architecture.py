@@ -581,3 +581,75 @@ def test_the_private_read_test_can_fail(tmp_path):
                      "x = boundary._hidden, power._other, boundary.public\n")
     assert private_module_reads([probe]) == ["probe.py:3 boundary._hidden",
                                              "probe.py:3 power._other"]
+
+
+# ---- issue 43: mechbook/app shows its parts, one package per kind ---------------------------
+# the modules left flat in mechbook/app, each shared by several of its packages (a module of
+# one package's kind belongs in that package)
+APP_FLAT = {
+    "options": "numeric options with bounds and a batch's default limits: the command line, "
+               "the API's argument checks, the batch, watch and sweeps read them (--help too)",
+    "outputs": "where results may be written (regular files, replaced whole): the store, "
+               "sweeps, formats, the report, the editor's schemas and restore write through it",
+    "bounded": "files mechbook reads back, read within bounds: the store's side file, the "
+               "report's page list, watch's polled files, the last failures",
+    "selection": "which problems a command means (ids, patterns, books, --lf): the command "
+                 "line and the check service",
+    "fingerprint": "content hashes for the warm-run cache: the store, the check and the report",
+    "docs": "the documentation pages, in a checkout or in the wheel: the command line, and "
+            "the pages --help and the starter point to",
+}
+# the packages of mechbook/app from the bottom up: each imports only those below it (and the
+# flat modules above), with the exceptions below, each with why
+APP_PACKAGES = ("output", "store", "running", "sweep", "report", "authoring", "api", "cli")
+APP_EXCEPTIONS = {
+    ("running", "mechbook.app.authoring.validate"):
+        "every check starts with validate's bounded build of the problem and its key",
+}
+
+
+def test_app_has_no_flat_module_beyond_the_shared_ones():
+    flat = sorted(p.stem for p in (PACKAGE / "app").glob("*.py") if p.stem != "__init__")
+    assert flat == sorted(APP_FLAT), ("a module of one kind belongs in its package (api/, "
+                                      "running/, authoring/, output/, ...); one shared by "
+                                      "several is listed in APP_FLAT with why")
+    packages = sorted(p.parent.name for p in (PACKAGE / "app").glob("*/__init__.py"))
+    assert packages == sorted(APP_PACKAGES), "a new package of mechbook.app: place it in order"
+
+
+def app_layer_breaches(known: dict[str, Path]) -> list[str]:
+    """Imports (TYPE_CHECKING ones too) from one package of mechbook.app to another that is
+    not below it in APP_PACKAGES, and from a flat module to any package."""
+    def package(module: str) -> str | None:  # None: a flat module, app itself, or outside
+        parts = module.split(".")
+        inside = len(parts) > 2 and parts[:2] == ["mechbook", "app"]
+        return parts[2] if inside and (PACKAGE / "app" / parts[2]).is_dir() else None
+
+    out = []
+    for m, path in sorted(known.items()):
+        if not m.startswith("mechbook.app."):
+            continue
+        own = package(m)
+        for n in sorted(imports(path)):
+            other = package(n)
+            if other is None or other == own or (own, n) in APP_EXCEPTIONS:
+                continue
+            if own is None or APP_PACKAGES.index(other) > APP_PACKAGES.index(own):
+                out.append(f"{m} -> {n}")
+    return out
+
+
+def test_each_app_package_imports_only_those_below_it():
+    assert app_layer_breaches(modules()) == []
+
+
+def test_the_app_layer_test_can_fail(tmp_path):
+    known = dict(modules())
+    up = tmp_path / "up.py"
+    up.write_text("from mechbook.app.cli.common import echo\n", encoding="utf-8")
+    known["mechbook.app.output.up"] = up
+    flat = tmp_path / "flat.py"
+    flat.write_text("from mechbook.app.store import read\n", encoding="utf-8")
+    known["mechbook.app.flat"] = flat
+    assert app_layer_breaches(known) == ["mechbook.app.flat -> mechbook.app.store",
+                                         "mechbook.app.output.up -> mechbook.app.cli.common"]

@@ -17,8 +17,8 @@ on `p` itself need a problem with one system (or take `system=`). Text given to 
 Results are simplified for reading (`simplify=True`, as `mechbook solve`; each
 simplification has a time limit); checks and simulations use the unsimplified engine, as
 `mechbook check` does. Objects show themselves in a notebook (`_repr_latex_`,
-`_repr_html_`). The system's methods live in mechbook.app.api.system, parameter values and
-the ODE function in api_params, the results in api_results.
+`_repr_html_`). The system's methods live in mechbook.app.api.system, parameter values in
+params (`params=`) and ode (the ODE function), the results in results.
 """
 
 from __future__ import annotations
