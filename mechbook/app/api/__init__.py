@@ -12,13 +12,14 @@ from here; the modules inside are its parts:
     animation      `animate()` and an inline `plot()` for a notebook
     display        results that show as mathematics in a notebook (lists and dicts)
     args           every argument checked with the command line's bounds
+    frames         the store as pandas DataFrames: `mechbook.results(path)`
 
 The names below load their module on first use (PEP 562), as `mechbook.load` does: `import
 mechbook` and the command line's --help must not load SymPy and the engine.
 
-May import: the engine's stages, mechbook.app's shared modules, running/ (a check) and
-output/ (MathML); nothing in mechbook.app imports the API but the command line's `solve`
-and mechbook.results' argument checks (args).
+May import: the stages below mechbook.app, its shared modules, and the packages below it:
+running/ (a check), store/ (mechbook.results), report/ (the motion's frames for animate())
+and output/ (MathML); of mechbook.app only the command line (`solve`) imports the API.
 """
 
 from __future__ import annotations

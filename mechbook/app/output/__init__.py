@@ -10,6 +10,6 @@ Import each part from its module (`from mechbook.app.output.text import for_term
 this `__init__` imports nothing, since the command line reads `text` at start-up and must
 not load SymPy for `mathml`.
 
-May import: the stages below mechbook.app and its shared modules (outputs); nothing else of
+May import: the stages below mechbook.app and its shared modules (outputs, bounded); nothing else of
 mechbook.app: every other package writes through it.
 """

@@ -15,7 +15,7 @@ QUANTITIES for its option choices at start-up, and importing this package must n
 NumPy and SymPy for that.
 
 May import: the stages below mechbook.app, its shared modules, store/ and running/ (the
-batch's limits, a cluster); spec only the standard library and the engine's names.
+batch's limits, a cluster); spec, read at start-up, nothing that loads NumPy or SymPy.
 """
 
 from __future__ import annotations
