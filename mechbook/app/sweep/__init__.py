@@ -14,8 +14,8 @@ The names below load their module on first use (PEP 562): the command line reads
 QUANTITIES for its option choices at start-up, and importing this package must not load
 NumPy and SymPy for that.
 
-May import: the stages below mechbook.app, its shared modules, store/ and running/ (the
-batch's limits, a cluster); spec, read at start-up, nothing that loads NumPy or SymPy.
+May import: the stages below mechbook.app, its shared modules, store/ and running/ (a
+pool of workers, a cluster); spec, read at start-up, nothing that loads NumPy or SymPy.
 """
 
 from __future__ import annotations
