@@ -617,6 +617,17 @@ def test_app_has_no_flat_module_beyond_the_shared_ones():
     assert packages == sorted(APP_PACKAGES), "a new package of mechbook.app: place it in order"
 
 
+def test_the_packages_passed_through_at_start_up_import_nothing():
+    """The fork server imports running.forkstart first (before the engine, to ignore Ctrl-C)
+    and the command line reads output.text and authoring's modules at start-up: their
+    packages' `__init__` import nothing; api's only importlib (its names load on first use)."""
+    for name in ("running", "authoring", "output", "api"):
+        tree = ast.parse((PACKAGE / "app" / name / "__init__.py").read_text("utf-8"))
+        imported = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+        imported |= {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
+        assert imported <= {"__future__", "importlib"}, (name, imported)
+
+
 def app_layer_breaches(known: dict[str, Path]) -> list[str]:
     """Imports (TYPE_CHECKING ones too) from one package of mechbook.app to another that is
     not below it in APP_PACKAGES, and from a flat module to any package."""
