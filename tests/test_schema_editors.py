@@ -30,7 +30,7 @@ PROBLEMS = sorted((ROOT / "problems").rglob("*.yaml"))
 ANSWERS = sorted((ROOT / "answers").rglob("*.yaml"))
 BOOKS = [ROOT / "books.yaml"]
 
-STARTER = ROOT / "mechbook" / "app" / "starter"
+STARTER = ROOT / "mechbook" / "app" / "authoring" / "starter"
 PROBLEM = (STARTER / "problem.yaml").read_text(encoding="utf-8")  # a valid problem
 ANSWERS_TEXT = (STARTER / "answers.yaml").read_text(encoding="utf-8")
 # each wrong file: (schema, text, what is wrong); both validators must flag each one
