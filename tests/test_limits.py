@@ -601,3 +601,21 @@ def test_unary_minuses_in_a_tensor_expression_are_an_expression_error():
 
     with pytest.raises(ExpressionError, match="nested too deeply"):
         parse_tensor("-" * 500 + "x", {"x": sp.Symbol("x")})
+
+
+@pytest.mark.parametrize("value", ["10000000000000000000000000000000000000000", "{x: 1}"])
+def test_a_principal_axis_that_is_no_vector_is_refused_at_its_line(tmp_path, value):
+    """The full fuzz run on the merged tree, case 8381: a `plane:` (or `axis:`) given as a
+    number made `validate` raise a raw TypeError ('int' object is not iterable)."""
+    for sub in ("problems", "answers"):
+        (tmp_path / sub / "symon").mkdir(parents=True)
+        shutil.copy(ROOT / sub / "symon" / "10-18.yaml", tmp_path / sub / "symon")
+    shutil.copy(ROOT / "books.yaml", tmp_path / "books.yaml")
+    key = tmp_path / "answers" / "symon" / "10-18.yaml"
+    text = key.read_text(encoding="utf-8")
+    assert "plane:" in text
+    key.write_text(text.replace("plane: n", f"plane: {value}", 1), encoding="utf-8")
+    res = run("--root", str(tmp_path), "validate", str(key))
+    assert res.exit_code == 1, res.output
+    assert "Traceback" not in res.output and "expected a vector" in res.output, res.output
+    assert "10-18.yaml:" in res.output, res.output

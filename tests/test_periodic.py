@@ -17,6 +17,7 @@ Reference values are never the engine's:
 from __future__ import annotations
 
 import math
+import time
 
 import mpmath
 import numpy as np
@@ -444,6 +445,23 @@ def test_a_declared_period_is_verified(mathieu_fixed, tmp_path):
     assert out.status == "unsupported" and "not a period" in out.detail, out.detail
     out = _check(mathieu_fixed, tmp_path, "lim-9402", **part, period="2*pi/omegaa")
     assert out.status == "error" and "unknown name 'omegaa'" in out.detail, out.detail
+
+
+MATHIEU_STIFF = MATHIEU_FIXED.replace("lim-9402", "lim-9407").replace(
+    "(alpha - 3*cos(2*t)/5)", "(10**40 + alpha - 3*cos(2*t)/5)")
+
+
+def test_a_period_too_long_to_integrate_is_refused_at_once(tmp_path):
+    """The fuzzer's case 897: a pivot driven at amplitude 1e90 looped in heyoka until the
+    check's 120 s limit. A period that holds ~1e20 oscillations of the fastest motion (rate
+    1e40 over T = π) is an error naming it, before any integration."""
+    analysis = load_analysis(tmp_path, MATHIEU_STIFF, "9407")
+    start = time.monotonic()
+    out = _check(analysis, tmp_path, "lim-9407", quantity="stability", about={"x": 0},
+                 book="stable", period="pi")
+    assert out.status == "error", (out.status, out.detail)
+    assert "oscillations of the system's fastest motion" in out.detail, out.detail
+    assert time.monotonic() - start < 60
 
 
 @pytest.mark.parametrize("period", ["1e-30", "1e-12", "pi*1e-15"])

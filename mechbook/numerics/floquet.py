@@ -66,6 +66,9 @@ def marginal_within(resolution: float, scale: float) -> float:
 
 SHORTEST = 1e-9  # T·rate below this: Φ = I + O(T·rate) puts every multiplier within 1e-9
 # of 1, where the integration's rounding decides its side: nothing can be told (an error)
+LONGEST = 1e5  # T·√rate above this: one period holds more oscillations of the fastest motion
+# than a monodromy in 113-bit arithmetic integrates in a check's time (a Kapitza pivot
+# driven at amplitude 1e90 looped in heyoka until the time limit): an error, at once
 ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
 
 
@@ -222,6 +225,13 @@ class Floquet:
                     f"{mpmath.nstr(T * rate, 2)} of itself (the system's rates are "
                     f"~{mpmath.nstr(rate, 3)} per unit time), so every multiplier is 1 to "
                     f"within the integration's resolution; give the coefficients' period")
+            if T * mpmath.sqrt(rate) > LONGEST:
+                raise MechbookError(
+                    f"the period {self.period} = {mpmath.nstr(T, 3)} holds about "
+                    f"{mpmath.nstr(T * mpmath.sqrt(rate) / (2 * mpmath.pi), 2)} oscillations "
+                    f"of the system's fastest motion (rates ~{mpmath.nstr(rate, 3)}): more "
+                    f"than one monodromy in {ARITHMETIC} can integrate; check the period "
+                    f"and the size of the coefficients")
             return T
 
     def _rate(self, values: dict) -> mpmath.mpf:

@@ -341,6 +341,9 @@ def check_principal_axes(ctx: Context, val) -> Verdict:
 
 
 def _vec(ctx: Context, spec, sub: tuple, names: dict) -> sp.Matrix:
+    if not isinstance(spec, str | list | tuple):  # a number, a mapping: no vector
+        raise ctx.part.error(sub, f"expected a vector ([x, y, z] or a vector expression), "
+                             f"got {spec!r:.60}")
     v = tparse(ctx, spec, sub, names) if isinstance(spec, str) else \
         sp.Matrix([tparse(ctx, x, sub + (j,), names) for j, x in enumerate(spec)])
     if kind(v) != "vector":
