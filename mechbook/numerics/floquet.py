@@ -133,6 +133,7 @@ class Floquet:
     symbols: list = field(default_factory=list)  # the parameters, in heyoka's par[] order
     _ta: object = field(default=None, repr=False)
     compile_seconds: float = 0.0
+    _at_zero: list | None = field(default=None, repr=False)  # M, K, C at t = 0
 
     @classmethod
     def of(cls, lin: LinearSystem, period: sp.Expr | None = None) -> Floquet:
@@ -238,16 +239,18 @@ class Floquet:
         """The largest rate of the linearized motion at t = 0 (1 + the largest entry of
         M⁻¹K and M⁻¹C there): a period T with T·rate below SHORTEST leaves Φ = I to the
         integration's resolution, and its multipliers tell nothing."""
-        lin = self.lin
+        if self._at_zero is None:  # M, K, C at t = 0, once (SymPy's LUsolve at every
+            t = self.lin.dyn.sys.t  # point was 40 % of a driven problem's check)
+            self._at_zero = [A.xreplace({t: 0}) for A in (self.lin.M, self.lin.K, self.lin.C)]
         at = {s: sp.Float(mpmath.nstr(_mp(v), 30), 30) for s, v in values.items()
               if isinstance(s, sp.Symbol)}
-        at[lin.dyn.sys.t] = 0
         try:
-            M = lin.M.xreplace(at).evalf(30)
-            rows = [M.LUsolve(X.xreplace(at).evalf(30)) for X in (lin.K, lin.C)]
-            big = max([abs(complex(x)) for R in rows for x in R] + [0.0])
-        except (TypeError, ValueError, ZeroDivisionError, sp.matrices.exceptions.
-                NonInvertibleMatrixError):
+            with mpmath.workdps(30):
+                M, K, C = (mpmath.matrix([[evaluate_mp(x, at, 30) for x in A.row(i)]
+                                          for i in range(A.rows)]) for A in self._at_zero)
+                rows = [mpmath.lu_solve(M, X) for X in (K, C)]
+                big = max([abs(complex(x)) for R in rows for x in R] + [0.0])
+        except (NotNumeric, TypeError, ValueError, ZeroDivisionError, KeyError):
             return mpmath.mpf(1)
         return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
 
