@@ -153,23 +153,32 @@ class Floquet:
 
     # ---- building the integrator --------------------------------------------------------
     def _integrator(self):
-        if self._ta is not None:
-            return self._ta
+        if self._ta is None:
+            start = time.perf_counter()
+            self._ta = self.taylor(_QuadTranslator, "real128")
+            self.compile_seconds = time.perf_counter() - start
+        return self._ta
+
+    def taylor(self, translator: type, fp: str, **options):
+        """heyoka's integrator of X' = A(t)X and Liouville's ∫tr M⁻¹C dt, in the floating
+        type `fp` ("real128"; "float64" for the double-precision screen,
+        mechbook.numerics.floquet_screen) with constants from `translator`; `options` go to
+        heyoka (`tol`). Parameters in `self.symbols` order, the state column by column."""
         try:
             import heyoka as hy
         except ImportError:
             raise UnsupportedError("Floquet multipliers need heyoka's Taylor integrator "
                                    "(pip install 'mechbook[taylor]')") from None
-        start = time.perf_counter()
         lin = self.lin
         n = lin.M.rows
         if any(not sp.simplify(lin.M[i, j] - lin.M[j, i]) == 0
                for i in range(n) for j in range(i + 1, n)):
             raise UnsupportedError("Floquet multipliers with a mass matrix that is not "
                                    "symmetric")
+        dtype = hy.real128 if fp == "real128" else np.float64
         symbols = {lin.dyn.sys.t: hy.time}
         symbols.update({s: hy.par[i] for i, s in enumerate(self.symbols)})
-        tr = _QuadTranslator(symbols)
+        tr = translator(symbols)
 
         def entry(e):
             return None if e == 0 else tr(e)
@@ -180,7 +189,7 @@ class Floquet:
         names = [f"x{i}_{j}" for j in range(2 * n) for i in range(2 * n)]
         X = list(hy.make_vars(*names, "liouville"))
         s = X.pop()
-        zero = hy.expression(hy.real128(0))
+        zero = hy.expression(dtype(0))
         ode = []
         for j in range(2 * n):  # column j of X: positions Q, velocities V
             Q, V = X[2 * n * j: 2 * n * j + n], X[2 * n * j + n: 2 * n * (j + 1)]
@@ -193,16 +202,15 @@ class Floquet:
         # Liouville: d/dt log det X = tr A = −tr(M⁻¹C); s carries ∫ tr(M⁻¹C) dt
         cols = [solve_spd(M, [C[i][j] for i in range(n)], _is_none) for j in range(n)]
         diag = [cols[j][j] for j in range(n) if cols[j][j] is not None]
+        self.traceless = not diag  # tr M⁻¹C ≡ 0: det Φ = 1 exactly, s stays 0
         ode.append((s, hy.sum(diag) if diag else zero))
-        state = np.zeros(len(ode), dtype=hy.real128)
-        pars = np.zeros(len(self.symbols), dtype=hy.real128)
+        state = np.zeros(len(ode), dtype=dtype)
+        pars = np.zeros(len(self.symbols), dtype=dtype)
         try:
-            self._ta = hy.taylor_adaptive(ode, state, pars=pars, fp_type=hy.real128)
+            return hy.taylor_adaptive(ode, state, pars=pars, fp_type=dtype, **options)
         except (ValueError, RuntimeError, TypeError) as exc:
             raise UnsupportedError(f"Floquet multipliers: heyoka refused the system ({exc})"
                                    ) from None
-        self.compile_seconds = time.perf_counter() - start
-        return self._ta
 
     # ---- one parameter point ------------------------------------------------------------
     def period_at(self, values: dict):
@@ -248,8 +256,9 @@ class Floquet:
             with mpmath.workdps(30):
                 M, K, C = (mpmath.matrix([[evaluate_mp(x, at, 30) for x in A.row(i)]
                                           for i in range(A.rows)]) for A in self._at_zero)
-                rows = [mpmath.lu_solve(M, X) for X in (K, C)]
-                big = max([abs(complex(x)) for R in rows for x in R] + [0.0])
+                cols = [mpmath.lu_solve(M, X.column(j)) for X in (K, C)
+                        for j in range(X.cols)]  # M⁻¹K and M⁻¹C, column by column
+                big = max([abs(complex(x)) for R in cols for x in R] + [0.0])
         except (NotNumeric, TypeError, ValueError, ZeroDivisionError, KeyError):
             return mpmath.mpf(1)
         return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
