@@ -134,6 +134,7 @@ class Floquet:
     _ta: object = field(default=None, repr=False)
     compile_seconds: float = 0.0
     _at_zero: list | None = field(default=None, repr=False)  # M, K, C at t = 0
+    traceless: bool = False  # tr M⁻¹C ≡ 0 (set by `taylor`): det Φ = 1 exactly
 
     @classmethod
     def of(cls, lin: LinearSystem, period: sp.Expr | None = None) -> Floquet:
@@ -263,22 +264,27 @@ class Floquet:
             return mpmath.mpf(1)
         return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
 
+    def checked_period(self, values: dict):
+        """The period at `values` (`period_at`), a declared one verified there, and every
+        parameter given: what any monodromy needs first, at 113 bits or in double."""
+        T = self.period_at(values)
+        if self.declared and not periodic.declared_period_holds(self.lin, self.period, values):
+            raise UnsupportedError(f"the declared period {self.period} is not a period of "
+                                   "the coefficients here")
+        for s in self.symbols:
+            if s not in values:
+                raise MechbookError(f"the linearized system keeps {s} without a value")
+        return T
+
     def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, object]:
         """(Φ, its entries exact as integrated; T; the Liouville exponent ∫tr M⁻¹C dt)."""
         import heyoka as hy
 
         ta = self._integrator()
         n2 = 2 * self.lin.M.rows
-        T = self.period_at(values)
-        if self.declared and not periodic.declared_period_holds(self.lin, self.period, values):
-            raise UnsupportedError(f"the declared period {self.period} is not a period of "
-                                   "the coefficients here")
+        T = self.checked_period(values)
         with mpmath.workdps(DPS):
-            pars = []
-            for s in self.symbols:
-                if s not in values:
-                    raise MechbookError(f"the linearized system keeps {s} without a value")
-                pars.append(hy.real128(mpmath.nstr(_mp(values[s]), 36)))
+            pars = [hy.real128(mpmath.nstr(_mp(values[s]), 36)) for s in self.symbols]
             ta.pars[:] = np.array(pars, dtype=hy.real128)
             state = np.zeros(n2 * n2 + 1, dtype=hy.real128)
             for j in range(n2):

@@ -238,6 +238,7 @@ def _engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, bel
     grid = offsets(floor, reach)
     missing = 0.0  # the largest offset at which a verdict was not given
     seen: dict[int, tuple[bool, bool]] = {}  # decade: (below agreed, above agreed)
+    raw: dict[int, tuple] = {}  # decade: the verdicts below and above
 
     def agrees(k: int) -> bool:
         nonlocal missing
@@ -245,7 +246,7 @@ def _engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, bel
             lo, hi = verdict(-1, grid[k]), verdict(1, grid[k])
             if lo is None or hi is None:
                 missing = max(missing, grid[k])
-            seen[k] = (lo == below, hi == above)
+            seen[k], raw[k] = (lo == below, hi == above), (lo, hi)
         return all(seen[k])
 
     first = _first_agreement(len(grid), agrees, start_decade(grid, guess))
@@ -255,17 +256,68 @@ def _engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, bel
         return floor, floor
     below_ok = seen[first - 1][0]  # the engine's crossing: between the two decades
     side, want = (-1, below) if not below_ok else (1, above)
-    s_in, s_out = grid[first - 1], grid[first]
+    lower = raw[first - 1][0 if side < 0 else 1]  # the verdict at the decade below
+    e, gap = _bisect(lambda x: verdict(side, x), want, grid[first - 1], grid[first],
+                     lower is not None, guess)
+    return e, max(floor, missing, gap)
+
+
+def _path(s_in: float, s_out: float, want_at) -> list[tuple[float, bool]]:
+    """The bisection's nodes (BISECTIONS of them, in the logarithm of the offset) and the
+    side each went, where want_at(mid) says whether the engine agrees there."""
+    out = []
     for _ in range(BISECTIONS):
         mid = math.sqrt(s_in * s_out)
-        got = verdict(side, mid)
-        if got is None:
-            missing = max(missing, mid)
+        ok = want_at(mid)
+        out.append((mid, ok))
+        s_in, s_out = (s_in, mid) if ok else (mid, s_out)
+    return out
+
+
+def _bisect(verdict, want: bool, s_in: float, s_out: float, lower_given: bool,
+            aim: float | None) -> tuple[float, float]:
+    """(the engine's crossing between the decades s_in and s_out, to 0.2 %: the bisection's
+    last midpoint; the largest node on its path where the engine gave no verdict, or 0).
+
+    The engine's verdict changes once between the decades (it disagrees at s_in, agrees at
+    s_out), and where it gives none that is below every verdict it gives: the offsets
+    without a verdict reach up from the floor. So a verdict tells the side of every node
+    beyond it, and the bisection asks only for the nodes that no verdict taken yet decides;
+    it takes first the two ends of the cell where `aim` (the crossing expected from the
+    walk's previous steps) falls, so where the guess is good two verdicts decide all ten
+    nodes. The nodes, the sides and the result are those of the plain bisection (ten
+    verdicts) wherever those two conditions hold; a node whose verdict was taken without
+    need (a guess that missed) never enters the result. Where the decade below gave no
+    verdict (`lower_given` false) nothing is inferred below a node: the plain bisection."""
+    taken: dict[float, bool | None] = {}
+    agree_from = s_out  # the smallest offset known to agree
+    disagree_to = s_in if lower_given else None  # the largest known to disagree (a verdict)
+
+    def ask(x: float) -> bool:
+        nonlocal agree_from, disagree_to
+        if x >= agree_from:
+            return True
+        if disagree_to is not None and x <= disagree_to:
+            return False
+        if x not in taken:
+            taken[x] = verdict(x)
+        got = taken[x]
         if got == want:
-            s_out = mid
-        else:
-            s_in = mid
-    return math.sqrt(s_in * s_out), max(floor, missing)
+            agree_from = min(agree_from, x)
+        elif got is not None and lower_given:
+            disagree_to = x if disagree_to is None else max(disagree_to, x)
+        return got == want
+
+    if aim is not None and lower_given and s_in < aim < s_out:
+        cell = _path(s_in, s_out, lambda m: m >= aim)
+        ends = [m for m, ok in cell if ok][-1:] + [m for m, ok in cell if not ok][-1:]
+        for x in ends:  # the cell's two ends: the last node on each side
+            ask(x)
+    path = _path(s_in, s_out, ask)
+    gap = max([m for m, _ in path if taken.get(m, False) is None] + [0.0])
+    lo = max([m for m, ok in path if not ok] + [s_in])  # the plain bisection's last bracket
+    hi = min([m for m, ok in path if ok] + [s_out])
+    return math.sqrt(lo * hi), gap
 
 
 def _first_agreement(n: int, agrees, start: int | None) -> int | None:

@@ -1,0 +1,180 @@
+"""Floquet verdicts in double precision where they are certain, the 113-bit computation
+everywhere else (issue 42).
+
+A driven problem's check takes hundreds of verdicts near a stability boundary, and each
+monodromy in 113-bit arithmetic (mechbook.numerics.floquet) costs milliseconds; in double
+precision it costs microseconds. The screen integrates Φ = X(T) in double twice, at
+heyoka's default tolerance (~2e-16) and at LOOSE_TOL, and bounds Φ's error by SAFETY
+times their difference (at least SAFETY ε times Φ's size): a conservative estimate, a
+hundred times the error of an integration ten thousand times looser than the one used.
+It gives a verdict only where every multiplier consistent with that bound gives the same
+verdict as the 113-bit computation, by margins far above that computation's own
+thresholds; everywhere else it returns None and the 113-bit computation decides:
+
+- **unstable**, any size: the multipliers lie in Bauer–Fike discs about Φ's eigenvalues,
+  radius κ(V)·(the error bound); a connected group of discs lying wholly beyond
+  |μ| = 1 + NEAR holds a multiplier there (for one degree of freedom the 2×2 formula
+  μ = (tr ± √(tr² − 4 det))/2 is used instead, with det from Liouville's formula: sharp
+  near a double root, where κ(V) is not). The 113-bit verdict there is unstable: it calls
+  a multiplier marginal only within marginal_within(resolution, scale) ≤ 100·√(1e-20 ·
+  MAX_SCALE) ≈ 3e-7 < NEAR of ±1 (any resolution it accepts), and on the circle only
+  within on_circle ≤ 1e-14 of it.
+- **stable**, one degree of freedom only: the trace's bound keeps tr² < 4 det by
+  MARGIN, so the multipliers are a complex pair, |μ|² = det Φ exactly, and det Φ is 1
+  exactly where tr M⁻¹C ≡ 0 (no damping, no velocity terms) or below 1 − MARGIN where the
+  Liouville exponent says so; the pair stays NEAR clear of ±1. The 113-bit verdict there
+  is stable: its |μ| − 1 is half its determinant's mismatch, below its on_circle where
+  Φ's entries are at most MAX_STABLE_SCALE (κ(Φ) ≤ 4·scale² for a 2×2 of determinant 1).
+  Two or more degrees of freedom: a multiplier on the circle cannot be told from one 1e-20
+  off it in double precision without the system's symplectic structure: never decided.
+
+The screen assumes what the 113-bit path shows wherever it has been measured: that it
+resolves Φ (Liouville's mismatch over κ(Φ) below 1e-20; 4e-36 to 2e-31 in the tests) at
+points where double precision resolves Φ's entries to its bound and they are at most
+MAX_SCALE. Where it would not, the 113-bit computation is no more than an unsupported
+point, which a screened verdict then replaces: the only assumption the screen makes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mechbook.errors import MechbookError
+from mechbook.numerics.floquet import Floquet
+from mechbook.numerics.hyexpr import Translator
+
+LOOSE_TOL = 1e-12  # the second integration's tolerance: their difference bounds Φ's error
+SAFETY = 100.0  # the bound: this many times that difference (and SAFETY·ε·‖Φ‖ at least)
+EPS = float(np.finfo(float).eps)
+NEAR = 1e-6  # a decided multiplier stays this clear of ±1 and of the unit circle
+MARGIN = 1e-11  # 4 det − tr² beyond its bound: the pair is complex in both arithmetics
+MAX_SCALE = 1e3  # Φ's largest entry above this: not screened (its growth costs digits)
+MAX_STABLE_SCALE = 500.0  # a stable verdict: the 113-bit |μ| − 1 stays within its bound
+MAX_BOUND = 1e-6  # an error bound above this: not screened (the integration is poor)
+
+
+class Screen:
+    """The double-precision monodromy of one Floquet system, and the verdicts it certifies.
+    Built once per linear system; `verdict(values)` is 'stable', 'unstable' or None."""
+
+    def __init__(self, floquet: Floquet):
+        self.floquet = floquet
+        self.n2 = 2 * floquet.lin.M.rows
+        self._tight = self._loose = None
+        self.broken = False  # heyoka refused the double system: every point escalates
+        self.decided = 0
+        self.escalated = 0
+
+    def _build(self) -> bool:
+        if self._tight is None and not self.broken:
+            try:
+                self._tight = self.floquet.taylor(Translator, "float64")
+                self._loose = self.floquet.taylor(Translator, "float64", tol=LOOSE_TOL)
+            except MechbookError:
+                self.broken = True
+        return not self.broken
+
+    def _run(self, ta, pars: np.ndarray, T: float) -> np.ndarray | None:
+        import heyoka as hy
+
+        ta.pars[:] = pars
+        ta.time = 0.0
+        state = np.zeros(self.n2 * self.n2 + 1)
+        state[: self.n2 * self.n2: self.n2 + 1] = 1.0
+        ta.state[:] = state
+        out = ta.propagate_until(T)
+        if out[0] != hy.taylor_outcome.time_limit or not np.all(np.isfinite(ta.state)):
+            return None
+        return np.array(ta.state)
+
+    def verdict(self, values: dict) -> str | None:
+        """'stable' or 'unstable' where double precision certifies the 113-bit verdict
+        (module docstring), None where it does not (the caller computes it in 113 bits).
+        The period's checks (mechbook.numerics.floquet.Floquet.period_at) run first and
+        raise as they do for the 113-bit monodromy. Example: Mathieu's α = 1, q = 0.3 far
+        inside a stable band: 'stable'; 1e-12 of α from a tongue's edge: None."""
+        flo = self.floquet
+        T = flo.checked_period(values)
+        got = self._decide(values, T) if self._build() else None
+        if got is None:
+            self.escalated += 1
+        else:
+            self.decided += 1
+        return got
+
+    def _decide(self, values: dict, T) -> str | None:
+        flo = self.floquet
+        try:
+            pars = np.array([float(values[s]) for s in flo.symbols], dtype=float)
+            Tf = float(T)
+        except (TypeError, ValueError, KeyError, OverflowError):
+            return None
+        if not (np.all(np.isfinite(pars)) and math.isfinite(Tf)):
+            return None
+        a, b = self._run(self._tight, pars, Tf), self._run(self._loose, pars, Tf)
+        if a is None or b is None:
+            return None
+        n2 = self.n2
+        phi = a[:-1].reshape(n2, n2).T  # the state is Φ column by column
+        scale = float(np.max(np.abs(phi)))
+        if not scale <= MAX_SCALE:
+            return None
+        bound = SAFETY * max(float(np.max(np.abs(a[:-1] - b[:-1]))), EPS * max(scale, 1.0))
+        if bound > MAX_BOUND:
+            return None
+        s = float(a[-1])  # ∫ tr M⁻¹C dt: det Φ = exp(−s)
+        ds = SAFETY * max(abs(s - float(b[-1])), EPS * (1.0 + abs(s)))
+        if flo.traceless:
+            det_lo = det_hi = 1.0
+        else:
+            det_lo, det_hi = math.exp(-s - ds), math.exp(-s + ds)
+        if n2 == 2:
+            return _two_by_two(phi, bound, det_lo, det_hi, flo.traceless, scale)
+        return _unstable_by_discs(phi, bound)
+
+
+def _two_by_two(phi: np.ndarray, bound: float, det_lo: float, det_hi: float,
+                exact_det: bool, scale: float) -> str | None:
+    """One degree of freedom: the multipliers from the trace's interval and Liouville's
+    determinant (module docstring)."""
+    tr = float(phi[0, 0] + phi[1, 1])
+    dtr = 2 * bound + 4 * EPS * abs(tr)
+    lo, hi = max(0.0, abs(tr) - dtr), abs(tr) + dtr  # |tr| of the exact Φ lies in [lo, hi]
+    if lo * lo > 4 * det_hi + MARGIN:  # a real pair: the larger is (|tr| + √(tr² − 4d))/2
+        big = (lo + math.sqrt(lo * lo - 4 * det_hi)) / 2
+        return "unstable" if big > 1 + NEAR else None
+    if hi * hi < 4 * det_lo - MARGIN:  # a complex pair, |μ|² = det Φ
+        if det_lo > (1 + NEAR) ** 2:
+            return "unstable"
+        inside = exact_det or det_hi < 1 - MARGIN
+        clear = det_lo + 1 - hi > NEAR * NEAR  # |μ ∓ 1|² = det ∓ tr + 1
+        if inside and clear and scale <= MAX_STABLE_SCALE:
+            return "stable"
+    return None
+
+
+def _unstable_by_discs(phi: np.ndarray, bound: float) -> str | None:
+    """Two or more degrees of freedom: 'unstable' where a connected group of Bauer–Fike
+    discs lies wholly beyond |μ| = 1 + NEAR (it holds as many multipliers as eigenvalues
+    of Φ), else None."""
+    n = phi.shape[0]
+    try:
+        lam, V = np.linalg.eig(phi)
+        kappa = float(np.linalg.cond(V))
+    except np.linalg.LinAlgError:
+        return None
+    if not math.isfinite(kappa):
+        return None
+    # ‖ΔΦ‖₂ ≤ n·(entrywise bound), plus the eigensolver's own backward error
+    r = kappa * (n * bound + 100 * n * EPS * float(np.linalg.norm(phi, 2)))
+    groups = []  # connected components of the union of discs
+    for k in range(n):
+        joined = [g for g in groups if any(abs(lam[k] - lam[j]) <= 2 * r for j in g)]
+        merged = {k}.union(*joined) if joined else {k}
+        groups = [g for g in groups if g not in joined] + [merged]
+    for g in groups:
+        if all(abs(lam[j]) - r > 1 + NEAR for j in g):
+            return "unstable"
+    return None
