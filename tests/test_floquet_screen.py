@@ -27,7 +27,7 @@ import sympy as sp
 from systems import load_analysis
 
 from mechbook.numerics.floquet import Floquet
-from mechbook.numerics.floquet_screen import Screen
+from mechbook.numerics.floquet_screen import WORTH_IT, Screen
 from mechbook.verify import boundary_limit
 from mechbook.verify.boundary_limit import BISECTIONS, FLOQUET_FLOOR, _engine_offset
 
@@ -183,15 +183,20 @@ potential: >-
 
 def test_two_degrees_of_freedom_are_decided_unstable_only(tmp_path):
     """The rotating saddle (k = 1, κ = 2) is stable exactly where 1 < Ω² < 9/8 (the closed
-    form derived in tests/test_periodic.py). Inside, the screen gives no verdict (four
-    multipliers on the circle); at Ω = 1.2, beyond the window, it finds one wholly outside
-    the circle: unstable, as in 113 bits."""
+    form derived in tests/test_periodic.py). The screen is built only once the 113-bit
+    computation has found WORTH_IT points unstable (before, it has nothing to offer a
+    claim of stability). Then: inside, no verdict (four multipliers on the circle); at
+    Ω = 1.2, beyond the window, a multiplier wholly outside the circle: unstable, as in
+    113 bits."""
     flo = _floquet(tmp_path, SADDLE, "9803")
     screen = Screen(flo)
     inside = _at(flo, m="1", k="1", kappa="2", Omega="1.03")
+    outside = _at(flo, m="1", k="1", kappa="2", Omega="1.2")
+    assert screen.verdict(outside) is None and screen._tight is None  # not built yet
+    for _ in range(WORTH_IT):
+        screen.note(flo.stability(outside))
     assert screen.verdict(inside) is None
     assert flo.stability(inside) == "stable"
-    outside = _at(flo, m="1", k="1", kappa="2", Omega="1.2")
     assert screen.verdict(outside) == "unstable"
     assert flo.stability(outside) == "unstable"
 

@@ -53,6 +53,7 @@ MARGIN = 1e-11  # 4 det − tr² beyond its bound: the pair is complex in both a
 MAX_SCALE = 1e3  # Φ's largest entry above this: not screened (its growth costs digits)
 MAX_STABLE_SCALE = 500.0  # a stable verdict: the 113-bit |μ| − 1 stays within its bound
 MAX_BOUND = 1e-6  # an error bound above this: not screened (the integration is poor)
+WORTH_IT = 4  # 2 or more degrees of freedom: screened once this many were unstable
 
 
 class Screen:
@@ -66,6 +67,7 @@ class Screen:
         self.broken = False  # heyoka refused the double system: every point escalates
         self.decided = 0
         self.escalated = 0
+        self.unstable_seen = 0  # 113-bit verdicts 'unstable' (`note`)
 
     def _build(self) -> bool:
         if self._tight is None and not self.broken:
@@ -97,12 +99,20 @@ class Screen:
         inside a stable band: 'stable'; 1e-12 of α from a tongue's edge: None."""
         flo = self.floquet
         T = flo.checked_period(values)
-        got = self._decide(values, T) if self._build() else None
+        useful = self.n2 == 2 or self.unstable_seen >= WORTH_IT
+        got = self._decide(values, T) if useful and self._build() else None
         if got is None:
             self.escalated += 1
         else:
             self.decided += 1
         return got
+
+    def note(self, verdict: str) -> None:
+        """A 113-bit verdict taken where the screen gave none: with two or more degrees of
+        freedom the screen can only tell 'unstable', so it is built (two compiles) only
+        once WORTH_IT such verdicts have been met."""
+        if verdict == "unstable":
+            self.unstable_seen += 1
 
     def _decide(self, values: dict, T) -> str | None:
         flo = self.floquet

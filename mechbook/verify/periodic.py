@@ -54,7 +54,9 @@ class FloquetVerdicts:
         got = self.floquet.multipliers(pt)
         self.points += 1
         self.worst = max(self.worst, got.resolution)
-        return got.verdict()
+        verdict = got.verdict()
+        self.screen.note(verdict)
+        return verdict
 
     def classify(self, pt: dict, near: bool) -> bool | None:
         """The boundary comparison's classifier: True stable, False unstable, None marginal
