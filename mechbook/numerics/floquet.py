@@ -135,6 +135,7 @@ class Floquet:
     compile_seconds: float = 0.0
     _at_zero: list | None = field(default=None, repr=False)  # M, K, C at t = 0
     traceless: bool = False  # tr M⁻¹C ≡ 0 (set by `taylor`): det Φ = 1 exactly
+    _checked: tuple | None = field(default=None, repr=False)  # the last point's period
 
     @classmethod
     def of(cls, lin: LinearSystem, period: sp.Expr | None = None) -> Floquet:
@@ -251,8 +252,7 @@ class Floquet:
         if self._at_zero is None:  # M, K, C at t = 0, once (SymPy's LUsolve at every
             t = self.lin.dyn.sys.t  # point was 40 % of a driven problem's check)
             self._at_zero = [A.xreplace({t: 0}) for A in (self.lin.M, self.lin.K, self.lin.C)]
-        at = {s: sp.Float(mpmath.nstr(_mp(v), 30), 30) for s, v in values.items()
-              if isinstance(s, sp.Symbol)}
+        at = {s: values[s] for s in self.symbols if s in values}
         try:
             with mpmath.workdps(30):
                 M, K, C = (mpmath.matrix([[evaluate_mp(x, at, 30) for x in A.row(i)]
@@ -267,6 +267,9 @@ class Floquet:
     def checked_period(self, values: dict):
         """The period at `values` (`period_at`), a declared one verified there, and every
         parameter given: what any monodromy needs first, at 113 bits or in double."""
+        key = tuple(values.get(s) for s in self.symbols)
+        if self._checked is not None and self._checked[0] == key:
+            return self._checked[1]  # the screen asked first, then the 113-bit monodromy
         T = self.period_at(values)
         if self.declared and not periodic.declared_period_holds(self.lin, self.period, values):
             raise UnsupportedError(f"the declared period {self.period} is not a period of "
@@ -274,6 +277,7 @@ class Floquet:
         for s in self.symbols:
             if s not in values:
                 raise MechbookError(f"the linearized system keeps {s} without a value")
+        self._checked = (key, T)
         return T
 
     def monodromy(self, values: dict) -> tuple[mpmath.matrix, object, object]:
