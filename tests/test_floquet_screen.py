@@ -312,3 +312,41 @@ def test_the_expected_error_extrapolates_the_fall():
     assert boundary_limit.expected([1e-5, 1e-6]) == pytest.approx(1e-7)
     assert boundary_limit.expected([1e-6, 1e-6]) == 1e-6
     assert boundary_limit.expected([math.inf]) == math.inf
+
+
+KAPITZA = """\
+id: lim-9804
+source: test
+title: pendulum on a pivot driven up and down
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  a: {value: 0.1}
+  omega: {value: 45.0}
+  g: {value: 9.81}
+coordinates:
+  theta: {}
+driven:
+  y0: a*cos(omega*t)
+particles:
+  bob: {mass: m, position: [l*sin(theta), y0 - l*cos(theta)]}
+gravity: {}
+"""
+
+
+def test_the_rate_guard_reads_the_coefficients_at_t0(tmp_path):
+    """The rate the period guards use, 1 + the largest entry of M⁻¹K and M⁻¹C at t = 0,
+    against closed forms: about θ = π the pendulum's l δθ̈ − (g + ÿ0) δθ = 0 with
+    ÿ0(0) = −aω² gives 1 + |g − aω²|/l; the rotating saddle at t = 0 has M⁻¹K =
+    diag(k, −κ): 1 + max(k, κ)."""
+    analysis = load_analysis(tmp_path, KAPITZA, "9804")
+    theta = analysis.system(None).q[0]
+    flo = Floquet.of(analysis.linear(None, {theta: sp.pi}))
+    for a, w, g, ell in ((0.1, 45.0, 9.81, 1.0), (0.003, 1500.0, 9.81, 0.7),
+                         (1e-6, 2.0, 9.81, 3.0)):
+        pt = _at(flo, a=a, omega=w, g=g, l=ell, m=2.0)
+        assert float(flo._rate(pt)) == pytest.approx(1 + abs(g - a * w * w) / ell,
+                                                     rel=1e-14)
+    saddle = _floquet(tmp_path / "saddle", SADDLE, "9805")
+    pt = _at(saddle, m="1.5", k="1", kappa="2.5", Omega="1.03")
+    assert float(saddle._rate(pt)) == pytest.approx(3.5, rel=1e-14)
