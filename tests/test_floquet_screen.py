@@ -8,7 +8,7 @@
   oscillator (det Φ < 1 by Liouville) is decided stable; two degrees of freedom are never
   decided stable (a multiplier on the circle is not told from one 1e-20 off it without
   the system's structure).
-- The walk's search (`_engine_offset`: a gallop from the previous steps' error, a
+- The walk's search (`engine_offset`: a gallop from the previous steps' error, a
   bisection that infers what its verdicts decide) gives the same error as the plain climb
   from the floor, written out here as the reference, on synthetic engines with a crossing
   and a band without verdicts below it, from any guess; its resolution is the climb's
@@ -29,7 +29,7 @@ from systems import load_analysis
 from mechbook.numerics.floquet import Floquet
 from mechbook.numerics.floquet_screen import WORTH_IT, Screen
 from mechbook.verify import boundary_limit
-from mechbook.verify.boundary_limit import BISECTIONS, FLOQUET_FLOOR, _engine_offset
+from mechbook.verify.boundary_limit import BISECTIONS, FLOQUET_FLOOR, engine_offset
 
 pytest.importorskip("heyoka")
 
@@ -275,13 +275,13 @@ def test_the_search_finds_the_climbs_error(crossing, silent, side):
     want_e, want_r = _climb(plain, False, True, reach, FLOQUET_FLOOR)
     for guess in (None, crossing, crossing * 10, crossing / 10, 1e-20, 0.5, math.inf):
         verdict_calls.clear()
-        e, r = _engine_offset(counted(engine), _Line(), t_star, False, True, reach,
+        e, r = engine_offset(counted(engine), _Line(), t_star, False, True, reach,
                               FLOQUET_FLOOR, guess)
         assert e == want_e, (guess, e, want_e)
         if r != want_r:
             assert r < want_r and e >= 10 * want_r and e >= 10 * r, (guess, r, want_r, e)
     verdict_calls.clear()
-    _engine_offset(counted(engine), _Line(), t_star, False, True, reach, FLOQUET_FLOOR,
+    engine_offset(counted(engine), _Line(), t_star, False, True, reach, FLOQUET_FLOOR,
                    crossing * 1.0001)
     if math.isfinite(want_e) and want_e > FLOQUET_FLOOR and silent < crossing / 10:
         assert len(verdict_calls) <= 8, len(verdict_calls)  # the climb took up to 68
@@ -300,7 +300,7 @@ def test_a_missing_verdict_up_to_the_error_is_the_resolution():
 
         want = _climb(plain, False, True, 1.0, FLOQUET_FLOOR)
         for guess in (None, crossing, crossing * 30):
-            got = _engine_offset(engine, _Line(), t_star, False, True, 1.0, FLOQUET_FLOOR,
+            got = engine_offset(engine, _Line(), t_star, False, True, 1.0, FLOQUET_FLOOR,
                                  guess)
             assert got == want, (crossing, guess, got, want)
             assert got[0] < 10 * got[1]  # at the resolution

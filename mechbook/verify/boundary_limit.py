@@ -85,7 +85,7 @@ def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier,
                 at = ray.point(t_star)  # the book's boundary value of p at this step
                 book.append(None if at is None else at[p])
                 seen = history.setdefault((p, i), [])
-                e, r = _engine_offset(classify, ray, t_star, below, above, reach, floor,
+                e, r = engine_offset(classify, ray, t_star, below, above, reach, floor,
                                       expected(seen))
                 seen.append(e)
                 resolution = max(resolution, r)
@@ -199,7 +199,7 @@ def start_decade(grid: list[float], guess: float | None) -> int | None:
     return len(grid) - 1
 
 
-def _engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, below: bool,
+def engine_offset(classify: boundary.Classifier, ray: boundary.Ray, t_star, below: bool,
                    above: bool, reach: float, floor: float = FLOOR,
                    guess: float | None = None) -> tuple[float, float]:
     """(how far from t_star the engine's verdict changes the way the book's does there, the
