@@ -308,7 +308,8 @@ def test_a_missing_verdict_up_to_the_error_is_the_resolution():
 
 def test_the_expected_error_extrapolates_the_fall():
     assert boundary_limit.expected([]) is None
-    assert boundary_limit.expected([1e-5]) == 1e-5
+    assert boundary_limit.expected([1e-5]) == pytest.approx(10 ** -5.5)
+    assert boundary_limit.expected([1e-5], order=3) == pytest.approx(1e-7)
     assert boundary_limit.expected([1e-5, 1e-6]) == pytest.approx(1e-7)
     assert boundary_limit.expected([1e-6, 1e-6]) == 1e-6
     assert boundary_limit.expected([math.inf]) == math.inf
