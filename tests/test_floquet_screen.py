@@ -351,3 +351,32 @@ def test_the_rate_guard_reads_the_coefficients_at_t0(tmp_path):
     saddle = _floquet(tmp_path / "saddle", SADDLE, "9805")
     pt = _at(saddle, m="1.5", k="1", kappa="2.5", Omega="1.03")
     assert float(saddle._rate(pt)) == pytest.approx(3.5, rel=1e-14)
+
+
+def test_the_bound_covers_the_parameters_rounding_to_doubles(mathieu):
+    """The double integration runs at the doubles of the 30-digit values; the screen moves
+    each parameter and the period by NUDGE ulps and adds how far Φ moves. For q = 0 (a
+    harmonic oscillator over T = π) Φ is closed-form, [[cos wT, sin wT/w], [−w sin wT,
+    cos wT]] with w = √α: the moves the screen measures are those of the closed form
+    (α and T moved; q = 0 is exact and does not move)."""
+    from mechbook.numerics.floquet_screen import EPS, NUDGE
+
+    flo, screen = mathieu
+    assert screen._build()
+    alpha, T = 2.0, math.pi
+    pars = np.array([alpha if s.name == "alpha" else 0.0 for s in flo.symbols])
+    a = screen._run(screen._tight, pars, T)
+    moved = screen._rounding(pars, T, a)
+
+    def phi(al, t):
+        with mpmath.workdps(40):
+            w = mpmath.sqrt(al)
+            return [mpmath.cos(w * t), -w * mpmath.sin(w * t), mpmath.sin(w * t) / w,
+                    mpmath.cos(w * t)]
+
+    with mpmath.workdps(40):
+        nudge = 1 + NUDGE * mpmath.mpf(EPS)
+        base = phi(mpmath.mpf(alpha), mpmath.pi)
+        want = sum(max(abs(x - y) for x, y in zip(phi(al, t), base, strict=True))
+                   for al, t in ((alpha * nudge, mpmath.pi), (alpha, mpmath.pi * nudge)))
+    assert abs(moved[0] / float(want) - 1) < 0.2, (moved, float(want))

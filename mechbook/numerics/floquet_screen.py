@@ -4,9 +4,13 @@ everywhere else (issue 42).
 A driven problem's check takes hundreds of verdicts near a stability boundary, and each
 monodromy in 113-bit arithmetic (mechbook.numerics.floquet) costs milliseconds; in double
 precision it costs microseconds. The screen integrates Φ = X(T) in double twice, at
-heyoka's default tolerance (~2e-16) and at LOOSE_TOL, and bounds Φ's error by SAFETY
-times their difference (at least SAFETY ε times Φ's size): a conservative estimate, a
-hundred times the error of an integration ten thousand times looser than the one used.
+heyoka's default tolerance (~2e-16) and at LOOSE_TOL, and once more with each parameter
+and the period moved by NUDGE ulps in turn (the doubles of the 30-digit values are half
+an ulp off them), and bounds Φ's error by the larger of SAFETY times the two
+tolerances' difference and the summed moves (and at least SAFETY ε times Φ's size): a
+conservative estimate, a hundred times the error of an integration ten thousand times
+looser than the one used, or the move of every parameter sixteen times more off than it
+is, all at once (Φ's response to such moves is linear).
 It gives a verdict only where every multiplier consistent with that bound gives the same
 verdict as the 113-bit computation, by margins far above that computation's own
 thresholds; everywhere else it returns None and the 113-bit computation decides:
@@ -54,6 +58,7 @@ MAX_SCALE = 1e3  # Φ's largest entry above this: not screened (its growth costs
 MAX_STABLE_SCALE = 500.0  # a stable verdict: the 113-bit |μ| − 1 stays within its bound
 MAX_BOUND = 1e-6  # an error bound above this: not screened (the integration is poor)
 WORTH_IT = 4  # 2 or more degrees of freedom: screened once this many were unstable
+NUDGE = 8  # ulps each parameter (and the period) is moved by to measure Φ's sensitivity
 
 
 class Screen:
@@ -107,6 +112,26 @@ class Screen:
             self.decided += 1
         return got
 
+    def _rounding(self, pars: np.ndarray, T: float, a: np.ndarray) -> tuple | None:
+        """How far Φ and Liouville's exponent move when each parameter, and the period, is
+        moved by NUDGE ulps in turn (summed): more than the rounding of the 30-digit values
+        to doubles (half an ulp each) can move them, so the bound covers the Φ of the values
+        the 113-bit computation integrates, not only of their doubles. None where a run
+        fails."""
+        dphi = ds = 0.0
+        for i in range(len(pars) + 1):
+            p, t = pars.copy(), T
+            if i < len(pars):
+                p[i] *= 1 + NUDGE * EPS
+            else:
+                t *= 1 + NUDGE * EPS
+            c = self._run(self._tight, p, t)
+            if c is None:
+                return None
+            dphi += float(np.max(np.abs(c[:-1] - a[:-1])))
+            ds += abs(float(c[-1] - a[-1]))
+        return dphi, ds
+
     def note(self, verdict: str) -> None:
         """A 113-bit verdict taken where the screen gave none: with two or more degrees of
         freedom the screen can only tell 'unstable', so it is built (two compiles) only
@@ -131,11 +156,15 @@ class Screen:
         scale = float(np.max(np.abs(phi)))
         if not scale <= MAX_SCALE:
             return None
-        bound = SAFETY * max(float(np.max(np.abs(a[:-1] - b[:-1]))), EPS * max(scale, 1.0))
+        moved = self._rounding(pars, Tf, a)
+        if moved is None:
+            return None
+        bound = max(SAFETY * float(np.max(np.abs(a[:-1] - b[:-1]))), moved[0],
+                    SAFETY * EPS * max(scale, 1.0))
         if bound > MAX_BOUND:
             return None
         s = float(a[-1])  # ∫ tr M⁻¹C dt: det Φ = exp(−s)
-        ds = SAFETY * max(abs(s - float(b[-1])), EPS * (1.0 + abs(s)))
+        ds = max(SAFETY * abs(s - float(b[-1])), moved[1], SAFETY * EPS * (1.0 + abs(s)))
         if flo.traceless:
             det_lo = det_hi = 1.0
         else:
