@@ -32,7 +32,10 @@ thresholds; everywhere else it returns None and the 113-bit computation decides:
   Two or more degrees of freedom: a multiplier on the circle cannot be told from one 1e-20
   off it in double precision without the system's symplectic structure: never decided.
 
-The screen assumes what the 113-bit path shows wherever it has been measured: that it
+The equations' constants are doubles here (a 1/3 is rounded, as a parameter is); where a
+constant multiplies a parameter its rounding is one of the moves measured, and where it
+multiplies none only the bound's floor (SAFETY ε) covers it. The screen assumes what the
+113-bit path shows wherever it has been measured: that it
 resolves Φ (Liouville's mismatch over κ(Φ) below 1e-20; 4e-36 to 2e-31 in the tests) at
 points where double precision resolves Φ's entries to its bound and they are at most
 MAX_SCALE. Where it would not, the 113-bit computation is no more than an unsupported
