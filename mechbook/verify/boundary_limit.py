@@ -77,10 +77,19 @@ def check(ctx: Context, cond: sp.Basic, classify: boundary.Classifier,
     last: dict = {}  # the probe along which the last step's error was largest
     history: dict = {}  # (probe, crossing): its errors at the steps so far
 
+    # the points of a probe's ray, shared by every part of the problem that walks the same
+    # steps with the same sampler (two orders of one boundary: the same rays, 40 grid
+    # points each per step)
+    shared = ctx.analysis.reuse(("limit-ray-points",), dict)
+    sampler_key = (tuple(sorted(ctx.sampler.derived.items(), key=lambda kv: kv[0].name)),
+                   tuple(str(c) for c in ctx.sampler.conditions))
+
     def error(pt: dict) -> tuple[float, float, list]:
         worst, found, resolution, book = 0.0, 0, floor, []
+        origin = tuple(sorted(((s.name, v) for s, v in pt.items()), key=lambda kv: kv[0]))
         for p in along:
             ray = _Ray(ctx.sampler, pt, np.array([1.0]), [p])
+            ray._points = shared.setdefault((sampler_key, p, origin), {})
             for i, (t_star, below, above, reach) in enumerate(
                     _book_crossings(cond, atoms, ray)):
                 found += 1
