@@ -102,13 +102,18 @@ class Screen:
     def verdict(self, values: dict) -> str | None:
         """'stable' or 'unstable' where double precision certifies the 113-bit verdict
         (module docstring), None where it does not (the caller computes it in 113 bits).
-        The period's checks (mechbook.numerics.floquet.Floquet.period_at) run first and
-        raise as they do for the 113-bit monodromy. Example: Mathieu's α = 1, q = 0.3 far
-        inside a stable band: 'stable'; 1e-12 of α from a tongue's edge: None."""
+        Where the screen is built, the period's checks (Floquet.checked_period) run first
+        and raise as they do for the 113-bit monodromy; where it is not, nothing runs.
+        Example: Mathieu's equation at q = 0.3: α = 0.4 (inside the first stable band)
+        'stable', α = 1 (in the first tongue) 'unstable', α a relative 1e-13 from an edge
+        None."""
         flo = self.floquet
-        T = flo.checked_period(values)
         useful = self.n2 == 2 or self.unstable_seen >= WORTH_IT
-        got = self._decide(values, T) if useful and self._build() else None
+        if not (useful and self._build()):  # the 113-bit path raises what it raises
+            self.escalated += 1
+            return None
+        T = flo.checked_period(values)  # the same checks the 113-bit monodromy makes
+        got = self._decide(values, T)
         if got is None:
             self.escalated += 1
         else:
@@ -170,6 +175,8 @@ class Screen:
         ds = max(SAFETY * abs(s - float(b[-1])), moved[1], SAFETY * EPS * (1.0 + abs(s)))
         if flo.traceless:
             det_lo = det_hi = 1.0
+        elif abs(s) + ds > 700:  # det Φ beyond a double's range
+            return None
         else:
             det_lo, det_hi = math.exp(-s - ds), math.exp(-s + ds)
         if n2 == 2:
