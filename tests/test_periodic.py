@@ -273,6 +273,8 @@ def test_kapitza_formula_holds_as_the_drive_gets_fast_and_small(kapitza, tmp_pat
                  book="a**2*omega**2 > 2*g*l")
     assert out.status == "pass", out.detail
     assert "ε^2.0" in out.power or "ε^1.9" in out.power, out.power
+    # the points far from the boundary were decided in double precision (issue 42)
+    assert "points decided in double precision" in out.power, out.power
     first = float(out.detail.split("relative error ")[1].split(",")[0])
     assert abs(first / (7 * 0.01**2 / 16) - 1) < 0.05, out.detail  # a = 0.01: 7a²/16
     out = _check(kapitza, tmp_path, "lim-9404", V, **KAPITZA_LIMIT,
