@@ -12,10 +12,12 @@ boundary is located along each *probe*: every free parameter the relation depend
 through the step's point in that parameter alone (log scale for a positive one, factors up
 to e^SPAN each way) finds every place where the book's relation changes truth, refined to
 30 digits (mechbook.verify.boundary). Around each crossing the engine's verdict is taken
-on both sides at offsets growing by decades from FLOOR until it agrees with the book's on
-both (a crossing of the engine's own within that offset), never farther than halfway to
-the next crossing; the engine's crossing is then bisected in the logarithm of the offset
-to 0.2 %. The error at the step is the largest such offset (relative, for a positive
+on both sides at the decades from FLOOR, never farther than halfway to the next crossing:
+the smallest at which it agrees with the book's on both (a crossing of the engine's own
+within that offset) is found from the error the walk's previous steps lead it to expect
+(`engine_offset`: the decades and the result of a climb from FLOOR, with a dozen verdicts
+instead of fifty; issue 42); the engine's crossing is then bisected in the logarithm of
+the offset to 0.2 %. The error at the step is the largest such offset (relative, for a positive
 parameter): the distance between the two boundaries. An engine with no crossing near the
 book's is an infinite error. Offsets below FLOOR are not resolved: the walk stops there.
 """
