@@ -439,23 +439,23 @@ def test_a_second_order_transfer_matrix_in_closed_form():
     the oscillator's own closed form (φ″ = −k²φ: [[cos kL, sin kL/k], [−k sin kL, cos kL]]),
     the growing one's (cosh, sinh), a double root (φ″ − φ′ + φ/4 = 0: e^{L/2}(1 − L/2, L;
     −L/4, 1 + L/2)), and mpmath's series to 38 digits."""
-    from mechbook.engine.continuum import _transfer
+    from mechbook.engine.continuum import transfer_matrix
 
     with mp.workdps(40):
         k, L = mp.mpf("2.7"), mp.mpf("1.3")
-        osc = _transfer(mp.matrix([[0, 1], [-k * k, 0]]), L)
+        osc = transfer_matrix(mp.matrix([[0, 1], [-k * k, 0]]), L)
         want = mp.matrix([[mp.cos(k * L), mp.sin(k * L) / k], [-k * mp.sin(k * L),
                                                                 mp.cos(k * L)]])
         assert mp.mnorm(osc - want, 1) < mp.mpf(10) ** -38
-        grow = _transfer(mp.matrix([[0, 1], [k * k, 0]]), L)
+        grow = transfer_matrix(mp.matrix([[0, 1], [k * k, 0]]), L)
         want = mp.matrix([[mp.cosh(k * L), mp.sinh(k * L) / k], [k * mp.sinh(k * L),
                                                                   mp.cosh(k * L)]])
         assert mp.mnorm(grow - want, 1) < mp.mpf(10) ** -37 * mp.mnorm(want, 1)
-        double = _transfer(mp.matrix([[0, 1], [-mp.mpf(1) / 4, 1]]), L)
+        double = transfer_matrix(mp.matrix([[0, 1], [-mp.mpf(1) / 4, 1]]), L)
         want = mp.exp(L / 2) * mp.matrix([[1 - L / 2, L], [-L / 4, 1 + L / 2]])
         assert mp.mnorm(double - want, 1) < mp.mpf(10) ** -38
         A = mp.matrix([[mp.mpf("0.3"), mp.mpf("-1.7")], [mp.mpf("2.2"), mp.mpf("-0.9")]])
-        assert mp.mnorm(_transfer(A, L) - mp.expm(A * L), 1) < mp.mpf(10) ** -38
+        assert mp.mnorm(transfer_matrix(A, L) - mp.expm(A * L), 1) < mp.mpf(10) ** -38
 
 
 def test_squared_frequencies_are_computed_once_per_point(tmp_path, monkeypatch):

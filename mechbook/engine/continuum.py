@@ -156,13 +156,18 @@ def _bc_rows(model: FieldModel, edge, axis_orders: int, point: dict) -> list:
     return rows
 
 
-def _transfer(A, length):
-    """exp(A·L): for a 2×2 matrix (a second-order mode ODE) in closed form, with t = tr A/2
-    and s² = t² − det A, (A − tI)² = s²I gives exp(AL) = e^{tL}[cosh(sL)·I +
-    (sinh(sL)/s)·(A − tI)] (cos and sin where s² < 0): exact, and a twentieth of the time
+def transfer_matrix(A, length) -> mp.matrix:
+    """exp(A·L), the transfer matrix of a mode ODE's first-order form A (an mpmath matrix)
+    over the length L. For a 2×2 A (a second-order ODE) in closed form: with t = tr A/2 and
+    s² = t² − det A, (A − tI)² = s²I gives exp(AL) = e^{tL}[cosh(sL)·I + (sinh(sL)/s)·
+    (A − tI)] (cos and sin where s² < 0): exact, and a twentieth of the time
     of mpmath's Taylor series with squarings, which a root's polish calls ten times; other
     sizes by mpmath's expm (a Vandermonde diagonalization of a beam's 4×4 companion matrix
-    was tried: its roots at twice the digits cost as much as the series)."""
+    was tried: its roots at twice the digits cost as much as the series).
+
+    >>> transfer_matrix(mp.matrix([[0, 1], [-1, 0]]), mp.pi / 2)[0, 1]  # sin(π/2)
+    mpf('1.0')
+    """
     if A.rows != 2:
         return mp.expm(A * length)
     t = (A[0, 0] + A[1, 1]) / 2
@@ -192,7 +197,7 @@ def _boundary_matrix(ode: list, weight, length, left: list, right: list, lam):
             A[i, i + 1] = 1
         for k in range(n):
             A[n - 1, k] = -a[k] / a[n]
-        phi = _transfer(A, length)
+        phi = transfer_matrix(A, length)
         M = mp.zeros(n, n)
         for i, (row, mass) in enumerate(left):
             for k in range(n):
