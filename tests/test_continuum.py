@@ -432,3 +432,46 @@ def test_the_spectral_crosscheck_can_fail(tmp_path, monkeypatch):
                         lambda *a: [v * (1 + mp.mpf("1e-6")) for v in real(*a)])
     got = spectral.spectral_part(analysis, part, {})
     assert got.status == Status.FAIL and got.error > 1e-7, got.detail
+
+
+def test_a_second_order_transfer_matrix_in_closed_form():
+    """exp(A·L) of a 2×2 mode matrix by e^{tL}[cosh(sL)·I + sinh(sL)/s·(A − tI)]: against
+    the oscillator's own closed form (φ″ = −k²φ: [[cos kL, sin kL/k], [−k sin kL, cos kL]]),
+    the growing one's (cosh, sinh), a double root (φ″ − φ′ + φ/4 = 0: e^{L/2}(1 − L/2, L;
+    −L/4, 1 + L/2)), and mpmath's series to 38 digits."""
+    from mechbook.engine.continuum import transfer_matrix
+
+    with mp.workdps(40):
+        k, L = mp.mpf("2.7"), mp.mpf("1.3")
+        osc = transfer_matrix(mp.matrix([[0, 1], [-k * k, 0]]), L)
+        want = mp.matrix([[mp.cos(k * L), mp.sin(k * L) / k], [-k * mp.sin(k * L),
+                                                                mp.cos(k * L)]])
+        assert mp.mnorm(osc - want, 1) < mp.mpf(10) ** -38
+        grow = transfer_matrix(mp.matrix([[0, 1], [k * k, 0]]), L)
+        want = mp.matrix([[mp.cosh(k * L), mp.sinh(k * L) / k], [k * mp.sinh(k * L),
+                                                                  mp.cosh(k * L)]])
+        assert mp.mnorm(grow - want, 1) < mp.mpf(10) ** -37 * mp.mnorm(want, 1)
+        double = transfer_matrix(mp.matrix([[0, 1], [-mp.mpf(1) / 4, 1]]), L)
+        want = mp.exp(L / 2) * mp.matrix([[1 - L / 2, L], [-L / 4, 1 + L / 2]])
+        assert mp.mnorm(double - want, 1) < mp.mpf(10) ** -38
+        A = mp.matrix([[mp.mpf("0.3"), mp.mpf("-1.7")], [mp.mpf("2.2"), mp.mpf("-0.9")]])
+        assert mp.mnorm(transfer_matrix(A, L) - mp.expm(A * L), 1) < mp.mpf(10) ** -38
+
+
+def test_squared_frequencies_are_computed_once_per_point(tmp_path, monkeypatch):
+    """A part's default point is its spectral cross-check's: the second asks no root of
+    the boundary determinant, and gets the same 30-digit values whatever its precision."""
+    import mechbook.engine.continuum as continuum
+
+    an = Analysis(load_problem(write_problem(tmp_path, MEMBRANE)))
+    model = an.built.field()
+    point = {p.symbol: sp.Float(p.value, 30) for p in an.problem.parameters.values()}
+    with mp.workdps(30):
+        first = squared_frequencies(model, point, 3)
+    calls = []
+    real = continuum._polish
+    monkeypatch.setattr(continuum, "_polish", lambda *a: calls.append(a) or real(*a))
+    again = squared_frequencies(model, point, 3)  # at the default 15 digits
+    assert again == first and not calls
+    other = squared_frequencies(model, {**point, next(iter(point)): sp.Float(0.9, 30)}, 3)
+    assert calls and other != first

@@ -204,3 +204,32 @@ def test_vector_atol_is_solve_ivps(tmp_path):
     with pytest.raises(ValueError, match="atol"):
         c_stepping.adaptive(model.native, model.stats, "DOP853", (0, 3), y0, 1e-8,
                           [1e-8, 1e-8, 1e-8])
+
+
+@pytest.mark.parametrize("rows, terminal", [(4096, True), (7, True), (4096, False)])
+def test_every_step_with_a_largest_step_as_solve_ivp(tmp_path, rows, terminal):
+    """`max_step` bounds the steps as solve_ivp's does, and `steps` answers every step's end
+    (the start first, a terminal event's state last): solve_ivp's steps, over records of any
+    size, to rounding."""
+    model = model_of(tmp_path, "pendulum")
+    y0 = np.array([1.0, 0.0])
+
+    def make():
+        return [event(lambda t, y: y[0] + 0.5, terminal, -1.0), event(lambda t, y: y[1], False,
+                                                                       1.0)]
+
+    ref = solve_ivp(model.rhs, (0.0, 12.0), y0, method="DOP853", rtol=1e-12, atol=1e-13,
+                    events=make(), max_step=0.05)
+    new = solve_with_events(model.native, model.rhs, (0.0, 12.0), y0, rtol=1e-12, atol=1e-13,
+                            events=make(), max_step=0.05, steps=True, rows=rows)
+    assert new.status == ref.status == (1 if terminal else 0)
+    assert len(ref.t) >= ref.t[-1] / 0.05 > 40  # max_step ruled the steps
+    assert np.max(np.diff(new.t)) <= 0.05 * (1 + 1e-12)
+    assert new.t.shape == ref.t.shape and new.y.shape == ref.y.shape
+    assert np.allclose(new.t, ref.t, rtol=1e-12, atol=1e-14)
+    assert np.allclose(new.y, ref.y, rtol=1e-9, atol=1e-11)
+    for te, rte in zip(new.t_events, ref.t_events, strict=True):
+        assert len(te) == len(rte) and np.allclose(te, rte, rtol=1e-12, atol=1e-12)
+    free = solve_with_events(model.native, model.rhs, (0.0, 12.0), y0, rtol=1e-12, atol=1e-13,
+                             max_step=0.05)
+    assert free.t.shape == (1,) and free.t[-1] == 12.0  # without `steps`: the end alone

@@ -242,7 +242,8 @@ def test_a_quadrature_short_of_its_digits_is_unsupported(systems, tmp_path, monk
         return quad(f, points, maxdegree=2 if mpmath.mp.dps < 50 else 8)
 
     monkeypatch.setattr(engine.mpmath, "quad", short)
-    status, detail = check(systems["coulomb"], tmp_path,
+    fresh = Analysis(systems["coulomb"].problem)  # no orbit the other tests computed
+    status, detail = check(fresh, tmp_path,
                            {"quantity": "deflection_angle", "book": "3*atan(k/(2*E*b))"})
     assert status == "unsupported" and "did not reach" in detail, detail
 
@@ -312,3 +313,21 @@ def test_the_asymptote_crosscheck_can_fail(systems, tmp_path, monkeypatch):
     monkeypatch.setattr(engine.Orbit, "deflection", property(off))
     (x,) = _crosscheck(systems["coulomb"], tmp_path, "1")
     assert x.status.value == "fail", x.detail
+
+
+def test_an_orbit_is_computed_once_per_precision(systems):
+    """The same numbers at the same precision give the same orbit (its values computed
+    once); another precision, b or E gives another, so the two-precision check still sees
+    two independent quadratures."""
+    fresh = Analysis(systems["coulomb"].problem)
+    dyn = fresh.dynamics()
+    sc = engine.Scattering(dyn, fresh.system().q[0])
+    pt = dict(fresh.problem.values())
+    b, E = sp.Float("0.8", 30), sp.Float("0.9", 30)
+    one = sc.orbit(pt, b, E)
+    assert sc.orbit(pt, b, E) is one and sc.orbit(pt, sp.Float("0.8", 30), E) is one
+    assert sc.orbit(pt, b, E, engine.DPS + 15) is not one
+    assert sc.orbit(pt, b * (1 + sp.Float("1e-20", 30)), E) is not one
+    k = next(float(v) for s, v in pt.items() if str(s) == "k")
+    assert abs(float(one.deflection) - 2 * math.atan(k / (2 * 0.9 * 0.8))) < 1e-14
+    assert sc.orbit(pt, b, E).deflection is one.deflection  # not computed again

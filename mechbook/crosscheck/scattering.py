@@ -1,11 +1,12 @@
 """The cross-check of a scattering part: the orbit integrated far out, its asymptote fitted.
 
 At the part's default values (its b and E), the full equations of motion (the system's
-compiled model, DOP853 at rtol 1e-12, not the engine's reduction or its quadrature) are
-integrated from a start at R on the incoming branch (energy E, angular momentum b·√(2mE):
-ṙ < 0 and θ̇ from them) until r is back at R, reflecting ṙ on a hard core. The velocity's
-turn between the two ends, Θ(R) = ψ_in − ψ_out − Δθ (ψ the velocity's angle to the radius,
-Δθ the angle swept), is the deflection up to the field's pull beyond R; it is taken at
+compiled model, DOP853 at rtol 1e-12, not the engine's reduction or its quadrature;
+solve_ivp's steps, taken in the compiled loop where there is one) are integrated from a
+start at R on the incoming branch (energy E, angular momentum b·√(2mE): ṙ < 0 and θ̇ from
+them) until r is back at R, reflecting ṙ on a hard core. The velocity's turn between the
+two ends, Θ(R) = ψ_in − ψ_out − Δθ (ψ the velocity's angle to the radius, Δθ the angle
+swept), is the deflection up to the field's pull beyond R; it is taken at
 R = 1000, 2000, … 16000 length scales and fitted by a cubic in 1/R, whose value at 1/R = 0
 is the asymptote's deflection. The smallest r met is the closest approach. Both must agree
 with the engine's to TOL. Where the engine has a time delay, the time from R back to R less
@@ -19,12 +20,12 @@ import math
 
 import numpy as np
 import sympy as sp
-from scipy.integrate import solve_ivp
 
 from mechbook.crosscheck.guard import guarded
 from mechbook.crosscheck.partview import PartView
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
+from mechbook.numerics.events import solve_with_events
 from mechbook.numerics.rhs import build_model
 from mechbook.records import CrossCheck, Status
 from mechbook.verify.answers import Part
@@ -126,10 +127,14 @@ class _Flight:
         return event
 
     def run(self, t, y, events, max_step=np.inf, span=None):
-        """((t, y, which event) at the first terminal event or None, the solution)."""
+        """((t, y, which event) at the first terminal event or None, the solution: every
+        step's end in y, as solve_ivp's). The steps are solve_ivp's, taken in the compiled
+        loop where there is one (mechbook.numerics.events)."""
         span = span if span is not None else 40 * self.R / self.speed
-        sol = solve_ivp(self.model.rhs, (t, t + span), y, method="DOP853", rtol=1e-12,
-                        atol=self.atol, events=events, max_step=max_step)
+        native = self.model.native
+        sol = solve_with_events(native, self.model.rhs, (t, t + span), y, rtol=1e-12,
+                                atol=self.atol, events=events, max_step=max_step, steps=True,
+                                stats=self.model.stats)
         if not sol.success:
             raise UnsupportedError(f"the orbit could not be integrated: {sol.message}")
         hits = [(float(te[0]), i) for i, te in enumerate(sol.t_events) if te.size and
@@ -137,8 +142,10 @@ class _Flight:
         if not hits:
             return None, sol
         t_hit, i = min(hits)
-        end = solve_ivp(self.model.rhs, (t, t_hit), y, method="DOP853", rtol=1e-12,
-                        atol=self.atol, max_step=max_step)
+        end = solve_with_events(native, self.model.rhs, (t, t_hit), y, rtol=1e-12,
+                                atol=self.atol, max_step=max_step, stats=self.model.stats)
+        if not end.success:
+            raise UnsupportedError(f"the orbit could not be integrated: {end.message}")
         return (t_hit, end.y[:, -1].copy(), i), sol
 
 

@@ -41,6 +41,7 @@ DIGITS = 30  # digits a result must keep at both precisions
 FAR = 10 ** 8  # the inward search for r_min starts this many length scales out
 STEP = mpmath.mpf("0.98")  # its geometric step (a barrier narrower than 2 % of r is missed)
 MAX_STEPS = 6000
+ORBITS = 4096  # orbits a Scattering keeps (their values computed once), then forgets
 
 
 class Unbound(Exception):
@@ -87,6 +88,7 @@ class Scattering:
             raise UnsupportedError("scattering: the effective potential is not even and "
                                    "quadratic in the angular momentum")
         self.P = P
+        self._orbits: dict[tuple, Orbit] = {}  # (params, b, E, dps) -> its Orbit
 
     @cached_property
     def functions(self):
@@ -115,10 +117,19 @@ class Scattering:
 
     def orbit(self, point: dict, b, E, dps: int = DPS) -> Orbit:
         """The scattering orbit of impact parameter `b` and energy `E` (numbers) at the
-        parameter `point`, in `dps`-digit arithmetic; Unbound if it is not one."""
+        parameter `point`, in `dps`-digit arithmetic; Unbound if it is not one. The same
+        numbers at the same precision give the same Orbit (its values computed once: the
+        parts of a problem draw the same points, and its cross-check asks them again)."""
         with mpmath.workdps(dps):
             params = [_mp(point[p], dps) for p in self.level.params]
-            return Orbit(self, params, _mp(b, dps), _mp(E, dps), dps)
+            b, E = _mp(b, dps), _mp(E, dps)
+            key = (tuple(params), b, E, dps)
+            orbit = self._orbits.get(key)
+            if orbit is None:
+                if len(self._orbits) >= ORBITS:
+                    self._orbits.clear()
+                orbit = self._orbits[key] = Orbit(self, params, b, E, dps)
+            return orbit
 
 
 def _mp(value, dps: int):

@@ -1,0 +1,137 @@
+"""What the example book `classic` adds to a cold `mechbook check` of the books (issues 39, 40).
+
+Both issues allow the example problems at most 10 % of the cold `make check`. Measured on
+this tree, in one run, the two configurations taking turns:
+
+    books      `mechbook check lim symon --fresh --no-store -j N --format json`
+    + classic  `mechbook check lim symon classic --fresh --no-store -j N --format json`
+
+Each run's wall time and its problems' worker seconds (as the workers report them) are
+taken; the ratio the issues ask for is the wall time of `+ classic` over `books`, less one,
+and, in the same `+ classic` run, classic's worker seconds over the books' (the figure the
+order of the problems in the pool does not move). With --cpu, both sets are checked once
+more `--serial` in one process each, and their CPU time (user + system: the figure a
+loaded machine does not inflate) is compared too. Every classic part must pass, no
+problem may end in an error, and the books' outcomes (status and power line of each part,
+each cross-check) must be the same in both configurations (exit 1 otherwise). The classic
+problems' seconds are listed, the slowest first. Never gates CI: timings depend on the
+machine and its load.
+
+    python bench/classic_cost.py [-j N] [--repeat 1] [--cpu] [--books lim symon]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BUDGET = 0.10  # the issues' limit: classic adds at most 10 % to the cold check
+
+
+def check(ids: list[str], jobs: int | None) -> tuple[float, float, dict]:
+    """(wall seconds, CPU seconds of the child and its workers, the JSON document) of one
+    cold check of `ids` (`jobs` None: --serial)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    how = ["--serial"] if jobs is None else ["-j", str(jobs)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    out = subprocess.run([sys.executable, "-m", "mechbook", "--root", str(ROOT), "check", *ids,
+                          "--fresh", "--no-store", *how, "--format", "json"],
+                         env=env, cwd=str(ROOT), capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    try:
+        doc = json.loads(out.stdout)
+    except json.JSONDecodeError:
+        sys.exit(f"mechbook check {' '.join(ids)} gave no JSON (exit {out.returncode}):\n"
+                 f"{out.stderr[-2000:]}")
+    return wall, cpu, doc
+
+
+def outcomes(doc: dict) -> dict:
+    """{(problem, 'part', name): (status, power), (problem, 'cross', name, parts): status}."""
+    found = {}
+    for prob in doc["problems"]:
+        for part in prob.get("parts", []):
+            found[(prob["id"], "part", part["part"])] = (part["status"], part.get("power"))
+        for x in prob.get("crosschecks", []):
+            found[(prob["id"], "cross", x["name"], tuple(x["parts"]))] = x["status"]
+        if prob.get("error"):
+            found[(prob["id"], "error")] = prob["error"]
+    return found
+
+
+def seconds(doc: dict, classic: bool) -> dict[str, float]:
+    """Each problem's worker seconds, of the classic book's problems or of the others."""
+    return {p["id"]: p["seconds"] for p in doc["problems"] if (p["book"] == "classic") == classic}
+
+
+def not_passing(doc: dict) -> list[str]:
+    """The classic parts that do not pass, and the problems that ended in an error (every
+    classic key is an own derivation: each of its parts passes)."""
+    return [f"{p['id']}/{part['part']}: {part['status']}" for p in doc["problems"]
+            if p["book"] == "classic" for part in p.get("parts", [])
+            if part["status"] != "pass"] + \
+        [f"{p['id']}: {p['error']}" for p in doc["problems"] if p.get("error")]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-j", "--jobs", type=int, default=0, help="workers (0: one per core, as "
+                    "`make check`)")
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--cpu", action="store_true", help="also the serial CPU time of each set")
+    ap.add_argument("--books", nargs="+", default=["lim", "symon"])
+    opts = ap.parse_args()
+    walls: dict[str, list[float]] = {"books": [], "all": []}
+    shares, docs, bad = [], {}, []
+    for rnd in range(opts.repeat):
+        for name, ids in (("books", opts.books), ("all", [*opts.books, "classic"])):
+            wall, _, doc = check(ids, opts.jobs)
+            walls[name].append(wall)
+            docs.setdefault(name, []).append(doc)
+            bad += not_passing(doc) if name == "all" else []
+            print(f"round {rnd + 1} {name}: {wall:.1f} s wall", file=sys.stderr)
+        last = docs["all"][-1]
+        shares.append(sum(seconds(last, True).values()) / sum(seconds(last, False).values()))
+    same = all(outcomes(a) == {k: v for k, v in outcomes(b).items()
+                               if not k[0].startswith("classic-")}
+               for a, b in zip(docs["books"], docs["all"], strict=True))
+    wb, wa = statistics.median(walls["books"]), statistics.median(walls["all"])
+    print(f"cold check -j {opts.jobs}, median of {opts.repeat} round(s), one tree "
+          f"({ROOT.name}):")
+    print(f"  books ({' '.join(opts.books)}): {wb:.1f} s wall; + classic: {wa:.1f} s wall; "
+          f"classic adds {100 * (wa / wb - 1):+.1f} % of the wall time (budget "
+          f"{100 * BUDGET:.0f} %)")
+    print(f"  worker seconds in the + classic run: classic / books = "
+          f"{100 * statistics.median(shares):.1f} %")
+    if opts.cpu:
+        _, cb, _ = check(opts.books, None)
+        _, cc, _ = check(["classic"], None)
+        print(f"  serial CPU: books {cb:.1f} s, classic {cc:.1f} s: classic adds "
+              f"{100 * cc / cb:.1f} %")
+    last = docs["all"][-1]
+    classic = sorted(seconds(last, True).items(), key=lambda kv: -kv[1])
+    print(f"classic problems, worker seconds (last round; {sum(v for _, v in classic):.1f} s "
+          f"against the books' {sum(seconds(last, False).values()):.1f} s):")
+    for pid, sec in classic:
+        print(f"  {sec:6.2f}  {pid}")
+    print(f"outcomes: books the same in both configurations: {'yes' if same else 'NO'}; "
+          f"not passing: {len(bad)}")
+    for line in bad:
+        print(f"  {line}")
+    if bad or not same:
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()
