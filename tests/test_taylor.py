@@ -99,16 +99,28 @@ def test_pendulum_against_the_jacobi_elliptic_solution(tmp_path):
 def test_linear_system_against_the_matrix_exponential(tmp_path):
     model, _ = model_of(tmp_path, COUPLED, "9202")
     y0 = np.array([0.3, -0.1, 0.2, 0.5])
-    # y' = A y with A from the model's own (linear) right-hand side, exactly
-    A = np.column_stack([model.rhs(0.0, e) for e in np.eye(4)])
     ts = np.linspace(0, 20, 11)
     traj = integrate(model, (0, 20), y0[:2], y0[2:], "taylor", t_eval=ts)
-    # exp(At)·y0 at 40 digits (scipy's expm is good to ~1e-12 here, not enough)
+    # y' = A y, A from COUPLED's T and V by hand at 40 digits: M = [[m1 + m2, m2 + c],
+    # [m2 + c, m2]], K = [[k1 + k2, -k2], [-k2, k2]], q̈ = -M⁻¹K q (an A rounded to
+    # doubles, e.g. from model.rhs, is itself ~1e-12 off the motion by t = 20)
     with mp.workdps(40):
-        Am, ym = mp.matrix(A.tolist()), mp.matrix(y0.tolist())
+        # the parameters as the problem holds them: doubles (0.4 is not 2/5), taken exactly
+        m1, m2, k1, k2, c = (mp.mpf(x) for x in (1.0, 2.5, 3.0, 7.0, 0.4))
+        acc = -(mp.matrix([[m1 + m2, m2 + c], [m2 + c, m2]]) ** -1
+                * mp.matrix([[k1 + k2, -k2], [-k2, k2]]))
+        Am = mp.zeros(4, 4)
+        Am[0, 2] = Am[1, 3] = 1
+        for i in range(2):
+            for j in range(2):
+                Am[2 + i, j] = acc[i, j]
+        ym = mp.matrix(y0.tolist())
         exact = np.column_stack([[float(v) for v in mp.expm(Am * t) * ym] for t in ts])
-    assert np.max(np.abs(traj.y - exact)) < 1e-12
+        A = np.array(Am.tolist(), dtype=float)
+    assert np.max(np.abs(traj.y - exact)) < 1e-13
     assert np.max(np.abs(expm(A * 2.0) @ y0 - exact[:, 1])) < 1e-11  # scipy: float only
+    assert np.allclose(A, np.column_stack([model.rhs(0.0, e) for e in np.eye(4)]),
+                       rtol=1e-14, atol=1e-14)  # the model's equations are these
 
 
 def test_constrained_particle_is_the_pendulum(tmp_path):
