@@ -3,10 +3,13 @@
 Why: Taylor's method compiled through LLVM (heyoka.py) is at the work–precision front for
 smooth, non-stiff motion at tight tolerances — 10⁴ pendulum periods at tol 1e-15 in a
 tenth of a second with the energy held to ~1e-14 — and it detects events on its own dense
-output. The equations are the engine's, M q̈ = f (+ A q̈ + b = 0), translated from SymPy by
-`hyexpr` with the parameters as heyoka runtime parameters; the accelerations solve M by
-LDLᵀ inside the expression (M is symmetric positive definite; with constraints the
-multipliers come from the Schur complement A M⁻¹ Aᵀ, also SPD). One system compiles once
+output. The equations are the engine's, M q̈ = f (+ A q̈ + b = 0), brought to the form a
+Taylor step is cheapest in by `taylor_form` — the accelerations solved by LDLᵀ in SymPy
+(M is symmetric positive definite; with constraints the multipliers come from the Schur
+complement A M⁻¹ Aᵀ, also SPD), small entries trigsimp'd, every parameter-only
+subexpression one derived heyoka runtime parameter — and translated by `hyexpr`: the
+pendulum's right-hand side is par[0]·sin q₀, as short as heyoka written by hand, and a
+10⁴-period run costs what heyoka's own propagate_grid costs. One system compiles once
 per process: the integrators are cached on the model by tolerance and event set, and
 heyoka's own in-memory LLVM cache reuses the machine code for a model rebuilt at other
 parameter values. heyoka is optional (`pip install 'mechbook[taylor]'`); without it,
