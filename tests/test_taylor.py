@@ -365,3 +365,22 @@ def test_derived_parameters_follow_the_parameters_in_quadruple_precision(tmp_pat
     with mp.workdps(40):  # −g/l of the doubles 9.81 and 0.7, to real128's 113 bits
         want = -mp.mpf(G) / mp.mpf(LEN)
         assert abs(mp.mpf(str(ta.pars[0])) / want - 1) < 1e-32
+
+
+def test_a_parameter_combination_that_is_not_real_is_refused(tmp_path):
+    text = """\
+id: lim-9206
+source: test
+title: a spring whose stiffness is a root of the parameters
+parameters:
+  m: {value: 1.0}
+  a: {value: 1.0}
+  b: {value: 2.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: sqrt(a - b)*x**2/2
+"""
+    model, _ = model_of(tmp_path, text, "9206")
+    with pytest.raises(UnsupportedError, match="not real"):
+        taylor.integrator(model, 1e-12, key="plain")

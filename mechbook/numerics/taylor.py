@@ -79,7 +79,10 @@ class TaylorSystem:
         them), each rounded once from 40 digits to `fp_type`."""
         at = dict(zip(self.params, self.pars, strict=True))
         at.update(base or {})
-        values = self.hoisted.values(at)
+        try:
+            values = self.hoisted.values(at)
+        except ValueError as exc:  # e.g. √(k − m) with k < m: no real equation to integrate
+            raise UnsupportedError(f"Taylor backend: {exc}") from None
         if fp_type is float:
             return np.array([float(x) for x in values], dtype=float)
         return np.array([fp_type(sp.sstr(x, full_prec=True)) for x in values], dtype=fp_type)
