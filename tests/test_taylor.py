@@ -384,3 +384,25 @@ potential: sqrt(a - b)*x**2/2
     model, _ = model_of(tmp_path, text, "9206")
     with pytest.raises(UnsupportedError, match="not real"):
         taylor.integrator(model, 1e-12, key="plain")
+
+
+def test_parameter_only_subexpressions_become_one_parameter_each():
+    from mechbook.numerics.taylor_form import Hoisted, tidy
+
+    x, t = sp.symbols("x t")
+    g, l, m, w = sp.symbols("g l m w", positive=True)  # noqa: E741
+    h = Hoisted(frozenset([x, t]), frozenset([g, l, m, w]))
+    mass = tidy(m * l**2 * (sp.sin(x) ** 2 + sp.cos(x) ** 2))
+    assert mass == m * l**2
+    acc = h(-g * l * m * sp.sin(x) / mass + 3 * sp.cos(w * t) / (m * l) + sp.pi * x)
+    assert set(h.derived) == {-g / l, 3 / (m * l), w}  # and π stays a number
+    p = dict(zip(h.derived, h.symbols, strict=True))
+    assert acc == (p[-g / l] * sp.sin(x) + p[3 / (m * l)] * sp.cos(p[w] * t)
+                   + sp.Float(sp.pi.evalf(40), 40) * x)
+    assert h(-g * l * m * sp.sin(x) / mass) == p[-g / l] * sp.sin(x)  # shared, not a new one
+    at = {g: 9.81, l: 1.3, m: 2.0, w: 0.1}
+    with mp.workdps(40):
+        want = {-g / l: -mp.mpf(9.81) / mp.mpf(1.3), 3 / (m * l): 3 / (mp.mpf(2.0) * mp.mpf(1.3)),
+                w: mp.mpf(0.1)}
+        for e, value in zip(h.derived, h.values(at), strict=True):
+            assert abs(mp.mpf(str(value)) - want[e]) < mp.mpf(10) ** -38

@@ -106,7 +106,10 @@ class Hoisted:
         """A subexpression free of t, q, q̇: a number stays a number, anything else (a
         parameter, −g/l, π·m) is one derived parameter."""
         if not e.free_symbols:
-            return e if e.is_Number else sp.Float(e.evalf(VALUE_DPS), VALUE_DPS)
+            if e.is_Number:
+                return e
+            x = e.evalf(VALUE_DPS)
+            return sp.Float(x, VALUE_DPS) if x.is_real else e  # complex: refused later
         if not e.free_symbols <= self.params:  # a symbol without a value: the translator
             return e                          # refuses it, naming it
         sym = self._index.get(e)
