@@ -5,7 +5,7 @@ BIN     = $(VENV)/bin
 STAMP   = $(VENV)/.installed
 AJV     = .ci/ajv/node_modules/.package-lock.json
 
-.PHONY: check test test-quick test-mutation test-min test-install lint fuzz report bench bench-check bench-sweep bench-power clean
+.PHONY: check test test-quick test-mutation test-min test-install lint fuzz report bench bench-check bench-sweep bench-power bench-taylor clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -87,6 +87,11 @@ bench-sweep: $(STAMP)  ## 10^6-point sweeps: points per second, float64 vs 30 di
 	mkdir -p results/bench
 	$(BIN)/python bench/sweep.py --csv results/bench/sweep.csv > results/bench/sweep.txt \
 		&& cat results/bench/sweep.txt
+
+bench-taylor: $(STAMP)  ## `simulate --method taylor` against heyoka's own propagate_grid, pendulum, 10^4 periods (~2 min)
+	mkdir -p results/bench
+	$(BIN)/python bench/taylor.py --repeat 7 --cli 3 --float128 > results/bench/taylor.txt \
+		&& cat results/bench/taylor.txt
 
 bench-power: $(STAMP)  ## the checker's power: small wrong answers rejected, per quantity, before/after -> docs/answers.md (~1 h)
 	mkdir -p results/bench

@@ -237,3 +237,17 @@ def test_a_tiny_span_simulates_and_its_drift_rate_is_a_number(t_end):
     res = run("--root", ROOT, "simulate", "lim-2031", "--no-store", "--t-end", t_end)
     assert res.exit_code == 0, res.output
     assert "drift of energy_function" in res.output and "LinAlg" not in res.output
+
+
+def test_a_repeated_run_reuses_the_compiled_model(tmp_path):
+    from systems import OSCILLATOR, load_analysis
+
+    an = load_analysis(tmp_path, OSCILLATOR, "9301")  # m = 1.5, k = 6
+    first = simulate(an, init={"x": "0.5"}, t_span=(0, 3), points=31)
+    again = simulate(an, init={"x": "0.5"}, t_span=(0, 3), points=31)
+    other = simulate(an, init={"x": "0.5"}, t_span=(0, 3), points=31, parameters={"k": "4"})
+    assert again.model is first.model and other.model is not first.model
+    assert np.array_equal(again.trajectory.y, first.trajectory.y)
+    for sim, k in ((first, 6.0), (other, 4.0)):  # each with its own k: x = 0.5 cos(√(k/m) t)
+        t = sim.trajectory.t
+        assert np.allclose(sim.trajectory.q[0], 0.5 * np.cos(np.sqrt(k / 1.5) * t), atol=1e-6)

@@ -99,16 +99,28 @@ def test_pendulum_against_the_jacobi_elliptic_solution(tmp_path):
 def test_linear_system_against_the_matrix_exponential(tmp_path):
     model, _ = model_of(tmp_path, COUPLED, "9202")
     y0 = np.array([0.3, -0.1, 0.2, 0.5])
-    # y' = A y with A from the model's own (linear) right-hand side, exactly
-    A = np.column_stack([model.rhs(0.0, e) for e in np.eye(4)])
     ts = np.linspace(0, 20, 11)
     traj = integrate(model, (0, 20), y0[:2], y0[2:], "taylor", t_eval=ts)
-    # exp(At)·y0 at 40 digits (scipy's expm is good to ~1e-12 here, not enough)
+    # y' = A y, A from COUPLED's T and V by hand at 40 digits: M = [[m1 + m2, m2 + c],
+    # [m2 + c, m2]], K = [[k1 + k2, -k2], [-k2, k2]], q̈ = -M⁻¹K q (an A rounded to
+    # doubles, e.g. from model.rhs, is itself ~1e-12 off the motion by t = 20)
     with mp.workdps(40):
-        Am, ym = mp.matrix(A.tolist()), mp.matrix(y0.tolist())
+        # the parameters as the problem holds them: doubles (0.4 is not 2/5), taken exactly
+        m1, m2, k1, k2, c = (mp.mpf(x) for x in (1.0, 2.5, 3.0, 7.0, 0.4))
+        acc = -(mp.matrix([[m1 + m2, m2 + c], [m2 + c, m2]]) ** -1
+                * mp.matrix([[k1 + k2, -k2], [-k2, k2]]))
+        Am = mp.zeros(4, 4)
+        Am[0, 2] = Am[1, 3] = 1
+        for i in range(2):
+            for j in range(2):
+                Am[2 + i, j] = acc[i, j]
+        ym = mp.matrix(y0.tolist())
         exact = np.column_stack([[float(v) for v in mp.expm(Am * t) * ym] for t in ts])
-    assert np.max(np.abs(traj.y - exact)) < 1e-12
+        A = np.array(Am.tolist(), dtype=float)
+    assert np.max(np.abs(traj.y - exact)) < 1e-13
     assert np.max(np.abs(expm(A * 2.0) @ y0 - exact[:, 1])) < 1e-11  # scipy: float only
+    assert np.allclose(A, np.column_stack([model.rhs(0.0, e) for e in np.eye(4)]),
+                       rtol=1e-14, atol=1e-14)  # the model's equations are these
 
 
 def test_constrained_particle_is_the_pendulum(tmp_path):
@@ -289,3 +301,108 @@ def test_integer_powers_are_smooth_at_zero(tmp_path):
     ref = integrate(model, (0, 10), [0.0], [1.0], "DOP853", t_eval=ts, rtol=1e-13,
                     atol=1e-14)
     assert tay.success and np.max(np.abs(tay.y - ref.y)) < 1e-11
+
+
+OSCILLATOR = """\
+id: lim-9205
+source: test
+title: mass on a spring
+parameters:
+  m: {value: 1.5}
+  k: {value: 6.1}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: k*x**2/2
+"""
+
+
+def test_simulate_taylor_holds_the_harmonic_oscillator_over_many_periods(tmp_path):
+    from systems import load_analysis
+
+    from mechbook.numerics.simulate import simulate
+
+    an = load_analysis(tmp_path, OSCILLATOR, "9205")
+    with mp.workdps(30):  # x = x0 cos(ωt), ω = √(k/m) of the doubles the problem holds
+        w = mp.sqrt(mp.mpf(6.1) / mp.mpf(1.5))
+        t_end = float(1000 * 2 * mp.pi / w)
+        sim = simulate(an, init={"x": "0.7"}, t_span=(0, t_end), method="taylor",
+                       points=2001, rtol=1e-15)
+        t = sim.trajectory.t
+        x = np.array([float(mp.mpf(0.7) * mp.cos(w * mp.mpf(s))) for s in t])
+        v = np.array([float(-mp.mpf(0.7) * w * mp.sin(w * mp.mpf(s))) for s in t])
+    assert sim.trajectory.success and len(t) == 2001
+    # 1000 periods at tol 1e-15: the error stays at rounding level (2.8e-15 measured), and a
+    # frequency off by 1e-12 (relative) would be 4e-9 off by the end
+    assert np.max(np.abs(sim.trajectory.q[0] - x)) < 2e-14
+    assert np.max(np.abs(sim.trajectory.qd[0] - v)) < 5e-14
+
+
+def test_the_pendulum_costs_what_heyoka_written_by_hand_costs(tmp_path):
+    import heyoka as hy
+
+    model, _ = model_of(tmp_path, PENDULUM, "9201")
+    ta = taylor.integrator(model, 1e-15, key="plain")
+    th, v = hy.make_vars("th", "v")
+    by_hand = hy.taylor_adaptive([(th, v), (v, -(G / LEN) * hy.sin(th))], [1.0, 0.0],
+                                 tol=1e-15)
+    # m·l²·(sin² + cos²) and −g·l·m simplified and hoisted: −(g/l) as one parameter
+    assert len(ta.decomposition) == len(by_hand.decomposition)
+    assert ta.pars[0] == pytest.approx(-G / LEN, rel=1e-16)
+    ts = np.linspace(0, 50, 11)
+    traj = integrate(model, (0, 50), [1.0], [0.0], "taylor", t_eval=ts, tol=1e-15)
+    by_hand.time, by_hand.state[:] = 0.0, [1.0, 0.0]
+    assert np.max(np.abs(traj.q[0] - np.asarray(by_hand.propagate_grid(ts)[5])[:, 0])) < 1e-14
+
+
+def test_derived_parameters_follow_the_parameters_in_quadruple_precision(tmp_path):
+    import heyoka as hy
+
+    if not hasattr(hy, "real128"):
+        pytest.skip("heyoka without real128")
+    model, _ = model_of(tmp_path, PENDULUM, "9201")
+    ta = taylor.integrator(model, 1e-30, key="q", fp_type=hy.real128)
+    with mp.workdps(40):  # −g/l of the doubles 9.81 and 0.7, to real128's 113 bits
+        want = -mp.mpf(G) / mp.mpf(LEN)
+        assert abs(mp.mpf(str(ta.pars[0])) / want - 1) < 1e-32
+
+
+def test_a_parameter_combination_that_is_not_real_is_refused(tmp_path):
+    text = """\
+id: lim-9206
+source: test
+title: a spring whose stiffness is a root of the parameters
+parameters:
+  m: {value: 1.0}
+  a: {value: 1.0}
+  b: {value: 2.0}
+coordinates:
+  x: {}
+kinetic: m*xdot**2/2
+potential: sqrt(a - b)*x**2/2
+"""
+    model, _ = model_of(tmp_path, text, "9206")
+    with pytest.raises(UnsupportedError, match="not real"):
+        taylor.integrator(model, 1e-12, key="plain")
+
+
+def test_parameter_only_subexpressions_become_one_parameter_each():
+    from mechbook.numerics.taylor_form import Hoisted, tidy
+
+    x, t = sp.symbols("x t")
+    g, l, m, w = sp.symbols("g l m w", positive=True)  # noqa: E741
+    h = Hoisted(frozenset([x, t]), frozenset([g, l, m, w]))
+    mass = tidy(m * l**2 * (sp.sin(x) ** 2 + sp.cos(x) ** 2))
+    assert mass == m * l**2
+    acc = h(-g * l * m * sp.sin(x) / mass + 3 * sp.cos(w * t) / (m * l) + sp.pi * x)
+    assert set(h.derived) == {-g / l, 3 / (m * l), w}  # and π stays a number
+    p = dict(zip(h.derived, h.symbols, strict=True))
+    assert acc == (p[-g / l] * sp.sin(x) + p[3 / (m * l)] * sp.cos(p[w] * t)
+                   + sp.Float(sp.pi.evalf(40), 40) * x)
+    assert h(-g * l * m * sp.sin(x) / mass) == p[-g / l] * sp.sin(x)  # shared, not a new one
+    at = {g: 9.81, l: 1.3, m: 2.0, w: 0.1}
+    with mp.workdps(40):
+        want = {-g / l: -mp.mpf(9.81) / mp.mpf(1.3), 3 / (m * l): 3 / (mp.mpf(2.0) * mp.mpf(1.3)),
+                w: mp.mpf(0.1)}
+        for e, value in zip(h.derived, h.values(at), strict=True):
+            assert abs(mp.mpf(str(value)) - want[e]) < mp.mpf(10) ** -38

@@ -5,7 +5,9 @@ the command line (`--init theta=0.1`), which overrides it key by key. Values are
 safe parser and may use the parameters (`initial: {theta: pi/6}`); a coordinate or velocity
 left out starts at 0. With no initial conditions at all the run starts at rest, 0.1 away
 (in every coordinate) from the first stable equilibrium the engine finds, and says so.
-Parameters take their default values unless overridden (`--param k=1e6`).
+Parameters take their default values unless overridden (`--param k=1e6`). The compiled
+model of a (system, parameter values, backend) is kept on the analysis for the last few
+runs, so a repeated run pays only for its integration.
 
 Choosing the method: with none given, DOP853, unless the run is stiff (`stiffness.assess`:
 linear rates far apart over a long span, fast modes hardly excited), when it switches to
@@ -18,6 +20,7 @@ bench/work_precision.py (`accuracy.choose`), and the run reports the error it ex
 from __future__ import annotations
 
 import time
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 
@@ -37,6 +40,7 @@ from mechbook.numerics.stiffness import IMPLICIT, Stiffness, assess, fixed_step_
 from mechbook.version import __version__
 
 FALLBACK_OFFSET = 0.1
+MODELS_KEPT = 4  # compiled models kept per analysis for repeated runs (their integrators too)
 FALLBACK_SEARCH = 20.0  # seconds for finding a stable equilibrium to start near
 
 
@@ -239,6 +243,21 @@ def parameter_values(analysis: Analysis, overrides: dict[str, str] | None) -> di
     return values
 
 
+def _model(analysis: Analysis, sys, dyn, values: dict, backend: str) -> Model:
+    """The compiled model of `sys` at `values`, built once per analysis for the last
+    MODELS_KEPT (system, values, backend): a repeated run (the API in a notebook, a report)
+    reuses it and the Taylor integrators cached on it, which are reset before each run."""
+    models = analysis.reuse(("simulation-models",), OrderedDict)
+    key = (sys.name, backend, tuple(sorted((str(k), str(v)) for k, v in values.items())))
+    model = models.pop(key, None)
+    if model is None:
+        model = build_model(sys, dyn, values, conserved_quantities(sys, dyn), backend)
+    models[key] = model
+    while len(models) > MODELS_KEPT:
+        models.popitem(last=False)
+    return model
+
+
 def simulate(analysis: Analysis, system_name: str | None = None, *,
              init: dict[str, str] | None = None, t_span: tuple[float, float] = (0.0, 10.0),
              method: str | None = None, points: int = 2001, backend: str = DEFAULT_BACKEND,
@@ -259,7 +278,7 @@ def simulate(analysis: Analysis, system_name: str | None = None, *,
     dyn = analysis.dynamics(sys.name)
     q0, qd0, source = initial_state(analysis, sys.name, init or {}, values)
     check_start(sys, q0, values)  # inside the coordinates' domains (numerics.domain)
-    model = build_model(sys, dyn, values, conserved_quantities(sys, dyn), backend)
+    model = _model(analysis, sys, dyn, values, backend)
     given = {k for k in ("rtol", "atol", "step") if options.get(k) is not None}
     if accuracy is not None and given:
         raise MechbookError(f"give either an accuracy or {'/'.join(sorted(given))}, not both")

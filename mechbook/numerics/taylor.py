@@ -3,10 +3,13 @@
 Why: Taylor's method compiled through LLVM (heyoka.py) is at the work–precision front for
 smooth, non-stiff motion at tight tolerances — 10⁴ pendulum periods at tol 1e-15 in a
 tenth of a second with the energy held to ~1e-14 — and it detects events on its own dense
-output. The equations are the engine's, M q̈ = f (+ A q̈ + b = 0), translated from SymPy by
-`hyexpr` with the parameters as heyoka runtime parameters; the accelerations solve M by
-LDLᵀ inside the expression (M is symmetric positive definite; with constraints the
-multipliers come from the Schur complement A M⁻¹ Aᵀ, also SPD). One system compiles once
+output. The equations are the engine's, M q̈ = f (+ A q̈ + b = 0), brought to the form a
+Taylor step is cheapest in by `taylor_form` — the accelerations solved by LDLᵀ in SymPy
+(M is symmetric positive definite; with constraints the multipliers come from the Schur
+complement A M⁻¹ Aᵀ, also SPD), small entries trigsimp'd, every parameter-only
+subexpression one derived heyoka runtime parameter — and translated by `hyexpr`: the
+pendulum's right-hand side is par[0]·sin q₀, as short as heyoka written by hand, and a
+10⁴-period run costs what heyoka's own propagate_grid costs. One system compiles once
 per process: the integrators are cached on the model by tolerance and event set, and
 heyoka's own in-memory LLVM cache reuses the machine code for a model rebuilt at other
 parameter values. heyoka is optional (`pip install 'mechbook[taylor]'`); without it,
@@ -23,9 +26,10 @@ import sympy as sp
 
 from mechbook.core.optional import require
 from mechbook.errors import MissingDependencyError, UnsupportedError
-from mechbook.numerics.hyexpr import Translator, solve_spd
+from mechbook.numerics.hyexpr import Translator
 from mechbook.numerics.integrator_base import Integrator, IntegratorError, Trajectory
 from mechbook.numerics.rhs import Model
+from mechbook.numerics.taylor_form import Hoisted, accelerations
 
 DEFAULT_TOL = 2.0 ** -52  # heyoka's own default: machine epsilon
 COMPACT_OPS = 2000  # above this many SymPy operations, heyoka's compact mode (faster compile)
@@ -47,20 +51,41 @@ def _hy():
 
 @dataclass
 class TaylorSystem:
-    """The heyoka form of one model's equations."""
+    """The heyoka form of one model's equations (`taylor_form`: solved in SymPy, the
+    parameter-only subexpressions hoisted into derived runtime parameters)."""
 
     ode: list  # [(variable, right-hand side)] for y = (q, q̇)
     variables: list
     translator: Translator
-    params: list  # parameter symbols, in par[] order
+    hoisted: Hoisted  # heyoka's par[i] is hoisted.derived[i], an expression in `params`
+    params: list  # the parameter symbols, sorted by name
     pars: list[float]  # their values
     compact: bool
     build_seconds: float
     compile_seconds: dict = field(default_factory=dict)  # tol -> seconds of the first compile
 
+    def translate(self, expr: sp.Expr):
+        """A SymPy expression in (t, q, q̇) and the parameters as a heyoka expression on
+        this system's par[] (new parameter combinations are appended)."""
+        out = self.hoisted(expr)
+        known = self.translator.symbols
+        for i, s in enumerate(self.hoisted.symbols):
+            if s not in known:
+                known[s] = _hy().par[i]
+        return self.translator(out)
 
-def _is_zero(e) -> bool:
-    return e is None
+    def par_values(self, fp_type=float, base: dict | None = None) -> np.ndarray:
+        """heyoka's par[] at the parameters' values (`base`, {symbol: value}, overriding
+        them), each rounded once from 40 digits to `fp_type`."""
+        at = dict(zip(self.params, self.pars, strict=True))
+        at.update(base or {})
+        try:
+            values = self.hoisted.values(at)
+        except ValueError as exc:  # e.g. √(k − m) with k < m: no real equation to integrate
+            raise UnsupportedError(f"Taylor backend: {exc}") from None
+        if fp_type is float:
+            return np.array([float(x) for x in values], dtype=float)
+        return np.array([fp_type(sp.sstr(x, full_prec=True)) for x in values], dtype=fp_type)
 
 
 def system_of(model: Model) -> TaylorSystem:
@@ -71,9 +96,9 @@ def system_of(model: Model) -> TaylorSystem:
     hy = _hy()
     start = time.perf_counter()
     src = model.source
-    n, m = len(src.q), len(src.b)
+    n = len(src.q)
     used = set().union(*(e.free_symbols for e in (*src.M, *src.f, *src.A, *src.b)))
-    params = sorted((p for p in src.values if p in used), key=str)  # heyoka counts par[i]
+    params = sorted((p for p in src.values if p in used), key=str)
     qv = hy.make_vars(*[f"q{i}" for i in range(n)])
     vv = hy.make_vars(*[f"v{i}" for i in range(n)])
     qv = [qv] if n == 1 else list(qv)
@@ -81,55 +106,16 @@ def system_of(model: Model) -> TaylorSystem:
     symbols = {src.t: hy.time}
     symbols.update(zip(src.q, qv, strict=True))
     symbols.update(zip(src.qd, vv, strict=True))
-    symbols.update({p: hy.par[i] for i, p in enumerate(params)})
-    tr = Translator(symbols)
-
-    def entry(e):
-        return None if e == 0 else tr(e)
-
-    M = [[entry(src.M[i * n + j]) for j in range(n)] for i in range(n)]
-    f = [entry(e) for e in src.f]
-    if m == 0:
-        acc = solve_spd(M, f, _is_zero)
-    else:
-        A = [[entry(src.A[r * n + j]) for j in range(n)] for r in range(m)]
-        b = [entry(e) for e in src.b]
-        acc = _constrained(M, f, A, b, hy)
-    zero = hy.expression(0.0)
-    acc = [zero if a is None else a for a in acc]
-    ode = list(zip(qv, vv, strict=True)) + list(zip(vv, acc, strict=True))
+    hoisted = Hoisted(frozenset([src.t, *src.q, *src.qd]), frozenset(src.values))
+    ts = TaylorSystem([], qv + vv, Translator(symbols), hoisted, params,
+                      [src.values[p] for p in params], False, 0.0)
+    acc = [ts.translate(a) for a in accelerations(src.M, src.f, src.A, src.b, n)]
+    ts.ode = list(zip(qv, vv, strict=True)) + list(zip(vv, acc, strict=True))
     ops = sum(sp.count_ops(e) for e in (*src.M, *src.f, *src.A, *src.b))
-    ts = TaylorSystem(ode, qv + vv, tr, params, [src.values[p] for p in params],
-                      ops > COMPACT_OPS, time.perf_counter() - start)
+    ts.compact = ops > COMPACT_OPS
+    ts.build_seconds = time.perf_counter() - start
     model.cache["taylor_system"] = ts
     return ts
-
-
-def _constrained(M, f, A, b, hy):
-    """q̈ = M⁻¹(f + Aᵀλ) with (A M⁻¹ Aᵀ) λ = −b − A M⁻¹ f (as Model._solve's system)."""
-    n, m = len(f), len(b)
-    Minv_f = solve_spd(M, f, _is_zero)
-    Minv_At = [solve_spd(M, [A[r][i] for i in range(n)], _is_zero) for r in range(m)]
-
-    def dot(xs, ys):
-        terms = [x * y for x, y in zip(xs, ys, strict=True) if x is not None and y is not None]
-        if not terms:
-            return None
-        return hy.sum(terms) if len(terms) > 1 else terms[0]
-
-    S = [[dot(A[r], Minv_At[c]) for c in range(m)] for r in range(m)]
-    rhs = []
-    for r in range(m):
-        parts = [x for x in (b[r], dot(A[r], Minv_f)) if x is not None]
-        rhs.append(None if not parts else -(hy.sum(parts) if len(parts) > 1 else parts[0]))
-    lam = solve_spd(S, rhs, _is_zero)
-    out = []
-    for i in range(n):
-        terms = [Minv_f[i]] + [Minv_At[r][i] * lam[r] for r in range(m)
-                               if Minv_At[r][i] is not None and lam[r] is not None]
-        terms = [x for x in terms if x is not None]
-        out.append(None if not terms else (hy.sum(terms) if len(terms) > 1 else terms[0]))
-    return out
 
 
 def integrator(model: Model, tol: float = DEFAULT_TOL, *, nt_events=(), t_events=(),
@@ -144,11 +130,10 @@ def integrator(model: Model, tol: float = DEFAULT_TOL, *, nt_events=(), t_events
         return cache[ck]
     start = time.perf_counter()
     n2 = len(ts.variables)
-    kw = {"tol": tol, "compact_mode": ts.compact, "pars": ts.pars}
+    kw = {"tol": tol, "compact_mode": ts.compact}
     state = np.zeros(n2)
     if fp_type is not float:
-        kw = {"tol": fp_type(tol), "compact_mode": ts.compact, "fp_type": fp_type,
-              "pars": np.array(ts.pars, dtype=fp_type)}
+        kw = {"tol": fp_type(tol), "compact_mode": ts.compact, "fp_type": fp_type}
         state = np.zeros(n2, dtype=fp_type)
     if nt_events:
         kw["nt_events"] = list(nt_events)
@@ -158,6 +143,8 @@ def integrator(model: Model, tol: float = DEFAULT_TOL, *, nt_events=(), t_events
         ta = hy.taylor_adaptive(ts.ode, state, **kw)
     except (ValueError, RuntimeError, TypeError) as exc:  # heyoka refused the system
         raise UnsupportedError(f"Taylor backend: {exc}") from None
+    # heyoka sized par[] to the indices the equations and events use: the first ones
+    ta.pars[:] = ts.par_values(fp_type)[: len(ta.pars)]
     ts.compile_seconds.setdefault(tol, time.perf_counter() - start)
     if key is not None:
         cache[ck] = ta
@@ -222,7 +209,7 @@ def _failed(t0, y0, outcome, steps):
 
 def event_expression(model: Model, expr: sp.Expr):
     """A SymPy function of (t, q, q̇) and the parameters as a heyoka expression."""
-    return system_of(model).translator(expr)
+    return system_of(model).translate(expr)
 
 
 def turning_points(model: Model, rate: sp.Expr, y0: np.ndarray, time_scale: float,
@@ -290,19 +277,22 @@ def propagate_batch(model: Model, states: np.ndarray, t_end: float, tol: float =
     ts = system_of(model)
     states = np.atleast_2d(np.asarray(states, float))
     N, n2 = states.shape
-    P = len(ts.pars)
-    pars = np.tile(ts.pars, (N, 1)) if pars is None else np.atleast_2d(np.asarray(pars, float))
     lanes = max(1, int(hy.recommended_simd_size()))
     cache = model.cache.setdefault("taylor", {})
     key = ("batch", tol, lanes)
     if key not in cache:
         start = time.perf_counter()
         cache[key] = hy.taylor_adaptive_batch(ts.ode, np.zeros((n2, lanes)), tol=tol,
-                                              compact_mode=ts.compact,
-                                              pars=np.zeros((max(P, 1), lanes))[:P] if P
-                                              else np.zeros((0, lanes)))
+                                              compact_mode=ts.compact)
         ts.compile_seconds.setdefault(("batch", tol), time.perf_counter() - start)
     ta = cache[key]
+    P = len(ta.pars)  # heyoka's par[] (derived from the parameters), as the ODE uses it
+    if pars is None:
+        per_run = np.tile(ts.par_values()[:P], (N, 1))
+    else:  # each run's parameter values, then their derived combinations
+        rows = np.atleast_2d(np.asarray(pars, float))
+        per_run = np.array([ts.par_values(base=dict(zip(ts.params, r, strict=True)))[:P]
+                            for r in rows]).reshape(N, P)
     out = np.full((N, n2) if grid is None else (N, len(grid), n2), np.nan)
     for lo in range(0, N, lanes):
         hi = min(N, lo + lanes)
@@ -313,8 +303,8 @@ def propagate_batch(model: Model, states: np.ndarray, t_end: float, tol: float =
         ta.state[:] = block
         if P:
             pb = np.zeros((P, lanes))
-            pb[:, : hi - lo] = pars[lo:hi].T
-            pb[:, hi - lo:] = pars[lo:lo + 1].T
+            pb[:, : hi - lo] = per_run[lo:hi].T
+            pb[:, hi - lo:] = per_run[lo:lo + 1].T
             ta.pars[:] = pb
         if grid is None:
             ta.propagate_until(float(t_end))
@@ -347,12 +337,11 @@ def crossings_batch(model: Model, weights: np.ndarray, offset: tuple[float, floa
         hits.append((float(t), int(lane)))
 
     lanes = max(1, int(hy.recommended_simd_size()))
-    P = len(ts.pars)
     ev = hy.nt_event_batch(expr, record, direction=hy.event_direction.positive)
     ta = hy.taylor_adaptive_batch(ts.ode, np.zeros((n2, lanes)), tol=tol,
-                                  compact_mode=ts.compact, nt_events=[ev],
-                                  pars=np.tile(np.asarray(ts.pars, float)[:, None],
-                                               (1, lanes)) if P else np.zeros((0, lanes)))
+                                  compact_mode=ts.compact, nt_events=[ev])
+    if len(ta.pars):
+        ta.pars[:] = np.tile(ts.par_values()[: len(ta.pars), None], (1, lanes))
     out: list[list[float]] = [[] for _ in range(N)]
     for lo in range(0, N, lanes):
         hi = min(N, lo + lanes)
