@@ -63,6 +63,21 @@ def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
         return prog.run({k: _number(v) for k, v in point.items()})[0]
 
 
+def mp_values(point: dict, digits: int = 30) -> dict:
+    """The point's values as mpmath numbers of `digits` digits, converted once for the many
+    expressions evaluated there (a matrix's entries) by `evaluate_mp_at`."""
+    with mpmath.workdps(digits):
+        return {k: _number(v) for k, v in point.items()}
+
+
+def evaluate_mp_at(expr: sp.Basic, values: dict, digits: int = 30):
+    """`evaluate_mp` at a point already converted by `mp_values` (at the same digits): the
+    same number, without converting the point again for each expression."""
+    prog = program(expr)
+    with mpmath.workdps(digits):
+        return prog.run(values)[0]
+
+
 def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits: int = 240,
                       margin: int = 10):
     """expr at `point` as an mpmath number, the working precision doubled (from `digits` up

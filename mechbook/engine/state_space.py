@@ -152,18 +152,44 @@ class StateSpaceSystem:
         """How many exact zero exponents the structure gives (taken out of `core`)."""
         return self.Ahat.rows - len(self.core)
 
+    @cached_property
+    def _speed_block(self) -> int | None:
+        """k where E = diag(1_k, M_r) (the coordinates' rows are δṡ = …, as constrained.py
+        builds it): then A's first k rows are Â's and the rest M_r⁻¹ times Â's, and only
+        M_r is inverted. None for any other E."""
+        k = len(self.coords)
+        n = self.E.rows
+        ok = all((self.E[i, j] == (1 if i == j else 0)) for i in range(k) for j in range(n)) \
+            and all(self.E[i, j] == 0 for i in range(k, n) for j in range(k))
+        return k if ok else None
+
     def _mp_state(self, values: dict, dps: int, core: bool = True):
+        """A = E⁻¹Â at `values` (its `core` rows and columns only, unless core=False), at
+        `dps` digits: only the entries it needs are evaluated."""
+        n = self.Ahat.rows
+        idx = self.core if core else list(range(n))
+        k = self._speed_block
         with mpmath.workdps(dps):
-            E = mp_matrix(self.E, values, dps)
-            Ahat = mp_matrix(self.Ahat, values, dps)
-            A = mpmath.inverse(E) * Ahat if E.rows else Ahat
-            if not core:
-                return A
-            idx = self.core
+            if k is None:
+                E = mp_matrix(self.E, values, dps)
+                Ahat = mp_matrix(self.Ahat, values, dps)
+                A = mpmath.inverse(E) * Ahat if E.rows else Ahat
+                rows = {i: i for i in idx}
+            else:
+                head = [i for i in idx if i < k]
+                A = mp_matrix(self.Ahat.extract(head, idx), values, dps) if head else None
+                top = {i: a for a, i in enumerate(head)}
+                if k < n:
+                    low = mp_matrix(self.Ahat.extract(list(range(k, n)), idx), values, dps)
+                    low = mpmath.inverse(mp_matrix(self.E[k:, k:], values, dps)) * low
+                rows = top
             out = mpmath.matrix(len(idx), len(idx))
             for a, i in enumerate(idx):
                 for b, j in enumerate(idx):
-                    out[a, b] = A[i, j]
+                    if k is None:
+                        out[a, b] = A[i, j]
+                    else:
+                        out[a, b] = A[rows[i], b] if i < k else low[i - k, b]
             return out
 
     def mp_state_matrix(self, values: dict, dps: int = 50):
