@@ -51,7 +51,7 @@ def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, fl
     ZeroDivisionError or ValueError where the expression is singular at the point."""
     prog = program(expr)
     with mpmath.workdps(digits):
-        v, m = prog.run({k: _number(v) for k, v in point.items()})
+        v, m = prog.run(prog.values(point))
         return complex(v), float(m)
 
 
@@ -60,7 +60,7 @@ def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
     least that precision to keep them); errors as for `evaluate`."""
     prog = program(expr)
     with mpmath.workdps(digits):
-        return prog.run({k: _number(v) for k, v in point.items()})[0]
+        return prog.run(prog.values(point))[0]
 
 
 def mp_values(point: dict, digits: int = 30) -> dict:
@@ -88,7 +88,7 @@ def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits:
     d = digits
     while True:
         with mpmath.workdps(d):
-            v, m = prog.run({k: _number(v) for k, v in point.items()})
+            v, m = prog.run(prog.values(point))
             if abs(v) > mpmath.mpf(10) ** (margin - d) * m:
                 return v
         if d >= max_digits:
@@ -154,6 +154,14 @@ class Program:
         self._index: dict = {}
         self._emit(expr)
         del self._index
+        self.symbols = list(dict.fromkeys(
+            [ins[1] for ins in self.code if ins[0] == _SYMBOL]
+            + [x for ins in self.code if ins[0] == _SYMPY for x in ins[1].free_symbols]))
+
+    def values(self, point: dict) -> dict:
+        """The point's values of this program's symbols as mpmath numbers (at the working
+        precision): a point names every parameter and coordinate, an expression a few."""
+        return {k: _number(point[k]) for k in self.symbols if k in point}
 
     def _emit(self, e: sp.Basic) -> int:
         hit = self._index.get(e)
