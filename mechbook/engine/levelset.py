@@ -127,14 +127,18 @@ class LevelSet:
                 del self._orbits[next(iter(self._orbits))]
         return hit
 
+    @cached_property
+    def _momenta(self) -> list[sp.Expr]:
+        return [sp.diff(self.dyn.L, v) for v in self.rates]
+
     def _new_orbit(self, state: dict, values: dict, dps: int) -> Orbit:
         dyn = self.dyn
         with mpmath.workdps(dps):
             pt = {k: mpmath.mpf(str(sp.N(v, dps))) for k, v in values.items()}
             full = {**{k: sp.Float(str(v), dps) for k, v in pt.items()},
                     **{k: sp.Float(str(sp.N(v, dps)), dps) for k, v in state.items()}}
-            P = [sp.N(sp.diff(dyn.L, v).subs(full), dps) for v in self.rates]
-            E = sp.N(dyn.energy_function.subs(full), dps)
+            P = [sp.N(p.xreplace(full), dps) for p in self._momenta]
+            E = sp.N(dyn.energy_function.xreplace(full), dps)
             if any(not x.is_number for x in [*P, E]):
                 raise UnsupportedError("level set: the initial state leaves something unknown")
             params = [pt[p] for p in self.params]
