@@ -79,6 +79,7 @@ class Ray:
         self.direction = direction
         self.scales = scales or {}
         self._points: dict = {}
+        self._values: dict = {}
 
     def point(self, t) -> dict | None:
         """The admissible point at t (None where a condition fails or a derived symbol is
@@ -93,6 +94,18 @@ class Ray:
             self._points[key] = self._point(t)
         got = self._points[key]
         return None if got is None else dict(got)
+
+    def value(self, f: sp.Expr, t) -> tuple[float, float] | None:
+        """`value_at(f, self.point(t))`, each computed once (the atoms' roots and the
+        tangencies read the same grid)."""
+        with mpmath.workdps(DIGITS + 20):
+            key = (f, mpmath.mpf(t))
+        if key not in self._values:
+            if len(self._values) >= POINTS_KEPT:
+                self._values.clear()
+            pt = self.point(t)
+            self._values[key] = None if pt is None else value_at(f, pt)
+        return self._values[key]
 
     def _point(self, t) -> dict | None:
         with mpmath.workdps(DIGITS + 5):
@@ -131,8 +144,7 @@ def atom_roots(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
     for i, f in enumerate(atoms):
         vals = []
         for t in ts:
-            pt = ray.point(t)
-            got = None if pt is None else value_at(f, pt)
+            got = ray.value(f, t)
             vals.append(None if got is None else got[0])
         for k in range(len(ts) - 1):
             a, b = vals[k], vals[k + 1]
@@ -344,8 +356,7 @@ def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
     for i, f in enumerate(atoms):
         vals = []
         for t in ts:
-            pt = ray.point(t)
-            vals.append(None if pt is None else value_at(f, pt))
+            vals.append(ray.value(f, t))
         for k in range(1, len(ts) - 1):
             trio = vals[k - 1: k + 2]
             if any(v is None for v in trio):
