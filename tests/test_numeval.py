@@ -107,3 +107,33 @@ def test_the_kept_programs_are_bounded_and_the_recently_used_stay(monkeypatch):
     assert x + 100 in numeval._programs and x + 19 in numeval._programs
     assert x + 0 not in numeval._programs
     assert evaluate(x + 19, {x: 1})[0] == 20  # the newest are kept, still right
+
+
+@pytest.mark.parametrize("expr", [
+    x**3 * sp.sin(y) + sp.cos(x * y) ** 2 - sp.Rational(7, 3),
+    sp.sqrt(x + y) ** 3 + sp.exp(-x) * sp.log(y) + sp.pi * sp.atan2(y, x),
+    sp.elliptic_k(x) + sp.asin(y) * sp.acos(x),
+    sp.elliptic_e(x) + sp.sin(y),
+])
+def test_the_value_alone_is_runs_value_and_refuses_the_same_points(expr):
+    """`Program.value` (no magnitudes) gives the very number `run` gives first, and a point
+    `run` refuses — E(m)'s slope sampled past m = 1, where it has no real value — it
+    refuses too; a point may name symbols the expression does not use."""
+    prog = numeval.program(expr)
+    refused = 0
+    for xv, yv in ((0.7, 0.3), (1 - 1e-29, 0.5), (0.5, 1 - 1e-29), (0.2, 1.0), (1.0, 0.4)):
+        pt = {x: mpmath.mpf(xv), y: mpmath.mpf(yv), z: "not a number"}
+        for digits in (30, 50):
+            with mpmath.workdps(digits):
+                try:
+                    expected = prog.run(prog.values(pt))[0]
+                except (ValueError, ZeroDivisionError) as exc:
+                    expected = type(exc)
+                    refused += 1
+                try:
+                    got = prog.value(prog.values(pt))
+                except (ValueError, ZeroDivisionError) as exc:
+                    got = type(exc)
+            assert got == expected, (xv, yv, digits)
+    if expr.has(sp.elliptic_e):
+        assert refused, "the edge of E's domain refuses points"

@@ -134,6 +134,54 @@ def test_coin_energy_and_simulation_keep_the_constraints(tmp_path):
     assert "xdot solved from the constraints" in sim.initial_source  # ydot stays 0
 
 
+# ---- a steady motion of a constrained system: the constraints kept, their forces allowed --
+@pytest.mark.parametrize("x_rate, status", [
+    ("-R*Omega", "pass"),               # v_G = ω × (G − P) = (0, −Ω, 0) × (0, 0, R)
+    ("-1.01*R*Omega", "fail"),          # the coin would slip
+    ("-(1 + 1e-6)*R*Omega", "fail"),
+    ("R*Omega", "fail"),
+])
+def test_a_rolling_coins_steady_motion_keeps_its_contact(tmp_path, x_rate, status):
+    """Upright straight rolling: the coin's axis is −y (φ = 0, θ = π/2), so spinning at
+    ψ̇ = Ω its centre moves at −RΩ along x. The free body's equations hold at any x rate
+    (no force acts along x), so only the rolling rows tell the true rate from a slipping
+    one."""
+    out = check(tmp_path, "9510", COIN.replace("SHAPE", "disk"), key(
+        "  - part: a\n    cite: rolling\n    quantity: steady_motion\n"
+        "    book: {at: {y: 0, phi: 0, theta: pi/2}, rates: {x: \"" + x_rate + "\", "
+        "psi: Omega}}\n"))
+    assert out["a"].status == status, out["a"].detail
+
+
+POLAR_BEAD = """\
+id: lim-NUM
+source: a particle held at radius l by a multiplier, in polar coordinates
+title: particle on a circle (r, phi, one constraint)
+parameters:
+  m: {value: 0.5}
+  l: {value: 1.3}
+  w: {value: 2.0}
+coordinates:
+  r: {positive: true}
+  phi: {}
+kinetic: m*(rdot**2 + r**2*phidot**2)/2
+potential: "0"
+constraints:
+  - {name: rod, expr: r - l}
+"""
+
+
+@pytest.mark.parametrize("at, status", [("l", "pass"), ("1.01*l", "fail"),
+                                        ("(1 + 1e-6)*l", "fail")])
+def test_a_steady_turn_needs_its_constraint_force(tmp_path, at, status):
+    """Uniform turning at r = l: E_r = −m l ω² ≠ 0, the rod's pull λ = −m l ω² supplies it
+    (the residual alone would fail a true motion); at r ≠ l the constraint is broken."""
+    out = check(tmp_path, "9511", POLAR_BEAD, key(
+        "  - part: a\n    cite: turning\n    quantity: steady_motion\n"
+        f"    book: {{at: {{r: \"{at}\"}}, rates: {{phi: w}}}}\n"))
+    assert out["a"].status == status, out["a"].detail
+
+
 # ---- the Chaplygin sleigh: exponents of straight motion --------------------------------------
 def _sleigh(book: str, quantity: str = "exponents", extra: str = "    partial: true\n") -> str:
     return key(f"  - part: a\n    cite: straight motion\n    quantity: {quantity}\n"

@@ -37,6 +37,13 @@ _FUNCS = {
 }
 
 
+# functions whose value is all `Program.value` computes (no slope): defined, with their
+# numeric derivative, wherever mpmath gives them a value
+ELEMENTARY = frozenset((mpmath.sin, mpmath.cos, mpmath.tan, mpmath.cot, mpmath.sec,
+                        mpmath.csc, mpmath.sinh, mpmath.cosh, mpmath.tanh, mpmath.exp,
+                        abs, mpmath.sign, mpmath.re, mpmath.im, mpmath.conj))
+
+
 class NotNumeric(ValueError):
     """The expression has a part this evaluator cannot give a number for."""
 
@@ -51,7 +58,7 @@ def evaluate(expr: sp.Basic, point: dict, digits: int = 30) -> tuple[complex, fl
     ZeroDivisionError or ValueError where the expression is singular at the point."""
     prog = program(expr)
     with mpmath.workdps(digits):
-        v, m = prog.run({k: _number(v) for k, v in point.items()})
+        v, m = prog.run(prog.values(point))
         return complex(v), float(m)
 
 
@@ -60,7 +67,29 @@ def evaluate_mp(expr: sp.Basic, point: dict, digits: int = 30):
     least that precision to keep them); errors as for `evaluate`."""
     prog = program(expr)
     with mpmath.workdps(digits):
-        return prog.run({k: _number(v) for k, v in point.items()})[0]
+        return prog.value(prog.values(point))
+
+
+def _value(expr: sp.Basic, point: dict, digits: int) -> complex:
+    """`evaluate`'s value alone (a relation's side: its cancellation is not asked)."""
+    prog = program(expr)
+    with mpmath.workdps(digits):
+        return complex(prog.value(prog.values(point)))
+
+
+def mp_values(point: dict, digits: int = 30) -> dict:
+    """The point's values as mpmath numbers of `digits` digits, converted once for the many
+    expressions evaluated there (a matrix's entries) by `evaluate_mp_at`."""
+    with mpmath.workdps(digits):
+        return {k: _number(v) for k, v in point.items()}
+
+
+def evaluate_mp_at(expr: sp.Basic, values: dict, digits: int = 30):
+    """`evaluate_mp` at a point already converted by `mp_values` (at the same digits): the
+    same number, without converting the point again for each expression."""
+    prog = program(expr)
+    with mpmath.workdps(digits):
+        return prog.value(values)
 
 
 def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits: int = 240,
@@ -73,7 +102,7 @@ def evaluate_resolved(expr: sp.Basic, point: dict, digits: int = 30, max_digits:
     d = digits
     while True:
         with mpmath.workdps(d):
-            v, m = prog.run({k: _number(v) for k, v in point.items()})
+            v, m = prog.run(prog.values(point))
             if abs(v) > mpmath.mpf(10) ** (margin - d) * m:
                 return v
         if d >= max_digits:
@@ -139,6 +168,14 @@ class Program:
         self._index: dict = {}
         self._emit(expr)
         del self._index
+        self.symbols = list(dict.fromkeys(
+            [ins[1] for ins in self.code if ins[0] == _SYMBOL]
+            + [x for ins in self.code if ins[0] == _SYMPY for x in ins[1].free_symbols]))
+
+    def values(self, point: dict) -> dict:
+        """The point's values of this program's symbols as mpmath numbers (at the working
+        precision): a point names every parameter and coordinate, an expression a few."""
+        return {k: _number(point[k]) for k in self.symbols if k in point}
 
     def _emit(self, e: sp.Basic) -> int:
         hit = self._index.get(e)
@@ -185,6 +222,46 @@ class Program:
             self._const_prec = prec
         return self._const_values
 
+    def value(self, pt: dict):
+        """The value alone at `pt` (what `run` gives first, the same number): the
+        magnitudes and the slopes of functions (a numeric derivative per call) are not
+        carried, except for functions outside ELEMENTARY, whose slope's evaluation may
+        refuse a point near the edge of their domain, as `run` does."""
+        consts = self._constants()
+        vals: list = []
+        for ins in self.code:
+            op = ins[0]
+            if op == _SYMBOL:
+                v = pt.get(ins[1])
+                if v is None:
+                    raise NotNumeric(f"no value for {ins[1]}")
+            elif op == _CONST:
+                v = consts[ins[1]]
+            elif op == _ADD:
+                v = mpmath.mpf(0)
+                for a in ins[1]:
+                    v += vals[a]
+            elif op == _MUL:
+                v = mpmath.mpf(1)
+                for a in ins[1]:
+                    v *= vals[a]
+            elif op == _POWI:
+                v = vals[ins[1]] ** ins[2]
+            elif op == _POW:
+                v = _power_value(vals[ins[1]], vals[ins[2]], ins[3], ins[4])
+            elif op == _FUNC:
+                args = [vals[a] for a in ins[2]]
+                if ins[1] in ELEMENTARY:
+                    v = ins[1](*args)
+                else:
+                    v, _ = _function(ins[1], args, [abs(a) for a in args])
+            elif op == _RAISE:
+                raise ins[1](ins[2])
+            else:
+                v, _ = _sympy_value(ins[1], pt)
+            vals.append(v)
+        return vals[-1]
+
     def run(self, pt: dict) -> tuple:
         """(value, magnitude) at `pt` (symbols to mpmath numbers), at the current precision."""
         consts = self._constants()
@@ -225,13 +302,16 @@ class Program:
         return vals[-1], mags[-1]
 
 
-def _power(vb, mb, ve, me, iex, half, numeric_exponent):
+def _power_value(vb, ve, iex, half):
     if iex is not None:
-        v = vb ** iex
-    elif half is not None and mpmath.im(vb) == 0 and vb >= 0:
-        v = mpmath.sqrt(vb) ** half
-    else:
-        v = mpmath.power(vb, ve)
+        return vb ** iex
+    if half is not None and mpmath.im(vb) == 0 and vb >= 0:
+        return mpmath.sqrt(vb) ** half
+    return mpmath.power(vb, ve)
+
+
+def _power(vb, mb, ve, me, iex, half, numeric_exponent):
+    v = _power_value(vb, ve, iex, half)
     # first-order propagation: what the base's (and exponent's) cancellation can do
     m = abs(v) + abs(ve * v / vb) * mb if vb != 0 else abs(v)
     if not numeric_exponent and vb != 0:
@@ -340,8 +420,8 @@ def holds(cond: sp.Basic, point: dict, digits: int = 30) -> bool:
         return not holds(cond.args[0], point, digits)
     if isinstance(cond, sp.core.relational.Relational) and cond.rel_op in _RELATIONS:
         try:
-            a, _ = evaluate(cond.lhs, point, digits)
-            b, _ = evaluate(cond.rhs, point, digits)
+            a = _value(cond.lhs, point, digits)
+            b = _value(cond.rhs, point, digits)
         except NotNumeric:
             return bool(cond.subs(point))  # what the evaluator does not know: SymPy decides
         except (ZeroDivisionError, ValueError, TypeError, OverflowError):

@@ -34,6 +34,39 @@ from mechbook.errors import UnsupportedError
 DPS = 50
 MAX_STEP = 0.02  # largest step of the search for a turning point, relative to 1 + |c0|
 MAX_STEPS = 5000
+ORBITS = 256  # orbits a level set keeps (the oldest dropped first)
+
+
+KEPT = ("sin", "cos", "tan", "exp", "log", "sqrt", "sinh", "cosh", "tanh")
+KEPT_VALUES = 64  # values each kept function remembers before it starts afresh
+
+
+def kept_functions() -> dict:
+    """mpmath's functions of one argument that remember their latest values by (argument,
+    precision): a lambdified V_eff calls sin(θ) and cos(θ) a dozen times with the same θ
+    (its terms are not collected, so that its arithmetic stays the expression's own), and
+    each value is the same number mpmath would compute again."""
+    def kept(f):
+        memo: dict = {}
+
+        def g(x):
+            key = (x, mpmath.mp.prec)
+            try:
+                return memo[key]
+            except (KeyError, TypeError):
+                pass
+            v = f(x)
+            if len(memo) >= KEPT_VALUES:
+                memo.clear()
+            try:
+                memo[key] = v
+            except TypeError:  # an argument that cannot be a key
+                pass
+            return v
+
+        return g
+
+    return {name: kept(getattr(mpmath, name)) for name in KEPT}
 
 
 class LevelSet:
@@ -51,6 +84,8 @@ class LevelSet:
         self.rates = [sys.qd[sys.q.index(q)] for q in self.cyclic]
         self.P = [sp.Symbol(f"P_{q}", real=True) for q in self.cyclic]
         self.params = sorted(sys.problem.values(), key=str)
+        self._orbits: dict = {}  # (state, values, dps) → Orbit, the ORBITS latest
+
 
     @cached_property
     def reduced(self) -> tuple[sp.Expr, sp.Expr, list[sp.Expr]]:
@@ -73,20 +108,37 @@ class LevelSet:
     def numeric_functions(self):
         mass, V, u = self.reduced
         args = [self.c, *self.P, *self.params]
-        return (sp.lambdify(args, mass, modules="mpmath"),
-                sp.lambdify(args, V, modules="mpmath"),
-                [sp.lambdify(args, x, modules="mpmath") for x in u])
+        modules = [kept_functions(), "mpmath"]
+        return (sp.lambdify(args, mass, modules=modules),
+                sp.lambdify(args, V, modules=modules),
+                [sp.lambdify(args, x, modules=modules) for x in u])
 
     def orbit(self, state: dict, values: dict, dps: int = DPS) -> Orbit:
         """The orbit through `state` ({q: value, q̇: value}) at parameter `values`, computed
-        in `dps`-digit arithmetic (a second, higher precision measures the first's error)."""
+        in `dps`-digit arithmetic (a second, higher precision measures the first's error).
+        Kept: the parts of one start (its turning points, excursion, frequency, mean rate)
+        walk through the same points, and an orbit keeps what it computed (turning points,
+        period)."""
+        key = (frozenset(state.items()), frozenset(values.items()), dps)
+        hit = self._orbits.get(key)
+        if hit is None:
+            hit = self._orbits[key] = self._new_orbit(state, values, dps)
+            if len(self._orbits) > ORBITS:
+                del self._orbits[next(iter(self._orbits))]
+        return hit
+
+    @cached_property
+    def _momenta(self) -> list[sp.Expr]:
+        return [sp.diff(self.dyn.L, v) for v in self.rates]
+
+    def _new_orbit(self, state: dict, values: dict, dps: int) -> Orbit:
         dyn = self.dyn
         with mpmath.workdps(dps):
             pt = {k: mpmath.mpf(str(sp.N(v, dps))) for k, v in values.items()}
             full = {**{k: sp.Float(str(v), dps) for k, v in pt.items()},
                     **{k: sp.Float(str(sp.N(v, dps)), dps) for k, v in state.items()}}
-            P = [sp.N(sp.diff(dyn.L, v).subs(full), dps) for v in self.rates]
-            E = sp.N(dyn.energy_function.subs(full), dps)
+            P = [sp.N(p.xreplace(full), dps) for p in self._momenta]
+            E = sp.N(dyn.energy_function.xreplace(full), dps)
             if any(not x.is_number for x in [*P, E]):
                 raise UnsupportedError("level set: the initial state leaves something unknown")
             params = [pt[p] for p in self.params]

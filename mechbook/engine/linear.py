@@ -20,7 +20,14 @@ import scipy.linalg
 import sympy as sp
 
 from mechbook.core.compile import compile_exprs
-from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, is_zero
+from mechbook.core.numeval import (
+    NotNumeric,
+    evaluate,
+    evaluate_mp,
+    evaluate_mp_at,
+    is_zero,
+    mp_values,
+)
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
 from mechbook.errors import MechbookError, UnsupportedError
@@ -421,17 +428,21 @@ def mp_matrix(A: sp.Matrix, values: dict, dps: int):
 
     out = mpmath.matrix(A.rows, A.cols)
     with mpmath.workdps(dps):
+        converted = mp_values(values, dps)  # once for all the entries
         for i in range(A.rows):
             for j in range(A.cols):
-                out[i, j] = _mp_entry(A[i, j], values, dps)
+                x = A[i, j]
+                if x != 0:  # a zero entry stays the matrix's exact zero
+                    out[i, j] = _mp_entry(x, values, dps, converted)
     return out
 
 
-def _mp_entry(x: sp.Expr, values: dict, dps: int):
+def _mp_entry(x: sp.Expr, values: dict, dps: int, converted: dict | None = None):
     import mpmath
 
     try:
-        v = evaluate_mp(x, values, dps)
+        v = (evaluate_mp(x, values, dps) if converted is None else
+             evaluate_mp_at(x, converted, dps))
         if mpmath.isfinite(v):
             return mpmath.mpf(v) if mpmath.im(v) == 0 else v
     except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):

@@ -29,6 +29,8 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from mechbook.core.backends import FEW_CALLS_BACKEND
+from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import is_zero
 from mechbook.engine.linear import ZERO_CLUSTER, dependent_displacements, mp_matrix
 from mechbook.errors import MechbookError, UnsupportedError
@@ -152,18 +154,44 @@ class StateSpaceSystem:
         """How many exact zero exponents the structure gives (taken out of `core`)."""
         return self.Ahat.rows - len(self.core)
 
+    @cached_property
+    def _speed_block(self) -> int | None:
+        """k where E = diag(1_k, M_r) (the coordinates' rows are δṡ = …, as constrained.py
+        builds it): then A's first k rows are Â's and the rest M_r⁻¹ times Â's, and only
+        M_r is inverted. None for any other E."""
+        k = len(self.coords)
+        n = self.E.rows
+        ok = all((self.E[i, j] == (1 if i == j else 0)) for i in range(k) for j in range(n)) \
+            and all(self.E[i, j] == 0 for i in range(k, n) for j in range(k))
+        return k if ok else None
+
     def _mp_state(self, values: dict, dps: int, core: bool = True):
+        """A = E⁻¹Â at `values` (its `core` rows and columns only, unless core=False), at
+        `dps` digits: only the entries it needs are evaluated."""
+        n = self.Ahat.rows
+        idx = self.core if core else list(range(n))
+        k = self._speed_block
         with mpmath.workdps(dps):
-            E = mp_matrix(self.E, values, dps)
-            Ahat = mp_matrix(self.Ahat, values, dps)
-            A = mpmath.inverse(E) * Ahat if E.rows else Ahat
-            if not core:
-                return A
-            idx = self.core
+            if k is None:
+                E = mp_matrix(self.E, values, dps)
+                Ahat = mp_matrix(self.Ahat, values, dps)
+                A = mpmath.inverse(E) * Ahat if E.rows else Ahat
+                rows = {i: i for i in idx}
+            else:
+                head = [i for i in idx if i < k]
+                A = mp_matrix(self.Ahat.extract(head, idx), values, dps) if head else None
+                top = {i: a for a, i in enumerate(head)}
+                if k < n:
+                    low = mp_matrix(self.Ahat.extract(list(range(k, n)), idx), values, dps)
+                    low = mpmath.inverse(mp_matrix(self.E[k:, k:], values, dps)) * low
+                rows = top
             out = mpmath.matrix(len(idx), len(idx))
             for a, i in enumerate(idx):
                 for b, j in enumerate(idx):
-                    out[a, b] = A[i, j]
+                    if k is None:
+                        out[a, b] = A[i, j]
+                    else:
+                        out[a, b] = A[rows[i], b] if i < k else low[i - k, b]
             return out
 
     def mp_state_matrix(self, values: dict, dps: int = 50):
@@ -211,9 +239,59 @@ class StateSpaceSystem:
                     mpmath.re(x) > tiny]
             return sorted(out, key=lambda x: (mpmath.isnan(x), x))
 
+    @cached_property
+    def _compiled_core(self):
+        """(symbols, function, the core's rows among the coordinates' rows, k) for the core's
+        state matrix in double precision (E = diag(1_k, M_r) only), compiled once; None
+        where it cannot be."""
+        k = self._speed_block
+        if k is None:
+            return None
+        idx, n = self.core, self.Ahat.rows
+        head = [i for i in idx if i < k]
+        exprs = ([self.Ahat[i, j] for i in head for j in idx]
+                 + [self.Ahat[i, j] for i in range(k, n) for j in idx] + list(self.E[k:, k:]))
+        syms = sorted(set().union(*(sp.S(x).free_symbols for x in exprs)), key=lambda x: x.name)
+        try:
+            fn, _ = compile_exprs(syms, exprs, FEW_CALLS_BACKEND)
+        except UnsupportedError:
+            return None
+        return syms, fn, head, k
+
+    def fast_core_matrix(self, values: dict) -> np.ndarray | None:
+        """The core's state matrix at `values` in double precision (Â's entries and M_r by
+        the compile layer, M_r⁻¹ by LU): for the many verdicts of a boundary's rays, where
+        the 30-digit matrix would dominate. None where it cannot be had (the caller then
+        takes `numeric_state_matrix`)."""
+        got = self._compiled_core
+        if got is None:
+            return None
+        syms, fn, head, k = got
+        if any(x not in values for x in syms):
+            return None
+        idx, n = self.core, self.Ahat.rows
+        m, s = len(idx), n - k
+        with np.errstate(all="ignore"):
+            out = np.asarray(fn(np.array([float(values[x]) for x in syms])), dtype=float)
+            top = out[: len(head) * m].reshape(len(head), m)
+            low = out[len(head) * m: len(head) * m + s * m].reshape(s, m)
+            Mr = out[len(head) * m + s * m:].reshape(s, s)
+            try:
+                low = np.linalg.solve(Mr, low) if s else low
+            except np.linalg.LinAlgError:
+                return None
+        rows = {i: a for a, i in enumerate(head)}
+        A = np.array([top[rows[i]] if i < k else low[i - k] for i in idx],
+                     dtype=float).reshape(m, m)
+        return A if np.all(np.isfinite(A)) else None
+
     def numeric_stability(self, values: dict) -> str:
-        """'stable' or 'unstable' from the core's exponents (double precision)."""
-        core = self.numeric_state_matrix(values, core=True)
+        """'stable' or 'unstable' from the core's exponents in double precision (the core
+        by the compile layer where it can be); at 40 digits where those exponents are
+        ambiguous (`ambiguous_exponents`)."""
+        core = self.fast_core_matrix(values)
+        if core is None:
+            core = self.numeric_state_matrix(values, core=True)
         if not core.size:
             return "stable"
         if not np.all(np.isfinite(core)):

@@ -9,6 +9,8 @@ chapter 11's tops and chapter 12's orbits and three bodies use the same function
 
     steady_residuals   the equations of motion along q*(t) = point + rates·t (q̈ = 0): all
                        zero, at two times, exactly when that uniform motion is steady
+    constrained_steady_residuals  the same with constraints: the constraints kept along
+                       it, and the residual within what the constraint forces can supply
     steady_conditions  the conditions on the non-turning coordinates at fixed rates, or at
                        fixed cyclic momenta (the equilibria of Routh's reduced system)
     SteadyFamily       steady motions at a given point with one cyclic rate x unknown (the
@@ -52,6 +54,31 @@ def steady_residuals(dyn: Dynamics, rates: dict, point: dict) -> list[sp.Expr]:
     out = []
     for e in dyn.residuals:
         e = e.xreplace(sub)
+        out += [e.subs(sys.t, tv) for tv in TIMES] if e.has(sys.t) else [e]
+    return out
+
+
+def constrained_steady_residuals(dyn: Dynamics, rates: dict, point: dict) -> list[sp.Expr]:
+    """What must vanish along q*(t) = point + rates·t for a system with constraints, at two
+    times: the holonomic constraints g and every velocity-level row A·q̇ + b (the motion
+    keeps its constraints), and the residual E less its part some multipliers could supply,
+    E·det(G) − Aᵀ·adj(G)·A·E with G = A·Aᵀ (zero exactly where E = Aᵀλ for some λ: the
+    constraint forces can make the motion, however large they must be)."""
+    sys = dyn.sys
+    sub = {}
+    for q, v, a in zip(dyn.q, dyn.qd, dyn.qdd, strict=True):
+        sub[q] = sp.S(point.get(q, 0)) + sp.S(rates.get(q, 0)) * sys.t
+        sub[v] = sp.S(rates.get(q, 0))
+        sub[a] = sp.S.Zero
+    sub.update({s: sp.S.Zero for s in sys.small_params})
+    E = sp.Matrix([e.xreplace(sub) for e in dyn.residuals])
+    A = dyn.velocity_jacobian.xreplace(sub)
+    kept = [g.xreplace(sub) for _, g in sys.constraints] + \
+        [c.xreplace(sub) for c in dyn.velocity_rows]
+    G = A * A.T
+    free = E * G.det() - A.T * (G.adjugate() * (A * E))
+    out = []
+    for e in kept + list(free):
         out += [e.subs(sys.t, tv) for tv in TIMES] if e.has(sys.t) else [e]
     return out
 

@@ -44,6 +44,7 @@ EPS = 1e-8  # relative offset of the points judged on either side of a crossing
 EPS_STEPS = (1e-8, 1e-6, 1e-4)  # coarser offsets where the engine has no verdict closer
 BISECT_TOL = 1e-13  # the Boolean bisection's bracket (in ray units, ~ relative change)
 TANGENT_RTOL = 1e-12  # an atom's minimum this small against its scale is a touching zero
+POINTS_KEPT = 4096  # points a ray keeps
 
 Classifier = Callable[[dict, bool], "bool | None"]
 
@@ -77,10 +78,36 @@ class Ray:
         self.symbols = symbols
         self.direction = direction
         self.scales = scales or {}
+        self._points: dict = {}
+        self._values: dict = {}
 
     def point(self, t) -> dict | None:
         """The admissible point at t (None where a condition fails or a derived symbol is
-        not real), all values at 30 digits."""
+        not real), all values at 30 digits. Each is computed once (the grid's points are
+        asked for by the atoms' roots, the tangencies and both verdicts), and handed out
+        as a copy."""
+        with mpmath.workdps(DIGITS + 20):  # the key at full precision (offsets of 1e-25)
+            key = mpmath.mpf(t)
+        if key not in self._points:
+            if len(self._points) >= POINTS_KEPT:
+                self._points.clear()
+            self._points[key] = self._point(t)
+        got = self._points[key]
+        return None if got is None else dict(got)
+
+    def value(self, f: sp.Expr, t) -> tuple[float, float] | None:
+        """`value_at(f, self.point(t))`, each computed once (the atoms' roots and the
+        tangencies read the same grid)."""
+        with mpmath.workdps(DIGITS + 20):
+            key = (f, mpmath.mpf(t))
+        if key not in self._values:
+            if len(self._values) >= POINTS_KEPT:
+                self._values.clear()
+            pt = self.point(t)
+            self._values[key] = None if pt is None else value_at(f, pt)
+        return self._values[key]
+
+    def _point(self, t) -> dict | None:
         with mpmath.workdps(DIGITS + 5):
             t = mpmath.mpf(t)
             pt = dict(self.origin)
@@ -117,8 +144,7 @@ def atom_roots(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
     for i, f in enumerate(atoms):
         vals = []
         for t in ts:
-            pt = ray.point(t)
-            got = None if pt is None else value_at(f, pt)
+            got = ray.value(f, t)
             vals.append(None if got is None else got[0])
         for k in range(len(ts) - 1):
             a, b = vals[k], vals[k + 1]
@@ -330,8 +356,7 @@ def _tangencies(atoms: list[sp.Expr], ray: Ray, ts: np.ndarray) -> list[tuple]:
     for i, f in enumerate(atoms):
         vals = []
         for t in ts:
-            pt = ray.point(t)
-            vals.append(None if pt is None else value_at(f, pt))
+            vals.append(ray.value(f, t))
         for k in range(1, len(ts) - 1):
             trio = vals[k - 1: k + 2]
             if any(v is None for v in trio):

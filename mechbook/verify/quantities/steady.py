@@ -49,7 +49,8 @@ def coordinate_map(ctx: Context, mapping, sub) -> dict:
           how=('the uniform motion q = at + rates·t (every coordinate in `at:` or `rates:`) '
                'solves the equations of motion: each residual vanishes identically (at two '
                'times, at random points; answer symbols such as an orbit radius are '
-               'sampled too)'))
+               'sampled too); with constraints, each constraint holds along it and the '
+               'residual is one the constraint forces Aᵀλ can supply'))
 def check_steady_motion(ctx: Context, val) -> Verdict:
     val = ctx.as_map(val, ("book",))
     point = coordinate_map(ctx, val.get("at") or {}, ("book", "at"))
@@ -59,7 +60,9 @@ def check_steady_motion(ctx: Context, val) -> Verdict:
     if missing:
         raise ctx.part.error(("book",), f"give every coordinate a value (`at:`) or a rate "
                              f"(`rates:`): {', '.join(missing)} missing")
-    return all_vanish(steady.steady_residuals(ctx.dyn, rates, point), ctx.sampler)
+    residuals = (steady.constrained_steady_residuals if ctx.dyn.constrained
+                 else steady.steady_residuals)
+    return all_vanish(residuals(ctx.dyn, rates, point), ctx.sampler)
 
 
 def family(ctx: Context) -> SteadyFamily:
