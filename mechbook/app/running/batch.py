@@ -87,7 +87,8 @@ def _worker(conn: Connection, base: Path, options: object, task: Task, run_pid: 
     It dies with the run (mechbook.app.running.lifeline), even one killed with -9."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
     for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
-        signal.signal(ends, signal.SIG_DFL)
+        if signal.getsignal(ends) is not signal.SIG_IGN:  # ignored by the run (nohup): kept so
+            signal.signal(ends, signal.SIG_DFL)
     die_with(run_pid)
     install()  # a stray warning or unraisable exception: the debug log, not the terminal
     settle()

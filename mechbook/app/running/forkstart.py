@@ -1,6 +1,6 @@
 """Imported first by the batch's fork server (mechbook.app.running.batch), before the engine.
 
-Two things only the server itself can do:
+Three things only the server itself can do:
 - Ctrl-C is the run's business. The terminal sends SIGINT to every process of its group,
   and the server spends its first seconds importing the engine, where a KeyboardInterrupt
   would print a traceback; from here on it ignores SIGINT (Python's fork server does so
@@ -12,6 +12,12 @@ Two things only the server itself can do:
   SIGTERM or SIGHUP to the server itself (a whole process group ended) ends it the same
   way. Only a SIGKILL of the server as well leaves the folder: the next run removes it
   (mechbook.app.running.lifeline.sweep_stale_folders).
+- A signal its run ignores, the server and its workers ignore too. A run started under
+  `nohup` (or by a runner that ignores SIGHUP) hands the server SIGHUP ignored, as SIG_IGN
+  survives exec; ending the server and the workers on a hangup the run itself ignores left
+  the run alive with every problem in work failed ("the worker process died"), a new fork
+  server importing the engine again, and the rest of the book checked on, well past the
+  minute a killed run is given to end (issue 42's flake of test_interrupts).
 """
 
 from __future__ import annotations
@@ -40,6 +46,9 @@ def _remove_socket_folder() -> None:
         remove_if_abandoned(folder)
 
 
+ENDS = (signal.SIGTERM, signal.SIGHUP)  # the signals that end the server (and its run)
+
+
 def _end(signum, frame):
     """SIGTERM or SIGHUP: the server ends by way of atexit (which removes its folder); a
     worker forked from it that has not yet set its own handlers dies as by default (its run
@@ -52,6 +61,7 @@ def _end(signum, frame):
 
 
 signal.signal(signal.SIGINT, signal.SIG_IGN)
-signal.signal(signal.SIGTERM, _end)
-signal.signal(signal.SIGHUP, _end)
+for _ends in ENDS:
+    if signal.getsignal(_ends) is not signal.SIG_IGN:  # ignored: as its run does (nohup)
+        signal.signal(_ends, _end)
 atexit.register(_remove_socket_folder)
