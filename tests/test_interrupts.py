@@ -145,6 +145,48 @@ def test_a_killed_run_leaves_no_pymp_folder(tree, short_tmp, how):
     assert not list(tmpdir.glob("pymp-*"))
 
 
+def _server_starting(run: subprocess.Popen, tmpdir: Path, timeout: float = 60.0) -> int:
+    """The fork server's process id as soon as it exists (with its socket's folder made):
+    it is then still starting its interpreter or importing the engine."""
+    import psutil
+
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        try:
+            servers = [p for p in psutil.Process(run.pid).children()
+                       if "multiprocessing.forkserver" in " ".join(p.cmdline())]
+        except psutil.NoSuchProcess:
+            servers = []
+        if servers and list(tmpdir.glob("pymp-*")):
+            return servers[0].pid
+        assert run.poll() is None, "the run ended before its fork server started"
+        time.sleep(0.01)
+    raise AssertionError(f"no fork server in {timeout:g} s")
+
+
+@pytest.mark.parametrize("how", ["SIGHUP", "SIGTERM"])
+def test_a_group_signal_while_the_fork_server_starts_leaves_nothing(tree, short_tmp, how):
+    """A hangup (or SIGTERM) to the whole group while the fork server starts: before
+    issue 42's fix it died of it before forkstart could end it (or, importing the engine,
+    before it knew its socket), and left its folder on a loaded machine, where the start
+    takes longer than the 6 s test_a_killed_run_leaves_no_pymp_folder waited."""
+    import psutil
+
+    sig = getattr(signal, how)
+    proc = _start(tree, short_tmp, "check", "-j", "2", "--no-store")
+    server = _server_starting(proc, short_tmp)
+    assert not psutil.Process(server).children(), "the server was up: nothing tested"
+    family = _descendants(proc.pid)
+    os.killpg(proc.pid, sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == -sig, err
+    end = time.monotonic() + 10
+    while (_alive(family) or list(short_tmp.glob("pymp-*"))) and time.monotonic() < end:
+        time.sleep(0.2)
+    assert not _alive(family), "processes of the run outlived it"
+    assert not list(short_tmp.glob("pymp-*"))
+
+
 @pytest.mark.parametrize("settle", [0.0, 2.0])
 def test_a_run_hung_up_after_a_worker_died_ends_and_leaves_nothing(tree, short_tmp, settle):
     """Issue 42's flake: a worker dies (killed here), the run starts another in its place,
