@@ -130,7 +130,7 @@ def test_a_killed_run_leaves_no_pymp_folder(tree, short_tmp, how):
     exits removes it); now the fork server, which ends with its run, removes it."""
     tmpdir = short_tmp
     proc = _start(tree, tmpdir, "check", "-j", "2", "--no-store")
-    time.sleep(6)
+    _workers(proc, 2)  # at work (6 s of sleep did the same, burning CPU on a quiet machine)
     assert list(tmpdir.glob("pymp-*")), "the run made no folder: nothing tested"
     sig = getattr(signal, how.split()[-1])
     if how.startswith("group"):
@@ -235,7 +235,7 @@ def test_the_next_run_removes_what_a_run_killed_with_its_fork_server_left(tree, 
     the next run, which removes it (it is marked with the dead run's process id)."""
     tmpdir = short_tmp
     proc = _start(tree, tmpdir, "check", "-j", "2", "--no-store")
-    time.sleep(6)
+    _workers(proc, 2)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.communicate(timeout=60)
     left = list(tmpdir.glob("pymp-*"))
