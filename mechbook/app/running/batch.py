@@ -39,6 +39,7 @@ from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.running.lifeline import die_with, sweep_stale_folders
 from mechbook.app.running.quiet import install
 from mechbook.app.running.run import ProblemRun, RunOptions, Stage, run_problem
+from mechbook.app.running.serverstart import start_server
 from mechbook.errors import MechbookError, describe
 
 ItemT = TypeVar("ItemT", bound=Hashable)  # what one task is given: a problem id, a request
@@ -171,43 +172,6 @@ def kill_pool(pool) -> None:
         for process in list((getattr(pool, "_processes", None) or {}).values()):
             process.kill()
     pool.shutdown(wait=False, cancel_futures=True)
-
-
-SERVER_ENDS = (signal.SIGTERM, signal.SIGHUP)  # blocked in the fork server until it can end
-
-
-def start_server() -> None:
-    """Start the fork server (and multiprocessing's resource tracker) if it is not running,
-    with SIGINT ignored from the new processes' first instruction: a signal's disposition
-    SIG_IGN survives exec, so a Ctrl-C while their interpreters start up (before
-    mechbook.app.running.forkstart is imported) cannot kill them with a "Fatal Python error" on
-    the terminal. This process ignores SIGINT only for the instant of the spawn. SIGTERM
-    and SIGHUP are blocked for that instant (a blocked mask survives exec too): the server
-    receives one sent while its interpreter starts once forkstart can end it and remove its
-    socket's folder (a group SIGHUP then killed it outright and left the folder, issue 42).
-    The resource tracker is started first, with the signals as they were."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        _spawn_server()
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        _spawn_server()
-    finally:
-        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
-
-
-def _spawn_server() -> None:
-    """The resource tracker as it comes, then the fork server with SERVER_ENDS blocked."""
-    from multiprocessing import forkserver, resource_tracker
-
-    resource_tracker.ensure_running()
-    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, SERVER_ENDS)
-    try:
-        forkserver.ensure_running()
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
 def settle(preload: bool = False) -> None:
