@@ -11,10 +11,15 @@ checker's structural mutants, tests/test_checker.py, and its 1 % mutants,
 tests/test_power.py) run on a sample of six keys in `make test`; on every other key they
 are marked `mutation` too and run in `make test-mutation` (CI runs both; the sample and
 the marks: tests/mutation_keys.py).
+
+A test skipped for a missing tool (Chromium for the report's pages, node for ajv) says so
+in the run's last lines: `pytest_terminal_summary` below counts the skips by reason, so a
+`make test` without `-rs` still shows what it did not test.
 """
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 
@@ -46,3 +51,25 @@ def repo_analysis() -> Callable[[str], Analysis]:
         return cache[pid]
 
     return get
+
+
+def skip_reason(report: pytest.TestReport) -> str:
+    """Why a test was skipped: its `pytest.skip` (or `skipif`, `importorskip`) reason."""
+    longrepr = report.longrepr
+    reason = str(longrepr[2]) if isinstance(longrepr, (tuple, list)) and len(longrepr) == 3 \
+        else str(longrepr)
+    return reason.removeprefix("Skipped: ").strip() or "no reason given"
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
+    """Each skip reason, with how many tests it skipped, just above the run's last line
+    (pytest shows them only under `-rs`; a missing browser skips the report's page tests
+    and must not pass unnoticed)."""
+    skipped = [r for r in terminalreporter.stats.get("skipped", ())
+               if getattr(r, "longrepr", None) is not None and not hasattr(r, "wasxfail")]
+    if not skipped:
+        return
+    reasons = Counter(skip_reason(r) for r in skipped)
+    terminalreporter.write_sep("-", f"{len(skipped)} skipped, by reason", yellow=True)
+    for reason, count in reasons.most_common():
+        terminalreporter.write_line(f"{count:4d} × {reason}")

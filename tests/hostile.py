@@ -95,15 +95,18 @@ MEMORY_GB = 2.0  # the address space a command of the tests may take (issue 33)
 
 def limited(memory_gb: float = MEMORY_GB):
     """A preexec_fn: the child's address space bounded (a read without bound then fails in
-    the child, never fills the machine) and SIGINT at its default (a shell that runs the
-    tests in the background ignores it for its children)."""
+    the child, never fills the machine) and SIGINT, SIGHUP and SIGTERM at their defaults (a
+    shell that runs the tests in the background ignores SIGINT for its children, `nohup` or
+    a CI runner SIGHUP, and a child inherits what is ignored: a test that ends a run with
+    SIGHUP would find it running on)."""
     import resource
     import signal
 
     def setup() -> None:
         limit = int(memory_gb * 2**30)
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        for signum in (signal.SIGINT, signal.SIGHUP, signal.SIGTERM):
+            signal.signal(signum, signal.SIG_DFL)
 
     return setup
 

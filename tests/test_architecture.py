@@ -5,6 +5,7 @@ quantities equal to the registry, and no quantity named outside its registration
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from pathlib import Path
 
@@ -34,12 +35,33 @@ FORBIDDEN = {"crosscheck": {"mechbook.model.bodies", "mechbook.model.attitude"}}
 
 
 def modules() -> dict[str, Path]:
+    """{module name: its file} of the package (a copy: the caller may change it)."""
+    return dict(_modules())
+
+
+@functools.cache
+def _modules() -> dict[str, Path]:
+    """Walked once per test process: `imports` asks for every file it reads, and the
+    cycle tests read every module three times (each walk of the package took ~1.5 ms,
+    10^3 times per test)."""
     out = {}
     for path in PACKAGE.rglob("*.py"):
         rel = path.relative_to(ROOT).with_suffix("")
         name = ".".join(rel.parts)
         out[name.removesuffix(".__init__")] = path
     return out
+
+
+def parsed(path: Path) -> ast.Module:
+    """The file's syntax tree, parsed once per test process for each version of the file
+    (the tests below read the same few hundred files many times over). Read only."""
+    info = path.stat()
+    return _parse(path, info.st_mtime_ns, info.st_size)
+
+
+@functools.lru_cache(maxsize=4096)
+def _parse(path: Path, mtime_ns: int, size: int) -> ast.Module:
+    return ast.parse(path.read_text(encoding="utf-8"))
 
 
 def stage(module: str) -> str:
@@ -59,7 +81,7 @@ def _type_checking_only(tree: ast.Module) -> set[ast.AST]:
 def imports(path: Path, top_level_only: bool = False, runtime_only: bool = False) -> set[str]:
     """The mechbook modules a file imports (all of them, or only those at module level;
     `runtime_only`: without those under `if TYPE_CHECKING:`)."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = parsed(path)
     nodes = tree.body if top_level_only else list(ast.walk(tree))
     if runtime_only:
         skip = _type_checking_only(tree)
@@ -73,7 +95,7 @@ def imports(path: Path, top_level_only: bool = False, runtime_only: bool = False
                 out |= {f"{node.module}.{a.name}" for a in node.names}
         elif isinstance(node, ast.Import):
             out |= {a.name for a in node.names if a.name.startswith("mechbook")}
-    known = modules()
+    known = _modules()
     return {m for m in out if m in known}
 
 
@@ -159,7 +181,7 @@ def test_the_cycle_test_can_fail():
 def test_every_package_says_what_it_owns_and_may_import():
     """Each stage, and each package of mechbook.app (issue 43: the folder shows the parts)."""
     for init in [*PACKAGE.glob("*/__init__.py"), *(PACKAGE / "app").glob("*/__init__.py")]:
-        doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))) or ""
+        doc = ast.get_docstring(parsed(init)) or ""
         assert "May import" in doc, f"{init}: the docstring states no import rule"
 
 
@@ -434,8 +456,9 @@ def unused_modules(known: dict[str, Path], users: list[Path]) -> list[str]:
     a test: imports inside functions count) and no mechbook module names as a string (a
     fork server's preload list), and that are no entry point."""
     used: set[str] = set()
+    owner = {p: m for m, p in known.items()}
     for path in [*known.values(), *users]:
-        own = next((m for m, p in known.items() if p == path), None)
+        own = owner.get(path)
         for name in imports(path):
             if name != own:
                 parts = name.split(".")
@@ -505,7 +528,7 @@ def test_the_store_package_exports_what_it_lists():
 # ---- issue 35: no private name crosses a module, function-level imports only with a reason ----
 def _imports_from_mechbook(path: Path):
     """(node, inside a function?) for each `from mechbook... import ...` of a file."""
-    tree = ast.parse(path.read_text("utf-8"))
+    tree = parsed(path)
     inside = {id(n) for fn in ast.walk(tree)
               if isinstance(fn, ast.FunctionDef | ast.AsyncFunctionDef)
               for n in ast.walk(fn)}
@@ -555,7 +578,7 @@ def private_module_reads(paths) -> list[str]:
     known = set(modules())
     out = []
     for p in paths:
-        tree = ast.parse(p.read_text("utf-8"))
+        tree = parsed(p)
         bound = set()
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("mechbook"):

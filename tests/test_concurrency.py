@@ -61,6 +61,8 @@ class Reader(threading.Thread):
 
 
 def test_two_check_processes_into_one_store_lose_nothing(tmp_path):
+    """Each process checks in itself (`--serial`): the store is written by a run's parent
+    either way, and a fork server and a worker per run only added two start-ups each."""
     for pid in {p for pair in PAIRS for p in pair}:
         _copy(tmp_path, pid)
     h5 = tmp_path / "results" / "m.h5"
@@ -71,7 +73,7 @@ def test_two_check_processes_into_one_store_lose_nothing(tmp_path):
         for a, b in PAIRS:
             procs = [subprocess.Popen([sys.executable, "-m", "mechbook", "--root",
                                        str(tmp_path), "check", pid, "--store", str(h5),
-                                       "--fresh", "-j", "1", "--no-crosscheck"],
+                                       "--fresh", "--serial", "--no-crosscheck"],
                                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                       text=True) for pid in (a, b)]
             for proc in procs:

@@ -46,12 +46,43 @@ def tree(tmp_path) -> Path:
     return base
 
 
-def _start(tree: Path, tmpdir: Path, *args: str) -> subprocess.Popen:
+def _start(tree: Path, tmpdir: Path, *args: str, ignore_hangups: bool = False
+           ) -> subprocess.Popen:
+    """A run in a session of its own; with `ignore_hangups`, started as `nohup` starts it."""
     env = dict(os.environ, TMPDIR=str(tmpdir), PYTHONPATH=os.pathsep.join(
         [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    setup = limited(4.0)
+
+    def preexec() -> None:
+        setup()
+        if ignore_hangups:
+            signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
     return subprocess.Popen([sys.executable, "-m", "mechbook", "--root", str(tree), *args],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=env, start_new_session=True, preexec_fn=limited(4.0))
+                            env=env, start_new_session=True, preexec_fn=preexec)
+
+
+def _workers(run: subprocess.Popen, want: int, timeout: float = 90.0) -> list[int]:
+    """The process ids of the run's `want` workers (the fork server's live children), once
+    there are that many; fails after `timeout` seconds (a loaded machine takes a while to
+    import the engine in the fork server)."""
+    import psutil
+
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        try:
+            servers = [p for p in psutil.Process(run.pid).children()
+                       if "multiprocessing.forkserver" in " ".join(p.cmdline())]
+            live = [c.pid for s in servers for c in s.children()
+                    if c.status() != psutil.STATUS_ZOMBIE]
+        except psutil.NoSuchProcess:
+            live = []
+        if len(live) >= want:
+            return live
+        assert run.poll() is None, "the run ended before its workers started"
+        time.sleep(0.1)
+    raise AssertionError(f"the run did not start {want} workers in {timeout:g} s")
 
 
 def _descendants(pid: int) -> set[int]:
@@ -99,7 +130,7 @@ def test_a_killed_run_leaves_no_pymp_folder(tree, short_tmp, how):
     exits removes it); now the fork server, which ends with its run, removes it."""
     tmpdir = short_tmp
     proc = _start(tree, tmpdir, "check", "-j", "2", "--no-store")
-    time.sleep(6)
+    _workers(proc, 2)  # at work (6 s of sleep did the same, burning CPU on a quiet machine)
     assert list(tmpdir.glob("pymp-*")), "the run made no folder: nothing tested"
     sig = getattr(signal, how.split()[-1])
     if how.startswith("group"):
@@ -107,10 +138,96 @@ def test_a_killed_run_leaves_no_pymp_folder(tree, short_tmp, how):
     else:
         os.kill(proc.pid, sig)
     proc.communicate(timeout=60)
+    assert proc.returncode == -sig, "the run was not ended by the signal"
     end = time.monotonic() + 10
     while list(tmpdir.glob("pymp-*")) and time.monotonic() < end:
         time.sleep(0.2)
     assert not list(tmpdir.glob("pymp-*"))
+
+
+def _server_starting(run: subprocess.Popen, tmpdir: Path, timeout: float = 60.0) -> int:
+    """The fork server's process id as soon as it exists (with its socket's folder made):
+    it is then still starting its interpreter or importing the engine."""
+    import psutil
+
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        try:
+            servers = [p for p in psutil.Process(run.pid).children()
+                       if "multiprocessing.forkserver" in " ".join(p.cmdline())]
+        except psutil.NoSuchProcess:
+            servers = []
+        if servers and list(tmpdir.glob("pymp-*")):
+            return servers[0].pid
+        assert run.poll() is None, "the run ended before its fork server started"
+        time.sleep(0.01)
+    raise AssertionError(f"no fork server in {timeout:g} s")
+
+
+@pytest.mark.parametrize("how", ["SIGHUP", "SIGTERM"])
+def test_a_group_signal_while_the_fork_server_starts_leaves_nothing(tree, short_tmp, how):
+    """A hangup (or SIGTERM) to the whole group while the fork server starts: before
+    issue 42's fix it died of it before forkstart could end it (or, importing the engine,
+    before it knew its socket), and left its folder on a loaded machine, where the start
+    takes longer than the 6 s test_a_killed_run_leaves_no_pymp_folder waited."""
+    import psutil
+
+    sig = getattr(signal, how)
+    proc = _start(tree, short_tmp, "check", "-j", "2", "--no-store")
+    server = _server_starting(proc, short_tmp)
+    assert not psutil.Process(server).children(), "the server was up: nothing tested"
+    family = _descendants(proc.pid)
+    os.killpg(proc.pid, sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == -sig, err
+    end = time.monotonic() + 10
+    while (_alive(family) or list(short_tmp.glob("pymp-*"))) and time.monotonic() < end:
+        time.sleep(0.2)
+    assert not _alive(family), "processes of the run outlived it"
+    assert not list(short_tmp.glob("pymp-*"))
+
+
+@pytest.mark.parametrize("settle", [0.0, 2.0])
+def test_a_run_hung_up_after_a_worker_died_ends_and_leaves_nothing(tree, short_tmp, settle):
+    """Issue 42's flake: a worker dies (killed here), the run starts another in its place,
+    and a hangup to the whole group arrives while the replacement is being forked
+    (`settle` 0) or once it works (2 s): the run, its fork server and every worker end at
+    once, and no pymp folder stays."""
+    proc = _start(tree, short_tmp, "check", "-j", "2", "--no-store")
+    first = _workers(proc, 2)
+    os.kill(first[0], signal.SIGKILL)
+    if settle:
+        _workers(proc, 2)  # the replacement is there
+        time.sleep(settle)
+    family = _descendants(proc.pid)
+    os.killpg(proc.pid, signal.SIGHUP)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == -signal.SIGHUP, err
+    end = time.monotonic() + 10
+    while (_alive(family) or list(short_tmp.glob("pymp-*"))) and time.monotonic() < end:
+        time.sleep(0.2)
+    assert not _alive(family), "processes of the run outlived it"
+    assert not list(short_tmp.glob("pymp-*"))
+
+
+def test_a_run_that_ignores_hangups_keeps_its_workers_through_one(tree, short_tmp):
+    """A run started under `nohup` ignores SIGHUP, and so do its fork server and workers:
+    on 4c46ee6 the workers died of the hangup their run ignored (each problem in work an
+    error, "the worker process died"), the run forked a new server and checked on, and
+    test_a_killed_run_leaves_no_pymp_folder[group SIGHUP], run by a runner that ignores
+    SIGHUP, waited a whole book's check for a run it thought killed."""
+    ids = ("classic-hard-sphere-scattering", "classic-inverse-square-capture")  # 4 s each
+    proc = _start(tree, short_tmp, "check", *ids, "-j", "2", "--no-store",
+                  ignore_hangups=True)
+    workers = set(_workers(proc, 2))
+    os.killpg(proc.pid, signal.SIGHUP)
+    time.sleep(1.0)
+    assert proc.poll() is None, "the run ended on a hangup it ignores"
+    assert _alive(workers) == workers, "its workers died of a hangup the run ignores"
+    out, err = proc.communicate(timeout=300)
+    assert "died" not in err, err
+    assert proc.returncode == 0, err
+    assert not list(short_tmp.glob("pymp-*"))
 
 
 def test_the_next_run_removes_what_a_run_killed_with_its_fork_server_left(tree, short_tmp):
@@ -118,7 +235,7 @@ def test_the_next_run_removes_what_a_run_killed_with_its_fork_server_left(tree, 
     the next run, which removes it (it is marked with the dead run's process id)."""
     tmpdir = short_tmp
     proc = _start(tree, tmpdir, "check", "-j", "2", "--no-store")
-    time.sleep(6)
+    _workers(proc, 2)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.communicate(timeout=60)
     left = list(tmpdir.glob("pymp-*"))

@@ -65,16 +65,30 @@ def test_every_relation_of_both_books_is_found():
     assert len(RELATIONS) >= 15, RELATIONS
 
 
+_ORIGINALS: dict = {}
+
+
+def _original(answer_file: Path, part):
+    """The part's own outcome, checked once per test process: both moves of a relation
+    judge against it (the vibrating pivot's took ~9 s each time on a loaded machine)."""
+    slot = (answer_file, part.name)
+    if slot not in _ORIGINALS:
+        _ORIGINALS[slot] = check_part(_load(answer_file)[1], part)
+    return _ORIGINALS[slot]
+
+
+# delta varies fastest: a relation's two moves are neighbours in the collection, and xdist
+# hands out neighbours together, so the second finds the original outcome checked
 @pytest.mark.slow
+@pytest.mark.parametrize("delta", [Fraction(1, 100), Fraction(1, 10**6)], ids=["1e-2", "1e-6"])
 @pytest.mark.parametrize("answer_file, name", RELATIONS,
                          ids=[f"{f.stem}-{n}" for f, n in RELATIONS])
-@pytest.mark.parametrize("delta", [Fraction(1, 100), Fraction(1, 10**6)], ids=["1e-2", "1e-6"])
 def test_a_moved_boundary_fails(answer_file: Path, name: str, delta: Fraction):
     key, analysis = _load(answer_file)
     part = next(p for p in key.parts if p.name == name)
     names = set(analysis.problem.parameters) | set(key.symbols) | set(
         key.doc.data.get("abbreviations") or {})
-    original = check_part(analysis, part)
+    original = _original(answer_file, part)
     assert original.status in ("pass", "erratum"), original.detail
     assert "boundary" in original.power, original.power
     data = copy.deepcopy(part.data)

@@ -10,24 +10,34 @@ Real `mechbook show` and `mechbook check` processes with their address space bou
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
-from hostile import check, mechbook, pendulum_tree
+from hostile import mechbook, pendulum_tree, run
 
 import mechbook.app.store as store
 
 MARKER = "OUTSIDE-THE-STORE-3c9a"
 
 
-@pytest.fixture
-def tree(tmp_path) -> Path:
-    base = pendulum_tree(tmp_path / "tree", nums=("2101", "2102"))
-    res = check(base)  # a real record of each, written the way `check` writes them
+@pytest.fixture(scope="module")
+def checked(tmp_path_factory) -> Path:
+    """Two pendulums checked once for the module, with their cross-checks (a record's
+    crosschecks/ group is damaged below): a real record of each, written the way `check`
+    writes them (in this process, serially: the records are the same as a worker's)."""
+    base = pendulum_tree(tmp_path_factory.mktemp("checked") / "tree", nums=("2101", "2102"))
+    res = run("--root", base, "check", "--serial")
     assert res.exit_code == 0, res.output
     return base
+
+
+@pytest.fixture
+def tree(checked, tmp_path) -> Path:
+    """A copy of the checked tree of the test's own (each test damages its store)."""
+    return Path(shutil.copytree(checked, tmp_path / "tree"))
 
 
 def _store(tree: Path) -> Path:
@@ -169,13 +179,10 @@ def test_links_inside_a_store_are_not_followed(tree, tmp_path, how):
     (lambda f: f["problems/lim-2101/crosschecks/0"].attrs.__setitem__("error", "big"),
      "the attribute 'error' is 'big'"),
 ])
-def test_a_record_show_calls_damaged_is_moved_aside_by_the_next_check(tmp_path, damage, why):
+def test_a_record_show_calls_damaged_is_moved_aside_by_the_next_check(tree, damage, why):
     """On 0834a76 `show` said "the next check moves it aside" while a check that wrote the
     store kept the record with no word (its check of the file read strings, never JSON or
     outcomes); `show` of a record without its attributes printed 'stored None'."""
-    tree = pendulum_tree(tmp_path / "tree", nums=("2101", "2102"))
-    res = mechbook("--root", tree, "check", "-j", "1", cwd=tree)  # with its cross-checks
-    assert res.returncode == 0, res.stderr
     with h5py.File(_store(tree), "a") as f:
         damage(f)
     res = mechbook("--root", tree, "show", "lim-2101", cwd=tree)

@@ -39,6 +39,7 @@ from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.running.lifeline import die_with, sweep_stale_folders
 from mechbook.app.running.quiet import install
 from mechbook.app.running.run import ProblemRun, RunOptions, Stage, run_problem
+from mechbook.app.running.serverstart import start_server
 from mechbook.errors import MechbookError, describe
 
 ItemT = TypeVar("ItemT", bound=Hashable)  # what one task is given: a problem id, a request
@@ -87,7 +88,8 @@ def _worker(conn: Connection, base: Path, options: object, task: Task, run_pid: 
     It dies with the run (mechbook.app.running.lifeline), even one killed with -9."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the run stops its workers
     for ends in (signal.SIGTERM, signal.SIGHUP):  # the fork server's own ways to end: not ours
-        signal.signal(ends, signal.SIG_DFL)
+        if signal.getsignal(ends) is not signal.SIG_IGN:  # ignored by the run (nohup): kept so
+            signal.signal(ends, signal.SIG_DFL)
     die_with(run_pid)
     install()  # a stray warning or unraisable exception: the debug log, not the terminal
     settle()
@@ -170,25 +172,6 @@ def kill_pool(pool) -> None:
         for process in list((getattr(pool, "_processes", None) or {}).values()):
             process.kill()
     pool.shutdown(wait=False, cancel_futures=True)
-
-
-def start_server() -> None:
-    """Start the fork server (and multiprocessing's resource tracker) if it is not running,
-    with SIGINT ignored from the new processes' first instruction: a signal's disposition
-    SIG_IGN survives exec, so a Ctrl-C while their interpreters start up (before
-    mechbook.app.running.forkstart is imported) cannot kill them with a "Fatal Python error" on
-    the terminal. This process ignores SIGINT only for the instant of the spawn."""
-    import threading
-    from multiprocessing import forkserver
-
-    if threading.current_thread() is not threading.main_thread():
-        forkserver.ensure_running()
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        forkserver.ensure_running()
-    finally:
-        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
 
 
 def settle(preload: bool = False) -> None:

@@ -35,9 +35,10 @@ from dataclasses import replace
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
-from mechbook.app.running.batch import POLL, Batch, BatchOptions, pool_context, rss_mb, start_server
+from mechbook.app.running.batch import POLL, Batch, BatchOptions, pool_context, rss_mb
 from mechbook.app.running.lifeline import die_with
 from mechbook.app.running.run import ProblemRun
+from mechbook.app.running.serverstart import start_server
 from mechbook.core.optional import require
 from mechbook.errors import MechbookError
 from mechbook.model.catalog import answer_path, problem_path
