@@ -30,6 +30,7 @@ import itertools
 
 import sympy as sp
 
+from mechbook.core.algebra_reach import within_exact_reach
 from mechbook.core.numeval import NotNumeric, evaluate_mp, holds
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.errors import UnsupportedError
@@ -303,6 +304,8 @@ ctx: Context, e: sp.Expr) -> bool:
     """SymPy proves d/dt e = 0 along the motion (accelerations from the equations)."""
     dyn = ctx.dyn
     acc = dict(zip(dyn.qdd, dyn.accelerations, strict=True))
+    if not within_exact_reach(e):  # gmp would abort the process, not raise
+        return False
     try:
         with time_limit(PROOF_SECONDS):
             return sp.simplify(ctx.system.dt(e).subs(acc)) == 0
