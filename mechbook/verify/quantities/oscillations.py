@@ -14,7 +14,7 @@ from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError, WrongAnswerError
 from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
-from mechbook.verify.compare import Verdict, at_point, match_multiset, vanishes
+from mechbook.verify.compare import Verdict, all_vanish, at_point, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import EXPR, LIMIT, Family
 
@@ -59,8 +59,9 @@ def check_frequencies(ctx: Context, val) -> Verdict:
                                                 if precise else "")
     if partial:
         power += f"; partial: {len(book)} of {len(lin.q)} frequencies (the rest unchecked)"
-    return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or how,
-                   precise.detail if precise else "", power=power)
+    proved, why = _symbolic_frequencies(ctx, book, lin, partial)
+    return Verdict(True, "symbolic" if proved else how, precise.detail if precise else "",
+                   power=power, unproved=why)
 
 
 PRECISE_RTOL = 1e-20  # book against engine frequencies, both at 50 digits
@@ -120,26 +121,29 @@ def _has_doubles(x) -> bool:
     return isinstance(x, sp.Basic) and any(f._prec < 90 for f in x.atoms(sp.Float))
 
 
-def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
-    """'symbolic' when, asked to prove (`--prove`), the engine's closed-form frequencies
-    match the book's exactly; the numeric multiset comparison has already decided."""
+def _symbolic_frequencies(ctx, book, lin, partial) -> tuple[bool, str]:
+    """(proved, why not): with `--prove`, do the engine's closed-form frequencies match the
+    book's exactly? The numeric multiset comparison has already decided."""
     if not ctx.policy.prove:
-        return None
+        return False, ""
     pt = ctx.sampler.draw()
     try:
         engine = list(lin.frequencies_at(pt))  # the key's symbols (a steady rate) valued too
     except UnsupportedError:
-        return None
+        return False, "the engine's frequencies have no closed form here"
     eng_vals = numbers(engine, pt)
     used = set()
     for b in book:
         bv = numbers([b], pt)[0]
         idx = [i for i in range(len(engine)) if i not in used
                and abs(eng_vals[i] - bv) <= 1e-8 * max(1, abs(bv))]
-        if not idx or not vanishes(b**2 - engine[idx[0]] ** 2, ctx.sampler).method == "symbolic":
-            return None
+        if not idx:
+            return False, "no closed-form engine frequency to pair with"
+        v = vanishes(b**2 - engine[idx[0]] ** 2, ctx.sampler)
+        if v.method != "symbolic":
+            return False, v.unproved
         used.add(idx[0])
-    return "symbolic"
+    return True, ""
 
 
 def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
@@ -183,14 +187,19 @@ def check_period(ctx: Context, val) -> Verdict:
         if not any(abs(2 * np.pi / w - p) <= 1e-8 * p for w in freqs):
             return Verdict(False, "numeric", f"period {p:.10g} vs engine "
                            f"{[2 * np.pi / w for w in freqs]}" + at_point(pt))
+    why = ""
     try:
-        if ctx.policy.prove and any(vanishes(period - 2 * sp.pi / w, ctx.sampler).method
-                                    == "symbolic" for w in lin.frequencies if w != 0):
-            return Verdict(True, "symbolic", power="proved symbolically")
+        if ctx.policy.prove:
+            tries = [vanishes(period - 2 * sp.pi / w, ctx.sampler)
+                     for w in lin.frequencies if w != 0]
+            if any(v.method == "symbolic" for v in tries):
+                return Verdict(True, "symbolic", power="proved symbolically")
+            why = "; ".join(dict.fromkeys(v.unproved for v in tries if v.unproved))
     except UnsupportedError:
-        pass
+        why = "the engine's frequencies have no closed form here"
     return Verdict(True, "numeric(6 points)",
-                   power="6 points: 2π/ω matches one of the engine's frequencies to 1e-8")
+                   power="6 points: 2π/ω matches one of the engine's frequencies to 1e-8",
+                   unproved=why)
 
 
 def _mode_residual(lin: LinearSystem, freq: sp.Expr, shape: sp.Matrix, pt: dict) -> float:
@@ -237,9 +246,34 @@ def check_normal_modes(ctx: Context, val) -> Verdict:
             if res > 1e-8:
                 return Verdict(False, "numeric", f"mode {i}: (K - w^2 M) u relative residual "
                                f"{res:.3g}" + at_point(pt))
+    return _proved_modes(ctx, modes, lin) if ctx.policy.prove else _numeric_modes()
+
+
+def _numeric_modes() -> Verdict:
     return Verdict(True, "numeric(5 points)",
-                   power="5 points: each (ω, shape) satisfies (K − ω²M)u = 0 to 1e-8 of its scale "
-                   "(a shape up to its length)")
+                   power="5 points: each (ω, shape) satisfies (K − ω²M)u = 0 to 1e-8 of its "
+                   "scale (a shape up to its length)")
+
+
+def _proved_modes(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
+    """With `--prove`, after the numeric pass: each (K − ω²M)u proved 0 entry by entry
+    (u is nonzero at the points drawn, so ω² is an eigenvalue and u its eigenvector)."""
+    numeric = _numeric_modes()
+    if lin.first_order or lin.gyroscopic:
+        numeric.unproved = "gyroscopic or first-order modes: compared numerically"
+        return numeric
+    residuals = []
+    for i, mode in enumerate(modes):
+        mode = ctx.as_map(mode, ("book", i))
+        freq = ctx.parse(mode["frequency"], ("book", i, "frequency"))
+        shape = ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))
+        residuals += list((lin.K - freq**2 * lin.M) * shape)
+    proof = all_vanish(residuals, ctx.sampler)
+    if proof.ok and proof.method == "symbolic":
+        return Verdict(True, "symbolic", power="proved symbolically: (K − ω²M)u = 0 for "
+                       "each mode (a shape up to its length)")
+    numeric.unproved = proof.unproved
+    return numeric
 
 
 def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
