@@ -18,7 +18,7 @@ import sympy as sp
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, evaluate_resolved, holds
 from mechbook.core.words import plural
 from mechbook.records import NUMERIC, ProofPolicy
-from mechbook.verify.proof import OPEN, Budget, Proof, prove_zero
+from mechbook.verify.proof import FLOATS, OPEN, Budget, Proof, prove_zero
 
 RTOL = 1e-10  # relative tolerance of a numeric comparison
 # What an exact expression (no numbers below 30 digits in it) may leave at a 30-digit point,
@@ -351,6 +351,8 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
     proof = _proof(diff, sampler, symbolic)
+    if proof is not None and proof.ok and _floats(a, b):  # SymPy may fold 0.1·x − x/10 to 0
+        proof = Proof(False, FLOATS)
     if proof is not None and proof.ok:
         return Verdict(True, "symbolic", power=PROVED)
     return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
@@ -358,6 +360,10 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
                    power=(f"within the stated {sampler.rtol:.2g}" if sampler.rtol > RTOL else
                           f"{plural(valid, 'point')} at {DIGITS} digits, within {rtol:g}"),
                    unproved=proof.why if proof is not None else "")
+
+
+def _floats(*exprs: sp.Basic) -> bool:
+    return any(isinstance(e, sp.Basic) and e.atoms(sp.Float) for e in exprs)
 
 
 def _num(z: complex) -> str:
