@@ -177,3 +177,44 @@ def test_every_unproved_pass_says_why(tmp_path):
         assert o.method == "symbolic" or "; unproved: " in o.method, o.method
     assert any(proof.BRANCH in o.method for o in proved)
     assert not any("unproved" in o.method for o in plain)
+
+
+def test_frequencies_proved_as_roots_of_the_secular_polynomial(tmp_path):
+    """Lim 2055 (six coupled pendulums in a ring, two double roots): each book ω² makes
+    det(K − ω²M) and, for a double root, its derivative vanish identically: proved without
+    solving the sextic. A frequency wrong by 1e-6 fails."""
+    an = Analysis(load_problem(ROOT / "problems" / "lim" / "2055.yaml"))
+
+    def only_b(d):
+        d["parts"] = [p for p in d["parts"] if p["part"] == "b"]
+
+    right = check_problem(an, load_answers(_lim_key(tmp_path, "2055", only_b)), PROVE)
+    assert [(o.status, o.method) for o in right] == [(Status.PASS, "symbolic")]
+
+    def wrong(d):
+        only_b(d)
+        d["parts"][0]["book"][1] = f"(1 + 1e-6)*{d['parts'][0]['book'][1]}"
+
+    out = check_problem(an, load_answers(_lim_key(tmp_path, "2055", wrong)), PROVE)
+    assert out[0].status == Status.FAIL
+
+
+def test_an_initial_value_motion_is_proved(tmp_path):
+    """Lim 2043 (c): the book's motion satisfies the linearized equations and the initial
+    values exactly (unique solution): proved; its amplitude wrong by 1e-6 fails."""
+    an = Analysis(load_problem(ROOT / "problems" / "lim" / "2043.yaml"))
+
+    def only(d):
+        d["parts"] = [p for p in d["parts"] if p["part"] == "c-solution"]
+
+    right = check_problem(an, load_answers(_lim_key(tmp_path, "2043", only)), PROVE)
+    assert [(o.status, o.method) for o in right] == [(Status.PASS, "symbolic")]
+
+    def wrong(d):
+        only(d)
+        book = d["parts"][0]["book"]
+        k = next(iter(book))
+        book[k] = f"(1 + 1e-6)*({book[k]})"
+
+    out = check_problem(an, load_answers(_lim_key(tmp_path, "2043", wrong)), PROVE)
+    assert out[0].status == Status.FAIL

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import symengine as se
 import sympy as sp
 
-MAX_TERMS = 60_000  # bound on the expanded numerator's terms: beyond, no expansion is tried
+MAX_TERMS = 200_000  # terms of a product's two factors multiplied: beyond, no expansion
 # (SymEngine's expansion cannot be interrupted, so its size is bounded before it starts)
 MAX_MULTIPLE = 12  # largest multiple of a base angle expanded (sin 12x: degree 12)
 POINTS = 2  # exact rational points tried before the expansion
@@ -291,28 +291,34 @@ def _multiple(sc: tuple, n: int) -> tuple[se.Basic, se.Basic]:
     return (S, C) if n >= 0 else (-S, C)
 
 
-def _terms_bound(e: se.Basic, memo: dict) -> float:
-    """An upper bound on the number of terms of expand(e)."""
-    key = id(e)
-    if key in memo:
-        return memo[key][1]
-    if isinstance(e, se.Add):
-        n = sum(_terms_bound(a, memo) for a in e.args)
-    elif isinstance(e, se.Mul):
-        n = math.prod(_terms_bound(a, memo) for a in e.args)
-    elif isinstance(e, se.Pow) and e.args[1].is_integer and int(e.args[1]) > 0:
-        t, k = _terms_bound(e.args[0], memo), int(e.args[1])
-        n = math.comb(int(min(t, 1e6)) + k - 1, k) if t > 1 else 1
-    else:
-        n = 1
-    memo[key] = (e, n)  # keep e alive: its id stays its own
-    return n
+def _terms(e: se.Basic) -> int:
+    return len(e.args) if isinstance(e, se.Add) else 1
 
 
 def _expand(e: se.Basic) -> se.Basic:
-    if _terms_bound(e, {}) > MAX_TERMS:
-        raise NotCanonical("too large to expand")
-    return se.expand(e)
+    """se.expand(e), bottom up: each product is formed only when its two expanded factors'
+    terms multiply to at most MAX_TERMS (SymEngine's expansion cannot be interrupted, so
+    its size is bounded before each step; the sizes are the real ones, not a bound)."""
+    if isinstance(e, se.Add):
+        return se.expand(se.Add(*[_expand(a) for a in e.args]))
+    if isinstance(e, se.Mul):
+        out = se.Integer(1)
+        for f in e.args:
+            f = _expand(f)
+            if _terms(out) * _terms(f) > MAX_TERMS:
+                raise NotCanonical("too large to expand")
+            out = se.expand(out * f)
+        return out
+    if isinstance(e, se.Pow) and e.args[1].is_integer and int(e.args[1]) > 1 \
+            and isinstance(e.args[0], (se.Add, se.Mul)):
+        base, n = _expand(e.args[0]), int(e.args[1])
+        out = se.Integer(1)
+        for _ in range(n):
+            if _terms(out) * _terms(base) > MAX_TERMS:
+                raise NotCanonical("too large to expand")
+            out = se.expand(out * base)
+        return out
+    return e
 
 
 def _reduce(poly: se.Basic, relations: list) -> se.Basic:

@@ -7,10 +7,11 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from mechbook.core.identity import decide_zero
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.core.words import plural
 from mechbook.engine import perturbation
-from mechbook.engine.linear import LinearSystem
+from mechbook.engine.linear import LinearSystem, secular_determinant
 from mechbook.errors import UnsupportedError, WrongAnswerError
 from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
@@ -126,6 +127,8 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> tuple[bool, str]:
     book's exactly? The numeric multiset comparison has already decided."""
     if not ctx.policy.prove:
         return False, ""
+    if not (lin.first_order or lin.gyroscopic):
+        return _secular_roots(ctx, book, lin)
     pt = ctx.sampler.draw()
     try:
         engine = list(lin.frequencies_at(pt))  # the key's symbols (a steady rate) valued too
@@ -143,6 +146,38 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> tuple[bool, str]:
         if v.method != "symbolic":
             return False, v.unproved
         used.add(idx[0])
+    return True, ""
+
+
+def _secular_roots(ctx: Context, book, lin: LinearSystem) -> tuple[bool, str]:
+    """(proved, why not) without solving the secular equation: each book ω² is a root of
+    P(w) = det(K − wM) of the multiplicity the book gives it (P and its first k − 1
+    derivatives vanish there identically), values the book repeats are proved equal, and
+    det M is decided nonzero, so P has degree n: n book values are then all its roots (the
+    numeric pass has matched them as a multiset, which also tells the distinct ones
+    apart)."""
+    w = sp.Dummy("w")
+    if decide_zero(lin.M.det()).zero is not False:
+        return False, "the mass matrix is not shown invertible"
+    P = secular_determinant(lin.K - w * lin.M)
+    pt = ctx.sampler.draw()
+    squares = [b**2 for b in book]
+    values = numbers(squares, pt)
+    groups: list[list[int]] = []
+    for i, v in enumerate(values):
+        for grp in groups:
+            if abs(values[grp[0]] - v) <= 1e-12 * max(1.0, abs(v)):
+                grp.append(i)
+                break
+        else:
+            groups.append([i])
+    for grp in groups:
+        first = squares[grp[0]]
+        claims = [squares[i] - first for i in grp[1:]]
+        claims += [sp.diff(P, w, j).subs(w, first) for j in range(len(grp))]
+        v = all_vanish(claims, ctx.sampler)
+        if not v.ok or v.method != "symbolic":
+            return False, v.unproved or "a book value is not a root of det(K − ω²M)"
     return True, ""
 
 
