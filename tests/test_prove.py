@@ -218,3 +218,22 @@ def test_an_initial_value_motion_is_proved(tmp_path):
 
     out = check_problem(an, load_answers(_lim_key(tmp_path, "2043", wrong)), PROVE)
     assert out[0].status == Status.FAIL
+
+
+def test_normal_coordinates_are_proved(tmp_path):
+    """Lim 2028 (b): K·adj(M)·c = ω²·det(M)·c for each form, exactly; the centre-of-mass
+    form with its coefficient wrong by 1e-6 fails."""
+    an = Analysis(load_problem(ROOT / "problems" / "lim" / "2028.yaml"))
+
+    def only(d):
+        d["parts"] = [p for p in d["parts"] if p["part"] == "b"]
+
+    right = check_problem(an, load_answers(_lim_key(tmp_path, "2028", only)), PROVE)
+    assert [(o.status, o.method) for o in right] == [(Status.PASS, "symbolic")]
+
+    def wrong(d):
+        only(d)
+        d["parts"][0]["book"][0]["coordinate"] = "x + (1 + 1e-6)*m*b*theta/(m + M)"
+
+    out = check_problem(an, load_answers(_lim_key(tmp_path, "2028", wrong)), PROVE)
+    assert out[0].status == Status.FAIL

@@ -411,8 +411,44 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
                                    f"{w:.10g}, engine {np.sqrt(max(w2, 0)):.10g}")
         if len(rows) == len(ctx.system.q) and np.linalg.matrix_rank(np.array(rows)) < len(rows):
             return Verdict(False, "numeric", "the normal coordinates are not independent")
-    return Verdict(True, "numeric(5 points)",
-                   power="5 points: M⁻¹c an eigenvector to 1e-8 (a form up to a factor), ω to 1e-8")
+    numeric = Verdict(True, "numeric(5 points)",
+                      power="5 points: M⁻¹c an eigenvector to 1e-8 (a form up to a factor), "
+                      "ω to 1e-8")
+    return _proved_normal_coordinates(ctx, items, lin, numeric) if ctx.policy.prove else numeric
+
+
+def _proved_normal_coordinates(ctx: Context, items: list, lin: LinearSystem,
+                               numeric: Verdict) -> Verdict:
+    """With `--prove`, after the numeric pass: for each form c·q, v = K·adj(M)·c is
+    parallel to c (v_i c_j = v_j c_i), or v = ω²·det(M)·c where the book gives ω; det M
+    and, with every coordinate given, the forms' determinant decided nonzero. Then M⁻¹c
+    is a mode, exactly."""
+    if lin.first_order or lin.gyroscopic or decide_zero(lin.M.det()).zero is not False:
+        numeric.unproved = "velocity terms, or a mass matrix not shown invertible"
+        return numeric
+    adj, det = lin.M.adjugate(), lin.M.det()
+    claims, rows = [], []
+    for i, item in enumerate(items):
+        item = ctx.as_map(item, ("book", i))
+        form = ctx.parse(item["coordinate"], ("book", i, "coordinate"))
+        c = sp.Matrix([sp.diff(form, q) for q in ctx.system.q])
+        rows.append(list(c))
+        v = lin.K * adj * c
+        if "frequency" in item:
+            w = ctx.parse(item["frequency"], ("book", i, "frequency"))
+            claims += list(v - w**2 * det * c)
+        else:
+            n = len(c)
+            claims += [v[a] * c[b] - v[b] * c[a] for a in range(n) for b in range(a + 1, n)]
+    if len(rows) == len(ctx.system.q) and decide_zero(sp.Matrix(rows).det()).zero is not False:
+        numeric.unproved = "the forms' independence is checked numerically only"
+        return numeric
+    proof = all_vanish(claims, ctx.sampler)
+    if proof.method == "symbolic":
+        return Verdict(True, "symbolic", power="proved symbolically: M⁻¹c is a mode of each "
+                       "form (a form up to a factor)")
+    numeric.unproved = proof.unproved
+    return numeric
 
 
 @quantity('mode_count',
