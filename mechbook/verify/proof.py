@@ -33,6 +33,9 @@ BOUNDARY = "decided at a relation's boundary (crossings found numerically)"
 LIMIT = "a limit: the error's order is measured numerically"
 MEASURED = "measured by integration"
 NO_PATH = "no symbolic proof path for this quantity's check"
+EXACT = "decided exactly, with no identity to prove (a count)"
+# the reasons no proof can remove: what is left is what a proof could reach ("expressible")
+UNREACHABLE = (ESTIMATE, FLOATS, BOUNDARY, LIMIT, MEASURED, EXACT)
 
 CACHE_SIZE = 512  # proof results kept per process (the same difference met again: an erratum)
 _cache: dict = {}
@@ -142,4 +145,6 @@ def unproved_reason(method: str) -> str:
         return LIMIT
     if "simulated" in method or "integrat" in method:
         return MEASURED
+    if method == "exact":
+        return EXACT
     return NO_PATH
