@@ -91,7 +91,9 @@ def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict
           how=('with `initial:`, equals the solution of the linearized initial-value problem '
                '(driven, damped or gyroscopic too: matrix exponential, or DOP853 at rtol '
                '1e-13 with a force) at several times; without, satisfies the linearized '
-               'equations for any value of its constants'),
+               'equations for any value of its constants; with `--prove` and `initial:`, '
+               '`symbolic` where the motion is proved to satisfy the linearized equations '
+               'and the initial values exactly, det M decided nonzero (a unique solution)'),
           keys={"initial": POINT})
 def check_motion(ctx: Context, val) -> Verdict:
     """With `initial:`, compare with the modal solution of the linearized initial-value

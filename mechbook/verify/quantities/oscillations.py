@@ -31,7 +31,10 @@ def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:
           book='list of ω',
           how=("multiset equality with the engine's normal frequencies at random points "
                '(numeric `eigh`, or state-space eigenvalues with gyroscopic terms), '
-               'symbolic with `--prove` where SymPy confirms; `partial: true` for a '
+               'symbolic with `--prove` where each book ω² is proved a root of '
+               'det(K − ω²M) of the multiplicity the book gives it (det M decided nonzero: '
+               "no closed-form roots needed), or, with gyroscopic terms, equal to the "
+               "engine's closed-form root; `partial: true` for a "
                'subset; `limit: {parameter, to: 0 or oo, order}` for asymptotic formulas'),
           keys={"partial": {"type": "boolean"},
                 "limit": LIMIT},
@@ -256,7 +259,8 @@ def _eig_residual(K: np.ndarray, M: np.ndarray, w2: float, u: np.ndarray) -> flo
           how=('(K − ω²M)u = 0: shapes compared up to scale and sign; any vector of a '
                'degenerate eigenspace passes; with `limit:`, each book mode must '
                'approach an engine mode (frequency and the angle between shapes) as the '
-               'parameter goes to its limit'),
+               'parameter goes to its limit; with `--prove`, `symbolic` where each '
+               '(K − ω²M)u is proved 0 entry by entry (no velocity terms)'),
           keys={"limit": LIMIT},
           equivalent=("direction",),
           crosschecks=("modes",))
@@ -375,7 +379,10 @@ def _near(values, x, rtol=1e-8):
 @quantity('normal_coordinates',
           book='list of `{coordinate: linear form, frequency?}`',
           how=('c·q is a normal coordinate iff M⁻¹c is a mode (with velocity terms C, also '
-               'an eigenvector of M⁻¹C: then C does not couple it)'),
+               'an eigenvector of M⁻¹C: then C does not couple it); with `--prove`, '
+               '`symbolic` where K·adj(M)·c is proved parallel to c (= ω²·det(M)·c with a '
+               "frequency) and, with every coordinate given, the forms' determinant "
+               'decided nonzero'),
           equivalent=("scale", "shift"),
           crosschecks=("modes",))
 def check_normal_coordinates(ctx: Context, val) -> Verdict:
