@@ -237,3 +237,9 @@ def test_normal_coordinates_are_proved(tmp_path):
 
     out = check_problem(an, load_answers(_lim_key(tmp_path, "2028", wrong)), PROVE)
     assert out[0].status == Status.FAIL
+
+
+def test_undefined_values_are_never_proved():
+    """nan and infinities are no numbers: nothing holding one is proved."""
+    for e in (sp.Add(sp.nan, -x, evaluate=False), sp.Mul(sp.zoo, x, evaluate=False) - x):
+        assert decide_zero(e).zero is not True

@@ -119,6 +119,8 @@ def _convert_new(e: sp.Basic, form: _Form) -> se.Basic:
         return se.Rational(int(e.p), int(e.q))
     if e.is_Float:
         raise NotCanonical("holds floating-point numbers")
+    if e in (sp.nan, sp.zoo, sp.oo, -sp.oo):
+        raise NotCanonical("holds an infinity or an undefined value")
     if e is sp.I:
         return se.I
     if e.is_Add:
@@ -395,11 +397,15 @@ def decide_zero(expr: sp.Basic, seed: int = 20261207) -> Decision:
         reduced = _reduce(_expand(num), form.relations)
     except NotCanonical as exc:
         return Decision(None, str(exc))
+    except (RecursionError, RuntimeError, TypeError, ValueError, AttributeError) as exc:
+        return Decision(None, f"no canonical form ({type(exc).__name__})")
     if reduced == 0:
         try:
             den_reduced = _reduce(_expand(den), form.relations)
         except NotCanonical as exc:
             return Decision(None, str(exc))
+        except (RecursionError, RuntimeError, TypeError, ValueError, AttributeError) as exc:
+            return Decision(None, f"no canonical form ({type(exc).__name__})")
         if den_reduced != 0:
             return Decision(True)
         return Decision(None, "its denominator vanishes identically")

@@ -12,7 +12,7 @@ from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.core.words import plural
 from mechbook.engine import perturbation
 from mechbook.engine.linear import LinearSystem, secular_determinant
-from mechbook.errors import UnsupportedError, WrongAnswerError
+from mechbook.errors import MechbookError, UnsupportedError, WrongAnswerError
 from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import Verdict, all_vanish, at_point, match_multiset, vanishes
@@ -131,7 +131,10 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> tuple[bool, str]:
     if not ctx.policy.prove:
         return False, ""
     if not (lin.first_order or lin.gyroscopic):
-        return _secular_roots(ctx, book, lin)
+        try:
+            return _secular_roots(ctx, book, lin)
+        except (MechbookError, ValueError, TypeError, ZeroDivisionError) as exc:
+            return False, f"the secular polynomial could not be formed ({type(exc).__name__})"
     pt = ctx.sampler.draw()
     try:
         engine = list(lin.frequencies_at(pt))  # the key's symbols (a steady rate) valued too
