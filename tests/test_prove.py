@@ -243,3 +243,9 @@ def test_undefined_values_are_never_proved():
     """nan and infinities are no numbers: nothing holding one is proved."""
     for e in (sp.Add(sp.nan, -x, evaluate=False), sp.Mul(sp.zoo, x, evaluate=False) - x):
         assert decide_zero(e).zero is not True
+
+
+def test_a_float_inside_an_angle_is_never_rationalized():
+    """sin(0.1·x) is not sin(x/10): the canonical form refuses the angle, never rounds it."""
+    e = sp.Add(sp.sin(sp.Float(0.1) * x), -sp.sin(x / 10), evaluate=False)
+    assert decide_zero(e).zero is None

@@ -83,7 +83,9 @@ def _linear_terms(arg: sp.Expr) -> list[tuple[sp.Rational, sp.Expr]]:
     out = []
     for term in sp.Add.make_args(sp.expand(arg)):
         coeff, rest = term.as_coeff_Mul()
-        out.append((sp.Rational(coeff), rest))
+        if not coeff.is_Rational:  # a float in an angle: no exact multiple of a base
+            raise NotCanonical("holds floating-point numbers")
+        out.append((coeff, rest))
     return out
 
 
