@@ -57,11 +57,16 @@ def main() -> int:
     ap.add_argument("--book", default="lim")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--seconds", type=float, default=10.0, help="--prove-seconds")
+    ap.add_argument("--keep", type=Path, help="write the last plain.json and prove.json here")
     args = ap.parse_args()
     plain, proved = [], []
     for _ in range(args.repeat):
         plain.append(run(args.book, False, args.seconds))
         proved.append(run(args.book, True, args.seconds))
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
+        (args.keep / "plain.json").write_text(json.dumps(plain[-1][1]))
+        (args.keep / "prove.json").write_text(json.dumps(proved[-1][1]))
     a, b = parts(plain[-1][1]), parts(proved[-1][1])
     differ = [k for k in a if k not in b or a[k]["status"] != b[k]["status"]]
     wall_a = statistics.median(w for w, _ in plain)

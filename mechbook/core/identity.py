@@ -433,3 +433,28 @@ def _one_branch(reduced: se.Basic, form: _Form) -> bool:
         if norm == 0:
             return True
     return False
+
+
+def nonzero_determinant(M: sp.Matrix, seed: int = 20261207) -> bool:
+    """Is det M not identically 0, decided exactly and cheaply: its entries at a rational
+    point (each symbol a small positive rational) are rational numbers whose determinant is
+    nonzero (a polynomial nonzero at a point is not identically 0). False where that cannot
+    be shown so (entries irrational there, or the determinant 0 at the points tried).
+
+    >>> a = sp.Symbol("a", positive=True)
+    >>> nonzero_determinant(sp.Matrix([[a, 1], [1, a]]))
+    True
+    """
+    rng = random.Random(seed)
+    symbols = sorted(M.free_symbols, key=str)
+    for _ in range(POINTS):
+        point = {s: sp.Rational(rng.randint(1, 97), rng.randint(1, 13)) for s in symbols}
+        try:
+            values = M.xreplace(point)
+        except Exception:  # noqa: BLE001 - an entry that does not take the point
+            return False
+        if not all(v.is_Rational for v in values):
+            return False
+        if values.det(method="bareiss") != 0:
+            return True
+    return False

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from mechbook.core.identity import decide_zero
+from mechbook.core.identity import nonzero_determinant
 from mechbook.engine import response
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
@@ -149,7 +149,7 @@ def _proved_initial_value(ctx: Context, lin: LinearSystem, funcs: dict,
     if lin.dependent or set(lin.q) != set(sys.q) or set(coords) != set(sys.q):
         numeric.unproved = "not every coordinate is given as a function of t"
         return numeric
-    if decide_zero(lin.M.det()).zero is not False:
+    if not nonzero_determinant(lin.M):
         numeric.unproved = "the mass matrix is not shown invertible (no uniqueness)"
         return numeric
     t = sys.t

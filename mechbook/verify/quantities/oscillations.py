@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from mechbook.core.identity import decide_zero
+from mechbook.core.identity import nonzero_determinant
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.core.words import plural
 from mechbook.engine import perturbation
@@ -163,7 +163,7 @@ def _secular_roots(ctx: Context, book, lin: LinearSystem) -> tuple[bool, str]:
     numeric pass has matched them as a multiset, which also tells the distinct ones
     apart)."""
     w = sp.Dummy("w")
-    if decide_zero(lin.M.det()).zero is not False:
+    if not nonzero_determinant(lin.M):
         return False, "the mass matrix is not shown invertible"
     P = secular_determinant(lin.K - w * lin.M)
     pt = ctx.sampler.draw()
@@ -433,10 +433,10 @@ def _proved_normal_coordinates(ctx: Context, items: list, lin: LinearSystem,
     parallel to c (v_i c_j = v_j c_i), or v = ω²·det(M)·c where the book gives ω; det M
     and, with every coordinate given, the forms' determinant decided nonzero. Then M⁻¹c
     is a mode, exactly."""
-    if lin.first_order or lin.gyroscopic or decide_zero(lin.M.det()).zero is not False:
+    if lin.first_order or lin.gyroscopic or not nonzero_determinant(lin.M):
         numeric.unproved = "velocity terms, or a mass matrix not shown invertible"
         return numeric
-    adj, det = lin.M.adjugate(), lin.M.det()
+    adj, det = lin.M.adjugate(method="berkowitz"), lin.M.det(method="berkowitz")
     claims, rows = [], []
     for i, item in enumerate(items):
         item = ctx.as_map(item, ("book", i))
@@ -450,7 +450,7 @@ def _proved_normal_coordinates(ctx: Context, items: list, lin: LinearSystem,
         else:
             n = len(c)
             claims += [v[a] * c[b] - v[b] * c[a] for a in range(n) for b in range(a + 1, n)]
-    if len(rows) == len(ctx.system.q) and decide_zero(sp.Matrix(rows).det()).zero is not False:
+    if len(rows) == len(ctx.system.q) and not nonzero_determinant(sp.Matrix(rows)):
         numeric.unproved = "the forms' independence is checked numerically only"
         return numeric
     proof = all_vanish(claims, ctx.sampler)
