@@ -26,7 +26,8 @@ from dataclasses import dataclass, field
 import symengine as se
 import sympy as sp
 
-MAX_TERMS = 200_000  # terms of a product's two factors multiplied: beyond, no expansion
+MAX_TERMS = 20_000  # terms of a product's two factors multiplied: beyond, no expansion
+# (200 000 let Symon 12-06's and 12-10's motions spend 80 s each in SymEngine)
 # (SymEngine's expansion cannot be interrupted, so its size is bounded before it starts)
 MAX_MULTIPLE = 12  # largest multiple of a base angle expanded (sin 12x: degree 12)
 POINTS = 2  # exact rational points tried before the expansion
@@ -453,8 +454,8 @@ def nonzero_determinant(M: sp.Matrix, seed: int = 20261207) -> bool:
             values = M.xreplace(point)
         except Exception:  # noqa: BLE001 - an entry that does not take the point
             return False
-        if not all(v.is_Rational for v in values):
-            return False
+        if not all(v.is_Rational for v in values):  # irrational there: a small one exactly
+            return M.rows <= 4 and decide_zero(M.det(method="berkowitz")).zero is False
         if values.det(method="bareiss") != 0:
             return True
     return False
