@@ -19,6 +19,7 @@ import numpy as np
 import scipy.linalg
 import symengine as se
 import sympy as sp
+from sympy.matrices.utilities import dotprodsimp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, is_zero
@@ -40,7 +41,8 @@ def secular_determinant(A: sp.Matrix) -> sp.Expr:
     det leaves; SymPy's Bareiss with its intermediate simplification took 25 s for six
     coupled pendulums, Lim 2055, this 0.1 s), expanded by SymEngine: the proof of a book
     frequency substitutes ω² into it (mechbook.verify.quantities.oscillations)."""
-    det = A.det(method="berkowitz")
+    with dotprodsimp(False):  # SymPy's intermediate cancel: 96 s on Symon 12-23's 4×4
+        det = A.det(method="berkowitz")
     try:
         return to_sympy(se.expand(se.sympify(det)), A.free_symbols)
     except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's expand
