@@ -42,9 +42,10 @@ class ProofPolicy:
     """The checker's trade of speed for certainty, chosen by the user.
 
     By default a comparison is decided numerically (30 digits at random admissible
-    points); with `prove`, an expression that passed is also handed to SymPy's simplify
-    for a symbolic proof, each attempt limited to `seconds`. A verdict's method says
-    which it got ('symbolic' or 'numeric(…)')."""
+    points); with `prove`, an expression that passed is also proved exactly where it can
+    be (mechbook.verify.proof: canonical forms, then SymPy's simplify, a part's attempts
+    sharing `seconds` of simplify). A verdict's method says which it got ('symbolic', or
+    'numeric(…); unproved: why')."""
 
     prove: bool = False
     seconds: float = 10.0

@@ -17,7 +17,9 @@ from functools import cached_property
 
 import numpy as np
 import scipy.linalg
+import symengine as se
 import sympy as sp
+from sympy.matrices.utilities import dotprodsimp
 
 from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import (
@@ -28,6 +30,7 @@ from mechbook.core.numeval import (
     is_zero,
     mp_values,
 )
+from mechbook.core.secalc import to_sympy
 from mechbook.core.timeout import Timeout, time_limit, try_simplify
 from mechbook.engine.lagrange import Dynamics
 from mechbook.errors import MechbookError, UnsupportedError
@@ -37,6 +40,20 @@ ZERO_TOL = 1e-9  # |ω²| below this (relative) is beyond what double precision 
 # never set to zero here
 ZERO_CLUSTER = 1e-6  # |p| below this (relative) is a zero exponent split by rounding
 MARGIN_DIGITS = 12  # at dps digits, |ω²| below 10^(MARGIN_DIGITS − dps) of the largest is 0
+
+
+def secular_determinant(A: sp.Matrix) -> sp.Expr:
+    """det A as an expanded polynomial in its entries' symbols: Berkowitz's division-free
+    algorithm (no denominators that vanish where the polynomial does not, as SymEngine's
+    det leaves; SymPy's Bareiss with its intermediate simplification took 25 s for six
+    coupled pendulums, Lim 2055, this 0.1 s), expanded by SymEngine: the proof of a book
+    frequency substitutes ω² into it (mechbook.verify.quantities.oscillations)."""
+    with dotprodsimp(False):  # SymPy's intermediate cancel: 96 s on Symon 12-23's 4×4
+        det = A.det(method="berkowitz")
+    try:
+        return to_sympy(se.expand(se.sympify(det)), A.free_symbols)
+    except Exception:  # noqa: BLE001 - a function SymEngine does not know: SymPy's expand
+        return sp.expand(det)
 
 
 def zero_below(dps: int) -> float:

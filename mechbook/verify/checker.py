@@ -24,6 +24,7 @@ from mechbook.records import Outcome, Status
 from mechbook.verify.answers import AnswerKey, Part
 from mechbook.verify.compare import NUMERIC, ProofPolicy
 from mechbook.verify.context import Context
+from mechbook.verify.proof import unproved_reason
 from mechbook.verify.registration import QuantityTable
 
 Stage = Callable[[str], None]  # told the stage a check is in, e.g. "part a (frequencies)"
@@ -53,12 +54,14 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC,
                 out.status = Status.FAIL
                 out.detail = f"the corrected value fails too: {corrected.detail}"
             else:
-                out.status, out.method = Status.ERRATUM, corrected.method
+                out.status, out.method = Status.ERRATUM, _method(corrected, policy)
                 out.detail = f"book value fails ({verdict.detail}); corrected value passes"
                 out.power = _power(part, corrected)
         else:
             out.status = Status.PASS if verdict.ok else Status.FAIL
             out.method, out.detail = verdict.method, verdict.detail
+            if verdict.ok:
+                out.method = _method(verdict, policy)
             if verdict.ok:
                 out.power = _power(part, verdict)
     except UnsupportedError as exc:
@@ -75,6 +78,15 @@ def check_part(analysis: Analysis, part: Part, policy: ProofPolicy = NUMERIC,
     finally:
         out.seconds = time.perf_counter() - start
     return out
+
+
+def _method(verdict, policy: ProofPolicy) -> str:
+    """A pass's method; with --prove, one not proved says why ("numeric(6 points, …);
+    unproved: holds floating-point numbers")."""
+    if not policy.prove or verdict.method == "symbolic":
+        return verdict.method
+    why = getattr(verdict, "unproved", "") or unproved_reason(verdict.method)
+    return f"{verdict.method}; unproved: {why}"
 
 
 def _power(part: Part, verdict) -> str:

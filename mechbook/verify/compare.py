@@ -16,9 +16,9 @@ import numpy as np
 import sympy as sp
 
 from mechbook.core.numeval import NotNumeric, evaluate, evaluate_mp, evaluate_resolved, holds
-from mechbook.core.timeout import Timeout, time_limit
 from mechbook.core.words import plural
 from mechbook.records import NUMERIC, ProofPolicy
+from mechbook.verify.proof import FLOATS, OPEN, Budget, Proof, prove_zero
 
 RTOL = 1e-10  # relative tolerance of a numeric comparison
 # What an exact expression (no numbers below 30 digits in it) may leave at a 30-digit point,
@@ -38,6 +38,8 @@ class Verdict:
     # what a pass is worth: the smallest wrong answer it would have rejected, in words
     # ("6 points at 30 digits, residual ≤ 1e-20 of its scale"); '' where the method says it
     power: str = ""
+    # with --prove, why a pass is not proved (a fixed phrase of mechbook.verify.proof)
+    unproved: str = ""
 
 
 def _derived_value(expr: sp.Basic, point: dict) -> tuple:
@@ -79,6 +81,14 @@ class Sampler:
         # gives a coordinate or a velocity a value is moved onto the constraint manifold,
         # where the system's motion is (its solved accelerations hold nowhere else)
         self.manifold = manifold
+        self._budget: Budget | None = None
+
+    def proof_budget(self) -> Budget:
+        """The CPU seconds this part's proofs may still spend in `simplify` (one budget
+        for every comparison the sampler serves, of `policy.seconds`)."""
+        if self._budget is None:
+            self._budget = Budget(self.policy.seconds)
+        return self._budget
 
     def _complete(self, point: dict) -> dict | None:
         """The point with its derived symbols computed (None where one is not real)."""
@@ -147,9 +157,11 @@ class Sampler:
 
     def widened(self, spread: float) -> Sampler:
         """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
-        return Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
-                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived,
-                       manifold=self.manifold)
+        out = Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
+                      rtol=self.rtol, fixed=list(self.fixed), derived=self.derived,
+                      manifold=self.manifold)
+        out._budget = self.proof_budget()  # the same part: the same budget
+        return out
 
     def default(self) -> dict[sp.Symbol, sp.Float]:
         """The default values (when they satisfy the conditions on the parameters alone;
@@ -189,16 +201,12 @@ def _free_variables(exprs: Iterable[sp.Basic], known: dict) -> set[sp.Symbol]:
     return out
 
 
-def _symbolic_zero(expr: sp.Basic, seconds: float) -> bool:
-    try:
-        with time_limit(seconds):
-            if expr == 0:
-                return True
-            return sp.simplify(expr) == 0
-    except Timeout:
-        return False
-    except Exception:  # SymPy can raise odd errors on odd input; then decide numerically
-        return False
+PROVED = "proved symbolically"
+
+
+def _proof(expr: sp.Basic, sampler: Sampler, symbolic: bool | None) -> Proof | None:
+    """The proof attempt's result, or None where none is asked for."""
+    return prove_zero(expr, sampler) if _prove(sampler, symbolic) else None
 
 
 def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
@@ -231,12 +239,13 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
                            f"residual {abs(v):.3g} (relative {rel:.3g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expression does not evaluate at any sample point")
-    if _prove(sampler, symbolic) and _symbolic_zero(expr, sampler.policy.seconds):
-        return Verdict(True, "symbolic", power="proved symbolically")
+    proof = _proof(expr, sampler, symbolic)
+    if proof is not None and proof.ok:
+        return Verdict(True, "symbolic", power=PROVED)
     return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=f"{plural(valid, 'point')} at {DIGITS} digits, residual ≤ {rtol:g} "
-                         "of its scale")
+                         "of its scale", unproved=proof.why if proof is not None else "")
 
 
 AMBIGUOUS = 1e-27  # a residual above this fraction of its scale is more than rounding
@@ -275,11 +284,13 @@ def all_vanish(exprs: Sequence[sp.Basic], sampler: Sampler,
     for v in verdicts:
         if not v.ok:
             return v
-    if _prove(sampler, symbolic):
-        verdicts = [Verdict(True, "symbolic", power="proved symbolically")
-                    if _symbolic_zero(e, sampler.policy.seconds)
-                    else v
-                    for e, v in zip(exprs, verdicts, strict=True)]
+    if _prove(sampler, symbolic):  # the canonical forms for all first, then simplify
+        first = [prove_zero(e, sampler, canonical_only=True) for e in exprs]
+        proofs = [prove_zero(e, sampler) if p.why == OPEN else p
+                  for e, p in zip(exprs, first, strict=True)]
+        verdicts = [Verdict(True, "symbolic", power=PROVED) if p.ok else
+                    Verdict(v.ok, v.method, v.detail, v.power, unproved=p.why)
+                    for p, v in zip(proofs, verdicts, strict=True)]
     return combine(verdicts)
 
 
@@ -292,8 +303,9 @@ def combine(verdicts: Sequence[Verdict]) -> Verdict:
     method = "symbolic" if methods == {"symbolic"} else ("numeric" if "numeric" in methods else
                                                           ",".join(sorted(methods)))
     powers = list(dict.fromkeys(v.power for v in verdicts if v.power))  # once each, in order
+    unproved = list(dict.fromkeys(v.unproved for v in verdicts if v.unproved))
     return Verdict(True, method, "; ".join(v.detail for v in verdicts if v.detail),
-                   power="; ".join(powers))
+                   power="; ".join(powers), unproved="; ".join(unproved))
 
 
 def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> Verdict:
@@ -338,12 +350,20 @@ def equal(a: sp.Basic, b: sp.Basic, sampler: Sampler, symbolic: bool | None = No
                            f"{_num(va)} vs {_num(vb)} (relative {rel:.2g}) at {_fmt(point)}")
     if valid == 0:
         return Verdict(False, "numeric", "expressions do not evaluate at any sample point")
-    if _prove(sampler, symbolic) and _symbolic_zero(diff, sampler.policy.seconds):
-        return Verdict(True, "symbolic", power="proved symbolically")
+    proof = _proof(diff, sampler, symbolic)
+    if proof is not None and proof.ok and _floats(a, b):  # SymPy may fold 0.1·x − x/10 to 0
+        proof = Proof(False, FLOATS)
+    if proof is not None and proof.ok:
+        return Verdict(True, "symbolic", power=PROVED)
     return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=(f"within the stated {sampler.rtol:.2g}" if sampler.rtol > RTOL else
-                          f"{plural(valid, 'point')} at {DIGITS} digits, within {rtol:g}"))
+                          f"{plural(valid, 'point')} at {DIGITS} digits, within {rtol:g}"),
+                   unproved=proof.why if proof is not None else "")
+
+
+def _floats(*exprs: sp.Basic) -> bool:
+    return any(isinstance(e, sp.Basic) and e.atoms(sp.Float) for e in exprs)
 
 
 def _num(z: complex) -> str:

@@ -34,6 +34,7 @@ import sympy as sp
 from sympy.matrices.utilities import dotprodsimp
 
 from mechbook.core.compile import as_expr
+from mechbook.core.identity import decide_zero
 from mechbook.core.numeval import holds
 from mechbook.core.rational import (
     is_rational_function,
@@ -301,8 +302,9 @@ def _proved(st: Statement, sampler: Sampler) -> bool:
                            for e in exprs)
             if all(_rational(e) for e in exprs):
                 return all(e == 0 or _rational_zero(e) for e in exprs)
-            if policy.prove:
-                return all(e == 0 or sp.simplify(e) == 0 for e in exprs)
+            if policy.prove:  # the exact canonical forms first, simplify for the rest
+                return all(e == 0 or decide_zero(e).zero is True or sp.simplify(e) == 0
+                           for e in exprs)
     except Timeout:
         return False
     except Exception:  # noqa: BLE001 - SymPy's odd failures: the instances have decided

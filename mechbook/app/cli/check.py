@@ -47,9 +47,11 @@ from mechbook.errors import MechbookError
                "limits (for a debugger).")
 @click.option("--prove", is_flag=True,
               help="After a part passes numerically (30 digits at random admissible points), "
-                   "also try a symbolic proof with SymPy; the method column says which it got.")
+                   "also try an exact symbolic proof (canonical forms, then SymPy's simplify); "
+                   "the method column says `symbolic`, or why the part is unproved.")
 @click.option("--prove-seconds", type=opt.seconds(opt.MAX_STEP_SECONDS), default=10.0,
-              show_default=True, help="Time limit of each symbolic proof attempt.")
+              show_default=True, help="CPU seconds each part's proofs may spend in SymPy's "
+                   "simplify (the canonical forms are cheap and always tried).")
 @scheduler_option("Run the problems on the Dask cluster whose scheduler is at ADDRESS "
                   "(tcp://host:8786; default $MECHBOOK_SCHEDULER, else the local pool). "
                   "The limits hold per problem on the workers.")

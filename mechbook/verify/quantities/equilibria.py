@@ -48,9 +48,14 @@ def check_equilibrium(ctx: Context, val) -> Verdict:
         if not candidates:
             return Verdict(False, "numeric", "no equilibrium found by the engine satisfies "
                            f"{val['where']}; engine found {_engine_points(ctx)}")
-        verdicts = [Verdict(True, "symbolic", f"engine equilibrium {candidates[0]}",
+        # a numeric pass (6 points, 30 digits) is not a proof: proved only with --prove
+        proof = all_vanish([w.subs(candidates[0]) for w in where], ctx.sampler)
+        verdicts = [Verdict(True, proof.method if proof.method == "symbolic" else "numeric",
+                            f"engine equilibrium {candidates[0]}",
                             power="an equilibrium the engine solves for in closed form "
-                                  "satisfies the book's equations (6 points, 30 digits)")]
+                                  "satisfies the book's equations" +
+                                  (" (proved symbolically)" if proof.method == "symbolic"
+                                   else " (6 points, 30 digits)"), unproved=proof.unproved)]
 
     else:
         raise ctx.part.error(("book",), "an equilibrium answer gives 'at:' or 'where:'")

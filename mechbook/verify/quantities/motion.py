@@ -7,11 +7,13 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from mechbook.core.identity import nonzero_determinant
 from mechbook.engine import response
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish
 from mechbook.verify.context import Context, numbers
+from mechbook.verify.proof import OPEN
 from mechbook.verify.registration import POINT, Family
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
@@ -89,7 +91,9 @@ def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict
           how=('with `initial:`, equals the solution of the linearized initial-value problem '
                '(driven, damped or gyroscopic too: matrix exponential, or DOP853 at rtol '
                '1e-13 with a force) at several times; without, satisfies the linearized '
-               'equations for any value of its constants'),
+               'equations for any value of its constants; with `--prove` and `initial:`, '
+               '`symbolic` where the motion is proved to satisfy the linearized equations '
+               'and the initial values exactly, det M decided nonzero (a unique solution)'),
           keys={"initial": POINT})
 def check_motion(ctx: Context, val) -> Verdict:
     """With `initial:`, compare with the modal solution of the linearized initial-value
@@ -130,6 +134,35 @@ def check_motion(ctx: Context, val) -> Verdict:
                     return Verdict(False, "numeric", f"{name}(t={tv}) = {got:.10g}, "
                                    f"engine {expected:.10g}")
     how = "driven, DOP853 rtol 1e-13" if lin.driven else "matrix exponential"
-    return Verdict(True, f"numeric(4 points x 4 times, linear initial-value solution, {how})",
-                   power="4 points x 4 times: each coordinate to 1e-8 of the motion's size")
+    numeric = Verdict(True, f"numeric(4 points x 4 times, linear initial-value solution, {how})",
+                      power="4 points x 4 times: each coordinate to 1e-8 of the motion's size")
+    return _proved_initial_value(ctx, lin, funcs, numeric) if ctx.policy.prove else numeric
+
+
+def _proved_initial_value(ctx: Context, lin: LinearSystem, funcs: dict,
+                          numeric: Verdict) -> Verdict:
+    """With `--prove`, after the numeric pass: the book's motion satisfies the linearized
+    equations and the initial values exactly, and det M is not identically 0, so (the
+    initial-value problem's solution being unique) it is that solution."""
+    sys = ctx.system
+    coords = _coordinates_from(ctx, funcs)
+    if lin.dependent or set(lin.q) != set(sys.q) or set(coords) != set(sys.q):
+        numeric.unproved = "not every coordinate is given as a function of t"
+        return numeric
+    if not nonzero_determinant(lin.M):
+        numeric.unproved = "the mass matrix is not shown invertible (no uniqueness)"
+        return numeric
+    t = sys.t
+    given_q, given_v = ctx.initial()
+    start = []
+    for i, q in enumerate(sys.q):
+        start.append(coords[q].subs(t, 0) - given_q.get(i, 0))
+        start.append(sp.diff(coords[q], t).subs(t, 0) - given_v.get(i, 0))
+    equations = _residual_of_motion(ctx, lin, funcs)
+    initial = all_vanish(start, ctx.sampler)
+    if equations.method == "symbolic" and initial.method == "symbolic":
+        return Verdict(True, "symbolic", power="proved symbolically: the linearized equations "
+                       "and the initial values hold exactly (the solution is unique)")
+    numeric.unproved = equations.unproved or initial.unproved or OPEN
+    return numeric
 

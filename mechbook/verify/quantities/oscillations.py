@@ -7,14 +7,15 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from mechbook.core.identity import nonzero_determinant
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.core.words import plural
 from mechbook.engine import perturbation
-from mechbook.engine.linear import LinearSystem
-from mechbook.errors import UnsupportedError, WrongAnswerError
+from mechbook.engine.linear import LinearSystem, secular_determinant
+from mechbook.errors import MechbookError, UnsupportedError, WrongAnswerError
 from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
-from mechbook.verify.compare import Verdict, at_point, match_multiset, vanishes
+from mechbook.verify.compare import Verdict, all_vanish, at_point, match_multiset, vanishes
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.registration import EXPR, LIMIT, Family
 
@@ -30,7 +31,10 @@ def _book_frequencies(ctx: Context, val) -> list[sp.Expr]:
           book='list of ω',
           how=("multiset equality with the engine's normal frequencies at random points "
                '(numeric `eigh`, or state-space eigenvalues with gyroscopic terms), '
-               'symbolic with `--prove` where SymPy confirms; `partial: true` for a '
+               'symbolic with `--prove` where each book ω² is proved a root of '
+               'det(K − ω²M) of the multiplicity the book gives it (det M decided nonzero: '
+               "no closed-form roots needed), or, with gyroscopic terms, equal to the "
+               "engine's closed-form root; `partial: true` for a "
                'subset; `limit: {parameter, to: 0 or oo, order}` for asymptotic formulas'),
           keys={"partial": {"type": "boolean"},
                 "limit": LIMIT},
@@ -59,8 +63,9 @@ def check_frequencies(ctx: Context, val) -> Verdict:
                                                 if precise else "")
     if partial:
         power += f"; partial: {len(book)} of {len(lin.q)} frequencies (the rest unchecked)"
-    return Verdict(True, _symbolic_frequencies(ctx, book, lin, partial) or how,
-                   precise.detail if precise else "", power=power)
+    proved, why = _symbolic_frequencies(ctx, book, lin, partial)
+    return Verdict(True, "symbolic" if proved else how, precise.detail if precise else "",
+                   power=power, unproved=why)
 
 
 PRECISE_RTOL = 1e-20  # book against engine frequencies, both at 50 digits
@@ -120,26 +125,66 @@ def _has_doubles(x) -> bool:
     return isinstance(x, sp.Basic) and any(f._prec < 90 for f in x.atoms(sp.Float))
 
 
-def _symbolic_frequencies(ctx, book, lin, partial) -> str | None:
-    """'symbolic' when, asked to prove (`--prove`), the engine's closed-form frequencies
-    match the book's exactly; the numeric multiset comparison has already decided."""
+def _symbolic_frequencies(ctx, book, lin, partial) -> tuple[bool, str]:
+    """(proved, why not): with `--prove`, do the engine's closed-form frequencies match the
+    book's exactly? The numeric multiset comparison has already decided."""
     if not ctx.policy.prove:
-        return None
+        return False, ""
+    if not (lin.first_order or lin.gyroscopic):
+        try:
+            return _secular_roots(ctx, book, lin)
+        except (MechbookError, ValueError, TypeError, ZeroDivisionError) as exc:
+            return False, f"the secular polynomial could not be formed ({type(exc).__name__})"
     pt = ctx.sampler.draw()
     try:
         engine = list(lin.frequencies_at(pt))  # the key's symbols (a steady rate) valued too
     except UnsupportedError:
-        return None
+        return False, "the engine's frequencies have no closed form here"
     eng_vals = numbers(engine, pt)
     used = set()
     for b in book:
         bv = numbers([b], pt)[0]
         idx = [i for i in range(len(engine)) if i not in used
                and abs(eng_vals[i] - bv) <= 1e-8 * max(1, abs(bv))]
-        if not idx or not vanishes(b**2 - engine[idx[0]] ** 2, ctx.sampler).method == "symbolic":
-            return None
+        if not idx:
+            return False, "no closed-form engine frequency to pair with"
+        v = vanishes(b**2 - engine[idx[0]] ** 2, ctx.sampler)
+        if v.method != "symbolic":
+            return False, v.unproved
         used.add(idx[0])
-    return "symbolic"
+    return True, ""
+
+
+def _secular_roots(ctx: Context, book, lin: LinearSystem) -> tuple[bool, str]:
+    """(proved, why not) without solving the secular equation: each book ω² is a root of
+    P(w) = det(K − wM) of the multiplicity the book gives it (P and its first k − 1
+    derivatives vanish there identically), values the book repeats are proved equal, and
+    det M is decided nonzero, so P has degree n: n book values are then all its roots (the
+    numeric pass has matched them as a multiset, which also tells the distinct ones
+    apart)."""
+    w = sp.Dummy("w")
+    if not nonzero_determinant(lin.M):
+        return False, "the mass matrix is not shown invertible"
+    P = secular_determinant(lin.K - w * lin.M)
+    pt = ctx.sampler.draw()
+    squares = [b**2 for b in book]
+    values = numbers(squares, pt)
+    groups: list[list[int]] = []
+    for i, v in enumerate(values):
+        for grp in groups:
+            if abs(values[grp[0]] - v) <= 1e-12 * max(1.0, abs(v)):
+                grp.append(i)
+                break
+        else:
+            groups.append([i])
+    for grp in groups:
+        first = squares[grp[0]]
+        claims = [squares[i] - first for i in grp[1:]]
+        claims += [sp.diff(P, w, j).subs(w, first) for j in range(len(grp))]
+        v = all_vanish(claims, ctx.sampler)
+        if not v.ok or v.method != "symbolic":
+            return False, v.unproved or "a book value is not a root of det(K − ω²M)"
+    return True, ""
 
 
 def _check_limit(ctx: Context, book, lin: LinearSystem) -> Verdict:
@@ -183,14 +228,19 @@ def check_period(ctx: Context, val) -> Verdict:
         if not any(abs(2 * np.pi / w - p) <= 1e-8 * p for w in freqs):
             return Verdict(False, "numeric", f"period {p:.10g} vs engine "
                            f"{[2 * np.pi / w for w in freqs]}" + at_point(pt))
+    why = ""
     try:
-        if ctx.policy.prove and any(vanishes(period - 2 * sp.pi / w, ctx.sampler).method
-                                    == "symbolic" for w in lin.frequencies if w != 0):
-            return Verdict(True, "symbolic", power="proved symbolically")
+        if ctx.policy.prove:
+            tries = [vanishes(period - 2 * sp.pi / w, ctx.sampler)
+                     for w in lin.frequencies if w != 0]
+            if any(v.method == "symbolic" for v in tries):
+                return Verdict(True, "symbolic", power="proved symbolically")
+            why = "; ".join(dict.fromkeys(v.unproved for v in tries if v.unproved))
     except UnsupportedError:
-        pass
+        why = "the engine's frequencies have no closed form here"
     return Verdict(True, "numeric(6 points)",
-                   power="6 points: 2π/ω matches one of the engine's frequencies to 1e-8")
+                   power="6 points: 2π/ω matches one of the engine's frequencies to 1e-8",
+                   unproved=why)
 
 
 def _mode_residual(lin: LinearSystem, freq: sp.Expr, shape: sp.Matrix, pt: dict) -> float:
@@ -212,7 +262,8 @@ def _eig_residual(K: np.ndarray, M: np.ndarray, w2: float, u: np.ndarray) -> flo
           how=('(K − ω²M)u = 0: shapes compared up to scale and sign; any vector of a '
                'degenerate eigenspace passes; with `limit:`, each book mode must '
                'approach an engine mode (frequency and the angle between shapes) as the '
-               'parameter goes to its limit'),
+               'parameter goes to its limit; with `--prove`, `symbolic` where each '
+               '(K − ω²M)u is proved 0 entry by entry (no velocity terms)'),
           keys={"limit": LIMIT},
           equivalent=("direction",),
           crosschecks=("modes",))
@@ -237,9 +288,34 @@ def check_normal_modes(ctx: Context, val) -> Verdict:
             if res > 1e-8:
                 return Verdict(False, "numeric", f"mode {i}: (K - w^2 M) u relative residual "
                                f"{res:.3g}" + at_point(pt))
+    return _proved_modes(ctx, modes, lin) if ctx.policy.prove else _numeric_modes()
+
+
+def _numeric_modes() -> Verdict:
     return Verdict(True, "numeric(5 points)",
-                   power="5 points: each (ω, shape) satisfies (K − ω²M)u = 0 to 1e-8 of its scale "
-                   "(a shape up to its length)")
+                   power="5 points: each (ω, shape) satisfies (K − ω²M)u = 0 to 1e-8 of its "
+                   "scale (a shape up to its length)")
+
+
+def _proved_modes(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
+    """With `--prove`, after the numeric pass: each (K − ω²M)u proved 0 entry by entry
+    (u is nonzero at the points drawn, so ω² is an eigenvalue and u its eigenvector)."""
+    numeric = _numeric_modes()
+    if lin.first_order or lin.gyroscopic:
+        numeric.unproved = "gyroscopic or first-order modes: compared numerically"
+        return numeric
+    residuals = []
+    for i, mode in enumerate(modes):
+        mode = ctx.as_map(mode, ("book", i))
+        freq = ctx.parse(mode["frequency"], ("book", i, "frequency"))
+        shape = ctx.mode_shape(mode.get("shape"), ("book", i, "shape"))
+        residuals += list((lin.K - freq**2 * lin.M) * shape)
+    proof = all_vanish(residuals, ctx.sampler)
+    if proof.ok and proof.method == "symbolic":
+        return Verdict(True, "symbolic", power="proved symbolically: (K − ω²M)u = 0 for "
+                       "each mode (a shape up to its length)")
+    numeric.unproved = proof.unproved
+    return numeric
 
 
 def _modes_limit(ctx: Context, modes: list, lin: LinearSystem) -> Verdict:
@@ -306,7 +382,10 @@ def _near(values, x, rtol=1e-8):
 @quantity('normal_coordinates',
           book='list of `{coordinate: linear form, frequency?}`',
           how=('c·q is a normal coordinate iff M⁻¹c is a mode (with velocity terms C, also '
-               'an eigenvector of M⁻¹C: then C does not couple it)'),
+               'an eigenvector of M⁻¹C: then C does not couple it); with `--prove`, '
+               '`symbolic` where K·adj(M)·c is proved parallel to c (= ω²·det(M)·c with a '
+               "frequency) and, with every coordinate given, the forms' determinant "
+               'decided nonzero'),
           equivalent=("scale", "shift"),
           crosschecks=("modes",))
 def check_normal_coordinates(ctx: Context, val) -> Verdict:
@@ -342,8 +421,44 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
                                    f"{w:.10g}, engine {np.sqrt(max(w2, 0)):.10g}")
         if len(rows) == len(ctx.system.q) and np.linalg.matrix_rank(np.array(rows)) < len(rows):
             return Verdict(False, "numeric", "the normal coordinates are not independent")
-    return Verdict(True, "numeric(5 points)",
-                   power="5 points: M⁻¹c an eigenvector to 1e-8 (a form up to a factor), ω to 1e-8")
+    numeric = Verdict(True, "numeric(5 points)",
+                      power="5 points: M⁻¹c an eigenvector to 1e-8 (a form up to a factor), "
+                      "ω to 1e-8")
+    return _proved_normal_coordinates(ctx, items, lin, numeric) if ctx.policy.prove else numeric
+
+
+def _proved_normal_coordinates(ctx: Context, items: list, lin: LinearSystem,
+                               numeric: Verdict) -> Verdict:
+    """With `--prove`, after the numeric pass: for each form c·q, v = K·adj(M)·c is
+    parallel to c (v_i c_j = v_j c_i), or v = ω²·det(M)·c where the book gives ω; det M
+    and, with every coordinate given, the forms' determinant decided nonzero. Then M⁻¹c
+    is a mode, exactly."""
+    if lin.first_order or lin.gyroscopic or not nonzero_determinant(lin.M):
+        numeric.unproved = "velocity terms, or a mass matrix not shown invertible"
+        return numeric
+    adj, det = lin.M.adjugate(method="berkowitz"), lin.M.det(method="berkowitz")
+    claims, rows = [], []
+    for i, item in enumerate(items):
+        item = ctx.as_map(item, ("book", i))
+        form = ctx.parse(item["coordinate"], ("book", i, "coordinate"))
+        c = sp.Matrix([sp.diff(form, q) for q in ctx.system.q])
+        rows.append(list(c))
+        v = lin.K * adj * c
+        if "frequency" in item:
+            w = ctx.parse(item["frequency"], ("book", i, "frequency"))
+            claims += list(v - w**2 * det * c)
+        else:
+            n = len(c)
+            claims += [v[a] * c[b] - v[b] * c[a] for a in range(n) for b in range(a + 1, n)]
+    if len(rows) == len(ctx.system.q) and not nonzero_determinant(sp.Matrix(rows)):
+        numeric.unproved = "the forms' independence is checked numerically only"
+        return numeric
+    proof = all_vanish(claims, ctx.sampler)
+    if proof.method == "symbolic":
+        return Verdict(True, "symbolic", power="proved symbolically: M⁻¹c is a mode of each "
+                       "form (a form up to a factor)")
+    numeric.unproved = proof.unproved
+    return numeric
 
 
 @quantity('mode_count',

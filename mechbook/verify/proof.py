@@ -1,0 +1,150 @@
+"""Symbolic proofs with `--prove`: canonical forms first, SymPy's `simplify` with what is left
+of the part's budget, and a fixed phrase for why a passing part is not proved.
+
+A proof is attempted only after the numeric comparison has passed. It is decided early
+where none can exist (an estimate, numbers of double precision), then tried by the exact
+canonical forms of mechbook.core.identity (milliseconds: SymEngine expansions reduced by
+sin² + cos² = 1 and r² = R), which either prove the identity, or decide that it is not one
+in free symbols (so that `simplify` is not run for nothing), or leave it open; only an open
+one is handed to `simplify`, within the time the part has left. A `restrict:` symbol is
+replaced by its expression first and a condition `x > y` on a symbol by x = y + δ, δ > 0,
+so that what is proved is the statement on the admissible points, which is what the numeric
+comparison sampled. Nothing numeric is ever called a proof.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import sympy as sp
+
+from mechbook.core.identity import decide_zero
+from mechbook.core.timeout import Timeout, time_limit
+
+# why a passing part is not proved: one fixed phrase per reason (the method column's tail)
+ESTIMATE = "an estimate (compared within its stated tolerance)"
+FLOATS = "holds floating-point numbers (a numeric root or value)"
+NOT_FREE = "not an identity in free symbols (holds where the conditions or constraints put them)"
+BRANCH = "holds on one branch of a root only (a sign SymPy cannot fix)"
+OPEN = "SymPy did not reduce it to 0 within the budget"
+BUDGET = "the part's proof budget was spent"
+BOUNDARY = "decided at a relation's boundary (crossings found numerically)"
+LIMIT = "a limit: the error's order is measured numerically"
+MEASURED = "measured by integration"
+NO_PATH = "no symbolic proof path for this quantity's check"
+EXACT = "decided exactly, with no identity to prove (a count)"
+# the reasons no proof can remove: what is left is what a proof could reach ("expressible")
+UNREACHABLE = (ESTIMATE, FLOATS, BOUNDARY, LIMIT, MEASURED, EXACT)
+
+CACHE_SIZE = 512  # proof results kept per process (the same difference met again: an erratum)
+_cache: dict = {}
+
+
+@dataclass(frozen=True)
+class Proof:
+    """A proof attempt's result: `ok` (proved exactly) and, when not, the phrase why."""
+
+    ok: bool
+    why: str = ""
+
+
+class Budget:
+    """The CPU seconds a part's proofs may spend in `simplify` (the canonical forms are
+    cheap and always tried)."""
+
+    def __init__(self, seconds: float):
+        self.seconds = seconds
+        self.spent = 0.0
+
+    def left(self) -> float:
+        return max(0.0, self.seconds - self.spent)
+
+
+def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
+    """Is `expr` identically 0 on the sampler's admissible points, proved exactly?
+    `canonical_only`: no `simplify` (a first pass over several expressions).
+
+    Example: prove_zero(sin(x)**2 + cos(x)**2 - 1, sampler) == Proof(True)."""
+    if expr == 0:
+        return Proof(True)
+    if sampler.rtol > 1e-10 or sampler.fixed:
+        return Proof(False, ESTIMATE)
+    expr = _on_admissible_points(expr, sampler)
+    if expr.atoms(sp.Float):
+        return Proof(False, FLOATS)
+    key = (expr, canonical_only)
+    if key in _cache:
+        return _cache[key]
+    decision = decide_zero(expr)
+    if decision.zero is True:
+        return _keep(key, Proof(True))
+    if decision.zero is False:
+        return _keep(key, Proof(False, NOT_FREE))
+    if decision.why.startswith("a root's branch"):
+        return _keep(key, Proof(False, BRANCH))
+    if canonical_only:
+        return Proof(False, OPEN)
+    budget = sampler.proof_budget()
+    seconds = min(budget.left(), sampler.policy.seconds)
+    if seconds <= 0:
+        return Proof(False, BUDGET)
+    start = time.process_time()
+    try:
+        with time_limit(seconds):
+            ok = sp.simplify(expr) == 0
+    except Timeout:
+        ok = False
+    except Exception:  # noqa: BLE001 - SymPy's odd failures: the numeric verdict stands
+        ok = False
+    finally:
+        budget.spent += time.process_time() - start
+    return _keep(key, Proof(True) if ok else Proof(False, OPEN))
+
+
+def _keep(key, proof: Proof) -> Proof:
+    if len(_cache) >= CACHE_SIZE:
+        _cache.clear()
+    _cache[key] = proof
+    return proof
+
+
+def _on_admissible_points(expr: sp.Basic, sampler) -> sp.Basic:
+    """expr with each `restrict:` symbol replaced by its expression (the latest first: it
+    may use an earlier one), and each condition x > y (x < y) on a symbol x not in y by
+    x = y + δ (y − δ) with δ > 0: an identity there holds on every admissible point."""
+    for sym in reversed(list(sampler.derived)):
+        expr = expr.xreplace({sym: sampler.derived[sym]})
+    for cond in sampler.conditions:
+        sub = _shift(cond)
+        if sub is not None and expr.has(sub[0]):
+            expr = expr.xreplace({sub[0]: sub[1]})
+    return expr
+
+
+def _shift(cond: sp.Basic) -> tuple[sp.Symbol, sp.Expr] | None:
+    """(x, y + δ) for x > y or y < x, (x, y − δ) for x < y, with a fresh positive δ."""
+    if not isinstance(cond, (sp.StrictGreaterThan, sp.StrictLessThan)):
+        return None
+    big, small = (cond.lhs, cond.rhs) if isinstance(cond, sp.StrictGreaterThan) \
+        else (cond.rhs, cond.lhs)
+    delta = sp.Dummy("delta", positive=True)
+    if big.is_Symbol and not small.has(big):
+        return big, small + delta
+    if small.is_Symbol and not big.has(small):
+        return small, big - delta
+    return None
+
+
+def unproved_reason(method: str) -> str:
+    """The phrase for a passing part whose check has no proof attempt of its own, read from
+    how it was decided."""
+    if method.startswith("boundary"):
+        return BOUNDARY
+    if "asymptotic" in method:
+        return LIMIT
+    if "simulated" in method or "integrat" in method:
+        return MEASURED
+    if method == "exact":
+        return EXACT
+    return NO_PATH
