@@ -33,6 +33,7 @@ import numpy as np
 import sympy as sp
 from sympy.matrices.utilities import dotprodsimp
 
+from mechbook.core.algebra_reach import within_exact_reach
 from mechbook.core.compile import as_expr
 from mechbook.core.identity import decide_zero
 from mechbook.core.numeval import holds
@@ -293,6 +294,8 @@ def _proved(st: Statement, sampler: Sampler) -> bool:
     statement is rational, `expand`/`radsimp` for numbers, `simplify` only with --prove."""
     policy = sampler.policy
     exprs = [as_expr(e) for e in st.exprs]
+    if not within_exact_reach(*exprs):  # SymPy's algebra would abort the process in gmp
+        return False
     try:
         with time_limit(policy.seconds if policy.prove else CANCEL_SECONDS):
             if all(e == 0 for e in exprs):

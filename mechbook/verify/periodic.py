@@ -6,8 +6,8 @@ multipliers of the monodromy over one period T, detected from the coefficients o
 by the part's `period:` (then verified at every point). One compiled integrator per linear
 system serves every parameter point of a part and of the parts after it. Each point is
 first put to the double-precision screen (mechbook.numerics.floquet_screen), which decides
-only where every multiplier within its conservative error estimate gives the 113-bit verdict; every other point is
-integrated in 113 bits (issue 42).
+only where every multiplier within its conservative error estimate gives the 113-bit
+verdict; every other point is integrated in 113 bits (issue 42).
 """
 
 from __future__ import annotations
@@ -66,7 +66,8 @@ class FloquetVerdicts:
 
     def power(self) -> str:
         screened = (f"; {plural(self.screened, 'point')} decided in double precision, "
-                    "where every multiplier within its (conservative, estimated) error bound gives the 113-bit verdict"
+                    "where every multiplier within its (conservative, estimated) error "
+                    "bound gives the 113-bit verdict"
                     if self.screened else "")
         if not self.points:
             return (f"the engine's verdicts from Floquet multipliers (the monodromy over one "

@@ -296,6 +296,8 @@ def _proportional_lists(a: list, b: list) -> bool:
     if pivot is None:
         return all(y == 0 for y in b)
     c = b[pivot] / a[pivot]
+    if not within_exact_reach(c, *a, *b):
+        return False
     return c != 0 and all(sp.simplify(y - c * x) == 0 for x, y in zip(a, b, strict=True))
 
 

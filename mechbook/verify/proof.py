@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from mechbook.core.algebra_reach import within_exact_reach
 from mechbook.core.identity import decide_zero
 from mechbook.core.timeout import Timeout, time_limit
 
@@ -29,6 +30,7 @@ NOT_FREE = "not an identity in free symbols (holds where the conditions or const
 BRANCH = "holds on one branch of a root only (a sign SymPy cannot fix)"
 OPEN = "SymPy did not reduce it to 0 within the budget"
 BUDGET = "the part's proof budget was spent"
+OUT_OF_REACH = "a rational exponent too large for exact algebra (decided numerically)"
 BOUNDARY = "decided at a relation's boundary (crossings found numerically)"
 LIMIT = "a limit: the error's order is measured numerically"
 MEASURED = "measured by integration"
@@ -85,6 +87,8 @@ def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
         return _keep(key, Proof(False, BRANCH))
     if canonical_only:
         return Proof(False, OPEN)
+    if not within_exact_reach(expr):  # simplify would abort the process in gmp
+        return _keep(key, Proof(False, OUT_OF_REACH))
     budget = sampler.proof_budget()
     seconds = min(budget.left(), sampler.policy.seconds)
     if seconds <= 0:

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from mechbook.core.algebra_reach import within_exact_reach
 from mechbook.core.identity import decide_zero
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.errors import UnsupportedError
@@ -212,6 +213,8 @@ def _proved(expr: sp.Expr, sampler: Sampler) -> bool:
     """0 by the exact canonical forms (milliseconds), else by SymPy within its seconds."""
     if not expr.atoms(sp.Float) and decide_zero(expr).zero is True:
         return True
+    if not within_exact_reach(expr):  # simplify would abort the process in gmp
+        return False
     seconds = sampler.policy.seconds if sampler.policy.prove else SYMBOLIC_SECONDS
     try:
         with time_limit(seconds):
