@@ -40,14 +40,15 @@ def _tree(tmp_path: Path) -> Path:
     return tmp_path
 
 
-def test_prove_leaves_a_huge_exponent_to_the_numbers_and_fails_it(tmp_path):
+def test_prove_leaves_a_huge_exponent_to_the_numbers_and_ends_normally(tmp_path):
     tree = _tree(tmp_path)
     got = subprocess.run([sys.executable, "-m", "mechbook", "--root", str(tree), "check",
                           "symon-11-08", "--prove", "--serial", "--no-store", "-v"],
                          capture_output=True, text=True, timeout=600)
     out = got.stdout + got.stderr
-    assert got.returncode == 1, out  # a part failed; not an abort (-6) or an error
-    assert "died" not in out and "Traceback" not in out, out
+    assert got.returncode in (0, 1), out  # an outcome for every part: not an abort (-6)
+    assert "died" not in out and "Traceback" not in out and "error" not in out.lower(), out
     row = next(line for line in out.splitlines() if "a-polhode" in line and "conserved " in line)
-    assert " fail " in row, row
-
+    # the mutant moves the residual by ~2e-20 of its scale, at the check's 1e-20: it is
+    # judged numerically (pass or fail by the points drawn), never proved
+    assert "symbolic" not in row, row
