@@ -178,15 +178,19 @@ def test_watch_survives_special_files_and_links_in_place_of_its_files(tmp_path):
     seen: list[str] = []
 
     def replace(path: Path, how: str) -> None:
-        path.unlink()
+        """In one step (built beside it, then renamed over it), as an editor saves: with an
+        unlink first, a watch that looked in between saw the file missing, kept the tree it
+        had, and passed (seen once in CI under load)."""
+        new = path.with_name(path.name + ".new")
         if how == "fifo":
-            os.mkfifo(path)
+            os.mkfifo(new)
         elif how == "devzero":
-            path.symlink_to("/dev/zero")
+            new.symlink_to("/dev/zero")
         elif how == "large":
-            path.write_bytes(b"# " + b"x" * 300_000 + b"\n")
+            new.write_bytes(b"# " + b"x" * 300_000 + b"\n")
         else:
-            path.write_bytes(how)
+            new.write_bytes(how)
+        os.replace(new, path)
 
     try:
         assert "6 pass" in _until(lines, r"lim-2031: .*checked in", seen)
