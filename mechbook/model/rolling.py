@@ -87,8 +87,7 @@ def _linear_in_velocities(sys, name: str, c: sp.Expr, sub: tuple) -> None:
                          f"a velocity appears inside a function or a power{where}; it must "
                          "read A(q, t)·q̇ + b(q, t) = 0")
     for powers, coeff in poly.terms():
-        if sum(powers) > 1 and not _vanishes(coeff.as_expr() if hasattr(coeff, "as_expr")
-                                             else sp.sympify(coeff)):
+        if sum(powers) > 1 and not _vanishes(coeff):  # Poly.terms(): SymPy coefficients
             term = sp.Mul(*[v**k for v, k in zip(sys.qd, powers, strict=True)])
             raise sys.error(sub, f"velocity constraint {name!r} is not linear in the "
                              f"velocities (it holds {sp.sstr(term)} times "

@@ -48,15 +48,15 @@ class _WithInputs:
         fixed = {k: sp.Float(float(v), 17) for k, v in values.items() if k not in inputs}
         qdd = list(dyn.qdd)
         rest = {a: 0 for a in qdd}
-        res = [sp.sympify(e).xreplace(fixed) for e in dyn.residuals]
+        res = [e.xreplace(fixed) for e in dyn.residuals]  # SymPy already
         exprs = [sp.diff(e, a) for e in res for a in qdd] + [-e.xreplace(rest) for e in res]
         self.m = dyn.velocity_jacobian.rows
         if self.m:  # A q̈ + bias = 0: the constraints differentiated to the accelerations
-            exprs += [sp.sympify(x).xreplace(fixed) for x in dyn.velocity_jacobian]
-            exprs += [sp.sympify(x).xreplace(fixed) for x in dyn.constraint_bias]
+            exprs += [x.xreplace(fixed) for x in dyn.velocity_jacobian]
+            exprs += [x.xreplace(fixed) for x in dyn.constraint_bias]
         args = [sys.t, *dyn.q, *dyn.qd, *inputs]
         self.n = len(qdd)
-        self.fn, _ = compile_exprs(args, [sp.sympify(e) for e in exprs], DEFAULT_BACKEND)
+        self.fn, _ = compile_exprs(args, exprs, DEFAULT_BACKEND)
 
     def rhs(self, t: float, y: np.ndarray, u: np.ndarray) -> np.ndarray:
         out = np.asarray(self.fn(np.concatenate(([t], y, u))), dtype=float).ravel()

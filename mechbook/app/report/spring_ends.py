@@ -74,7 +74,7 @@ def _along(sys, spring: dict, i: int, values: dict, args: list, idx: np.ndarray,
         length = as_expr(sys.parse(spring["length"], ("springs", i, "length")))
     except Exception:  # noqa: BLE001 - the system was built from it; a drawing is optional
         return None
-    comps = components(sp.sympify(length).xreplace(values))
+    comps = components(length.xreplace(values))
     if comps is None or len(comps) > dims:
         return None
     comps = comps + [sp.S.Zero] * (dims - len(comps))
