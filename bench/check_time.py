@@ -114,11 +114,10 @@ def children_cpu() -> float:
     return ru.ru_utime + ru.ru_stime
 
 
-def run_check(tree: Path, ids: list[str], extra: list[str], before: bool) -> dict:
-    """One `mechbook check --fresh --no-store --format json`: wall, CPU, per-problem
-    seconds, outcomes."""
-    cmd = launcher(tree) + ["check", *ids, "--fresh", "--no-store", "--format", "json",
-                            *extra]
+def timed_check(tree: Path, args: list[str], before: bool) -> tuple[dict, float, float]:
+    """`mechbook check ARGS --fresh --no-store --format json` in `tree`: its JSON, wall
+    seconds and CPU seconds (this process's children's)."""
+    cmd = launcher(tree) + ["check", *args, "--fresh", "--no-store", "--format", "json"]
     cpu0, start = children_cpu(), time.perf_counter()
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tree,
                           env=environment(tree, before))
@@ -126,7 +125,15 @@ def run_check(tree: Path, ids: list[str], extra: list[str], before: bool) -> dic
     try:
         doc = json.loads(proc.stdout)
     except json.JSONDecodeError:
-        raise SystemExit(f"{tree}: check printed no JSON:\n{proc.stderr[-2000:]}") from None
+        raise SystemExit(f"{tree}: check {' '.join(args)} printed no JSON:\n"
+                         f"{proc.stderr[-2000:]}") from None
+    return doc, wall, cpu
+
+
+def run_check(tree: Path, ids: list[str], extra: list[str], before: bool) -> dict:
+    """One `mechbook check --fresh --no-store --format json`: wall, CPU, per-problem
+    seconds, outcomes."""
+    doc, wall, cpu = timed_check(tree, [*ids, *extra], before)
     seconds = {p["id"]: p["seconds"] for p in doc["problems"]}
     outcomes = {}
     for p in doc["problems"]:

@@ -24,7 +24,6 @@ most time). Never gates anything: timings depend on the machine and its load.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import re
 import statistics
@@ -37,10 +36,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from check_time import (  # noqa: E402  (a sibling bench script: its launcher and profiler)
     ROOT,
-    environment,
     hot_functions,
-    launcher,
     profile,
+    timed_check,
 )
 
 DRIVEN = ["classic-pendulum-on-vibrating-pivot", "classic-rotating-saddle"]
@@ -57,21 +55,16 @@ def reference() -> str:
                          capture_output=True, text=True)
     if got.returncode != 0 or not got.stdout.strip():
         raise SystemExit("no merge-base with main: give --ref")
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"],
+                          capture_output=True, text=True).stdout.strip()
+    if got.stdout.strip() == head:  # on main itself: the tree against itself says nothing
+        raise SystemExit("this tree is main: give --ref (d002f7a is main before issue 42)")
     return got.stdout.strip()[:12]
 
 
 def check(tree: Path, ids: list[str], before: bool) -> dict:
     """One cold check of `ids` in `tree`: wall, each problem's seconds, every part."""
-    cmd = launcher(tree) + ["check", *ids, "--fresh", "--no-store", "-j", "1",
-                            "--format", "json"]
-    start = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tree,
-                          env=environment(tree, before))
-    wall = time.perf_counter() - start
-    try:
-        doc = json.loads(proc.stdout)
-    except json.JSONDecodeError:
-        raise SystemExit(f"{tree}: check printed no JSON:\n{proc.stderr[-2000:]}") from None
+    doc, wall, _ = timed_check(tree, [*ids, "-j", "1"], before)
     parts, seconds = {}, {}
     for p in doc["problems"]:
         seconds[p["id"]] = p["seconds"]

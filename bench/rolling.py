@@ -27,23 +27,19 @@ report (or --out FILE); never gates CI: timings depend on the machine and its lo
 from __future__ import annotations
 
 import argparse
-import json
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from datetime import UTC, datetime
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from check_time import (  # noqa: E402 - bench/ is not a package
-    children_cpu,
-    environment,
     hot_functions,
-    launcher,
     profile,
+    timed_check,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -81,16 +77,7 @@ def provide(reference: Path, ids: list[str]) -> list[str]:
 def check_once(tree: Path, pid: str, reference: bool, how: tuple[str, ...]) -> dict:
     """One `mechbook check PID HOW --fresh --no-store --format json` (HOW: `-j 1`, or
     `--serial`, whose CPU is all this process's children's): wall, CPU, outcomes."""
-    cmd = launcher(tree) + ["check", pid, *how, "--fresh", "--no-store", "--format", "json"]
-    cpu0, start = children_cpu(), time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tree,
-                          env=environment(tree, reference))
-    wall, cpu = time.perf_counter() - start, children_cpu() - cpu0
-    try:
-        doc = json.loads(proc.stdout)
-    except json.JSONDecodeError:
-        raise SystemExit(f"{tree}: check {pid} printed no JSON:\n{proc.stderr[-2000:]}") \
-            from None
+    doc, wall, cpu = timed_check(tree, [pid, *how], reference)
     return {"wall": wall, "cpu": cpu, **outcomes(doc)}
 
 

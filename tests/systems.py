@@ -82,3 +82,24 @@ coordinates:
 kinetic: m*xdot**2/2
 potential: k*x**2/2
 """
+
+
+# a particle in a saddle potential turning at Omega: a linear system with periodic
+# coefficients whose Floquet multipliers have a closed form (test_periodic, test_floquet_screen)
+SADDLE = """\
+id: lim-9406
+source: test
+title: particle in a rotating saddle
+parameters:
+  m: {value: 1.0}
+  k: {value: 1.0}
+  kappa: {value: 2.0}
+  Omega: {value: 1.03}
+coordinates:
+  x: {}
+  y: {}
+kinetic: m*(xdot**2 + ydot**2)/2
+potential: >-
+  m*(k*(x*cos(Omega*t) + y*sin(Omega*t))**2
+  - kappa*(-x*sin(Omega*t) + y*cos(Omega*t))**2)/2
+"""

@@ -24,7 +24,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from systems import load_analysis
+from systems import SADDLE, load_analysis
 
 from mechbook.numerics.floquet import Floquet
 from mechbook.numerics.floquet_screen import WORTH_IT, Screen
@@ -162,23 +162,6 @@ def test_a_damped_oscillator_is_decided_stable_by_its_determinant(tmp_path):
     assert flo.stability(pt) == "unstable"
 
 
-SADDLE = """\
-id: lim-9803
-source: test
-title: particle in a rotating saddle
-parameters:
-  m: {value: 1.0}
-  k: {value: 1.0}
-  kappa: {value: 2.0}
-  Omega: {value: 1.03}
-coordinates:
-  x: {}
-  y: {}
-kinetic: m*(xdot**2 + ydot**2)/2
-potential: >-
-  m*(k*(x*cos(Omega*t) + y*sin(Omega*t))**2
-  - kappa*(-x*sin(Omega*t) + y*cos(Omega*t))**2)/2
-"""
 
 
 def test_two_degrees_of_freedom_are_decided_unstable_only(tmp_path):

@@ -26,7 +26,7 @@ import scipy.integrate
 import scipy.special
 import sympy as sp
 from ruamel.yaml import YAML
-from systems import load_analysis
+from systems import SADDLE, load_analysis
 
 from mechbook.engine.periodic import period
 from mechbook.errors import UnsupportedError
@@ -331,24 +331,7 @@ def test_the_tongue_width_holds_to_first_order(modulated, tmp_path):
     assert out.status == "fail", out.detail  # right to first order only
 
 
-# ---- a closed form: the rotating saddle --------------------------------------------------
-SADDLE = """\
-id: lim-9406
-source: test
-title: particle in a rotating saddle
-parameters:
-  m: {value: 1.0}
-  k: {value: 1.0}
-  kappa: {value: 2.0}
-  Omega: {value: 1.03}
-coordinates:
-  x: {}
-  y: {}
-kinetic: m*(xdot**2 + ydot**2)/2
-potential: >-
-  m*(k*(x*cos(Omega*t) + y*sin(Omega*t))**2
-  - kappa*(-x*sin(Omega*t) + y*cos(Omega*t))**2)/2
-"""
+# ---- a closed form: the rotating saddle (SADDLE, from tests/systems.py) ----------------
 
 
 @pytest.mark.slow

@@ -41,16 +41,23 @@ DIGITS = 30
 TIMES = (sp.Rational(7, 5), sp.Rational(-3, 7))  # a steady motion's residual vanishes at all t
 
 
+def _uniform_motion(dyn: Dynamics, rates: dict, point: dict) -> dict:
+    """The substitution q = point + rates·t, q̇ = rates, q̈ = 0, small parameters 0."""
+    t = dyn.sys.t
+    sub = {}
+    for q, v, a in zip(dyn.q, dyn.qd, dyn.qdd, strict=True):
+        sub[q] = sp.S(point.get(q, 0)) + sp.S(rates.get(q, 0)) * t
+        sub[v] = sp.S(rates.get(q, 0))
+        sub[a] = sp.S.Zero
+    sub.update({s: sp.S.Zero for s in dyn.sys.small_params})
+    return sub
+
+
 def steady_residuals(dyn: Dynamics, rates: dict, point: dict) -> list[sp.Expr]:
     """E_i along q*(t) = point + rates·t, q̇ = rates, q̈ = 0 (small parameters off), at two
     times: every one vanishes exactly when that uniform motion solves the equations."""
     sys = dyn.sys
-    sub = {}
-    for q, v, a in zip(dyn.q, dyn.qd, dyn.qdd, strict=True):
-        sub[q] = sp.S(point.get(q, 0)) + sp.S(rates.get(q, 0)) * sys.t
-        sub[v] = sp.S(rates.get(q, 0))
-        sub[a] = sp.S.Zero
-    sub.update({s: sp.S.Zero for s in sys.small_params})
+    sub = _uniform_motion(dyn, rates, point)
     out = []
     for e in dyn.residuals:
         e = e.xreplace(sub)
@@ -65,12 +72,7 @@ def constrained_steady_residuals(dyn: Dynamics, rates: dict, point: dict) -> lis
     E·det(G) − Aᵀ·adj(G)·A·E with G = A·Aᵀ (zero exactly where E = Aᵀλ for some λ: the
     constraint forces can make the motion, however large they must be)."""
     sys = dyn.sys
-    sub = {}
-    for q, v, a in zip(dyn.q, dyn.qd, dyn.qdd, strict=True):
-        sub[q] = sp.S(point.get(q, 0)) + sp.S(rates.get(q, 0)) * sys.t
-        sub[v] = sp.S(rates.get(q, 0))
-        sub[a] = sp.S.Zero
-    sub.update({s: sp.S.Zero for s in sys.small_params})
+    sub = _uniform_motion(dyn, rates, point)
     E = sp.Matrix([e.xreplace(sub) for e in dyn.residuals])
     A = dyn.velocity_jacobian.xreplace(sub)
     kept = [g.xreplace(sub) for _, g in sys.constraints] + \
