@@ -179,6 +179,21 @@ def test_every_unproved_pass_says_why(tmp_path):
     assert not any("unproved" in o.method for o in plain)
 
 
+def test_a_first_order_linearizations_frequencies_are_unproved_not_an_error():
+    """The coin rolling upright (velocity constraints: a first-order linearization) under
+    --prove: its wobble frequencies pass as in a plain check and say why they are unproved
+    (they raised AttributeError: the prover asked it for closed-form frequencies)."""
+    an = Analysis(load_problem(ROOT / "problems" / "classic" / "coin-rolling-upright.yaml"))
+    key = load_answers(ROOT / "answers" / "classic" / "coin-rolling-upright.yaml")
+    proved = check_problem(an, key, PROVE)
+    plain = check_problem(an, key)
+    assert [o.status for o in proved] == [o.status for o in plain]
+    assert all(o.status == Status.PASS for o in proved), [o.detail for o in proved]
+    wobbles = [o for o in proved if o.part.endswith("wobble")]
+    assert len(wobbles) == 3
+    assert all("first-order linearization" in o.method for o in wobbles)
+
+
 def test_frequencies_proved_as_roots_of_the_secular_polynomial(tmp_path):
     """Lim 2055 (six coupled pendulums in a ring, two double roots): each book ω² makes
     det(K − ω²M) and, for a double root, its derivative vanish identically: proved without

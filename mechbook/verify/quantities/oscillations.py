@@ -135,6 +135,9 @@ def _symbolic_frequencies(ctx, book, lin, partial) -> tuple[bool, str]:
             return _secular_roots(ctx, book, lin)
         except (MechbookError, ValueError, TypeError, ZeroDivisionError) as exc:
             return False, f"the secular polynomial could not be formed ({type(exc).__name__})"
+    if not hasattr(lin, "frequencies_at"):  # a first-order linearization (rolling, velocity
+        # constraints): its frequencies are eigenvalues of the state matrix, numbers only
+        return False, "no symbolic proof path for a first-order linearization's frequencies"
     pt = ctx.sampler.draw()
     try:
         engine = list(lin.frequencies_at(pt))  # the key's symbols (a steady rate) valued too
