@@ -92,3 +92,38 @@ def test_an_interrupt_during_the_imports_ends_with_130(tree, delay):
     # imports or the argument parsing; `list` could end before the signal on a fast machine
     _ended_by_ctrl_c(*_interrupted(["check", "lim-2101", "-j", "1", "--no-store"], tree, None,
                                    delay=delay))
+
+
+_INTERRUPT_IN_A_STRING_EXEC = '''
+import importlib.abc, sys
+
+class _Interrupt(importlib.abc.MetaPathFinder):
+    """A Ctrl-C that lands in a function built from a string (as a dataclass's are) while
+    {module} is imported."""
+    def find_spec(self, name, path=None, target=None):
+        if name == {module!r}:
+            sys.meta_path.remove(self)
+            exec("raise KeyboardInterrupt", {{}})
+        return None
+
+sys.meta_path.insert(0, _Interrupt())
+'''
+
+
+@pytest.mark.parametrize("module", ["mechbook.app.cli", "mechbook.app.running.service"])
+def test_an_interrupt_through_a_string_exec_still_ends_with_130(tree, tmp_path, module):
+    """On 8d0ecdc, 1 run in 80 interrupted at 0.23 s ended killed by SIGINT (-2) after
+    printing "interrupted": CPython notes a KeyboardInterrupt that ends a string exec even
+    when it is caught, and a `python -m` run then re-raises SIGINT at its exit. Here the
+    interrupt is put there on purpose: in the imports (mechbook.__main__'s handler) and in
+    the command (the group's handler)."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(_INTERRUPT_IN_A_STRING_EXEC.format(module=module),
+                                           encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(site), str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    done = subprocess.run([sys.executable, "-m", "mechbook", "check", "lim-2101", "-j", "1",
+                           "--no-store"], cwd=tree, env=env, capture_output=True, text=True,
+                          timeout=120, preexec_fn=limited())
+    _ended_by_ctrl_c(done.returncode, done.stdout, done.stderr)

@@ -202,6 +202,20 @@ def test_the_accuracy_check_catches_a_corrupted_float_path(monkeypatch):
     assert bad.attrs["max_rel_diff_float64_vs_30_digits"] > 5e-7
 
 
+def test_the_sample_pool_is_setdiff1ds_without_its_sort():
+    """The points left to sample once the boundary's are chosen: np.setdiff1d's result
+    (same seed, same samples as before), including points not in the pool at all."""
+    from mechbook.app.sweep.precision import points_left
+
+    rng = np.random.default_rng(3)
+    for n in (0, 1, 2, 50, 20_000):
+        pool = np.unique(rng.integers(0, 3 * n + 1, n)).astype(np.int64)
+        taken = pool[rng.choice(pool.size, min(pool.size, 9), replace=False)] \
+            if pool.size else np.zeros(0, dtype=np.int64)
+        taken = np.concatenate([taken, taken[:2], [-1, 10 ** 9]]).astype(np.int64)
+        assert np.array_equal(points_left(pool, taken), np.setdiff1d(pool, taken))
+
+
 def test_wrong_requests_are_refused():
     with pytest.raises(MechbookError, match="not a parameter"):
         Sweeper(make_spec("lim-2031", ROOT, "frequencies", [parse_axis("zeta=1:2:3")],

@@ -8,7 +8,7 @@ within time and memory limits, each result written as it ends.
     simrun       `mechbook simulate` in a worker, under the same limits
     distributed  the same on a Dask cluster (--scheduler), limits kept in the workers
     lifeline     a worker dies with the run that started it, even one killed with -9
-    serverstart  the fork server started with Ctrl-C ignored, SIGTERM and SIGHUP held
+    serverstart  the fork server started with Ctrl-C, SIGTERM and SIGHUP held
     forkstart    imported first by the fork server: Ctrl-C ignored, its folder removed
     frozen       imported last by the fork server: what it imported frozen out of the GC
     quiet        warnings and stray tracebacks become notes

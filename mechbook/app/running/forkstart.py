@@ -100,4 +100,6 @@ for _ends in ENDS:
     if signal.getsignal(_ends) is not signal.SIG_IGN:  # ignored: as its run does (nohup)
         signal.signal(_ends, _end)
 atexit.register(_remove_socket_folder)
-signal.pthread_sigmask(signal.SIG_UNBLOCK, ENDS)  # blocked by the run for the start-up
+# blocked by the run for the start-up (mechbook.app.running.serverstart): a Ctrl-C sent
+# meanwhile is dropped now, a SIGTERM or SIGHUP ends the server now
+signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, *ENDS))

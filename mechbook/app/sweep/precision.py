@@ -22,7 +22,7 @@ def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SWEEP
         return {"samples": 0, "max_rel_diff": float("nan"), "disagree": 0}
     chosen = list(rng.choice(edge, min(len(edge), samples // 3), replace=False)) \
         if len(edge) else []
-    rest = np.setdiff1d(defined, chosen)
+    rest = points_left(defined, np.asarray(chosen, dtype=defined.dtype))
     chosen += list(rng.choice(rest, min(len(rest), samples - len(chosen)), replace=False))
     worst, disagree, worst_at = 0.0, [], None
     for flat in sorted(int(c) for c in chosen):
@@ -44,6 +44,18 @@ def sample_accuracy(sweeper, arrays: dict[str, np.ndarray], samples: int = SWEEP
     return {"samples": len(chosen), "boundary_samples": min(len(edge), samples // 3),
             "max_rel_diff": worst, "worst_at": worst_at, "disagree": len(disagree),
             "disagree_at": disagree[:5]}
+
+
+def points_left(defined: np.ndarray, taken: np.ndarray) -> np.ndarray:
+    """`defined` (sorted, unique) less the points `taken` from it: `np.setdiff1d`'s result,
+    found by bisection instead of sorting every grid point again (on a 3000 × 3000 map
+    that sort took seconds in one C call, where Ctrl-C could not stop it)."""
+    keep = np.ones(defined.size, dtype=bool)
+    at = np.searchsorted(defined, taken)
+    inside = at < defined.size
+    at = at[inside][defined[at[inside]] == taken[inside]]
+    keep[at] = False
+    return defined[keep]
 
 
 def _candidates(sweeper, arrays: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
