@@ -29,7 +29,8 @@ def start_server() -> None:
     from multiprocessing import forkserver, resource_tracker
 
     resource_tracker.ensure_running()
-    if threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread() \
+            or signal.getsignal(signal.SIGINT) is signal.SIG_IGN:  # a background job's
         _spawn(forkserver)
         return
     # held in this thread's mask, but another thread of the process may take the signal
