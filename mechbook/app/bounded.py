@@ -12,6 +12,7 @@ back only up to a depth: an `Unreadable` error saying why, never a hang or a tra
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import stat
@@ -29,10 +30,11 @@ MAX_JSON_DEPTH = 32  # mechbook's own documents nest at most 6 levels
 
 
 class Unreadable(MechbookError):
-    """A file that cannot be read as asked: names it and says why."""
+    """A file that cannot be read as asked: names it and says why (`missing`: there is no
+    such file, which a cache takes as no entry rather than a damaged one)."""
 
-    def __init__(self, path: str | Path, reason: str):
-        self.path, self.reason = Path(path), reason
+    def __init__(self, path: str | Path, reason: str, missing: bool = False):
+        self.path, self.reason, self.missing = Path(path), reason, missing
         super().__init__(f"cannot read {path}: {reason}")
 
 
@@ -53,7 +55,8 @@ def regular_file(path: str | Path, max_bytes: int) -> Iterator[IO[bytes]]:
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
     except OSError as exc:
-        raise Unreadable(path, exc.strerror or str(exc)) from None
+        raise Unreadable(path, exc.strerror or str(exc),
+                         missing=exc.errno == errno.ENOENT) from None
     fh = None
     try:
         info = os.fstat(fd)

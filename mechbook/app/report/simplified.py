@@ -61,9 +61,13 @@ class SimplifiedCache:
             text = read_regular(path, MAX_BYTES).decode("utf-8")
             names = {s.name: s for s in expr.free_symbols if isinstance(s, sp.Symbol)}
             form = read(text, names)
+        except Unreadable as exc:
+            if not exc.missing:  # none kept yet is no form, not a damaged one
+                log.warning("%s: not a simplified form mechbook wrote; simplified again", path)
+            return None
         except FileNotFoundError:
             return None
-        except (Unreadable, OSError, UnicodeDecodeError, MechbookError, ValueError):
+        except (OSError, UnicodeDecodeError, MechbookError, ValueError):
             log.warning("%s: not a simplified form mechbook wrote; simplified again", path)
             return None
         if not isinstance(form, sp.Expr) or not _same(expr, form):
