@@ -95,6 +95,22 @@ def test_a_form_not_kept_yet_is_no_warning(tmp_path, caplog):
     assert caplog.text == ""
 
 
+def test_a_form_the_reader_would_refuse_is_not_kept(tmp_path, caplog):
+    """A simplified form with an integer longer than the safe parser reads (a ratio of
+    45-digit numbers, 10 of them on a fresh report of the books) is shown but not kept: kept, it
+    warned and was simplified again on every run."""
+    q, length = sp.symbols("q l", positive=True)
+    expr = q / (length + sp.Rational(302019499782769, 10**15)) ** 3 * sp.Integer(10) ** 45
+    form = sp.factor(expr)
+    assert sp.sstr(form) != sp.sstr(expr)
+    cache = SimplifiedCache(tmp_path)
+    cache.put(expr, form)
+    assert cache.stored == 0 and not list(tmp_path.rglob("*.txt"))
+    with caplog.at_level("WARNING", logger="mechbook.report"):
+        assert SimplifiedCache(tmp_path).get(expr) is None
+    assert caplog.text == ""
+
+
 def test_a_link_in_the_kept_folder_is_not_written_through(tmp_path):
     x, y = sp.symbols("x y", positive=True)
     expr = sp.sin(x) ** 2 * y + sp.cos(x) ** 2 * y

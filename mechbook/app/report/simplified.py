@@ -81,6 +81,9 @@ class SimplifiedCache:
         """Keep `form` as the simplified `expr` (a failure to write costs only the time)."""
         if self.directory is None or form == expr:
             return
+        text = sp.sstr(form)
+        if not _readable(text, expr):  # kept, it would be refused on every later read
+            return
         path = self._path(expr)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -88,7 +91,7 @@ class SimplifiedCache:
                 log.warning("%s: a symbolic link in the way; the form is not kept", path)
                 return
             with replaced(output_file(path, "simplified form")) as fh:
-                fh.write(sp.sstr(form).encode("utf-8"))
+                fh.write(text.encode("utf-8"))
             self.stored += 1
         except (OSError, OutputError) as exc:
             log.debug("%s: not kept (%s)", path, exc)
@@ -99,6 +102,17 @@ class SimplifiedCache:
         folder, its subfolder, the file)."""
         top = self.directory
         return not any(p.is_symlink() for p in (top, path.parent, path))
+
+
+def _readable(text: str, expr: sp.Expr) -> bool:
+    """Whether `get` can read `text` back (the safe parser refuses, say, an integer of
+    more digits than a problem file may hold: such a form is shown, not kept)."""
+    names = {s.name: s for s in expr.free_symbols if isinstance(s, sp.Symbol)}
+    try:
+        read(text, names)
+    except (MechbookError, ValueError):
+        return False
+    return True
 
 
 def _same(a: sp.Expr, b: sp.Expr) -> bool:
