@@ -66,7 +66,8 @@ class Sampler:
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
                  seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
                  rtol: float = RTOL, fixed: Sequence[sp.Symbol] = (),
-                 derived: dict[sp.Symbol, sp.Expr] | None = None, manifold=None):
+                 derived: dict[sp.Symbol, sp.Expr] | None = None, manifold=None,
+                 approximate: bool = False):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
@@ -81,6 +82,9 @@ class Sampler:
         # gives a coordinate or a velocity a value is moved onto the constraint manifold,
         # where the system's motion is (its solved accelerations hold nowhere else)
         self.manifold = manifold
+        # the expressions compared hold a number written to more digits than a double (a
+        # root to 36 digits): true to those digits, so an identity in it is not exact
+        self.approximate = approximate
         self._budget: Budget | None = None
 
     def proof_budget(self) -> Budget:
@@ -170,7 +174,7 @@ class Sampler:
         """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
         out = Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived,
-                      manifold=self.manifold)
+                      manifold=self.manifold, approximate=self.approximate)
         out._budget = self.proof_budget()  # the same part: the same budget
         return out
 
@@ -271,7 +275,8 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
     elif exact_inputs:
         decided = f" (none above {CLEAR:g} of it at {2 * DIGITS} digits: exact inputs)"
     else:  # the inputs' own 30-digit rounding: below AMBIGUOUS of the scale it is that
-        decided = f" (under {AMBIGUOUS:g} of it undecided: inputs rounded at {DIGITS} digits)"
+        decided = (f" (under {AMBIGUOUS:g} of it undecided: inputs rounded, at {DIGITS} "
+                   "digits or to their written digits)")
     return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=f"{plural(valid, 'point')} at {DIGITS} digits, residual ≤ {rtol:g} "
@@ -300,9 +305,10 @@ def _resolved(expr: sp.Basic, point: dict, max_digits: int = DEEP_DIGITS) -> com
 
 def _rounded_inputs(expr: sp.Basic, sampler: Sampler) -> bool:
     """Whether `expr` at a drawn point carries a rounding of its inputs that no raised
-    precision removes: a symbol the sampler computes (Sampler.rounded) or a number of 30
-    digits written in it."""
-    return bool(expr.free_symbols & sampler.rounded()) or bool(expr.atoms(sp.Float))
+    precision removes: a symbol the sampler computes (Sampler.rounded), a number of 30
+    digits in it, or one the key writes to its digits (Sampler.approximate)."""
+    return sampler.approximate or bool(expr.free_symbols & sampler.rounded()) \
+        or bool(expr.atoms(sp.Float))
 
 
 def _residual_rtol(expr: sp.Basic, sampler: Sampler) -> float:
