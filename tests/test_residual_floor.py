@@ -113,6 +113,7 @@ def test_a_number_written_to_its_digits_keeps_the_floor():
     assert decimal_digits("0.5*m*v**2 + 9.81*m*h") == 3
     assert decimal_digits("I3**(2*(10000000000000000001/10000000000000000000))") == 0
     assert decimal_digits("x1**2 = 2.50e3") == 3
+    assert decimal_digits(1.8751040687119612) == 17  # a YAML float: its repr
     root = sp.Rational("1.87510406871196116644530824107821416")  # as the parser reads it
     e = ONE * (1 + sp.cos(root) * sp.cosh(root))  # 4e-31, 8e-43 of the scale
     assert not vanishes(e, Sampler(BASE), symbolic=False).ok  # exact: the root is not one

@@ -420,6 +420,8 @@ def decimal_digits(text) -> int:
     is written with in `text`; 0 if it writes none. Integers are exact and not counted.
     A literal longer than a double carries (a root to 36 digits) is a rounded value: true
     to its digits, not beyond them. Example: decimal_digits("1.8751040687*x + 2") == 11."""
+    if isinstance(text, float):  # a YAML number: the digits of its shortest repr
+        text = repr(text)
     if not isinstance(text, str):
         return 0
     most = 0

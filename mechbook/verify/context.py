@@ -141,7 +141,7 @@ class Context:
         while texts:
             t = texts.pop()
             if isinstance(t, dict):
-                texts.extend(t.values())
+                texts.extend(v for k, v in t.items() if k not in PROSE)
             elif isinstance(t, list):
                 texts.extend(t)
             else:
@@ -292,6 +292,9 @@ class Context:
                                        f"({sp.sstr(implied)} for the other entries given): "
                                        f"{got.detail}")
         return u
+
+
+PROSE = ("part", "cite", "origin", "quantity", "note", "transcription")  # words, not values
 
 
 def _merge_declared(names: dict, extra: dict, part: Part) -> None:
