@@ -16,7 +16,9 @@ every step.
 from __future__ import annotations
 
 import ast
+import io
 import math
+import tokenize
 import unicodedata
 import warnings
 from collections.abc import Mapping
@@ -408,3 +410,32 @@ def split_single_equals(text: str) -> list[str]:
             start = i + 1
     out.append(text[start:])
     return out
+
+
+DOUBLE_DIGITS = 15  # the significant digits a binary64 number carries
+
+
+def decimal_digits(text) -> int:
+    """The most significant digits a decimal literal (a number with a point or an exponent)
+    is written with in `text`; 0 if it writes none. Integers are exact and not counted.
+    A literal longer than a double carries (a root to 36 digits) is a rounded value: true
+    to its digits, not beyond them. Example: decimal_digits("1.8751040687*x + 2") == 11."""
+    if isinstance(text, float):  # a YAML number: the digits of its shortest repr
+        text = repr(text)
+    if not isinstance(text, str):
+        return 0
+    most = 0
+    try:
+        for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+            if tok.type != tokenize.NUMBER:
+                continue
+            body = tok.string.lower().replace("_", "")
+            if body.startswith(("0x", "0o", "0b")) or body.endswith("j") \
+                    or not ("." in body or "e" in body):
+                continue
+            mantissa = body.split("e")[0].replace(".", "").lstrip("0")
+            most = max(most, len(mantissa.rstrip("0")) if "." not in body.split("e")[0]
+                       else len(mantissa))
+    except (tokenize.TokenError, IndentationError, SyntaxError):
+        pass  # what the parser itself refuses is reported there
+    return most

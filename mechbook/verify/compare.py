@@ -66,7 +66,8 @@ class Sampler:
     def __init__(self, base: dict[sp.Symbol, float], conditions: Sequence[sp.Basic] = (),
                  seed: int = 20261122, spread: float = 0.5, policy: ProofPolicy = NUMERIC,
                  rtol: float = RTOL, fixed: Sequence[sp.Symbol] = (),
-                 derived: dict[sp.Symbol, sp.Expr] | None = None, manifold=None):
+                 derived: dict[sp.Symbol, sp.Expr] | None = None, manifold=None,
+                 approximate: bool = False):
         self.base = dict(base)
         self.conditions = list(conditions)
         self.rng = np.random.default_rng(seed)
@@ -81,6 +82,9 @@ class Sampler:
         # gives a coordinate or a velocity a value is moved onto the constraint manifold,
         # where the system's motion is (its solved accelerations hold nowhere else)
         self.manifold = manifold
+        # the expressions compared hold a number written to more digits than a double (a
+        # root to 36 digits): true to those digits, so an identity in it is not exact
+        self.approximate = approximate
         self._budget: Budget | None = None
 
     def proof_budget(self) -> Budget:
@@ -114,7 +118,9 @@ class Sampler:
         spread = self.spread if spread is None else spread
         # a condition may bound a state variable (an `assume:` such as r > 0): draw it too
         extra = set().union(*(c.free_symbols for c in self.conditions)) - set(self.base)
-        variables = list(variables) + sorted(extra - set(variables), key=str)
+        # in a fixed order (by name, not a set's, which follows the process's hash seed):
+        # the same seed gives the same points in every run
+        variables = sorted(set(variables) | extra, key=sp.srepr)
         onto = self.manifold is not None and bool(self.manifold.state & set(variables))
         if onto and self.manifold.moving and self.manifold.t not in variables:
             variables.append(self.manifold.t)  # moving constraints: a state at a time
@@ -150,6 +156,15 @@ class Sampler:
                              "there), or none that satisfies the stated conditions")
         raise ValueError("no admissible parameter point satisfies the stated conditions")
 
+    def rounded(self) -> frozenset[sp.Symbol]:
+        """The symbols whose drawn values are computed at 30 digits, not drawn exactly: a
+        restriction's derived symbols and a state moved onto the constraint manifold. An
+        identity holds at such a point only to that rounding, which no raised precision
+        removes (a drawn value is a binary64 number: exact at any precision)."""
+        moved = self.manifold.state if self.manifold is not None and not self.manifold.empty \
+            else frozenset()
+        return frozenset(self.derived) | frozenset(moved)
+
     def complete(self, point: dict) -> dict | None:
         """`point` with its derived (restricted) symbols recomputed, or None if one is not
         real there (for a caller that moved a parameter itself, e.g. towards a limit)."""
@@ -159,7 +174,7 @@ class Sampler:
         """The same sampler (conditions, derived symbols, policy) drawing with `spread`."""
         out = Sampler(self.base, self.conditions, spread=spread, policy=self.policy,
                       rtol=self.rtol, fixed=list(self.fixed), derived=self.derived,
-                      manifold=self.manifold)
+                      manifold=self.manifold, approximate=self.approximate)
         out._budget = self.proof_budget()  # the same part: the same budget
         return out
 
@@ -214,6 +229,7 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
     attempted after the numeric pass when `symbolic` (default: the sampler's policy)."""
     variables = _free_variables([expr], sampler.base)
     rtol = _residual_rtol(expr, sampler)
+    exact_inputs = rtol == EXACT_RTOL and not _rounded_inputs(expr, sampler)
     worst = 0.0
     valid = 0
     for _ in range(POINTS * 3):
@@ -231,8 +247,20 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
             deeper = _resolved(expr, point)
             if deeper:
                 return Verdict(False, f"numeric({plural(valid, 'point')}, to {DEEP_DIGITS} digits)",
-                               f"residual {abs(deeper):.3g} at {_fmt(point)} (below 30 "
-                               f"digits' reach: {rel:.2g} of the terms that cancel)")
+                               f"residual {abs(deeper):.3g} at {_fmt(point)} ({rel:.2g} of "
+                               "the terms that cancel: under the tolerance, beyond 30 digits' "
+                               "rounding)")
+        elif exact_inputs and 0 < abs(v) <= AMBIGUOUS * scale:
+            # the scale bounds what cancelled; 30 digits' real rounding may lie far below
+            # it (1e-40 of it where a denominator cancels): a residual of 1e-28 of the
+            # scale can be 1e10 above that rounding. Exact inputs: one run at twice the
+            # digits tells rounding (it shrinks) from a residual (it stays)
+            deeper = _resolved(expr, point, 2 * DIGITS)
+            if deeper:
+                return Verdict(False, f"numeric({plural(valid, 'point')}, to {2 * DIGITS} "
+                               "digits)", f"residual {abs(deeper):.3g} at {_fmt(point)} "
+                               f"({rel:.2g} of the terms that cancel, standing clear at "
+                               f"{2 * DIGITS} digits: not rounding)")
         worst = max(worst, rel)
         if rel > rtol:
             return Verdict(False, f"numeric({plural(valid, 'point')})",
@@ -242,23 +270,45 @@ def vanishes(expr: sp.Basic, sampler: Sampler, symbolic: bool | None = None) -> 
     proof = _proof(expr, sampler, symbolic)
     if proof is not None and proof.ok:
         return Verdict(True, "symbolic", power=PROVED)
+    if rtol != EXACT_RTOL:
+        decided = ""
+    elif exact_inputs:
+        decided = f" (none above {CLEAR:g} of it at {2 * DIGITS} digits: exact inputs)"
+    else:  # the inputs' own 30-digit rounding: below AMBIGUOUS of the scale it is that
+        decided = (f" (under {AMBIGUOUS:g} of it undecided: inputs rounded, at {DIGITS} "
+                   "digits or to their written digits)")
     return Verdict(True, f"numeric({plural(valid, 'point')}, rtol {rtol:g})",
                    f"worst relative {worst:.2g}",
                    power=f"{plural(valid, 'point')} at {DIGITS} digits, residual ≤ {rtol:g} "
-                         "of its scale", unproved=proof.why if proof is not None else "")
+                         f"of its scale{decided}",
+                   unproved=proof.why if proof is not None else "")
 
 
-AMBIGUOUS = 1e-27  # a residual above this fraction of its scale is more than rounding
+# a residual above this fraction of its scale is more than 30 digits' rounding, of the
+# arithmetic or of a point's computed values (a state projected onto a constraint manifold
+# keeps its residuals below 1e-28 of their scale); below it, only exact inputs can tell
+AMBIGUOUS = 1e-27
 DEEP_DIGITS = 240  # how far the precision is raised to decide such a residual
+MARGIN = 10  # digits a residual must stand clear of what cancels to count as one
+CLEAR = 10.0 ** (MARGIN - 2 * DIGITS)  # the smallest residual, of its scale, 60 digits find
 
 
-def _resolved(expr: sp.Basic, point: dict) -> complex:
-    """expr at `point` with the precision raised (60 to DEEP_DIGITS digits) until the value
-    stands clear of what cancels in it; 0 if it never does (zero to that precision)."""
+def _resolved(expr: sp.Basic, point: dict, max_digits: int = DEEP_DIGITS) -> complex:
+    """expr at `point` with the precision raised (60 to `max_digits` digits) until the
+    value stands 10 digits clear of what cancels in it; 0 if it never does (zero to that
+    precision)."""
     try:
-        return complex(evaluate_resolved(expr, point, 60, DEEP_DIGITS))
+        return complex(evaluate_resolved(expr, point, 2 * DIGITS, max_digits, MARGIN))
     except (NotNumeric, ZeroDivisionError, ValueError, TypeError, OverflowError):
         return 0j
+
+
+def _rounded_inputs(expr: sp.Basic, sampler: Sampler) -> bool:
+    """Whether `expr` at a drawn point carries a rounding of its inputs that no raised
+    precision removes: a symbol the sampler computes (Sampler.rounded), a number of 30
+    digits in it, or one the key writes to its digits (Sampler.approximate)."""
+    return sampler.approximate or bool(expr.free_symbols & sampler.rounded()) \
+        or bool(expr.atoms(sp.Float))
 
 
 def _residual_rtol(expr: sp.Basic, sampler: Sampler) -> float:

@@ -19,7 +19,7 @@ from mechbook.engine.analysis import Analysis
 from mechbook.engine.lagrange import solve_accelerations
 from mechbook.engine.linear import LinearSystem
 from mechbook.errors import WrongAnswerError
-from mechbook.model.expr import split_single_equals
+from mechbook.model.expr import DOUBLE_DIGITS, decimal_digits, split_single_equals
 from mechbook.model.hints import did_you_mean
 from mechbook.model.manifold import manifold_of
 from mechbook.records import NUMERIC, ProofPolicy
@@ -115,9 +115,10 @@ class Context:
         # a constrained system's states are drawn on its constraint manifold
         manifold = (manifold_of(self.system) if self.system is not None and
                     not self.tensor_mode else None)
+        approximate = self._written_digits() > DOUBLE_DIGITS
         if "estimate" not in self.part.data:
             return Sampler(base, conds, policy=self.policy, derived=derived,
-                           manifold=manifold)
+                           manifold=manifold, approximate=approximate)
         est = self.part.data["estimate"]  # a number the book computed: one point, its rtol
         for k, v in (est.get("values") or {}).items():
             sym = self.names.get(k)
@@ -129,7 +130,23 @@ class Context:
                 raise self.part.error(("estimate", "values", k), "a number is expected")
             base[sym] = float(val)
         return Sampler(base, conds, policy=self.policy, rtol=float(est["rtol"]),
-                       fixed=list(base), derived=derived, manifold=manifold)
+                       fixed=list(base), derived=derived, manifold=manifold,
+                       approximate=approximate)
+
+    def _written_digits(self) -> int:
+        """The most digits a decimal number is written with in the part or the key's
+        abbreviations (a root to 36 digits: true to those, not exact)."""
+        texts = [self.part.data, self.part.key.doc.data.get("abbreviations") or {}]
+        most = 0
+        while texts:
+            t = texts.pop()
+            if isinstance(t, dict):
+                texts.extend(v for k, v in t.items() if k not in PROSE)
+            elif isinstance(t, list):
+                texts.extend(t)
+            else:
+                most = max(most, decimal_digits(t))
+        return most
 
     def _restrictions(self, base: dict) -> dict:
         """The part's `restrict:`: {symbol: its expression in the other symbols}."""
@@ -275,6 +292,9 @@ class Context:
                                        f"({sp.sstr(implied)} for the other entries given): "
                                        f"{got.detail}")
         return u
+
+
+PROSE = ("part", "cite", "origin", "quantity", "note", "transcription")  # words, not values
 
 
 def _merge_declared(names: dict, extra: dict, part: Part) -> None:

@@ -107,7 +107,8 @@ def check_accessible(ctx: Context, val) -> Verdict:
     held = {w: s for s, w in what.items() if w != "energy"}
     access = Access(ctx.dyn, list(held))
     sampler = Sampler({**ctx.sampler.base, **base}, ctx.sampler.conditions,
-                      policy=ctx.policy, derived=ctx.sampler.derived)
+                      policy=ctx.policy, derived=ctx.sampler.derived,
+                      approximate=ctx.sampler.approximate)
 
     def reachable(pt: dict, near: bool):
         dps = 60 if near else 40

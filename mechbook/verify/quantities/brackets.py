@@ -189,7 +189,7 @@ def free_sampler(ctx: Context) -> Sampler:
     freely (a bracket is an identity over all of phase space)."""
     s = ctx.sampler
     return Sampler(s.base, s.conditions, policy=s.policy, rtol=s.rtol, fixed=list(s.fixed),
-                   derived=s.derived)
+                   derived=s.derived, approximate=s.approximate)
 
 
 # ---- deciding residuals ------------------------------------------------------------------
