@@ -49,6 +49,25 @@ def test_the_outer_limit_survives_an_inner_search_that_swallows_its_alarm():
         assert cpu_time() - start < 2.0, inner  # 0.5 s, the repeat at 0.2 s, slack
 
 
+def test_the_outer_limit_survives_an_inner_alarm_swallowed_inside_the_inner_limit():
+    """CI hung 900 s in SymPy's integrate under validate (ci4, and again on 720c149): the
+    inner 5 s one-shot limit fired, its Timeout was swallowed inside the integral (the
+    inner limit not left), and the outer limit, whose timer is set again only when the
+    inner one is left, was never armed: the timer stayed at zero for good."""
+    start = cpu_time()
+    swallowed = []
+    with pytest.raises(Timeout):
+        with hard_time_limit(0.6):
+            with time_limit(0.2):
+                try:
+                    spin(5)
+                except Timeout:  # the inner limit's alarm, swallowed where it landed
+                    swallowed.append(cpu_time() - start)
+                spin(5)  # and the search goes on, still inside the inner limit
+    assert swallowed and swallowed[0] < 0.5
+    assert cpu_time() - start < 2.0  # ended by the outer limit, not after the 5 s
+
+
 def test_nothing_is_left_armed():
     with time_limit(1):
         with hard_time_limit(2):
