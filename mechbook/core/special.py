@@ -148,7 +148,10 @@ class _Special(sp.Function):
             if nums is None:
                 return None
             v = self._mp(*nums)
-            return sp.Float(v, precision=prec) if _is_real(v) else sp.sympify(complex(v))
+            if _is_real(v):
+                return sp.Float(v, precision=prec)
+            z = complex(v)  # as before: the complex value to double precision
+            return sp.Float(z.real) + sp.I * sp.Float(z.imag)
 
     def _eval_is_real(self):
         return None

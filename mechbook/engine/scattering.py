@@ -134,8 +134,14 @@ class Scattering:
 
 def _mp(value, dps: int):
     """A number as an mpf: a SymPy Float exactly (its binary value, the same at every
-    precision above its own, so two precisions see the same orbit), else to `dps` digits."""
-    value = sp.sympify(value)
+    precision above its own, so two precisions see the same orbit), else to `dps` digits.
+    Numbers only (a Python or mpmath number, or SymPy's): never text."""
+    if isinstance(value, bool | int):
+        value = sp.Integer(value)
+    elif isinstance(value, float | mpmath.mpf):
+        value = sp.Float(value)
+    elif not isinstance(value, sp.Basic):
+        raise TypeError(f"a number, not {type(value).__name__}")
     if isinstance(value, sp.Float) and value._prec <= mpmath.mp.prec:
         return mpmath.mpf(value._mpf_)
     return mpmath.mpf(str(sp.N(value, dps)))

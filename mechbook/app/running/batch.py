@@ -28,8 +28,7 @@ import multiprocessing as mp
 import os
 import signal
 import time
-from collections.abc import Callable, Hashable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
@@ -39,7 +38,7 @@ from mechbook.app.options import DEFAULT_MEMORY_MB, DEFAULT_TIMEOUT
 from mechbook.app.running.lifeline import die_with, sweep_stale_folders
 from mechbook.app.running.quiet import install
 from mechbook.app.running.run import ProblemRun, RunOptions, Stage, run_problem
-from mechbook.app.running.serverstart import start_server
+from mechbook.app.running.serverstart import deferred_interrupt, start_server
 from mechbook.errors import MechbookError, describe
 
 ItemT = TypeVar("ItemT", bound=Hashable)  # what one task is given: a problem id, a request
@@ -140,26 +139,6 @@ def pool_context():
     ctx.set_forkserver_preload(["mechbook.app.running.forkstart", *PRELOAD,
                                 "mechbook.app.running.frozen"])
     return ctx
-
-
-@contextmanager
-def deferred_interrupt() -> Iterator[None]:
-    """Ctrl-C held back until the block ends (then raised): for the moments a process is
-    being started, when an interrupt would leave one started but not yet recorded, to run
-    on without its run or fail on the terminal."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    pending: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: pending.append(signum))
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
-    if pending:
-        raise KeyboardInterrupt
 
 
 def kill_pool(pool) -> None:

@@ -32,7 +32,7 @@ import numpy as np
 import sympy as sp
 
 from mechbook.app.options import SWEEP_SAMPLES
-from mechbook.app.running.batch import deferred_interrupt, kill_pool, pool_context
+from mechbook.app.running.batch import kill_pool, pool_context
 from mechbook.app.running.distributed import (
     connect,
     dask_distributed,
@@ -40,7 +40,7 @@ from mechbook.app.running.distributed import (
     materialize,
     use_scratch,
 )
-from mechbook.app.running.serverstart import start_server
+from mechbook.app.running.serverstart import deferred_interrupt, start_server
 from mechbook.app.sweep.book_answer import book_overlay
 from mechbook.app.sweep.precision import sample_accuracy
 from mechbook.app.sweep.spec import (
