@@ -17,7 +17,15 @@ each cross-check) must be the same in both configurations (exit 1 otherwise). Th
 problems' seconds are listed, the slowest first. Never gates CI: timings depend on the
 machine and its load.
 
+With --cpu the serial figure is the margin: the CPU time of `books + classic` in one
+process less that of `books` in one process (start-up and imports are paid once either
+way, so they are not classic's). With --before REF, the issues' own wording is measured
+too: this tree's cold `make check` (every book, classic included) against REF's (main
+before issues 39 and 40, 83adced: every book it had), side by side, REF checked out in a
+temporary git worktree and run on the same interpreter.
+
     python bench/classic_cost.py [-j N] [--repeat 1] [--cpu] [--books lim symon]
+                                 [--before REF]
 """
 
 from __future__ import annotations
@@ -29,23 +37,32 @@ import resource
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 BUDGET = 0.10  # the issues' limit: classic adds at most 10 % to the cold check
+BEFORE = "83adced"  # main before issues 39 and 40 (no classic book)
+# `python -m mechbook` with an editable install's finder dropped, so that the tree on
+# PYTHONPATH is the only mechbook (bench/power.py does the same)
+ONLY_THIS_TREE = ("import sys, runpy\n"
+                  "sys.meta_path[:] = [f for f in sys.meta_path\n"
+                  "                    if 'editable' not in str(getattr(f, '__module__', ''))]\n"
+                  "sys.argv[0] = 'mechbook'\n"
+                  "runpy.run_module('mechbook', run_name='__main__', alter_sys=True)")
 
 
-def check(ids: list[str], jobs: int | None) -> tuple[float, float, dict]:
+def check(ids: list[str], jobs: int | None, tree: Path = ROOT) -> tuple[float, float, dict]:
     """(wall seconds, CPU seconds of the child and its workers, the JSON document) of one
-    cold check of `ids` (`jobs` None: --serial)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    cold check of `ids` (every book: []) on `tree` (`jobs` None: --serial)."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
     how = ["--serial"] if jobs is None else ["-j", str(jobs)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    out = subprocess.run([sys.executable, "-m", "mechbook", "--root", str(ROOT), "check", *ids,
-                          "--fresh", "--no-store", *how, "--format", "json"],
-                         env=env, cwd=str(ROOT), capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-c", ONLY_THIS_TREE, "--root", str(tree), "check",
+                          *ids, "--fresh", "--no-store", *how, "--format", "json"],
+                         env=env, cwd=str(tree), capture_output=True, text=True)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -84,6 +101,34 @@ def not_passing(doc: dict) -> list[str]:
         [f"{p['id']}: {p['error']}" for p in doc["problems"] if p.get("error")]
 
 
+def before_ratio(ref: str, jobs: int, repeat: int) -> None:
+    """This tree's cold `make check` (every book) against `ref`'s, alternating, the median of
+    `repeat` rounds each: the issues' ratio "against main before this issue"."""
+    with tempfile.TemporaryDirectory(prefix="mechbook-classic-cost-") as tmp:
+        old = Path(tmp) / "before"
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(old),
+                        ref], check=True)
+        try:
+            walls: dict[str, list[float]] = {"before": [], "now": []}
+            cpus: dict[str, list[float]] = {"before": [], "now": []}
+            for _ in range(repeat):
+                for name, tree in (("before", old), ("now", ROOT)):
+                    wall, cpu, doc = check([], jobs, tree)
+                    walls[name].append(wall)
+                    cpus[name].append(cpu)
+                    if any(p.get("error") for p in doc["problems"]):
+                        sys.exit(f"{name}: a problem ended in an error")
+            wb, wn = statistics.median(walls["before"]), statistics.median(walls["now"])
+            cb, cn = statistics.median(cpus["before"]), statistics.median(cpus["now"])
+            print(f"cold `make check` (every book) -j {jobs}, this tree against {ref}, median "
+                  f"of {repeat}: {wn:.1f} s against {wb:.1f} s wall ({wn / wb:.3f}x), CPU "
+                  f"{cn:.1f} s against {cb:.1f} s ({cn / cb:.3f}x; budget "
+                  f"{1 + BUDGET:.2f}x)")
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(old)],
+                           check=False)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-j", "--jobs", type=int, default=0, help="workers (0: one per core, as "
@@ -91,6 +136,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--cpu", action="store_true", help="also the serial CPU time of each set")
     ap.add_argument("--books", nargs="+", default=["lim", "symon"])
+    ap.add_argument("--before", metavar="REF", nargs="?", const=BEFORE, default=None,
+                    help=f"also this tree's cold `make check` against REF's (default {BEFORE})")
     opts = ap.parse_args()
     walls: dict[str, list[float]] = {"books": [], "all": []}
     shares, docs, bad = [], {}, []
@@ -116,9 +163,11 @@ def main() -> None:
           f"{100 * statistics.median(shares):.1f} %")
     if opts.cpu:
         _, cb, _ = check(opts.books, None)
-        _, cc, _ = check(["classic"], None)
-        print(f"  serial CPU: books {cb:.1f} s, classic {cc:.1f} s: classic adds "
-              f"{100 * cc / cb:.1f} %")
+        _, ca, _ = check([*opts.books, "classic"], None)
+        print(f"  serial CPU: books {cb:.1f} s, books + classic {ca:.1f} s: classic adds "
+              f"{ca - cb:.1f} s, {100 * (ca - cb) / cb:+.1f} % (budget {100 * BUDGET:.0f} %)")
+    if opts.before:
+        before_ratio(opts.before, opts.jobs, opts.repeat)
     last = docs["all"][-1]
     classic = sorted(seconds(last, True).items(), key=lambda kv: -kv[1])
     print(f"classic problems, worker seconds (last round; {sum(v for _, v in classic):.1f} s "
