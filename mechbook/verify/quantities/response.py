@@ -153,7 +153,9 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
 @quantity('exponents',
           book='list of p (complex: sqrt(-1))',
           how=('multiset equality with the 2n exponents p of e^{pt} solutions (roots of '
-               'det(Mp² + Cp + K) = 0) at 5 points; `partial: true` for a subset'),
+               'det(Mp² + Cp + K) = 0) at 5 points, each to 1e-8 of the largest |p| (a small '
+               'real part beside a large frequency is resolved only to that); `partial: '
+               'true` for a subset'),
           keys={"partial": {"type": "boolean"}},
           complex_values=True,
           crosschecks=("modes",))
@@ -185,7 +187,8 @@ def _multiset_at_points(ctx: Context, val, engine) -> Verdict:
         if not ok:
             return Verdict(False, f"numeric({plural(k + 1, 'point')})", why)
     return Verdict(True, f"numeric({POINTS} points, state-space eigenvalues)",
-                   power=f"{POINTS} points: the multiset of exponents to 1e-8")
+                   power=f"{POINTS} points: the multiset of exponents, each to 1e-8 of the "
+                         "largest")
 
 
 def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
