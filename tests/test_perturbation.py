@@ -112,3 +112,15 @@ def test_a_name_of_the_problem_that_is_also_the_texts_notation_is_refused(tmp_pa
     an = load(tmp_path, text, "9501")
     out = run(tmp_path, an, part(1, FIRST))
     assert out.status == "error" and words in out.detail, out.detail
+
+
+def test_a_table_entry_divided_by_zero_is_not_a_number():
+    """W0(j) − W0(1) is 0 at j = 1: SymPy gives zoo or nan there, which must be refused as
+    not a number (the walk skips that index), not end in an AttributeError."""
+    from mechbook.errors import UnsupportedError
+    from mechbook.verify.quantities.perturbation import _mp
+
+    for bad in (sp.zoo, sp.nan, sp.I * sp.zoo, 1 / sp.Integer(0)):
+        with pytest.raises(UnsupportedError, match="finite number|a number"):
+            _mp(bad)
+    assert abs(_mp(sp.Rational(1, 3)) - sp.Rational(1, 3)) < 1e-40

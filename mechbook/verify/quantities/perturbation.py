@@ -197,6 +197,8 @@ def _mp(expr: sp.Expr):
     re, im = z.as_real_imag()
     if not (re.is_number and im.is_number):
         raise UnsupportedError(f"does not evaluate to a number: {expr}")
+    if not (re.is_finite and im.is_finite):  # nan or zoo: a table entry divided by 0
+        raise UnsupportedError(f"does not evaluate to a finite number: {expr}")
     re = mpmath.mpf(sp.Float(re, pert.DPS)._mpf_)
     return re if im == 0 else mpmath.mpc(re, mpmath.mpf(sp.Float(im, pert.DPS)._mpf_))
 
