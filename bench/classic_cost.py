@@ -54,8 +54,9 @@ ONLY_THIS_TREE = ("import sys, runpy\n"
 
 
 def check(ids: list[str], jobs: int | None, tree: Path = ROOT) -> tuple[float, float, dict]:
-    """(wall seconds, CPU seconds of the child and its workers, the JSON document) of one
-    cold check of `ids` (every book: []) on `tree` (`jobs` None: --serial)."""
+    """(wall seconds, CPU seconds of the child and of the children it waited for, the JSON
+    document) of one cold check of `ids` (every book: []) on `tree` (`jobs` None: --serial,
+    the only way whose CPU figure is complete)."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
     how = ["--serial"] if jobs is None else ["-j", str(jobs)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -101,9 +102,12 @@ def not_passing(doc: dict) -> list[str]:
         [f"{p['id']}: {p['error']}" for p in doc["problems"] if p.get("error")]
 
 
-def before_ratio(ref: str, jobs: int, repeat: int) -> None:
+def before_ratio(ref: str, jobs: int, repeat: int, cpu: bool) -> None:
     """This tree's cold `make check` (every book) against `ref`'s, alternating, the median of
-    `repeat` rounds each: the issues' ratio "against main before this issue"."""
+    `repeat` rounds each: the issues' ratio "against main before this issue". Wall time
+    with `jobs` workers (as `make check`); with `cpu`, the CPU time of each checked
+    `--serial` in one process as well (a fork server's workers are not this process's
+    children, so their CPU is not counted under -j)."""
     with tempfile.TemporaryDirectory(prefix="mechbook-classic-cost-") as tmp:
         old = Path(tmp) / "before"
         subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(old),
@@ -113,17 +117,19 @@ def before_ratio(ref: str, jobs: int, repeat: int) -> None:
             cpus: dict[str, list[float]] = {"before": [], "now": []}
             for _ in range(repeat):
                 for name, tree in (("before", old), ("now", ROOT)):
-                    wall, cpu, doc = check([], jobs, tree)
-                    walls[name].append(wall)
-                    cpus[name].append(cpu)
-                    if any(p.get("error") for p in doc["problems"]):
-                        sys.exit(f"{name}: a problem ended in an error")
+                    runs = [(jobs, walls)] + ([(None, cpus)] if cpu else [])
+                    for how, into in runs:
+                        wall, used, doc = check([], how, tree)
+                        into[name].append(wall if how is not None else used)
+                        if any(p.get("error") for p in doc["problems"]):
+                            sys.exit(f"{name}: a problem ended in an error")
             wb, wn = statistics.median(walls["before"]), statistics.median(walls["now"])
-            cb, cn = statistics.median(cpus["before"]), statistics.median(cpus["now"])
-            print(f"cold `make check` (every book) -j {jobs}, this tree against {ref}, median "
-                  f"of {repeat}: {wn:.1f} s against {wb:.1f} s wall ({wn / wb:.3f}x), CPU "
-                  f"{cn:.1f} s against {cb:.1f} s ({cn / cb:.3f}x; budget "
-                  f"{1 + BUDGET:.2f}x)")
+            print(f"cold `make check` (every book), this tree against {ref}, median of "
+                  f"{repeat}: -j {jobs} {wn:.1f} s against {wb:.1f} s wall "
+                  f"({wn / wb:.3f}x; budget {1 + BUDGET:.2f}x)")
+            if cpu:
+                cb, cn = statistics.median(cpus["before"]), statistics.median(cpus["now"])
+                print(f"  serial CPU: {cn:.1f} s against {cb:.1f} s ({cn / cb:.3f}x)")
         finally:
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(old)],
                            check=False)
@@ -167,7 +173,7 @@ def main() -> None:
         print(f"  serial CPU: books {cb:.1f} s, books + classic {ca:.1f} s: classic adds "
               f"{ca - cb:.1f} s, {100 * (ca - cb) / cb:+.1f} % (budget {100 * BUDGET:.0f} %)")
     if opts.before:
-        before_ratio(opts.before, opts.jobs, opts.repeat)
+        before_ratio(opts.before, opts.jobs, opts.repeat, opts.cpu)
     last = docs["all"][-1]
     classic = sorted(seconds(last, True).items(), key=lambda kv: -kv[1])
     print(f"classic problems, worker seconds (last round; {sum(v for _, v in classic):.1f} s "
