@@ -109,6 +109,18 @@ class Scattering:
             return None
 
     @cached_property
+    def float_functions(self):
+        """(m, V_eff, dV_eff/dr, u) of (r, P, params) in NumPy, for arrays of r (None where
+        the expressions have no NumPy form): mechbook.engine.scattering_float's."""
+        mass, V, u = self.level.reduced
+        args = [self.r, self.P, *self.level.params]
+        try:
+            return tuple(sp.lambdify(args, f, "numpy")
+                         for f in (mass, V, sp.diff(V, self.r), u[0]))
+        except Exception:  # noqa: BLE001 - a function NumPy lacks: the decisions stay exact
+            return None
+
+    @cached_property
     def potential_is_zero(self) -> bool:
         """Whether V_eff at P = 0 (the potential alone) vanishes identically: a finite range
         is then the hard core's."""

@@ -17,6 +17,8 @@ compared at POINTS random points to RTOL.
 
 from __future__ import annotations
 
+import math
+
 import mpmath
 import sympy as sp
 
@@ -30,6 +32,7 @@ from mechbook.engine.scattering import (
     checked,
     critical_impact_parameter,
 )
+from mechbook.engine.scattering_float import float_deflection
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
@@ -356,27 +359,50 @@ def _differential(beam: Beam, pt: dict, b, E) -> tuple:
 
 
 def _one_branch(beam: Beam, pt: dict, b, E) -> None:
-    """One impact parameter per angle, judged on SCAN impact parameters from b/100 to 100b
-    (at 20 digits): Θ(b) monotone, within [−π, π], and no orbit among them captured (next
-    to b_c the deflection winds without bound, and every angle has infinitely many
-    branches); otherwise dσ/dΩ is a sum over branches, which is not computed."""
+    """One impact parameter per angle, judged on SCAN impact parameters from b/100 to 100b:
+    Θ(b) monotone (no step between neighbours above 1e-12 one way and another the other
+    way), within [−π, π], and no orbit among them captured (next to b_c the deflection
+    winds without bound, and every angle has infinitely many branches); otherwise dσ/dΩ is
+    a sum over branches, which is not computed. Each Θ is taken in double precision with
+    a bound on its error (mechbook.engine.scattering_float), and at 20 digits where that
+    cannot say or where a step or |Θ| is within its bound of the threshold: the decision
+    is the one the 20-digit values give."""
     why = None
+    tiny, pi = 1e-12, math.pi
     with mpmath.workdps(20):
         bb = mpmath.mpf(str(b))
-        thetas = []
+        orbits, thetas = [], []  # thetas: (Θ, a bound on its error; 0 for a 20-digit one)
         for k in range(SCAN):
             bk = bb * mpmath.mpf(10) ** (-2 + 4 * mpmath.mpf(k) / (SCAN - 1))
-            try:
-                thetas.append(beam.engine.orbit(pt, bk, E, 20).deflection)
-            except Captured:
-                why = f"the orbit at b = {float(bk):.4g} is captured, and next to the " \
-                      "capture the deflection winds without bound"
-                break
-        steps = [y - x for x, y in zip(thetas, thetas[1:], strict=False)]
-        tiny = mpmath.mpf(10) ** -12
+            orbit = beam.engine.orbit(pt, bk, E, 20)
+            got = float_deflection(orbit)
+            if got is None:
+                try:
+                    got = (orbit.deflection, 0.0)
+                except Captured:
+                    why = f"the orbit at b = {float(bk):.4g} is captured, and next to the " \
+                          "capture the deflection winds without bound"
+                    break
+            orbits.append(orbit)
+            thetas.append(got)
+
+        def exact(i):
+            if thetas[i][1]:
+                thetas[i] = (orbits[i].deflection, 0.0)
+
+        for i in range(len(thetas) - 1 if why is None else 0):  # a step near ±1e-12
+            s = float(thetas[i + 1][0] - thetas[i][0])
+            err = thetas[i][1] + thetas[i + 1][1]
+            if err and (abs(s - tiny) <= err or abs(s + tiny) <= err):
+                exact(i)
+                exact(i + 1)
+        for i, (t, err) in enumerate(thetas):
+            if err and abs(abs(float(t)) - pi) <= err:
+                exact(i)
+        steps = [y[0] - x[0] for x, y in zip(thetas, thetas[1:], strict=False)]
         if why is None and any(s > tiny for s in steps) and any(s < -tiny for s in steps):
             why = "Θ(b) is not monotone"
-        if why is None and any(abs(t) > mpmath.pi for t in thetas):
+        if why is None and any(abs(t) > mpmath.pi for t, _ in thetas):
             why = "|Θ(b)| exceeds π (the orbit winds round)"
     if why:
         raise UnsupportedError(f"dσ/dΩ: several impact parameters scatter into one angle "
