@@ -372,7 +372,7 @@ class Orbit:
                     u = self._f("u")(r, self.P, *self.params)
                     return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rs * w / one ** 2
 
-            total = mpmath.quad(integrand, [w_lo, (w_lo + 1) / 2, 1])
+            total = mpmath.quad(integrand, [w_lo, 1])
             return mpmath.pi - 2 * total
 
 

@@ -43,7 +43,8 @@ quantity = FAMILY.quantity
 
 POINTS = 6
 RTOL = 1e-20  # book against engine (the engine's values hold 30 digits)
-DERIVATIVE_RTOL = 1e-15  # dσ/dΩ: two Richardson estimates of db/dΘ must agree to this
+DERIVATIVE_RTOL = 1e-15  # dσ/dΩ: two central differences of dΘ/db must agree to this
+STEPS = (10, 9)  # their steps: 1e-10·b and 1e-9·b
 NEAR = 1e-8  # a capture relation is judged this far (relative) either side of b_c
 SINGULAR = 1e-10  # |dΘ/db|·b or |sin Θ| below this: a rainbow or a glory
 SCAN = 16  # impact parameters from b/100 to 100b on which one branch is confirmed
@@ -329,23 +330,26 @@ def _theta(beam: Beam, pt: dict, b, dps: int, E):
 
 
 def _differential(beam: Beam, pt: dict, b, E) -> tuple:
-    """(χ, dσ/dΩ) at the orbit (b, E); UnsupportedError where dσ/dΩ is singular. The
-    stencils at DPS digits: Θ holds ~38 there, so a step of 1e-8·b leaves db/dΘ ~29."""
+    """(χ, dσ/dΩ) at the orbit (b, E); UnsupportedError where dσ/dΩ is singular. dΘ/db by
+    central differences at two steps, STEPS[0]·b and STEPS[1]·b (four orbits at DPS
+    digits, where Θ holds ~39: the rounding leaves ~1e-30/(b|dΘ/db|) of the slope): the
+    two differ by c(h₂² − h₁²), c·h² the error of each, so their agreement to
+    DERIVATIVE_RTOL bounds the smaller step's error by a hundredth of it (and the c·h₁²
+    they measure is taken off: Richardson's extrapolation)."""
     d = DPS
     theta = beam.value(pt, b, E, lambda o: o.deflection)
     with mpmath.workdps(d):
         bb = mpmath.mpf(str(b))
 
         def slope(h):
-            th = {k: _theta(beam, pt, bb + k * h, d, E) for k in (-2, -1, 1, 2)}
-            d1 = (th[1] - th[-1]) / (2 * h)
-            d2 = (th[2] - th[-2]) / (4 * h)
-            return (4 * d1 - d2) / 3
+            return (_theta(beam, pt, bb + h, d, E) - _theta(beam, pt, bb - h, d, E)) / (2 * h)
 
-        s1, s2 = slope(bb * mpmath.mpf(10) ** -8), slope(bb * mpmath.mpf(10) ** -6)
+        h1, h2 = (mpmath.mpf(10) ** -k for k in STEPS)
+        s1, s2 = slope(bb * h1), slope(bb * h2)
         if abs(s1 - s2) > DERIVATIVE_RTOL * abs(s1) + mpmath.mpf(10) ** -25:
             raise UnsupportedError(f"dσ/dΩ: dΘ/db not resolved (two estimates "
                                    f"{mpmath.nstr(s1, 10)}, {mpmath.nstr(s2, 10)})")
+        s1 += (s1 - s2) * h1 ** 2 / (h2 ** 2 - h1 ** 2)  # the c·h₁² the two measure, removed
         chi = _observed(theta)
         if abs(s1) * bb < SINGULAR:
             raise UnsupportedError(f"dσ/dΩ: a rainbow angle (dΘ/db = 0) at b = {float(b):.6g}"
