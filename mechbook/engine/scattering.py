@@ -256,7 +256,8 @@ class Orbit:
         """The search's steps in double precision (a fiftieth of the cost): the last r
         before E − V_eff is not positive, before the core or before `tiny`, from which the
         search goes on at the working precision; a step the double-precision values
-        misjudged near the root is taken again there (r moved back out until allowed)."""
+        misjudged near the root is taken again there (r moved back out until allowed).
+        From the core down (`core` None) it finds the root inside the core the same way."""
         fn = self.scattering.float_kinetic
         if fn is None:
             return r
@@ -281,7 +282,7 @@ class Orbit:
     def _root_inside(self, core, tiny):
         """The largest root of E = V_eff below the core (the orbit never gets there, but
         a grazing orbit's integrands are nearly singular at it), or None."""
-        r = core
+        r = self._descend(core, None, tiny)
         for _ in range(MAX_STEPS):
             nxt = r * STEP
             if nxt < tiny:

@@ -435,8 +435,14 @@ def check_total_cross_section(ctx: Context, val) -> Verdict:
         orbit = beam.engine.orbit(pt, 1, E)
         R = orbit.core
         if R is not None and beam.engine.potential_is_zero:
-            inside = beam.value(pt, sp.Float(str(R * mpmath.mpf("0.999")), DIGITS), E,
-                                lambda o: o.deflection)
+            b_in = sp.Float(str(R * mpmath.mpf("0.999")), DIGITS)
+            try:
+                quick = float_deflection(beam.engine.orbit(pt, b_in, E))
+            except Unbound as exc:
+                raise beam.ctx.part.error(("energy",), str(exc)) from None
+            if quick is not None and abs(quick[0]) > quick[1]:
+                return mpmath.pi * R ** 2  # Θ ≠ 0 beyond its bound: no 30 digits needed
+            inside = beam.value(pt, b_in, E, lambda o: o.deflection)
             if inside == 0:
                 raise UnsupportedError("σ: no deflection just inside the hard core's radius")
             return mpmath.pi * R ** 2
