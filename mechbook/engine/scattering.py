@@ -42,6 +42,8 @@ FAR = 10 ** 8  # the inward search for r_min starts this many length scales out
 STEP = mpmath.mpf("0.98")  # its geometric step (a barrier narrower than 2 % of r is missed)
 MAX_STEPS = 6000
 ORBITS = 4096  # orbits a Scattering keeps (their values computed once), then forgets
+ROUGH = 1e-9  # the relative error a double-precision value of V_eff is allowed (b_c's grid)
+GOLDEN = 3  # golden sections per digit for b_c (its bracket to 10^-(dps·0.63))
 
 
 class Unbound(Exception):
@@ -121,6 +123,18 @@ class Scattering:
             return None
 
     @cached_property
+    def float_parts(self):
+        """(v0, c2) of (r, params) in double precision, V_eff = v0 + c2 P² (None where they
+        have no such form): the capture grid's."""
+        _, V, _ = self.level.reduced
+        args = [self.r, *self.level.params]
+        try:
+            return (sp.lambdify(args, V.subs(self.P, 0), "math"),
+                    sp.lambdify(args, sp.diff(V, self.P, 2) / 2, "math"))
+        except Exception:  # noqa: BLE001 - a function math lacks: the grid stays exact
+            return None
+
+    @cached_property
     def potential_is_zero(self) -> bool:
         """Whether V_eff at P = 0 (the potential alone) vanishes identically: a finite range
         is then the hard core's."""
@@ -166,6 +180,7 @@ class Orbit:
     b: object
     E: object
     dps: int
+    critical: object = None  # b_c at this orbit's E (critical_impact_parameter), once found
 
     def _f(self, name: str):
         m, V, u, core = self.scattering.functions
@@ -466,11 +481,19 @@ def checked(scattering: Scattering, point: dict, b, E, what) -> tuple:
 
 def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int = DPS):
     """b_c = inf_r B(r), B(r) the b at which E = V_eff(r; b·p∞) (0 where no b is captured,
-    a potential less singular than −1/r²): a log grid of r over 24 decades, then the
-    minimum refined by golden sections at `dps` digits."""
+    a potential less singular than −1/r²): a log grid of r over 24 decades at `dps`
+    digits (only where double precision, with a generous error, leaves B's least value
+    possible: `_candidates`), then the minimum refined by golden sections. Kept per
+    orbit: the capture parts of a problem ask for the same b_c at the same points."""
     orbit = scattering.orbit(point, 1, E, dps)
     if scattering.hard_core is not None:
         raise UnsupportedError("capture with a hard core: the core reflects every orbit")
+    if orbit.critical is None:
+        orbit.critical = _critical(orbit, dps)
+    return orbit.critical
+
+
+def _critical(orbit: Orbit, dps: int):
     with mpmath.workdps(dps):
         orbit.P  # noqa: B018 - an unbound orbit
         p_inf = mpmath.sqrt(2 * orbit.m_inf * orbit.E)
@@ -484,21 +507,28 @@ def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int =
             return mpmath.sqrt(room / c2) / p_inf if room > 0 else mpmath.mpf(0)
 
         grid = [mpmath.mpf(10) ** (mpmath.mpf(k) / 10) for k in range(-120, 121)]
-        values = [B(r) for r in grid]
-        i = min(range(len(values)), key=lambda j: values[j])
-        if values[i] == 0:
+        values: dict[int, object] = {}
+
+        def value(j):
+            if j not in values:
+                values[j] = B(grid[j])
+            return values[j]
+
+        candidates = _candidates(orbit, grid)
+        i = min(candidates if candidates is not None else range(len(grid)), key=value)
+        if value(i) == 0:
             return mpmath.mpf(0)
         if i == 0:  # still falling towards r → 0: the infimum is the limit there
-            if values[0] < values[1] * mpmath.mpf("0.999"):
+            if value(0) < value(1) * mpmath.mpf("0.999"):
                 return mpmath.mpf(0)
-            return values[0]
-        if i == len(values) - 1:
+            return value(0)
+        if i == len(grid) - 1:
             raise UnsupportedError("scattering: B(r) keeps falling far out")
         lo, hi = mpmath.log(grid[i - 1]), mpmath.log(grid[i + 1])
         g = (mpmath.sqrt(5) - 1) / 2
         a, c = hi - g * (hi - lo), lo + g * (hi - lo)
         fa, fc = B(mpmath.exp(a)), B(mpmath.exp(c))
-        for _ in range(4 * dps):
+        for _ in range(GOLDEN * dps):  # the bracket 0.46·0.618ⁿ: B's error its square
             if fa < fc:
                 hi, c, fc = c, a, fa
                 a = hi - g * (hi - lo)
@@ -508,3 +538,33 @@ def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int =
                 c = lo + g * (hi - lo)
                 fc = B(mpmath.exp(c))
         return min(fa, fc)
+
+
+def _candidates(orbit: Orbit, grid: list):
+    """The grid's indices where B may be least, by double precision: B² = (E − v0)/c2
+    (V_eff = v0 + c2 P², each lambdified on its own, so c2 is no difference), each of
+    E − v0 and c2 within ROUGH of its size (generous: a term of V_eff may cancel another);
+    an index whose least B² is above another's largest is out. None where double precision
+    has no value (every index is then taken at full precision). Ascending, so that the
+    first least one stays first."""
+    fns = orbit.scattering.float_parts
+    if fns is None:
+        return None
+    v0f, c2f = fns
+    try:
+        params = [float(p) for p in orbit.params]
+        E = float(orbit.E)
+        lows, highs = [], []
+        for r in grid:
+            x = float(r)
+            v0, c2 = v0f(x, *params), c2f(x, *params)
+            room = E - v0
+            e_room, e_c2 = ROUGH * (abs(E) + abs(v0)), ROUGH * abs(c2)
+            if not (math.isfinite(room) and math.isfinite(c2) and c2 > 0):
+                return None
+            lows.append(max(room - e_room, 0.0) / (c2 + e_c2))
+            highs.append(max(room + e_room, 0.0) / (c2 - e_c2))
+    except (ZeroDivisionError, ValueError, OverflowError, TypeError):
+        return None
+    top = min(highs)
+    return [j for j, low in enumerate(lows) if low <= top]
