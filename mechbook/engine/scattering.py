@@ -26,11 +26,13 @@ inf_r B(r), the critical impact parameter (√(α/E) for V = −α/r²).
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from functools import cached_property
 
 import mpmath
 import sympy as sp
+from scipy.optimize import brentq
 
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.levelset import LevelSet
@@ -308,11 +310,42 @@ class Orbit:
             r = nxt
         return None
 
+    def _float_bracket(self, lo, hi):
+        """[lo, hi] narrowed to 1e-13 around the root of E − V_eff found by Brent's method in
+        double precision, if E − V_eff at the working precision is not positive at its lower
+        end and positive at its upper one (else [lo, hi] as given)."""
+        fn = self.scattering.float_kinetic
+        if fn is None:
+            return lo, hi
+        args = [float(self.P), *(float(p) for p in self.params)]
+        E = float(self.E)
+
+        def k(x):
+            return E - fn(x, *args)
+
+        try:
+            a, b = float(lo), float(hi)
+            if not (k(a) <= 0 < k(b)):
+                return lo, hi
+            x = brentq(k, a, b, xtol=1e-300, rtol=4 * sys.float_info.epsilon)
+        except (ZeroDivisionError, ValueError, OverflowError, TypeError, RuntimeError):
+            return lo, hi
+        lo2 = max(lo, mpmath.mpf(x * (1 - 1e-13)))
+        hi2 = min(hi, mpmath.mpf(x * (1 + 1e-13)))
+        k_lo, k_hi = self.kinetic(lo2), self.kinetic(hi2)
+        if lo2 < hi2 and not (mpmath.isfinite(k_lo) and k_lo > 0) and \
+                mpmath.isfinite(k_hi) and k_hi > 0:
+            return lo2, hi2
+        return lo, hi
+
     def _bisect(self, lo, hi):
         """The root of E − V_eff between `lo` (not allowed) and `hi` (allowed): bisection,
         then the Illinois method at twice the working precision (an error δ in r_min moves
-        the deflection integral by ~√δ, so r_min needs twice the digits of Θ)."""
+        the deflection integral by ~√δ, so r_min needs twice the digits of Θ). The
+        bisection starts from the double-precision root's bracket where the working
+        precision confirms it (`_float_bracket`)."""
         tol = mpmath.mpf(10) ** (-(self.dps // 2))
+        lo, hi = self._float_bracket(lo, hi)
         while hi - lo > hi * tol:
             mid = (lo + hi) / 2
             k = self.kinetic(mid)
