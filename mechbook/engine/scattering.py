@@ -27,10 +27,12 @@ from __future__ import annotations
 
 import math
 import sys
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 
 import mpmath
+import numpy as np
 import sympy as sp
 from scipy.optimize import brentq
 
@@ -46,6 +48,12 @@ MAX_STEPS = 6000
 ORBITS = 4096  # orbits a Scattering keeps (their values computed once), then forgets
 ROUGH = 1e-9  # the relative error a double-precision value of V_eff is allowed (b_c's grid)
 GOLDEN = 3  # golden sections per digit for b_c (its bracket to 10^-(dps·0.63))
+
+
+def float_grid(r0: float) -> np.ndarray:
+    """The inward search's points below r0 in double precision, r0·STEPⁿ for n = 1 …
+    MAX_STEPS (the same numbers wherever the search is taken in double precision)."""
+    return r0 * np.cumprod(np.full(MAX_STEPS, float(STEP)))
 
 
 class Unbound(Exception):
@@ -275,22 +283,24 @@ class Orbit:
         search goes on at the working precision; a step the double-precision values
         misjudged near the root is taken again there (r moved back out until allowed).
         From the core down (`core` None) it finds the root inside the core the same way."""
-        fn = self.scattering.float_kinetic
-        if fn is None:
+        fns = self.scattering.float_functions
+        if fns is None:
             return r
         args = [float(self.P), *(float(p) for p in self.params)]
         E, x, stop = float(self.E), float(r), float(max(core or 0, tiny))
-        for _ in range(MAX_STEPS):
-            nxt = x * float(STEP)
-            if nxt <= stop:
-                break
+        grid = float_grid(x)
+        grid = grid[:int(np.argmax(grid <= stop)) if grid[-1] <= stop else grid.size]
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
             try:
-                k = E - fn(nxt, *args)
+                k = E - np.broadcast_to(np.asarray(fns[1](grid, *args), dtype=float),
+                                        grid.shape)
             except (ZeroDivisionError, ValueError, OverflowError, TypeError):
-                break
-            if not (math.isfinite(k) and k > 0):
-                break
-            x = nxt
+                return r
+        bad = ~(np.isfinite(k) & (k > 0))
+        last = (int(np.argmax(bad)) if bad.any() else grid.size) - 1
+        if last >= 0:
+            x = float(grid[last])
         back = mpmath.mpf(x)
         while back < r and not self.kinetic(back) > 0:
             back = back / STEP
@@ -409,17 +419,28 @@ class Orbit:
                 w_lo = mpmath.sqrt(1 - rs / rmin) if t.on_core else mpmath.mpf(0)
             w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
 
+            fm, fV, fu, _ = self.scattering.functions
+            P, params, E, two_rs = self.P, self.params, self.E, 2 * rs
+            ctx, inner = mpmath.mp, self.dps + 15  # E − V_eff is small near r_min
+
             def integrand(w):
                 w = max(w, w0)
-                with mpmath.workdps(self.dps + 15):  # E − V_eff is small near r_min
+                saved = ctx.prec
+                ctx.dps = inner
+                try:
                     one = (1 - w) * (1 + w)
                     r = max(rs / one, rmin)
-                    k = self.kinetic(r)
+                    try:
+                        k = E - fV(r, P, *params)
+                    except (ZeroDivisionError, ValueError):
+                        k = -1
                     if not k > 0:
                         raise UnsupportedError("scattering: the orbit leaves the allowed "
                                                "region beyond its turning point")
-                    u = self._f("u")(r, self.P, *self.params)
-                    return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rs * w / one ** 2
+                    return (fu(r, P, *params) * mpmath.sqrt(fm(r, P, *params) / (2 * k))
+                            * two_rs * w / (one * one))
+                finally:
+                    ctx.prec = saved
 
             total = mpmath.quad(integrand, [w_lo, 1])
             return mpmath.pi - 2 * total

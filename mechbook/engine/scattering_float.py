@@ -31,7 +31,7 @@ from functools import cache
 import numpy as np
 from scipy.optimize import brentq
 
-from mechbook.engine.scattering import DIGITS, FAR, MAX_STEPS, STEP, Orbit
+from mechbook.engine.scattering import DIGITS, FAR, MAX_STEPS, STEP, Orbit, float_grid
 
 NODES = 48  # Gauss–Legendre nodes of the coarser rule (the finer has twice as many)
 SWITCH = 0.25  # below this w, E − V_eff from its derivative (no cancellation)
@@ -97,7 +97,7 @@ def _turning(fns, args, E: float, core, scale: float):
     else:
         return None
     tiny = scale * 10.0 ** (-DIGITS)
-    grid = np.concatenate(([r0], r0 * np.cumprod(np.full(MAX_STEPS, float(STEP)))))
+    grid = np.concatenate(([r0], float_grid(r0)))
     inside = np.nonzero(grid <= max(core or 0.0, tiny))[0]
     end = int(inside[0]) if inside.size else grid.size  # the first step past the core/tiny
     hit = _first_barred(V, args, E, grid[:end])
