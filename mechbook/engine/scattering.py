@@ -470,13 +470,19 @@ class Orbit:
             X = 2 * max(rmin, self.b)
             m_inf, E, b = self.m_inf, self.E, self.b
 
+            fm, fV, _, _ = self.scattering.functions
+            P, params = self.P, self.params
+            ctx, inner = mpmath.mp, self.dps + 15
+
             def dt_dr(r):
-                with mpmath.workdps(self.dps + 15):
-                    k = self.kinetic(r)
-                    if not k > 0:
-                        raise UnsupportedError("time delay: the orbit leaves the allowed "
-                                               "region beyond its turning point")
-                    return mpmath.sqrt(self.mass(r) / (2 * k))
+                try:
+                    k = E - fV(r, P, *params)
+                except (ZeroDivisionError, ValueError):
+                    k = -1
+                if not k > 0:
+                    raise UnsupportedError("time delay: the orbit leaves the allowed "
+                                           "region beyond its turning point")
+                return mpmath.sqrt(fm(r, P, *params) / (2 * k))
 
             t = self.turning  # r = rs + (X − rs)w² from the singular point, as for Θ
             rs = t.singular if t.singular is not None else rmin
@@ -484,10 +490,16 @@ class Orbit:
                 w_lo = mpmath.sqrt((rmin - rs) / (X - rs))
             w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
 
+            span = X - rs
+
             def near(w):
                 w = max(w, w0)
-                with mpmath.workdps(self.dps + 15):
-                    return dt_dr(max(rs + (X - rs) * w * w, rmin)) * 2 * (X - rs) * w
+                saved = ctx.prec
+                ctx.dps = inner
+                try:
+                    return dt_dr(max(rs + span * w * w, rmin)) * 2 * span * w
+                finally:
+                    ctx.prec = saved
 
             def beyond(u):
                 # √(m/2k) − √(m∞/2k0) without the cancellation of two numbers near
@@ -507,7 +519,7 @@ class Orbit:
                     return top / (2 * k * k0) / total * X / one ** 2
 
             inside = mpmath.quad(near, [w_lo, 1])
-            outside = mpmath.quad(beyond, [0, mpmath.mpf(1) / 2, 1])
+            outside = mpmath.quad(beyond, [0, 1])
             free = mpmath.sqrt(X * X - b * b) / self.speed
             return 2 * (inside + outside - free)
 
