@@ -286,11 +286,13 @@ def _observed(theta):
           book='expression: the differential cross section dσ/dΩ, in b and E, or in the '
                'observed scattering angle χ ∈ [0, π] named by `scattering_angle:`',
           how=('(b/sin χ)|db/dχ| on the orbit of `impact_parameter:`, `energy:` (Θ as for '
-               '`deflection_angle`, dΘ/db by Richardson differences at 55 digits, two step '
-               'sizes agreeing to 1e-15), the book evaluated at the engine\'s χ; 6 points to '
-               '1e-15. Unsupported where it is singular: a rainbow (dΘ/db = 0), a glory '
-               '(sin Θ = 0, b ≠ 0), or several impact parameters scattering into one angle '
-               '(χ(b) not monotone on 16 values from b/100 to 100b)'),
+               '`deflection_angle`, dΘ/db by central differences at 40 digits, steps 1e-10·b '
+               'and 1e-9·b agreeing to 1e-15, Richardson-extrapolated), the book evaluated at '
+               'the engine\'s χ; 6 points to 1e-15. Unsupported where it is singular: a '
+               'rainbow (dΘ/db = 0), a glory (sin Θ = 0, b ≠ 0), or several impact parameters '
+               'scattering into one angle (χ(b) not monotone, steps beyond 1e-12, on 16 '
+               'values from b/100 to 100b, each Θ in double precision with an error bound, '
+               'at 20 digits where the bound leaves the decision open)'),
           keys={**ORBIT, "scattering_angle": NAME}, names=_angle_names,
           validate=validate_orbit, crosschecks=("scattering",))
 def check_cross_section(ctx: Context, val) -> Verdict:
@@ -317,7 +319,7 @@ def check_cross_section(ctx: Context, val) -> Verdict:
                                f"b = {float(b):.6g}, E = {float(E):.6g}, χ = {float(chi):.6g}")
     return Verdict(True, f"quadrature({POINTS} points)", f"worst relative {worst:.2g}",
                    power=f"{POINTS} points, each value to {DERIVATIVE_RTOL:g} (dΘ/db by two "
-                         f"Richardson estimates agreeing to {DERIVATIVE_RTOL:g}); one branch "
+                         f"central differences agreeing to {DERIVATIVE_RTOL:g}); one branch "
                          f"of χ(b) confirmed on {SCAN} impact parameters from b/100 to 100b")
 
 
@@ -419,7 +421,8 @@ def _one_branch(beam: Beam, pt: dict, b, E) -> None:
                'cross section)',
           how=('scattering: σ = π R², R the radius beyond which no orbit is deflected, where '
                'one exists: the hard core\'s with a potential that vanishes identically '
-               '(confirmed: Θ ≠ 0 at b = 0.999R); a potential that reaches to infinity '
+               '(confirmed: Θ ≠ 0 at b = 0.999R, in double precision beyond its error bound '
+               'or else at 40 and 55 digits); a potential that reaches to infinity '
                'deflects every b (Θ ≠ 0 at b = 1000R is shown) and fails a finite σ. '
                'capture: σ = π b_c² (`critical_impact_parameter`); 6 points to 1e-20'),
           keys={**BEAM, "process": {"enum": ["scattering", "capture"]}},
@@ -504,9 +507,10 @@ def _compare_beam(ctx: Context, what: str, book, engine_of) -> Verdict:
 @quantity('critical_impact_parameter',
           book='expression: b_c(E), below which the particle is captured (falls in)',
           how=('b_c = inf_r B(r), B(r) the impact parameter at which E = V_eff(r) (V_eff '
-               'rises with b): a log grid over 24 decades of r, the minimum by golden '
-               'sections, at 40 and 55 digits agreeing to 1e-30; 0 where no b is captured; '
-               '6 points to 1e-20'),
+               'rises with b): a log grid over 24 decades of r (at full precision where '
+               'double precision, allowed an error of 1e-9, leaves the least value possible), '
+               'the minimum by golden sections, at 40 and 55 digits agreeing to 1e-30; 0 '
+               'where no b is captured; 6 points to 1e-20'),
           keys=BEAM, validate=validate_orbit)
 def check_critical_impact_parameter(ctx: Context, val) -> Verdict:
     book = ctx.parse(val, ("book",))
