@@ -308,7 +308,9 @@ class Orbit:
 
     def _root_inside(self, core, tiny):
         """The largest root of E = V_eff below the core (the orbit never gets there, but
-        a grazing orbit's integrands are nearly singular at it), or None."""
+        a grazing orbit's integrands are nearly singular at it), or None. Only where the
+        substitutions start (any point below the core makes them exact): to half the
+        working precision, without the Illinois steps a turning point needs."""
         r = self._descend(core, None, tiny)
         for _ in range(MAX_STEPS):
             nxt = r * STEP
@@ -316,7 +318,7 @@ class Orbit:
                 return None
             k = self.kinetic(nxt)
             if not (mpmath.isfinite(k) and k > 0):
-                return self._bisect(nxt, r)
+                return self._bisect(nxt, r, refine=False)
             r = nxt
         return None
 
@@ -348,12 +350,12 @@ class Orbit:
             return lo2, hi2
         return lo, hi
 
-    def _bisect(self, lo, hi):
+    def _bisect(self, lo, hi, refine: bool = True):
         """The root of E − V_eff between `lo` (not allowed) and `hi` (allowed): bisection,
         then the Illinois method at twice the working precision (an error δ in r_min moves
         the deflection integral by ~√δ, so r_min needs twice the digits of Θ). The
         bisection starts from the double-precision root's bracket where the working
-        precision confirms it (`_float_bracket`)."""
+        precision confirms it (`_float_bracket`). `refine` False: the bisection's end."""
         tol = mpmath.mpf(10) ** (-(self.dps // 2))
         lo, hi = self._float_bracket(lo, hi)
         while hi - lo > hi * tol:
@@ -363,6 +365,8 @@ class Orbit:
                 hi = mid
             else:
                 lo = mid
+        if not refine:
+            return hi
         with mpmath.workdps(2 * self.dps + 10):
             k_lo, k_hi = self.kinetic(lo), self.kinetic(hi)
             if not (mpmath.isfinite(k_lo) and k_lo < 0):
