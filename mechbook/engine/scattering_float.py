@@ -74,7 +74,8 @@ def float_deflection(orbit: Orbit) -> tuple[float, float] | None:
             if turn is None:
                 return None
             return _integral(fns, args, E, *turn)
-        except (ZeroDivisionError, ValueError, OverflowError, TypeError, FloatingPointError):
+        except (ZeroDivisionError, ValueError, OverflowError, TypeError, FloatingPointError,
+                RuntimeError):  # RuntimeError: Brent's method did not converge
             return None
 
 
