@@ -2,7 +2,7 @@
 
 A decision about Θ(b) (is it monotone between b/100 and 100b, does it exceed π, is it
 nonzero) needs Θ to ~1e-13, not the 30 digits mechbook.engine.scattering's quadratures
-give at ~10 ms an orbit; NumPy does it in ~0.2 ms. The same orbit (its P, m∞, core and the
+give at ~5 ms an orbit at 20 digits; NumPy does it in ~1 ms. The same orbit (its P, m∞, core and the
 inward search's geometric grid are the mpmath Orbit's), in double precision:
 
 - the turning point: the search's grid r_n = r_0·0.98^n evaluated at once, the first
