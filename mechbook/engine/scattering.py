@@ -422,13 +422,14 @@ class Orbit:
             with mpmath.workdps(self.dps + 15):
                 w_lo = mpmath.sqrt(1 - rs / rmin) if t.on_core else mpmath.mpf(0)
             w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
-
+            with mpmath.workdps(self.dps + 15):  # a node rounded to w = 1 (r = ∞): below
+                w1 = 1 - mpmath.mpf(10) ** (-(self.dps + 5))
             fm, fV, fu, _ = self.scattering.functions
             P, params, E, two_rs = self.P, self.params, self.E, 2 * rs
             ctx, inner = mpmath.mp, self.dps + 15  # E − V_eff is small near r_min
 
             def integrand(w):
-                w = max(w, w0)
+                w = min(max(w, w0), w1)  # the integrand is bounded at both ends
                 saved = ctx.prec
                 ctx.dps = inner
                 try:
@@ -495,6 +496,8 @@ class Orbit:
             w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
 
             span = X - rs
+            with mpmath.workdps(self.dps + 15):
+                u1 = 1 - mpmath.mpf(10) ** (-(self.dps + 5))
 
             def near(w):
                 w = max(w, w0)
@@ -510,7 +513,7 @@ class Orbit:
                 # √(m∞/2E) far out: (m·k0 − m∞·k)/(2k·k0) over their sum, with
                 # k0 − k = V_eff − Eb²/r², a difference of two small numbers there
                 with mpmath.workdps(self.dps + 15):
-                    one = 1 - u
+                    one = 1 - min(u, u1)  # a node rounded to u = 1 (r = ∞)
                     r = X / one
                     centrifugal = E * (b / r) ** 2
                     v = self.veff(r)
