@@ -16,10 +16,11 @@ inward search's geometric grid are the mpmath Orbit's), in double precision:
   within a rounding of E, not one whose integral misses a √δ near a misplaced root).
 
 The bound: ERROR_SAFETY times the two rules' difference, plus a rounding floor scaled by
-the turning point's conditioning E/(r_s·|V_eff′(r_s)|). Where double precision cannot
-answer — no NumPy form of the system, an orbit that falls in, a sign of E − V_eff within
-rounding of zero on the grid, a nearly double root, a non-finite value, or a bound above
-MAX_ERROR — the answer is None and the caller takes the mpmath orbit.
+the turning point's conditioning E/(r_s·|V_eff′(r_s)|) or by 1/(1 − w_lo) (the rounding
+of w near 1 against a short interval, when the root is far inside a core). Where double
+precision cannot answer — no NumPy form of the system, an orbit that falls in, a sign of
+E − V_eff within rounding of zero on the grid, a nearly double root, a non-finite value,
+or a bound above MAX_ERROR — the answer is None and the caller takes the mpmath orbit.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from mechbook.engine.scattering import DIGITS, FAR, MAX_STEPS, STEP, Orbit, floa
 NODES = 48  # Gauss–Legendre nodes of the coarser rule (the finer has twice as many)
 SWITCH = 0.25  # below this w, E − V_eff from its derivative (no cancellation)
 ERROR_SAFETY = 10.0  # the bound: this many times the two rules' difference, ...
-ROUNDING = 1e-14  # ... plus this, times (1 + |Θ|) and the turning point's conditioning
+ROUNDING = 1e-13  # ... plus this, times (1 + |Θ|) and the turning point's conditioning
 MARGIN = 1e-9  # a sign of E − V_eff on the grid within this of |E| + |V_eff|: undecided
 MAX_CONDITION = 1e4  # E/(r_s|V_eff′|) above this: nearly a double root, undecided
 MAX_ERROR = 1e-10  # a bound above this: double precision cannot say
@@ -179,8 +180,10 @@ def _integral(fns, args, E: float, rs: float, rmin: float, Es: float, at_root: b
             return None
         values.append(float(np.dot(wt, f)) * (1 - w_lo))
     theta = math.pi - 2 * values[1]
+    # the rounding floor: the turning point's conditioning, and w's rounding near 1 against
+    # the interval's length (a root far inside a core leaves [w_lo, 1] short)
     bound = ERROR_SAFETY * 2 * abs(values[1] - values[0]) + \
-        ROUNDING * (1 + abs(theta)) * max(1.0, condition)
+        ROUNDING * (1 + abs(theta)) * max(1.0, condition, 1 / (1 - w_lo))
     if not bound <= MAX_ERROR:
         return None
     return theta, bound
