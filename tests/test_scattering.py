@@ -331,3 +331,33 @@ def test_an_orbit_is_computed_once_per_precision(systems):
     k = next(float(v) for s, v in pt.items() if str(s) == "k")
     assert abs(float(one.deflection) - 2 * math.atan(k / (2 * 0.9 * 0.8))) < 1e-14
     assert sc.orbit(pt, b, E).deflection is one.deflection  # not computed again
+
+
+def test_a_root_far_inside_the_core_does_not_divide_by_zero(tmp_path):
+    """V = −k/r outside a hard core a = k/2, b small: the orbit reaches the core and the
+    root of E = V_eff inside it is 1e-6 of a, so the substitution's interval [w_lo, 1] is
+    1e-12 wide and tanh-sinh nodes round to w = 1 (r = ∞; a ZeroDivisionError before).
+    With s = 1/r the swept angle from infinity to the core is ∫_0^{1/a} ds/√(A + 2Bs − s²),
+    A = 1/b², B = k/(2Eb²): asin((1/a − B)/R) + asin(B/R), R = √(A + B²); the orbit
+    reflects there and Θ = π − 2·that."""
+    a = load_problem_at(tmp_path, "coulomb-attractive-core", "-k/r")
+    dyn = a.dynamics(None)
+    pt = dict(a.problem.values())
+    k_sym = next(s for s in pt if str(s) == "k")
+    s = engine.Scattering(dyn, dyn.sys.q[0], k_sym / 2)
+    b, E = sp.Float("0.0032918532", 30), sp.Float("0.068055582", 30)
+    theta, _ = engine.checked(s, pt, b, E, lambda o: o.deflection)
+    with mpmath.workdps(60):
+        k = mpmath.mpf(pt[k_sym])
+        bb, ee = engine._mp(b, 60), engine._mp(E, 60)
+        A, B = 1 / bb ** 2, k / (2 * ee * bb ** 2)
+        R = mpmath.sqrt(A + B * B)
+        assert B + R > 2 / k  # the hyperbola's perihelion is inside the core: it hits it
+        exact = mpmath.pi - 2 * (mpmath.asin((2 / k - B) / R) + mpmath.asin(B / R))
+        assert abs(theta - exact) < mpmath.mpf(10) ** -29
+
+
+def load_problem_at(tmp_path, name: str, potential: str) -> Analysis:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(PLANE.format(name=name, potential=potential))
+    return Analysis(load_problem(path))

@@ -26,11 +26,15 @@ inf_r B(r), the critical impact parameter (√(α/E) for V = −α/r²).
 from __future__ import annotations
 
 import math
+import sys
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 
 import mpmath
+import numpy as np
 import sympy as sp
+from scipy.optimize import brentq
 
 from mechbook.engine.lagrange import Dynamics
 from mechbook.engine.levelset import LevelSet
@@ -42,6 +46,14 @@ FAR = 10 ** 8  # the inward search for r_min starts this many length scales out
 STEP = mpmath.mpf("0.98")  # its geometric step (a barrier narrower than 2 % of r is missed)
 MAX_STEPS = 6000
 ORBITS = 4096  # orbits a Scattering keeps (their values computed once), then forgets
+ROUGH = 1e-9  # the relative error a double-precision value of V_eff is allowed (b_c's grid)
+GOLDEN = 3  # golden sections per digit for b_c (its bracket to 10^-(dps·0.63))
+
+
+def float_grid(r0: float) -> np.ndarray:
+    """The inward search's points below r0 in double precision, r0·STEPⁿ for n = 1 …
+    MAX_STEPS (the same numbers wherever the search is taken in double precision)."""
+    return r0 * np.cumprod(np.full(MAX_STEPS, float(STEP)))
 
 
 class Unbound(Exception):
@@ -109,6 +121,30 @@ class Scattering:
             return None
 
     @cached_property
+    def float_functions(self):
+        """(m, V_eff, dV_eff/dr, u) of (r, P, params) in NumPy, for arrays of r (None where
+        the expressions have no NumPy form): mechbook.engine.scattering_float's."""
+        mass, V, u = self.level.reduced
+        args = [self.r, self.P, *self.level.params]
+        try:
+            return tuple(sp.lambdify(args, f, "numpy")
+                         for f in (mass, V, sp.diff(V, self.r), u[0]))
+        except Exception:  # noqa: BLE001 - a function NumPy lacks: the decisions stay exact
+            return None
+
+    @cached_property
+    def float_parts(self):
+        """(v0, c2) of (r, params) in double precision, V_eff = v0 + c2 P² (None where they
+        have no such form): the capture grid's."""
+        _, V, _ = self.level.reduced
+        args = [self.r, *self.level.params]
+        try:
+            return (sp.lambdify(args, V.subs(self.P, 0), "math"),
+                    sp.lambdify(args, sp.diff(V, self.P, 2) / 2, "math"))
+        except Exception:  # noqa: BLE001 - a function math lacks: the grid stays exact
+            return None
+
+    @cached_property
     def potential_is_zero(self) -> bool:
         """Whether V_eff at P = 0 (the potential alone) vanishes identically: a finite range
         is then the hard core's."""
@@ -154,6 +190,7 @@ class Orbit:
     b: object
     E: object
     dps: int
+    critical: object = None  # b_c at this orbit's E (critical_impact_parameter), once found
 
     def _f(self, name: str):
         m, V, u, core = self.scattering.functions
@@ -244,23 +281,26 @@ class Orbit:
         """The search's steps in double precision (a fiftieth of the cost): the last r
         before E − V_eff is not positive, before the core or before `tiny`, from which the
         search goes on at the working precision; a step the double-precision values
-        misjudged near the root is taken again there (r moved back out until allowed)."""
-        fn = self.scattering.float_kinetic
-        if fn is None:
+        misjudged near the root is taken again there (r moved back out until allowed).
+        From the core down (`core` None) it finds the root inside the core the same way."""
+        fns = self.scattering.float_functions
+        if fns is None:
             return r
         args = [float(self.P), *(float(p) for p in self.params)]
         E, x, stop = float(self.E), float(r), float(max(core or 0, tiny))
-        for _ in range(MAX_STEPS):
-            nxt = x * float(STEP)
-            if nxt <= stop:
-                break
+        grid = float_grid(x)
+        grid = grid[:int(np.argmax(grid <= stop)) if grid[-1] <= stop else grid.size]
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
             try:
-                k = E - fn(nxt, *args)
+                k = E - np.broadcast_to(np.asarray(fns[1](grid, *args), dtype=float),
+                                        grid.shape)
             except (ZeroDivisionError, ValueError, OverflowError, TypeError):
-                break
-            if not (math.isfinite(k) and k > 0):
-                break
-            x = nxt
+                return r
+        bad = ~(np.isfinite(k) & (k > 0))
+        last = (int(np.argmax(bad)) if bad.any() else grid.size) - 1
+        if last >= 0:
+            x = float(grid[last])
         back = mpmath.mpf(x)
         while back < r and not self.kinetic(back) > 0:
             back = back / STEP
@@ -268,23 +308,56 @@ class Orbit:
 
     def _root_inside(self, core, tiny):
         """The largest root of E = V_eff below the core (the orbit never gets there, but
-        a grazing orbit's integrands are nearly singular at it), or None."""
-        r = core
+        a grazing orbit's integrands are nearly singular at it), or None. Only where the
+        substitutions start (any point below the core makes them exact): to half the
+        working precision, without the Illinois steps a turning point needs."""
+        r = self._descend(core, None, tiny)
         for _ in range(MAX_STEPS):
             nxt = r * STEP
             if nxt < tiny:
                 return None
             k = self.kinetic(nxt)
             if not (mpmath.isfinite(k) and k > 0):
-                return self._bisect(nxt, r)
+                return self._bisect(nxt, r, refine=False)
             r = nxt
         return None
 
-    def _bisect(self, lo, hi):
+    def _float_bracket(self, lo, hi):
+        """[lo, hi] narrowed to 1e-13 around the root of E − V_eff found by Brent's method in
+        double precision, if E − V_eff at the working precision is not positive at its lower
+        end and positive at its upper one (else [lo, hi] as given)."""
+        fn = self.scattering.float_kinetic
+        if fn is None:
+            return lo, hi
+        args = [float(self.P), *(float(p) for p in self.params)]
+        E = float(self.E)
+
+        def k(x):
+            return E - fn(x, *args)
+
+        try:
+            a, b = float(lo), float(hi)
+            if not (k(a) <= 0 < k(b)):
+                return lo, hi
+            x = brentq(k, a, b, xtol=1e-300, rtol=4 * sys.float_info.epsilon)
+        except (ZeroDivisionError, ValueError, OverflowError, TypeError, RuntimeError):
+            return lo, hi
+        lo2 = max(lo, mpmath.mpf(x * (1 - 1e-13)))
+        hi2 = min(hi, mpmath.mpf(x * (1 + 1e-13)))
+        k_lo, k_hi = self.kinetic(lo2), self.kinetic(hi2)
+        if lo2 < hi2 and not (mpmath.isfinite(k_lo) and k_lo > 0) and \
+                mpmath.isfinite(k_hi) and k_hi > 0:
+            return lo2, hi2
+        return lo, hi
+
+    def _bisect(self, lo, hi, refine: bool = True):
         """The root of E − V_eff between `lo` (not allowed) and `hi` (allowed): bisection,
         then the Illinois method at twice the working precision (an error δ in r_min moves
-        the deflection integral by ~√δ, so r_min needs twice the digits of Θ)."""
+        the deflection integral by ~√δ, so r_min needs twice the digits of Θ). The
+        bisection starts from the double-precision root's bracket where the working
+        precision confirms it (`_float_bracket`). `refine` False: the bisection's end."""
         tol = mpmath.mpf(10) ** (-(self.dps // 2))
+        lo, hi = self._float_bracket(lo, hi)
         while hi - lo > hi * tol:
             mid = (lo + hi) / 2
             k = self.kinetic(mid)
@@ -292,6 +365,8 @@ class Orbit:
                 hi = mid
             else:
                 lo = mid
+        if not refine:
+            return hi
         with mpmath.workdps(2 * self.dps + 10):
             k_lo, k_hi = self.kinetic(lo), self.kinetic(hi)
             if not (mpmath.isfinite(k_lo) and k_lo < 0):
@@ -347,20 +422,32 @@ class Orbit:
             with mpmath.workdps(self.dps + 15):
                 w_lo = mpmath.sqrt(1 - rs / rmin) if t.on_core else mpmath.mpf(0)
             w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
+            with mpmath.workdps(self.dps + 15):  # a node rounded to w = 1 (r = ∞): below
+                w1 = 1 - mpmath.mpf(10) ** (-(self.dps + 5))
+            fm, fV, fu, _ = self.scattering.functions
+            P, params, E, two_rs = self.P, self.params, self.E, 2 * rs
+            ctx, inner = mpmath.mp, self.dps + 15  # E − V_eff is small near r_min
 
             def integrand(w):
-                w = max(w, w0)
-                with mpmath.workdps(self.dps + 15):  # E − V_eff is small near r_min
+                w = min(max(w, w0), w1)  # the integrand is bounded at both ends
+                saved = ctx.prec
+                ctx.dps = inner
+                try:
                     one = (1 - w) * (1 + w)
                     r = max(rs / one, rmin)
-                    k = self.kinetic(r)
+                    try:
+                        k = E - fV(r, P, *params)
+                    except (ZeroDivisionError, ValueError):
+                        k = -1
                     if not k > 0:
                         raise UnsupportedError("scattering: the orbit leaves the allowed "
                                                "region beyond its turning point")
-                    u = self._f("u")(r, self.P, *self.params)
-                    return u * mpmath.sqrt(self.mass(r) / (2 * k)) * 2 * rs * w / one ** 2
+                    return (fu(r, P, *params) * mpmath.sqrt(fm(r, P, *params) / (2 * k))
+                            * two_rs * w / (one * one))
+                finally:
+                    ctx.prec = saved
 
-            total = mpmath.quad(integrand, [w_lo, (w_lo + 1) / 2, 1])
+            total = mpmath.quad(integrand, [w_lo, 1])
             return mpmath.pi - 2 * total
 
 
@@ -388,13 +475,19 @@ class Orbit:
             X = 2 * max(rmin, self.b)
             m_inf, E, b = self.m_inf, self.E, self.b
 
+            fm, fV, _, _ = self.scattering.functions
+            P, params = self.P, self.params
+            ctx, inner = mpmath.mp, self.dps + 15
+
             def dt_dr(r):
-                with mpmath.workdps(self.dps + 15):
-                    k = self.kinetic(r)
-                    if not k > 0:
-                        raise UnsupportedError("time delay: the orbit leaves the allowed "
-                                               "region beyond its turning point")
-                    return mpmath.sqrt(self.mass(r) / (2 * k))
+                try:
+                    k = E - fV(r, P, *params)
+                except (ZeroDivisionError, ValueError):
+                    k = -1
+                if not k > 0:
+                    raise UnsupportedError("time delay: the orbit leaves the allowed "
+                                           "region beyond its turning point")
+                return mpmath.sqrt(fm(r, P, *params) / (2 * k))
 
             t = self.turning  # r = rs + (X − rs)w² from the singular point, as for Θ
             rs = t.singular if t.singular is not None else rmin
@@ -402,17 +495,25 @@ class Orbit:
                 w_lo = mpmath.sqrt((rmin - rs) / (X - rs))
             w0 = 0 if t.on_core else mpmath.mpf(10) ** (-(self.dps // 3))
 
+            span = X - rs
+            with mpmath.workdps(self.dps + 15):
+                u1 = 1 - mpmath.mpf(10) ** (-(self.dps + 5))
+
             def near(w):
                 w = max(w, w0)
-                with mpmath.workdps(self.dps + 15):
-                    return dt_dr(max(rs + (X - rs) * w * w, rmin)) * 2 * (X - rs) * w
+                saved = ctx.prec
+                ctx.dps = inner
+                try:
+                    return dt_dr(max(rs + span * w * w, rmin)) * 2 * span * w
+                finally:
+                    ctx.prec = saved
 
             def beyond(u):
                 # √(m/2k) − √(m∞/2k0) without the cancellation of two numbers near
                 # √(m∞/2E) far out: (m·k0 − m∞·k)/(2k·k0) over their sum, with
                 # k0 − k = V_eff − Eb²/r², a difference of two small numbers there
                 with mpmath.workdps(self.dps + 15):
-                    one = 1 - u
+                    one = 1 - min(u, u1)  # a node rounded to u = 1 (r = ∞)
                     r = X / one
                     centrifugal = E * (b / r) ** 2
                     v = self.veff(r)
@@ -425,7 +526,7 @@ class Orbit:
                     return top / (2 * k * k0) / total * X / one ** 2
 
             inside = mpmath.quad(near, [w_lo, 1])
-            outside = mpmath.quad(beyond, [0, mpmath.mpf(1) / 2, 1])
+            outside = mpmath.quad(beyond, [0, 1])
             free = mpmath.sqrt(X * X - b * b) / self.speed
             return 2 * (inside + outside - free)
 
@@ -453,11 +554,19 @@ def checked(scattering: Scattering, point: dict, b, E, what) -> tuple:
 
 def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int = DPS):
     """b_c = inf_r B(r), B(r) the b at which E = V_eff(r; b·p∞) (0 where no b is captured,
-    a potential less singular than −1/r²): a log grid of r over 24 decades, then the
-    minimum refined by golden sections at `dps` digits."""
+    a potential less singular than −1/r²): a log grid of r over 24 decades at `dps`
+    digits (only where double precision, with a generous error, leaves B's least value
+    possible: `_candidates`), then the minimum refined by golden sections. Kept per
+    orbit: the capture parts of a problem ask for the same b_c at the same points."""
     orbit = scattering.orbit(point, 1, E, dps)
     if scattering.hard_core is not None:
         raise UnsupportedError("capture with a hard core: the core reflects every orbit")
+    if orbit.critical is None:
+        orbit.critical = _critical(orbit, dps)
+    return orbit.critical
+
+
+def _critical(orbit: Orbit, dps: int):
     with mpmath.workdps(dps):
         orbit.P  # noqa: B018 - an unbound orbit
         p_inf = mpmath.sqrt(2 * orbit.m_inf * orbit.E)
@@ -471,21 +580,28 @@ def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int =
             return mpmath.sqrt(room / c2) / p_inf if room > 0 else mpmath.mpf(0)
 
         grid = [mpmath.mpf(10) ** (mpmath.mpf(k) / 10) for k in range(-120, 121)]
-        values = [B(r) for r in grid]
-        i = min(range(len(values)), key=lambda j: values[j])
-        if values[i] == 0:
+        values: dict[int, object] = {}
+
+        def value(j):
+            if j not in values:
+                values[j] = B(grid[j])
+            return values[j]
+
+        candidates = _candidates(orbit, grid)
+        i = min(candidates if candidates is not None else range(len(grid)), key=value)
+        if value(i) == 0:
             return mpmath.mpf(0)
         if i == 0:  # still falling towards r → 0: the infimum is the limit there
-            if values[0] < values[1] * mpmath.mpf("0.999"):
+            if value(0) < value(1) * mpmath.mpf("0.999"):
                 return mpmath.mpf(0)
-            return values[0]
-        if i == len(values) - 1:
+            return value(0)
+        if i == len(grid) - 1:
             raise UnsupportedError("scattering: B(r) keeps falling far out")
         lo, hi = mpmath.log(grid[i - 1]), mpmath.log(grid[i + 1])
         g = (mpmath.sqrt(5) - 1) / 2
         a, c = hi - g * (hi - lo), lo + g * (hi - lo)
         fa, fc = B(mpmath.exp(a)), B(mpmath.exp(c))
-        for _ in range(4 * dps):
+        for _ in range(GOLDEN * dps):  # the bracket 0.46·0.618ⁿ: B's error its square
             if fa < fc:
                 hi, c, fc = c, a, fa
                 a = hi - g * (hi - lo)
@@ -495,3 +611,33 @@ def critical_impact_parameter(scattering: Scattering, point: dict, E, dps: int =
                 c = lo + g * (hi - lo)
                 fc = B(mpmath.exp(c))
         return min(fa, fc)
+
+
+def _candidates(orbit: Orbit, grid: list):
+    """The grid's indices where B may be least, by double precision: B² = (E − v0)/c2
+    (V_eff = v0 + c2 P², each lambdified on its own, so c2 is no difference), each of
+    E − v0 and c2 within ROUGH of its size (generous: a term of V_eff may cancel another);
+    an index whose least B² is above another's largest is out. None where double precision
+    has no value (every index is then taken at full precision). Ascending, so that the
+    first least one stays first."""
+    fns = orbit.scattering.float_parts
+    if fns is None:
+        return None
+    v0f, c2f = fns
+    try:
+        params = [float(p) for p in orbit.params]
+        E = float(orbit.E)
+        lows, highs = [], []
+        for r in grid:
+            x = float(r)
+            v0, c2 = v0f(x, *params), c2f(x, *params)
+            room = E - v0
+            e_room, e_c2 = ROUGH * (abs(E) + abs(v0)), ROUGH * abs(c2)
+            if not (math.isfinite(room) and math.isfinite(c2) and c2 > 0):
+                return None
+            lows.append(max(room - e_room, 0.0) / (c2 + e_c2))
+            highs.append(max(room + e_room, 0.0) / (c2 - e_c2))
+    except (ZeroDivisionError, ValueError, OverflowError, TypeError):
+        return None
+    top = min(highs)
+    return [j for j, low in enumerate(lows) if low <= top]

@@ -17,6 +17,8 @@ compared at POINTS random points to RTOL.
 
 from __future__ import annotations
 
+import math
+
 import mpmath
 import sympy as sp
 
@@ -30,6 +32,7 @@ from mechbook.engine.scattering import (
     checked,
     critical_impact_parameter,
 )
+from mechbook.engine.scattering_float import float_deflection
 from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict
 from mechbook.verify.context import Context
@@ -40,7 +43,8 @@ quantity = FAMILY.quantity
 
 POINTS = 6
 RTOL = 1e-20  # book against engine (the engine's values hold 30 digits)
-DERIVATIVE_RTOL = 1e-15  # dσ/dΩ: two Richardson estimates of db/dΘ must agree to this
+DERIVATIVE_RTOL = 1e-15  # dσ/dΩ: two central differences of dΘ/db must agree to this
+STEPS = (10, 9)  # their steps: 1e-10·b and 1e-9·b
 NEAR = 1e-8  # a capture relation is judged this far (relative) either side of b_c
 SINGULAR = 1e-10  # |dΘ/db|·b or |sin Θ| below this: a rainbow or a glory
 SCAN = 16  # impact parameters from b/100 to 100b on which one branch is confirmed
@@ -282,11 +286,13 @@ def _observed(theta):
           book='expression: the differential cross section dσ/dΩ, in b and E, or in the '
                'observed scattering angle χ ∈ [0, π] named by `scattering_angle:`',
           how=('(b/sin χ)|db/dχ| on the orbit of `impact_parameter:`, `energy:` (Θ as for '
-               '`deflection_angle`, dΘ/db by Richardson differences at 55 digits, two step '
-               'sizes agreeing to 1e-15), the book evaluated at the engine\'s χ; 6 points to '
-               '1e-15. Unsupported where it is singular: a rainbow (dΘ/db = 0), a glory '
-               '(sin Θ = 0, b ≠ 0), or several impact parameters scattering into one angle '
-               '(χ(b) not monotone on 16 values from b/100 to 100b)'),
+               '`deflection_angle`, dΘ/db by central differences at 40 digits, steps 1e-10·b '
+               'and 1e-9·b agreeing to 1e-15, Richardson-extrapolated), the book evaluated at '
+               'the engine\'s χ; 6 points to 1e-15. Unsupported where it is singular: a '
+               'rainbow (dΘ/db = 0), a glory (sin Θ = 0, b ≠ 0), or several impact parameters '
+               'scattering into one angle (χ(b) not monotone, steps beyond 1e-12, on 16 '
+               'values from b/100 to 100b, each Θ in double precision with an error bound, '
+               'at 20 digits where the bound leaves the decision open)'),
           keys={**ORBIT, "scattering_angle": NAME}, names=_angle_names,
           validate=validate_orbit, crosschecks=("scattering",))
 def check_cross_section(ctx: Context, val) -> Verdict:
@@ -313,7 +319,7 @@ def check_cross_section(ctx: Context, val) -> Verdict:
                                f"b = {float(b):.6g}, E = {float(E):.6g}, χ = {float(chi):.6g}")
     return Verdict(True, f"quadrature({POINTS} points)", f"worst relative {worst:.2g}",
                    power=f"{POINTS} points, each value to {DERIVATIVE_RTOL:g} (dΘ/db by two "
-                         f"Richardson estimates agreeing to {DERIVATIVE_RTOL:g}); one branch "
+                         f"central differences agreeing to {DERIVATIVE_RTOL:g}); one branch "
                          f"of χ(b) confirmed on {SCAN} impact parameters from b/100 to 100b")
 
 
@@ -326,23 +332,26 @@ def _theta(beam: Beam, pt: dict, b, dps: int, E):
 
 
 def _differential(beam: Beam, pt: dict, b, E) -> tuple:
-    """(χ, dσ/dΩ) at the orbit (b, E); UnsupportedError where dσ/dΩ is singular. The
-    stencils at DPS digits: Θ holds ~38 there, so a step of 1e-8·b leaves db/dΘ ~29."""
+    """(χ, dσ/dΩ) at the orbit (b, E); UnsupportedError where dσ/dΩ is singular. dΘ/db by
+    central differences at two steps, STEPS[0]·b and STEPS[1]·b (four orbits at DPS
+    digits, where Θ holds ~39: the rounding leaves ~1e-30/(b|dΘ/db|) of the slope): the
+    two differ by c(h₂² − h₁²), c·h² the error of each, so their agreement to
+    DERIVATIVE_RTOL bounds the smaller step's error by a hundredth of it (and the c·h₁²
+    they measure is taken off: Richardson's extrapolation)."""
     d = DPS
     theta = beam.value(pt, b, E, lambda o: o.deflection)
     with mpmath.workdps(d):
         bb = mpmath.mpf(str(b))
 
         def slope(h):
-            th = {k: _theta(beam, pt, bb + k * h, d, E) for k in (-2, -1, 1, 2)}
-            d1 = (th[1] - th[-1]) / (2 * h)
-            d2 = (th[2] - th[-2]) / (4 * h)
-            return (4 * d1 - d2) / 3
+            return (_theta(beam, pt, bb + h, d, E) - _theta(beam, pt, bb - h, d, E)) / (2 * h)
 
-        s1, s2 = slope(bb * mpmath.mpf(10) ** -8), slope(bb * mpmath.mpf(10) ** -6)
+        h1, h2 = (mpmath.mpf(10) ** -k for k in STEPS)
+        s1, s2 = slope(bb * h1), slope(bb * h2)
         if abs(s1 - s2) > DERIVATIVE_RTOL * abs(s1) + mpmath.mpf(10) ** -25:
             raise UnsupportedError(f"dσ/dΩ: dΘ/db not resolved (two estimates "
                                    f"{mpmath.nstr(s1, 10)}, {mpmath.nstr(s2, 10)})")
+        s1 += (s1 - s2) * h1 ** 2 / (h2 ** 2 - h1 ** 2)  # the c·h₁² the two measure, removed
         chi = _observed(theta)
         if abs(s1) * bb < SINGULAR:
             raise UnsupportedError(f"dσ/dΩ: a rainbow angle (dΘ/db = 0) at b = {float(b):.6g}"
@@ -356,27 +365,50 @@ def _differential(beam: Beam, pt: dict, b, E) -> tuple:
 
 
 def _one_branch(beam: Beam, pt: dict, b, E) -> None:
-    """One impact parameter per angle, judged on SCAN impact parameters from b/100 to 100b
-    (at 20 digits): Θ(b) monotone, within [−π, π], and no orbit among them captured (next
-    to b_c the deflection winds without bound, and every angle has infinitely many
-    branches); otherwise dσ/dΩ is a sum over branches, which is not computed."""
+    """One impact parameter per angle, judged on SCAN impact parameters from b/100 to 100b:
+    Θ(b) monotone (no step between neighbours above 1e-12 one way and another the other
+    way), within [−π, π], and no orbit among them captured (next to b_c the deflection
+    winds without bound, and every angle has infinitely many branches); otherwise dσ/dΩ is
+    a sum over branches, which is not computed. Each Θ is taken in double precision with
+    a bound on its error (mechbook.engine.scattering_float), and at 20 digits where that
+    cannot say or where a step or |Θ| is within its bound of the threshold: the decision
+    is the one the 20-digit values give."""
     why = None
+    tiny, pi = 1e-12, math.pi
     with mpmath.workdps(20):
         bb = mpmath.mpf(str(b))
-        thetas = []
+        orbits, thetas = [], []  # thetas: (Θ, a bound on its error; 0 for a 20-digit one)
         for k in range(SCAN):
             bk = bb * mpmath.mpf(10) ** (-2 + 4 * mpmath.mpf(k) / (SCAN - 1))
-            try:
-                thetas.append(beam.engine.orbit(pt, bk, E, 20).deflection)
-            except Captured:
-                why = f"the orbit at b = {float(bk):.4g} is captured, and next to the " \
-                      "capture the deflection winds without bound"
-                break
-        steps = [y - x for x, y in zip(thetas, thetas[1:], strict=False)]
-        tiny = mpmath.mpf(10) ** -12
+            orbit = beam.engine.orbit(pt, bk, E, 20)
+            got = float_deflection(orbit)
+            if got is None:
+                try:
+                    got = (orbit.deflection, 0.0)
+                except Captured:
+                    why = f"the orbit at b = {float(bk):.4g} is captured, and next to the " \
+                          "capture the deflection winds without bound"
+                    break
+            orbits.append(orbit)
+            thetas.append(got)
+
+        def exact(i):
+            if thetas[i][1]:
+                thetas[i] = (orbits[i].deflection, 0.0)
+
+        for i in range(len(thetas) - 1 if why is None else 0):  # a step near ±1e-12
+            s = float(thetas[i + 1][0] - thetas[i][0])
+            err = thetas[i][1] + thetas[i + 1][1]
+            if err and (abs(s - tiny) <= err or abs(s + tiny) <= err):
+                exact(i)
+                exact(i + 1)
+        for i, (t, err) in enumerate(thetas):
+            if err and abs(abs(float(t)) - pi) <= err:
+                exact(i)
+        steps = [y[0] - x[0] for x, y in zip(thetas, thetas[1:], strict=False)]
         if why is None and any(s > tiny for s in steps) and any(s < -tiny for s in steps):
             why = "Θ(b) is not monotone"
-        if why is None and any(abs(t) > mpmath.pi for t in thetas):
+        if why is None and any(abs(t) > mpmath.pi for t, _ in thetas):
             why = "|Θ(b)| exceeds π (the orbit winds round)"
     if why:
         raise UnsupportedError(f"dσ/dΩ: several impact parameters scatter into one angle "
@@ -389,7 +421,8 @@ def _one_branch(beam: Beam, pt: dict, b, E) -> None:
                'cross section)',
           how=('scattering: σ = π R², R the radius beyond which no orbit is deflected, where '
                'one exists: the hard core\'s with a potential that vanishes identically '
-               '(confirmed: Θ ≠ 0 at b = 0.999R); a potential that reaches to infinity '
+               '(confirmed: Θ ≠ 0 at b = 0.999R, in double precision beyond its error bound '
+               'or else at 40 and 55 digits); a potential that reaches to infinity '
                'deflects every b (Θ ≠ 0 at b = 1000R is shown) and fails a finite σ. '
                'capture: σ = π b_c² (`critical_impact_parameter`); 6 points to 1e-20'),
           keys={**BEAM, "process": {"enum": ["scattering", "capture"]}},
@@ -405,8 +438,14 @@ def check_total_cross_section(ctx: Context, val) -> Verdict:
         orbit = beam.engine.orbit(pt, 1, E)
         R = orbit.core
         if R is not None and beam.engine.potential_is_zero:
-            inside = beam.value(pt, sp.Float(str(R * mpmath.mpf("0.999")), DIGITS), E,
-                                lambda o: o.deflection)
+            b_in = sp.Float(str(R * mpmath.mpf("0.999")), DIGITS)
+            try:
+                quick = float_deflection(beam.engine.orbit(pt, b_in, E))
+            except Unbound as exc:
+                raise beam.ctx.part.error(("energy",), str(exc)) from None
+            if quick is not None and abs(quick[0]) > quick[1]:
+                return mpmath.pi * R ** 2  # Θ ≠ 0 beyond its bound: no 30 digits needed
+            inside = beam.value(pt, b_in, E, lambda o: o.deflection)
             if inside == 0:
                 raise UnsupportedError("σ: no deflection just inside the hard core's radius")
             return mpmath.pi * R ** 2
@@ -468,9 +507,10 @@ def _compare_beam(ctx: Context, what: str, book, engine_of) -> Verdict:
 @quantity('critical_impact_parameter',
           book='expression: b_c(E), below which the particle is captured (falls in)',
           how=('b_c = inf_r B(r), B(r) the impact parameter at which E = V_eff(r) (V_eff '
-               'rises with b): a log grid over 24 decades of r, the minimum by golden '
-               'sections, at 40 and 55 digits agreeing to 1e-30; 0 where no b is captured; '
-               '6 points to 1e-20'),
+               'rises with b): a log grid over 24 decades of r (at full precision where '
+               'double precision, allowed an error of 1e-9, leaves the least value possible), '
+               'the minimum by golden sections, at 40 and 55 digits agreeing to 1e-30; 0 '
+               'where no b is captured; 6 points to 1e-20'),
           keys=BEAM, validate=validate_orbit)
 def check_critical_impact_parameter(ctx: Context, val) -> Verdict:
     book = ctx.parse(val, ("book",))
