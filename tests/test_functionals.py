@@ -390,3 +390,54 @@ def test_implicit_ray(tmp_path, curve, status):
     """
     part = f"quantity: extremal\nsolve_for: {{r: 1.2}}\nbook: {{implicit: \"{curve}\"}}\n"
     assert _one(tmp_path, "fermat", medium, part) == status
+
+
+def test_the_constants_by_broyden_and_a_loose_way():
+    """The hanging chain's c from its length, 2c·sinh(d/c) = l (d = 1, l = 3: the root by
+    mpmath's own findroot here at 50 digits): Gauss–Newton with Broyden's updates reaches
+    it to 28 digits from c = 0.6, with forward-difference Jacobians only where a step did
+    not halve the residual (here once: the start); followed to l = 3.4, d = 1.1 its
+    continuation's points on the way are solved to ON_THE_WAY digits and the last to 28,
+    the root there."""
+    import mpmath
+    import sympy as sp
+
+    from mechbook.engine import curve as cv
+
+    s, c, d, ell = sp.symbols("s c d l", positive=True)
+    crv = cv.Curve(s, s, [c * sp.cosh(s / c) - c * sp.cosh(d / c)], (-d, d), [c])
+    cond = cv.Conditions([], [], [("length", sp.cosh(s / c), ell)], [], [], [])
+
+    def root(dv: str, lv: str):
+        with mpmath.workdps(50):
+            dv, lv = mpmath.mpf(dv), mpmath.mpf(lv)
+            return mpmath.findroot(lambda x: 2 * x * mpmath.sinh(dv / x) - lv,
+                                   mpmath.mpf("0.6"))
+
+    calls = {"jacobian": 0, "digits": []}
+    jac, solve = cv._jacobian, cv.solve_unknowns
+
+    def counted(*a):
+        calls["jacobian"] += 1
+        return jac(*a)
+
+    def solved(*a):
+        calls["digits"].append(a[5] if len(a) > 5 else cv.DIGITS - 2)
+        return solve(*a)
+
+    base = {d: sp.Float(1, 30), ell: sp.Float(3, 30)}
+    mp = pytest.MonkeyPatch()
+    mp.setattr(cv, "_jacobian", counted)
+    try:
+        got = cv.solve_unknowns(cond, crv, [c], {c: 0.6}, base)
+        assert calls["jacobian"] == 1
+        assert abs(got[c] / root("1", "3") - 1) < mpmath.mpf(10) ** -28
+        mp.setattr(cv, "solve_unknowns", solved)
+        target = {d: sp.Float("1.1", 30), ell: sp.Float("3.4", 30)}
+        far = cv.continued(cond, crv, [c], got, base, target)
+    finally:
+        mp.undo()
+    assert abs(far[c] / root("1.1", "3.4") - 1) < \
+        mpmath.mpf(10) ** -27
+    assert calls["digits"][-1] == cv.DIGITS - 2
+    assert set(calls["digits"][:-1]) == {cv.ON_THE_WAY}
