@@ -28,6 +28,7 @@ import pytest
 import sympy as sp
 from systems import SADDLE, load_analysis
 
+from mechbook.errors import MechbookError
 from mechbook.numerics.floquet import Floquet
 from mechbook.numerics.floquet_screen import WORTH_IT, Screen
 from mechbook.verify import boundary_limit
@@ -443,11 +444,48 @@ def test_the_rate_guard_reads_the_coefficients_at_t0(tmp_path):
     for a, w, g, ell in ((0.1, 45.0, 9.81, 1.0), (0.003, 1500.0, 9.81, 0.7),
                          (1e-6, 2.0, 9.81, 3.0)):
         pt = _at(flo, a=a, omega=w, g=g, l=ell, m=2.0)
-        assert float(flo._rate(pt)) == pytest.approx(1 + abs(g - a * w * w) / ell,
-                                                     rel=1e-14)
+        want = 1 + abs(g - a * w * w) / ell
+        assert float(flo._rate(pt)) == pytest.approx(want, rel=1e-14)
+        assert flo._rate_in_double(pt) == pytest.approx(want, rel=1e-13)
     saddle = _floquet(tmp_path / "saddle", SADDLE, "9805")
     pt = _at(saddle, m="1.5", k="1", kappa="2.5", Omega="1.03")
     assert float(saddle._rate(pt)) == pytest.approx(3.5, rel=1e-14)
+    assert saddle._rate_in_double(pt) == pytest.approx(3.5, rel=1e-13)
+    assert saddle._rate_in_double({}) is None  # a value missing: the 30-digit path
+
+
+def test_the_period_guards_pass_in_double_only_far_from_their_limits(tmp_path, monkeypatch):
+    """The rotating saddle's period (c/Ω) against its rate 1 + max(k, κ) (closed form above):
+    T·rate from 1e-12 to 1e-6 (Ω huge) and T·√rate from 1e3 to 1e7 (Ω tiny) across the
+    guards' limits SHORTEST = 1e-9 and LONGEST = 1e5: the 30-digit rate is read exactly
+    where one of them lies within RATE_MARGIN of its limit, and the period is refused
+    exactly where the closed form puts it beyond one (the double rate never decides a
+    refusal)."""
+    import mechbook.numerics.floquet as fq
+
+    saddle = _floquet(tmp_path, SADDLE, "9806")
+    exact = []
+    real = fq.Floquet._rate
+    monkeypatch.setattr(fq.Floquet, "_rate", lambda self, v: exact.append(1) or real(self, v))
+    rate = 1 + 2.5
+    omega_sym = next(s for s in saddle.symbols if s.name == "Omega")
+    per = float(saddle.period * omega_sym)  # the period the engine found is per/Ω
+    for x in np.geomspace(1e-12, 1e-6, 13).tolist() + np.geomspace(1e3, 1e7, 13).tolist():
+        short = x < 1
+        T = x / rate if short else x / math.sqrt(rate)  # T·rate = x, or T·√rate = x
+        omega = per / T
+        pt = _at(saddle, m="1", k="1", kappa="2.5", Omega=repr(omega))
+        exact.clear()
+        refused = short and x < fq.SHORTEST or not short and x > fq.LONGEST
+        near = (fq.SHORTEST / fq.RATE_MARGIN <= x <= fq.RATE_MARGIN * fq.SHORTEST) if short \
+            else (fq.LONGEST / fq.RATE_MARGIN <= x <= fq.RATE_MARGIN * fq.LONGEST)
+        try:
+            saddle.period_at(pt)
+            assert not refused, x
+        except MechbookError:
+            assert refused, x
+        assert bool(exact) == (refused or near or (short and x < fq.SHORTEST * fq.RATE_MARGIN)
+                               or (not short and x > fq.LONGEST / fq.RATE_MARGIN)), x
 
 
 def test_the_bound_covers_the_parameters_rounding_to_doubles(mathieu):
