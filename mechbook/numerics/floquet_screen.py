@@ -23,7 +23,7 @@ thresholds; everywhere else it returns None and the 113-bit computation decides:
   a multiplier marginal only within marginal_within(resolution, scale) ≤ 100·√(1e-20 ·
   MAX_SCALE) ≈ 3e-7 < NEAR of ±1 (any resolution it accepts), and on the circle only
   within on_circle ≤ 1e-14 of it.
-- **stable**, one degree of freedom only: the trace's bound keeps tr² < 4 det by
+- **stable**, one degree of freedom: the trace's bound keeps tr² < 4 det by
   MARGIN, so the multipliers are a complex pair, |μ|² = det Φ exactly, and det Φ is 1
   exactly where tr M⁻¹C ≡ 0 (no damping, no velocity terms) or below 1 − MARGIN where the
   Liouville exponent says so; the pair stays NEAR clear of ±1. The 113-bit verdict there
