@@ -441,3 +441,27 @@ def test_the_constants_by_broyden_and_a_loose_way():
         mpmath.mpf(10) ** -27
     assert calls["digits"][-1] == cv.DIGITS - 2
     assert set(calls["digits"][:-1]) == {cv.ON_THE_WAY}
+
+
+def test_a_quadrature_converts_its_parameters_once(monkeypatch):
+    """∫₀^L (p·s² + q) ds = pL³/3 + qL at 30 digits, its parameters (SymPy Floats) converted
+    to mpmath once per precision, not at each of the quadrature's nodes (a node where the
+    integrand has no value at the working precision is still taken by `fast_value`, with
+    more digits: the brachistochrone's cusp, tested above)."""
+    import mpmath
+    import sympy as sp
+
+    from mechbook.engine import curve as cv
+
+    s, p, q, L = sp.symbols("s p q L", positive=True)
+    crv = cv.Curve(s, s, [s], (sp.S.Zero, L), [])
+    pt = {p: sp.Float("0.7", 30), q: sp.Float("1.3", 30), L: sp.Float("2.1", 30)}
+    conversions = []
+    real = cv._mp
+    monkeypatch.setattr(cv, "_mp", lambda x: conversions.append(x) or real(x))
+    got, err = cv.integral(p * s**2 + q, crv, pt)
+    with mpmath.workdps(40):
+        want = mpmath.mpf("0.7") * mpmath.mpf("2.1") ** 3 / 3 + mpmath.mpf("1.3") * \
+            mpmath.mpf("2.1")
+    assert abs(got - want) < mpmath.mpf(10) ** -28
+    assert 0 < len(conversions) <= 3 * 4  # three parameters, a few working precisions

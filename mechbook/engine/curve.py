@@ -130,9 +130,26 @@ def integral(expr_s: sp.Expr, curve: Curve, point: dict):
         a = mp_value(curve.ends[0], point)
         b = mp_value(curve.ends[1], point)
         pt = dict(point)
+        fn, syms = fast(expr_s)
+        at = syms.index(curve.s) if curve.s in syms else None
+        args: dict = {}  # the arguments at a precision, converted once (not at every node)
 
         def f(s):
-            pt[curve.s] = s
+            digits = mpmath.mp.dps  # fast_value's first try, its arguments the same numbers
+            with mpmath.workdps(digits):
+                held = args.get(mpmath.mp.prec)
+                if held is None:
+                    held = args[mpmath.mp.prec] = [_mp(pt[k]) if k != curve.s else None
+                                                   for k in syms]
+                if at is not None:
+                    held[at] = s
+                try:
+                    v = fn(*held)
+                    if mpmath.isfinite(v):
+                        return mpmath.re(v)
+                except (ZeroDivisionError, ValueError, OverflowError):
+                    pass
+            pt[curve.s] = s  # no value at the working precision: fast_value's more digits
             return mpmath.re(fast_value(expr_s, pt))
 
         return mpmath.quad(f, [a, (a + b) / 2, b], error=True)
