@@ -64,6 +64,11 @@ def test_a_restricted_symbol_is_recomputed_without_sympy_at_each_point(monkeypat
             want = mpmath.sqrt(mpmath.mpf("9.8") / mpmath.mpf("0.8")) * mpmath.mpf("4.5") \
                 / mpmath.mpf(bv)
             assert abs(mpmath.mpf(pt[w]._mpf_) / want - 1) < 1e-29, (bv, pt[w])
+        assert isinstance(pt[w], sp.Float) and pt[w]._prec == mpmath.libmp.dps_to_prec(30)
     assert not calls
     bad = Sampler({u: 1.0, g: 1.0}, derived={w: sp.sqrt(g - 2 * u)})
     assert bad.complete({u: sp.Float(1, 30), g: sp.Float(1, 30)}) is None
+    negative = Sampler({u: 1.0, g: 1.0}, derived={w: g - 2 * u})  # w declared positive
+    assert negative.complete({u: sp.Float(1, 30), g: sp.Float(1, 30)}) is None
+    assert negative.complete({u: sp.Float("0.25", 30), g: sp.Float(1, 30)})[w] == \
+        sp.Float("0.5", 30)

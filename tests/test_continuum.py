@@ -458,6 +458,50 @@ def test_a_second_order_transfer_matrix_in_closed_form():
         assert mp.mnorm(transfer_matrix(A, L) - mp.expm(A * L), 1) < mp.mpf(10) ** -38
 
 
+def test_a_beams_transfer_matrix_in_closed_form(monkeypatch):
+    """exp(A·L) of the companion matrix of φ⁗ = β⁴φ (a uniform beam) is f0·I + f1·A +
+    f2·A² + f3·A³ (A⁴ = β⁴I) with, from the solution basis cosh, sinh, cos, sin (derived
+    here: each f_k solves φ⁗ = β⁴φ with φ^(j)(0) = δ_jk): f0 = (cosh βL + cos βL)/2,
+    f1 = (sinh βL + sin βL)/(2β), f2 = (cosh βL − cos βL)/(2β²), f3 = (sinh βL −
+    sin βL)/(2β³); of φ‴ = ν³φ, from e^{νx} and e^{−νx/2}·(cos, sin)(√3νx/2): f0 = (e^{νL}
+    + 2e^{−νL/2}cos(√3νL/2))/3; of φ⁗ = −4γ⁴φ (roots γ(±1 ± i)): f0 = cosh γL·cos γL. To
+    38 digits, without mpmath's series (which runs only where a middle coefficient is not
+    zero, as for φ⁗ + φ″ = μφ)."""
+    from mechbook.engine import continuum
+    from mechbook.engine.continuum import transfer_matrix
+
+    def companion(last):
+        n = len(last)
+        A = mp.zeros(n, n)
+        for i in range(n - 1):
+            A[i, i + 1] = 1
+        for k, a in enumerate(last):
+            A[n - 1, k] = a
+        return A
+
+    with mp.workdps(40):
+        b, L = mp.mpf("1.9"), mp.mpf("1.3")
+        calls = []
+        monkeypatch.setattr(continuum.mp, "expm", lambda *a: calls.append(a) or
+                            mp.matrix(4, 4))
+        A = companion([b**4, 0, 0, 0])
+        got = transfer_matrix(A, L)
+        ch, sh, c, s = mp.cosh(b * L), mp.sinh(b * L), mp.cos(b * L), mp.sin(b * L)
+        f = [(ch + c) / 2, (sh + s) / (2 * b), (ch - c) / (2 * b**2), (sh - s) / (2 * b**3)]
+        want = f[0] * mp.eye(4) + f[1] * A + f[2] * A * A + f[3] * A * A * A
+        assert mp.mnorm(got - want, 1) < mp.mpf(10) ** -37 * mp.mnorm(want, 1)
+        nu = mp.mpf("0.8")
+        got = transfer_matrix(companion([nu**3, 0, 0]), L)
+        want = (mp.exp(nu * L) + 2 * mp.exp(-nu * L / 2) * mp.cos(mp.sqrt(3) * nu * L / 2)) / 3
+        assert abs(got[0, 0] - want) < mp.mpf(10) ** -38
+        g = mp.mpf("1.1")
+        got = transfer_matrix(companion([-4 * g**4, 0, 0, 0]), L)
+        assert abs(got[0, 0] - mp.cosh(g * L) * mp.cos(g * L)) < mp.mpf(10) ** -38
+        assert not calls
+        transfer_matrix(companion([b**4, 0, 1, 0]), L)  # φ⁗ = φ″ + β⁴φ: the series
+        assert len(calls) == 1
+
+
 def test_squared_frequencies_are_computed_once_per_point(tmp_path, monkeypatch):
     """A part's default point is its spectral cross-check's: the second asks no root of
     the boundary determinant, and gets the same 30-digit values whatever its precision."""

@@ -5,9 +5,10 @@
   from a Mathieu tongue's edge (the edges a0(q), b1(q) by Hill's method here, never the
   engine's) it decides, and its verdict is the edge's side and the 113-bit verdict; a
   relative 1e-13 from an edge it cannot, and the 113-bit computation decides; a damped
-  oscillator (det Φ < 1 by Liouville) is decided stable; two degrees of freedom are never
-  decided stable (a multiplier on the circle is not told from one 1e-20 off it without
-  the system's structure).
+  oscillator (det Φ < 1 by Liouville) is decided stable; two degrees of freedom are
+  decided stable only where the equations are Lagrange's of a quadratic Lagrangian (the
+  rotating saddle, inside its window by the closed form), never without that structure
+  (a multiplier on the circle is not told from one 1e-20 off it).
 - The walk's search (`engine_offset`: a gallop from the previous steps' error, a
   bisection that infers what its verdicts decide) gives the same error as the plain climb
   from the floor, written out here as the reference, on synthetic engines with a crossing
@@ -19,6 +20,7 @@
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import mpmath
 import numpy as np
@@ -26,6 +28,7 @@ import pytest
 import sympy as sp
 from systems import SADDLE, load_analysis
 
+from mechbook.errors import MechbookError
 from mechbook.numerics.floquet import Floquet
 from mechbook.numerics.floquet_screen import WORTH_IT, Screen
 from mechbook.verify import boundary_limit
@@ -164,24 +167,136 @@ def test_a_damped_oscillator_is_decided_stable_by_its_determinant(tmp_path):
 
 
 
-def test_two_degrees_of_freedom_are_decided_unstable_only(tmp_path):
-    """The rotating saddle (k = 1, κ = 2) is stable exactly where 1 < Ω² < 9/8 (the closed
-    form derived in tests/test_periodic.py). The screen is built only once the 113-bit
-    computation has found WORTH_IT points unstable (before, it has nothing to offer a
-    claim of stability). Then: inside, no verdict (four multipliers on the circle); at
-    Ω = 1.2, beyond the window, a multiplier wholly outside the circle: unstable, as in
-    113 bits."""
+def _window(omega: str) -> bool:
+    """The rotating saddle's stability (k = 1, κ = 2), derived here: in axes turning with
+    the saddle, u″ − 2Ωw′ + (k − Ω²)u = 0, w″ + 2Ωu′ − (κ + Ω²)w = 0, whose exponents λ
+    have x = λ² solving x² + (k − κ + 2Ω²)x − (k − Ω²)(κ + Ω²) = 0. Stable where both
+    roots are real and negative: product −(k − Ω²)(κ + Ω²) > 0 (Ω² > k = 1), sum < 0
+    (2Ω² > κ − k), discriminant (k − κ + 2Ω²)² + 4(k − Ω²)(κ + Ω²) = 9 − 8Ω² > 0."""
+    w2 = mpmath.mpf(omega) ** 2
+    return 1 < w2 < mpmath.mpf(9) / 8
+
+
+def test_a_hamiltonian_system_is_decided_stable_by_its_symmetry(tmp_path):
+    """The rotating saddle is Lagrange's equation of a quadratic Lagrangian (C = 0, K
+    symmetric): its multipliers come with 1/μ̄, so an isolated Bauer–Fike disc holds one on
+    the circle. Well inside the window 1 < Ω² < 9/8 the screen decides stable, as 113 bits
+    do; beyond it unstable, as 113 bits do; a relative 1e-13 inside the window's upper
+    edge (two multipliers meeting on the circle) and just above Ω² = 1 (a pair near −1)
+    it gives no stable verdict: the discs are not isolated."""
     flo = _floquet(tmp_path, SADDLE, "9803")
     screen = Screen(flo)
-    inside = _at(flo, m="1", k="1", kappa="2", Omega="1.03")
-    outside = _at(flo, m="1", k="1", kappa="2", Omega="1.2")
+    assert screen.symplectic
+    for omega in ("1.01", "1.03", "1.05"):
+        pt = _at(flo, m="1", k="1", kappa="2", Omega=omega)
+        assert _window(omega)
+        assert screen.verdict(pt) == "stable", omega
+        assert flo.stability(pt) == "stable", omega
+    for omega in ("0.9", "1.07", "1.2", "2.0"):
+        pt = _at(flo, m="1", k="1", kappa="2", Omega=omega)
+        assert not _window(omega)
+        assert screen.verdict(pt) == "unstable", omega
+        assert flo.stability(pt) == "unstable", omega
+    with mpmath.workdps(40):
+        edge = mpmath.sqrt(mpmath.mpf(9) / 8 * (1 - mpmath.mpf("1e-13")))
+        near_one = mpmath.sqrt(1 + mpmath.mpf("1e-9"))
+    for omega in (edge, near_one):
+        text = mpmath.nstr(omega, 35)
+        assert _window(text)
+        pt = _at(flo, m="1", k="1", kappa="2", Omega=text)
+        assert screen.verdict(pt) is None, text
+        assert flo.stability(pt) in ("stable", "marginal"), text
+
+
+def test_every_stable_verdict_of_the_symmetry_lies_in_the_window(tmp_path):
+    """Ω drawn across the window and beyond both edges, closer and closer to them
+    (relative 1e-1 … 1e-12): every verdict the screen gives is the closed form's side
+    and the 113-bit verdict, and it both decides and escalates along the way."""
+    flo = _floquet(tmp_path, SADDLE, "9807")
+    screen = Screen(flo)
+    rng = np.random.default_rng(7)
+    decided = escalated = 0
+    for edge in (mpmath.mpf(1), mpmath.sqrt(mpmath.mpf(9) / 8)):
+        for k in range(1, 13, 2):
+            for side in (-1, 1):
+                with mpmath.workdps(40):
+                    omega = edge * (1 + side * mpmath.mpf(10) ** -k *
+                                    (1 + mpmath.mpf(rng.uniform(0, 1))))
+                text = mpmath.nstr(omega, 35)
+                pt = _at(flo, m="1", k="1", kappa="2", Omega=text)
+                quick = screen.verdict(pt)
+                if quick is None:
+                    escalated += 1
+                    continue
+                decided += 1
+                assert quick == ("stable" if _window(text) else "unstable"), (text, quick)
+                assert quick == flo.stability(pt), (text, quick)
+    assert decided >= 6 and escalated >= 6, (decided, escalated)
+
+
+DAMPED_SADDLE = SADDLE.replace("lim-9406", "lim-9408").replace(
+    "  Omega: {value: 1.03}\n", "  Omega: {value: 1.03}\n  c: {value: 0.01}\n") + \
+    "dissipation: c*xdot**2/2\n"
+
+
+def test_two_degrees_of_freedom_without_the_structure_are_decided_unstable_only(tmp_path):
+    """The rotating saddle damped along x (C = diag(c, 0): not antisymmetric) has no
+    symplectic monodromy: the screen is built only once the 113-bit computation has found
+    WORTH_IT points unstable (before, it has nothing to offer a claim of stability), then
+    never says stable (at Ω = 1.03, inside the undamped window), and says unstable at
+    Ω = 1.2, beyond it, as 113 bits do."""
+    flo = _floquet(tmp_path, DAMPED_SADDLE, "9808")
+    screen = Screen(flo)
+    assert not screen.symplectic
+    inside = _at(flo, m="1", k="1", kappa="2", Omega="1.03", c="0.01")
+    outside = _at(flo, m="1", k="1", kappa="2", Omega="1.2", c="0.01")
     assert screen.verdict(outside) is None and screen._tight is None  # not built yet
     for _ in range(WORTH_IT):
         screen.note(flo.stability(outside))
     assert screen.verdict(inside) is None
-    assert flo.stability(inside) == "stable"
     assert screen.verdict(outside) == "unstable"
     assert flo.stability(outside) == "unstable"
+
+
+def _lin(M, C, K, t):
+    return SimpleNamespace(M=sp.Matrix(M), C=sp.Matrix(C), K=sp.Matrix(K),
+                           dyn=SimpleNamespace(sys=SimpleNamespace(t=t)))
+
+
+def _euler_lagrange(L, qs, t):
+    """M, C, K of Lagrange's equations of a Lagrangian quadratic in q and q̇, derived here
+    (d/dt ∂L/∂q̇ − ∂L/∂q, q(t) as functions of t)."""
+    fs = [sp.Function(f"f{i}")(t) for i in range(len(qs))]
+    Lt = L.subs({**{qd: f.diff(t) for (q, qd), f in zip(qs, fs, strict=True)},
+                 **{q: f for (q, _), f in zip(qs, fs, strict=True)}})
+    eqs = [sp.expand(sp.diff(sp.diff(Lt, f.diff(t)), t) - sp.diff(Lt, f)) for f in fs]
+    M = [[e.coeff(g.diff(t, 2)) for g in fs] for e in eqs]
+    C = [[e.coeff(g.diff(t)) for g in fs] for e in eqs]
+    K = [[e.subs({g.diff(t, 2): 0 for g in fs}).subs({g.diff(t): 0 for g in fs}).coeff(g)
+          for g in fs] for e in eqs]
+    return M, C, K
+
+
+def test_the_hamiltonian_structure_is_recognized():
+    """Lagrange's equations of quadratic Lagrangians, derived here, are recognized — a
+    mass m(t), a gyroscopic term q1·n(t)·q̇2 (C antisymmetric but for Ṁ, K with Ȧ as
+    its antisymmetric part), a modulated stiffness — and equations that are none are not:
+    damping, a non-symmetric mass, a gyroscopic C whose time derivative K lacks."""
+    from mechbook.numerics.floquet_screen import hamiltonian
+
+    t, x, y, xd, yd = sp.symbols("t x y xd yd")
+    m, n, k = (sp.Function(f)(t) for f in ("m", "n", "k"))
+    L = m * (xd**2 + yd**2) / 2 + x * n * yd - k * (x**2 + 3 * y**2) / 2 + sp.cos(t) * x * y
+    M, C, K = _euler_lagrange(L, [(x, xd), (y, yd)], t)
+    assert C != [[0, 0], [0, 0]] and K[0][1] != K[1][0]  # the structure is not trivial
+    assert hamiltonian(_lin(M, C, K, t))
+    assert hamiltonian(_lin([[1]], [[0]], [[1 + sp.cos(t)]], t))
+    c = sp.Symbol("c", positive=True)
+    assert not hamiltonian(_lin([[1, 0], [0, 1]], [[c, 0], [0, 0]], [[1, 0], [0, 1]], t))
+    assert not hamiltonian(_lin([[1, t], [0, 1]], [[0, 0], [0, 0]], [[1, 0], [0, 1]], t))
+    g = sp.sin(t)
+    assert not hamiltonian(_lin([[1, 0], [0, 1]], [[0, g], [-g, 0]], [[1, 0], [0, 1]], t))
+    assert hamiltonian(_lin([[1, 0], [0, 1]], [[0, g], [-g, 0]], [[1, g.diff(t)], [0, 1]], t))
 
 
 # ---- the walk's search against the plain climb ------------------------------------------
@@ -329,11 +444,48 @@ def test_the_rate_guard_reads_the_coefficients_at_t0(tmp_path):
     for a, w, g, ell in ((0.1, 45.0, 9.81, 1.0), (0.003, 1500.0, 9.81, 0.7),
                          (1e-6, 2.0, 9.81, 3.0)):
         pt = _at(flo, a=a, omega=w, g=g, l=ell, m=2.0)
-        assert float(flo._rate(pt)) == pytest.approx(1 + abs(g - a * w * w) / ell,
-                                                     rel=1e-14)
+        want = 1 + abs(g - a * w * w) / ell
+        assert float(flo._rate(pt)) == pytest.approx(want, rel=1e-14)
+        assert flo._rate_in_double(pt) == pytest.approx(want, rel=1e-13)
     saddle = _floquet(tmp_path / "saddle", SADDLE, "9805")
     pt = _at(saddle, m="1.5", k="1", kappa="2.5", Omega="1.03")
     assert float(saddle._rate(pt)) == pytest.approx(3.5, rel=1e-14)
+    assert saddle._rate_in_double(pt) == pytest.approx(3.5, rel=1e-13)
+    assert saddle._rate_in_double({}) is None  # a value missing: the 30-digit path
+
+
+def test_the_period_guards_pass_in_double_only_far_from_their_limits(tmp_path, monkeypatch):
+    """The rotating saddle's period (c/Ω) against its rate 1 + max(k, κ) (closed form above):
+    T·rate from 1e-12 to 1e-6 (Ω huge) and T·√rate from 1e3 to 1e7 (Ω tiny) across the
+    guards' limits SHORTEST = 1e-9 and LONGEST = 1e5: the 30-digit rate is read exactly
+    where one of them lies within RATE_MARGIN of its limit, and the period is refused
+    exactly where the closed form puts it beyond one (the double rate never decides a
+    refusal)."""
+    import mechbook.numerics.floquet as fq
+
+    saddle = _floquet(tmp_path, SADDLE, "9806")
+    exact = []
+    real = fq.Floquet._rate
+    monkeypatch.setattr(fq.Floquet, "_rate", lambda self, v: exact.append(1) or real(self, v))
+    rate = 1 + 2.5
+    omega_sym = next(s for s in saddle.symbols if s.name == "Omega")
+    per = float(saddle.period * omega_sym)  # the period the engine found is per/Ω
+    for x in np.geomspace(1e-12, 1e-6, 13).tolist() + np.geomspace(1e3, 1e7, 13).tolist():
+        short = x < 1
+        T = x / rate if short else x / math.sqrt(rate)  # T·rate = x, or T·√rate = x
+        omega = per / T
+        pt = _at(saddle, m="1", k="1", kappa="2.5", Omega=repr(omega))
+        exact.clear()
+        refused = short and x < fq.SHORTEST or not short and x > fq.LONGEST
+        near = (fq.SHORTEST / fq.RATE_MARGIN <= x <= fq.RATE_MARGIN * fq.SHORTEST) if short \
+            else (fq.LONGEST / fq.RATE_MARGIN <= x <= fq.RATE_MARGIN * fq.LONGEST)
+        try:
+            saddle.period_at(pt)
+            assert not refused, x
+        except MechbookError:
+            assert refused, x
+        assert bool(exact) == (refused or near or (short and x < fq.SHORTEST * fq.RATE_MARGIN)
+                               or (not short and x > fq.LONGEST / fq.RATE_MARGIN)), x
 
 
 def test_the_bound_covers_the_parameters_rounding_to_doubles(mathieu):

@@ -390,3 +390,78 @@ def test_implicit_ray(tmp_path, curve, status):
     """
     part = f"quantity: extremal\nsolve_for: {{r: 1.2}}\nbook: {{implicit: \"{curve}\"}}\n"
     assert _one(tmp_path, "fermat", medium, part) == status
+
+
+def test_the_constants_by_broyden_and_a_loose_way():
+    """The hanging chain's c from its length, 2c·sinh(d/c) = l (d = 1, l = 3: the root by
+    mpmath's own findroot here at 50 digits): Gauss–Newton with Broyden's updates reaches
+    it to 28 digits from c = 0.6, with forward-difference Jacobians only where a step did
+    not halve the residual (here once: the start); followed to l = 3.4, d = 1.1 its
+    continuation's points on the way are solved to ON_THE_WAY digits and the last to 28,
+    the root there."""
+    import mpmath
+    import sympy as sp
+
+    from mechbook.engine import curve as cv
+
+    s, c, d, ell = sp.symbols("s c d l", positive=True)
+    crv = cv.Curve(s, s, [c * sp.cosh(s / c) - c * sp.cosh(d / c)], (-d, d), [c])
+    cond = cv.Conditions([], [], [("length", sp.cosh(s / c), ell)], [], [], [])
+
+    def root(dv: str, lv: str):
+        with mpmath.workdps(50):
+            dv, lv = mpmath.mpf(dv), mpmath.mpf(lv)
+            return mpmath.findroot(lambda x: 2 * x * mpmath.sinh(dv / x) - lv,
+                                   mpmath.mpf("0.6"))
+
+    calls = {"jacobian": 0, "digits": []}
+    jac, solve = cv._jacobian, cv.solve_unknowns
+
+    def counted(*a):
+        calls["jacobian"] += 1
+        return jac(*a)
+
+    def solved(*a):
+        calls["digits"].append(a[5] if len(a) > 5 else cv.DIGITS - 2)
+        return solve(*a)
+
+    base = {d: sp.Float(1, 30), ell: sp.Float(3, 30)}
+    mp = pytest.MonkeyPatch()
+    mp.setattr(cv, "_jacobian", counted)
+    try:
+        got = cv.solve_unknowns(cond, crv, [c], {c: 0.6}, base)
+        assert calls["jacobian"] == 1
+        assert abs(got[c] / root("1", "3") - 1) < mpmath.mpf(10) ** -28
+        mp.setattr(cv, "solve_unknowns", solved)
+        target = {d: sp.Float("1.1", 30), ell: sp.Float("3.4", 30)}
+        far = cv.continued(cond, crv, [c], got, base, target)
+    finally:
+        mp.undo()
+    assert abs(far[c] / root("1.1", "3.4") - 1) < \
+        mpmath.mpf(10) ** -27
+    assert calls["digits"][-1] == cv.DIGITS - 2
+    assert set(calls["digits"][:-1]) == {cv.ON_THE_WAY}
+
+
+def test_a_quadrature_converts_its_parameters_once(monkeypatch):
+    """∫₀^L (p·s² + q) ds = pL³/3 + qL at 30 digits, its parameters (SymPy Floats) converted
+    to mpmath once per precision, not at each of the quadrature's nodes (a node where the
+    integrand has no value at the working precision is still taken by `fast_value`, with
+    more digits: the brachistochrone's cusp, tested above)."""
+    import mpmath
+    import sympy as sp
+
+    from mechbook.engine import curve as cv
+
+    s, p, q, L = sp.symbols("s p q L", positive=True)
+    crv = cv.Curve(s, s, [s], (sp.S.Zero, L), [])
+    pt = {p: sp.Float("0.7", 30), q: sp.Float("1.3", 30), L: sp.Float("2.1", 30)}
+    conversions = []
+    real = cv._mp
+    monkeypatch.setattr(cv, "_mp", lambda x: conversions.append(x) or real(x))
+    got, err = cv.integral(p * s**2 + q, crv, pt)
+    with mpmath.workdps(40):
+        want = mpmath.mpf("0.7") * mpmath.mpf("2.1") ** 3 / 3 + mpmath.mpf("1.3") * \
+            mpmath.mpf("2.1")
+    assert abs(got - want) < mpmath.mpf(10) ** -28
+    assert 0 < len(conversions) <= 3 * 4  # three parameters, a few working precisions

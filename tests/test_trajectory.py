@@ -47,6 +47,29 @@ def test_level_set_of_the_pendulum(pend, theta0):
     assert abs(float(orbit.period) / exact_period(theta0) - 1) < 1e-12
 
 
+@pytest.mark.parametrize("theta0", [0.3, 2.5])
+def test_the_action_shares_the_periods_nodes(pend, theta0, monkeypatch):
+    """J = (1/2π)∮ m l² θ̇ dθ with θ̇² = (2g/l)(cos θ − cos θ0) is, by ∫₀^θ0 √(cos θ − cos θ0)
+    dθ = 2√2 [E(k) − (1 − k²)K(k)], k = sin(θ0/2): J = (8/π) m √(g l³) [E(k) − (1 − k²)K(k)].
+    The orbit's action after its period evaluates E − V_eff once at each node the period's
+    quadrature had not taken, and at none it had (their values are kept on the orbit)."""
+    from scipy.special import ellipe
+
+    sys = pend.system()
+    th, thd = sys.q[0], sys.qd[0]
+    orbit = LevelSet(pend.dynamics(), th).orbit({th: theta0, thd: 0}, pend.problem.values())
+    m = math.sin(theta0 / 2) ** 2
+    exact = 8 / math.pi * M * math.sqrt(G * L**3) * (ellipe(m) - (1 - m) * ellipk(m))
+    assert abs(float(orbit.period) / exact_period(theta0) - 1) < 1e-12
+    taken = set(orbit._nodes)
+    calls = []
+    kinetic = type(orbit).kinetic
+    monkeypatch.setattr(type(orbit), "kinetic", lambda self, c: calls.append(c) or
+                        kinetic(self, c))
+    assert abs(float(orbit.action) / exact - 1) < 1e-12
+    assert len(calls) == len(set(orbit._nodes) - taken)
+
+
 @pytest.mark.parametrize("theta0", [0.3, 1.2, 2.5])
 def test_measured_pendulum_is_accurate_to_1e9(pend, theta0):
     """The stated accuracy of the integrator measurement (MEASURE_RTOL = 1e-7) has margin."""

@@ -163,13 +163,16 @@ def transfer_matrix(A, length) -> mp.matrix:
     (A − tI)] (cos and sin where s² < 0): exact, and a twentieth of the time
     of mpmath's Taylor series with squarings, which a root's polish calls ten times; other
     sizes by mpmath's expm (a Vandermonde diagonalization of a beam's 4×4 companion matrix
-    was tried: its roots at twice the digits cost as much as the series).
+    was tried: its roots at twice the digits cost as much as the series), but for a mode
+    ODE with only its highest and lowest derivatives (a uniform beam's φ⁗ = μφ): its
+    companion matrix has Aⁿ = μI, and exp(AL) in closed form (`_cyclic_transfer`).
 
     >>> transfer_matrix(mp.matrix([[0, 1], [-1, 0]]), mp.pi / 2)[0, 1]  # sin(π/2)
     mpf('1.0')
     """
     if A.rows != 2:
-        return mp.expm(A * length)
+        cyclic = _cyclic_transfer(A, length)
+        return mp.expm(A * length) if cyclic is None else cyclic
     t = (A[0, 0] + A[1, 1]) / 2
     s2 = t * t - (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0])
     if s2 > 0:
@@ -183,6 +186,35 @@ def transfer_matrix(A, length) -> mp.matrix:
     e = mp.exp(t * length)
     return mp.matrix([[e * (ch + sh * (A[0, 0] - t)), e * sh * A[0, 1]],
                       [e * sh * A[1, 0], e * (ch + sh * (A[1, 1] - t))]])
+
+
+def _cyclic_transfer(A, length) -> mp.matrix | None:
+    """exp(A·L) of an n×n companion matrix whose only last-row entry is μ = A[n−1, 0] ≠ 0
+    (A shifts e_j to e_{j−1}, e_0 to μ·e_{n−1}: Aⁿ = μI), else None. On A's eigenvector of
+    eigenvalue s (one of the n roots of sⁿ = μ), Σ_k f_k A^k = e^{sL} for f_k =
+    (1/n)·Σ_j s_j^(−k)·e^{s_j L}, as the roots' ratios are the n-th roots of unity; and
+    (A^k)_{ij} is 1 at j = i + k, μ at j = i + k − n, 0 elsewhere: exp(AL)_{ij} = f_{j−i},
+    or μ·f_{j−i+n} below the diagonal. n exponentials instead of the series' squarings;
+    None where |s|L < 1e-3 (the f_k cancel there: the series is as cheap)."""
+    n = A.rows
+    mu = A[n - 1, 0]
+    if n < 3 or mu == 0 or any(A[n - 1, k] != 0 for k in range(1, n)) or \
+            any(A[i, k] != (1 if k == i + 1 else 0) for i in range(n - 1) for k in range(n)):
+        return None
+    size = abs(mu) ** (mp.mpf(1) / n)
+    if size * abs(length) < mp.mpf("1e-3"):
+        return None
+    extra = 5 + int(n * max(0.0, float(-mp.log10(size * abs(length)))))
+    with mp.workdps(mp.mp.dps + extra):  # f_{n−1} ~ (sL)^(n−1)/(n−1)!: digits cancel below 1
+        roots = [mp.root(mp.mpc(mu), n, k) for k in range(n)]
+        exps = [mp.exp(r * length) for r in roots]
+        f = [mp.re(mp.fsum(e / r ** k for r, e in zip(roots, exps, strict=True))) / n
+             for k in range(n)]
+    out = mp.matrix(n, n)
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = +f[j - i] if j >= i else mu * f[j - i + n]
+    return out
 
 
 def _boundary_matrix(ode: list, weight, length, left: list, right: list, lam):

@@ -29,6 +29,7 @@ from mechbook.model.functional import Functional
 DIGITS = 30
 NEWTON_STEPS = 40  # Gauss–Newton iterations for the constants at one point
 CONTINUATION = 4  # steps from the default parameter values to a sampled point
+ON_THE_WAY = 12  # digits of the constants at the continuation's points before the last
 JACOBI_START = 1e-3  # the Jacobi field starts this fraction of the range inside
 JACOBI_CALLS = 20000  # right-hand sides the Jacobi field may take
 INTERIOR = (0.13, 0.29, 0.41, 0.58, 0.71, 0.87)  # fractions of [s_a, s_b] sampled
@@ -129,9 +130,26 @@ def integral(expr_s: sp.Expr, curve: Curve, point: dict):
         a = mp_value(curve.ends[0], point)
         b = mp_value(curve.ends[1], point)
         pt = dict(point)
+        fn, syms = fast(expr_s)
+        at = syms.index(curve.s) if curve.s in syms else None
+        args: dict = {}  # the arguments at a precision, converted once (not at every node)
 
         def f(s):
-            pt[curve.s] = s
+            digits = mpmath.mp.dps  # fast_value's first try, its arguments the same numbers
+            with mpmath.workdps(digits):
+                held = args.get(mpmath.mp.prec)
+                if held is None:
+                    held = args[mpmath.mp.prec] = [_mp(pt[k]) if k != curve.s else None
+                                                   for k in syms]
+                if at is not None:
+                    held[at] = s
+                try:
+                    v = fn(*held)
+                    if mpmath.isfinite(v):
+                        return mpmath.re(v)
+                except (ZeroDivisionError, ValueError, OverflowError):
+                    pass
+            pt[curve.s] = s  # no value at the working precision: fast_value's more digits
             return mpmath.re(fast_value(expr_s, pt))
 
         return mpmath.quad(f, [a, (a + b) / 2, b], error=True)
@@ -242,35 +260,49 @@ def residuals(cond: Conditions, curve: Curve, point: dict) -> list[tuple[str, ob
 
 
 def solve_unknowns(cond: Conditions, curve: Curve, unknowns: list[sp.Symbol],
-                   start: dict, params: dict) -> dict | None:
+                   start: dict, params: dict, digits: int = DIGITS - 2) -> dict | None:
     """The unknowns (constants, multipliers) that make every residual vanish at the
-    parameter values `params`, by Gauss–Newton at 30 digits from `start`; None if it does
-    not converge."""
+    parameter values `params`, by Gauss–Newton at 30 digits from `start`, until a step is
+    below 10^−digits of them (28 digits; a point on the way of a continuation needs
+    fewer); None if it does not converge. The Jacobian by forward differences at the start
+    and wherever a step did not halve the residual, else by Broyden's update (the secant
+    condition J·Δu = Δr: one residual vector a step instead of one per unknown more; the
+    steps then shrink superlinearly, and the answer is still where r = 0)."""
     u = mpmath.matrix([mpmath.mpf(str(start[k])) for k in unknowns])
     with mpmath.workdps(DIGITS + 10):
+        J = before = last = None
         for _ in range(NEWTON_STEPS):
             pt = {**params, **dict(zip(unknowns, u, strict=True))}
             try:
                 r = _vector(cond, curve, pt)
-                J = mpmath.matrix(len(r), len(unknowns))
-                for j, k in enumerate(unknowns):
-                    # a forward difference: its O(h) = 1e-12 error in J slows Newton by a
-                    # factor 1e-12 a step, and the answer is where r = 0 (one residual
-                    # vector a column, not two)
-                    h = mpmath.mpf(10) ** -12 * max(1, abs(u[j]))
-                    up = dict(pt)
-                    up[k] = u[j] + h
-                    col = (_vector(cond, curve, up) - r) / h
-                    for i in range(len(r)):
-                        J[i, j] = col[i]
+                if J is not None and mpmath.norm(r) <= mpmath.norm(before) / 2:
+                    J += (r - before - J * last) * last.T / mpmath.fsum(x * x for x in last)
+                else:
+                    J = _jacobian(cond, curve, unknowns, u, pt, r)
                 step = mpmath.lu_solve(J.T * J + mpmath.eye(len(unknowns)) *
                                        mpmath.mpf(10) ** -40, -(J.T * r))
             except (ZeroDivisionError, ValueError, TypeError, ArithmeticError):
                 return None
             u += step
-            if mpmath.norm(step) <= mpmath.mpf(10) ** -(DIGITS - 2) * (1 + mpmath.norm(u)):
+            before, last = r, step
+            if mpmath.norm(step) <= mpmath.mpf(10) ** -digits * (1 + mpmath.norm(u)):
                 return dict(zip(unknowns, u, strict=True))
     return None
+
+
+def _jacobian(cond: Conditions, curve: Curve, unknowns: list[sp.Symbol], u, pt: dict, r):
+    """∂r/∂u at `pt` by forward differences: the O(h) = 1e-12 error in J slows Newton by a
+    factor 1e-12 a step, and the answer is where r = 0 (one residual vector a column, not
+    two)."""
+    J = mpmath.matrix(len(r), len(unknowns))
+    for j, k in enumerate(unknowns):
+        h = mpmath.mpf(10) ** -12 * max(1, abs(u[j]))
+        up = dict(pt)
+        up[k] = u[j] + h
+        col = (_vector(cond, curve, up) - r) / h
+        for i in range(len(r)):
+            J[i, j] = col[i]
+    return J
 
 
 def _vector(cond: Conditions, curve: Curve, pt: dict):
@@ -287,20 +319,23 @@ def continued(cond: Conditions, curve: Curve, unknowns: list[sp.Symbol], start: 
     branch met at the sampled point); None where the branch is lost."""
     if not unknowns:
         return {}
-    at, before = solve_unknowns(cond, curve, unknowns, start, base), None
+    at, before = solve_unknowns(cond, curve, unknowns, start, base, ON_THE_WAY), None
     for k in range(1, CONTINUATION + 1):
         if at is None:
             return None
         t = mpmath.mpf(k) / CONTINUATION
         params = {p: base[p] + t * (target[p] - base[p]) for p in target}
+        # the points on the way only keep to the branch: ON_THE_WAY digits, far below the
+        # extrapolation's own error; the target to the full 28
+        digits = DIGITS - 2 if k == CONTINUATION else ON_THE_WAY
         # Newton from the branch extrapolated along the equal steps (off by the steps'
         # square, not by a step: three iterations fewer of eight), else from the last point
         found = None
         if before is not None:
             ahead = {u: 2 * at[u] - before[u] for u in unknowns}
-            found = solve_unknowns(cond, curve, unknowns, ahead, params)
+            found = solve_unknowns(cond, curve, unknowns, ahead, params, digits)
         if found is None:
-            found = solve_unknowns(cond, curve, unknowns, at, params)
+            found = solve_unknowns(cond, curve, unknowns, at, params, digits)
         at, before = found, at
     return at
 

@@ -20,7 +20,7 @@ mechbook.numerics.measure.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import mpmath
@@ -174,6 +174,9 @@ class Orbit:
     params: list
     dps: int = DPS  # the working precision: turning points to 10^(5 - dps), quadratures
     # until two agree to 10^(30 - dps)
+    # the quadratures' nodes (N, j): c, E − V_eff, √(m/(2(E − V_eff))), sin s: the period,
+    # the action and an advance of one orbit take the same midpoints
+    _nodes: dict = field(default_factory=dict, repr=False, compare=False)
 
     def _args(self, c):
         return [c, *self.P, *self.params]
@@ -277,7 +280,7 @@ class Orbit:
             return self._edge(-1), self._edge(+1)
 
     def _quad(self, weight) -> object:
-        """2 ∫ weight(c) √(m/(2(E − V))) dc between the turning points.
+        """2 ∫ weight(c, E − V(c)) √(m/(2(E − V))) dc between the turning points.
 
         With c = mid − half·cos s the integrand becomes weight·√(m/(2r(c))), r = (E − V)/
         ((c − lo)(hi − c)): smooth, even and 2π-periodic in s, so the midpoint rule on
@@ -285,7 +288,9 @@ class Orbit:
         10^(30 − dps), 1e-20 at 50 digits (E − V loses digits near the turning points of a
         very small orbit: 50 digits leave at least 20 there). What is left of the working
         precision is measured, where it matters, by computing the orbit at a second, higher
-        one (mechbook.verify.quantities.trajectory)."""
+        one (mechbook.verify.quantities.trajectory). The nodes' values are kept on the
+        orbit: its period, action and advances (their N the same at each doubling) evaluate
+        E − V_eff and m once a node, the action's weight 2(E − V) is the node's own."""
         mass, _, _ = self.level.numeric_functions
         lo, hi = self.turning_points
         if not (mpmath.isfinite(lo) and mpmath.isfinite(hi)):
@@ -294,17 +299,25 @@ class Orbit:
         with mpmath.workdps(self.dps):  # mid, half at full precision: c − lo tiny near s = 0
             mid, half = (lo + hi) / 2, (hi - lo) / 2
 
-            def f(s):
-                c = mid - half * mpmath.cos(s)
-                k = self.kinetic(c)
-                if k <= 0:
-                    raise UnsupportedError("level set: the motion leaves the allowed region "
-                                           "between its turning points")
-                return weight(c) * mpmath.sqrt(mass(*self._args(c)) / (2 * k)) * half \
-                    * mpmath.sin(s)
+            nodes_seen = self._nodes
+
+            def f(n, j):
+                key = (n, j)
+                hit = nodes_seen.get(key)
+                if hit is None:
+                    s = mpmath.pi * (j + mpmath.mpf(1) / 2) / n
+                    c = mid - half * mpmath.cos(s)
+                    k = self.kinetic(c)
+                    if k <= 0:
+                        raise UnsupportedError("level set: the motion leaves the allowed "
+                                               "region between its turning points")
+                    hit = nodes_seen[key] = (c, k, mpmath.sqrt(mass(*self._args(c)) / (2 * k)),
+                                             mpmath.sin(s))
+                c, k, root, sine = hit
+                return weight(c, k) * root * half * sine
 
             total, n, previous = mpmath.mpf(0), 8, None
-            nodes = [f(mpmath.pi * (j + mpmath.mpf(1) / 2) / n) for j in range(n)]
+            nodes = [f(n, j) for j in range(n)]
             while True:
                 total = mpmath.fsum(nodes) * mpmath.pi / n
                 if previous is not None and abs(total - previous) <= \
@@ -315,11 +328,11 @@ class Orbit:
                 previous = total
                 # the midpoints of 3n cells reuse none of the n; simply recompute at 2n
                 n *= 2
-                nodes = [f(mpmath.pi * (j + mpmath.mpf(1) / 2) / n) for j in range(n)]
+                nodes = [f(n, j) for j in range(n)]
 
     @cached_property
     def period(self):
-        return self._quad(lambda c: mpmath.mpf(1))
+        return self._quad(lambda c, k: mpmath.mpf(1))
 
     def time_to(self, target):
         """The time the motion takes from c0 to c = `target`, or None where it does not get
@@ -354,10 +367,10 @@ class Orbit:
         J = (1/2π)·2∫ 2(E − V_eff)·√(m/(2(E − V_eff))) dc, the period's quadrature with the
         weight 2(E − V_eff) (smooth after the same substitution)."""
         with mpmath.workdps(self.dps):
-            return self._quad(lambda c: 2 * self.kinetic(c)) / (2 * mpmath.pi)
+            return self._quad(lambda c, k: 2 * k) / (2 * mpmath.pi)
 
     def advance(self, coordinate: sp.Symbol):
         """How far a cyclic coordinate advances over one period."""
         i = self.level.cyclic.index(coordinate)
         u = self.level.numeric_functions[2][i]
-        return self._quad(lambda c: u(*self._args(c)))
+        return self._quad(lambda c, k: u(*self._args(c)))

@@ -45,6 +45,8 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from mechbook.core.backends import FEW_CALLS_BACKEND
+from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.engine import periodic
 from mechbook.engine.linear import LinearSystem
@@ -70,6 +72,7 @@ LONGEST = 1e5  # T·√rate above this: one period holds more oscillations of th
 # than a monodromy in 113-bit arithmetic integrates in a check's time (a Kapitza pivot
 # driven at amplitude 1e90 looped in heyoka until the time limit): an error, at once
 ARITHMETIC = "Taylor integration (heyoka) in 113-bit arithmetic"
+RATE_MARGIN = 2.0  # the double-precision rate passes a guard only this far inside its limit
 
 
 def on_circle(resolution: float, scale: float = 1.0) -> float:
@@ -136,6 +139,7 @@ class Floquet:
     _at_zero: list | None = field(default=None, repr=False)  # M, K, C at t = 0
     traceless: bool = False  # tr M⁻¹C ≡ 0 (set by `taylor`): det Φ = 1 exactly
     _checked: tuple | None = field(default=None, repr=False)  # the last point's period
+    _quick: object = field(default=None, repr=False)  # M, K, C at t = 0 compiled (double)
 
     @classmethod
     def of(cls, lin: LinearSystem, period: sp.Expr | None = None) -> Floquet:
@@ -228,6 +232,10 @@ class Floquet:
             if not mpmath.isfinite(T) or T == 0:
                 raise MechbookError(f"the period {self.period} is not a finite positive "
                                     "number here")
+            quick = self._rate_in_double(values)
+            if quick is not None and float(T) * quick > RATE_MARGIN * SHORTEST and \
+                    RATE_MARGIN * float(T) * math.sqrt(quick) < LONGEST:
+                return T  # both guards pass, far from their limits
             rate = self._rate(values)
             if T * rate < SHORTEST:
                 raise MechbookError(
@@ -263,6 +271,37 @@ class Floquet:
         except (NotNumeric, TypeError, ValueError, ZeroDivisionError, KeyError):
             return mpmath.mpf(1)
         return mpmath.mpf(1) + (mpmath.mpf(big) if math.isfinite(big) else 0)
+
+    def _rate_in_double(self, values: dict) -> float | None:
+        """`_rate` in double precision (M, K, C at t = 0 compiled once, M solved by LAPACK):
+        enough to pass both guards where T·rate and T·√rate lie RATE_MARGIN inside their
+        limits (the point's check then costs microseconds); None where it is not to be
+        trusted (a value missing or not finite, M far from invertible: κ(M) > 1e8), and the
+        30-digit `_rate` decides."""
+        if self._quick is None:
+            t = self.lin.dyn.sys.t
+            mats = [A.xreplace({t: 0}) for A in (self.lin.M, self.lin.K, self.lin.C)]
+            try:
+                f, _ = compile_exprs(self.symbols, [e for A in mats for e in A],
+                                     FEW_CALLS_BACKEND)
+            except (UnsupportedError, TypeError, ValueError):
+                f = False
+            self._quick = f
+        if self._quick is False or any(s not in values for s in self.symbols):
+            return None
+        n = self.lin.M.rows
+        try:
+            x = np.array([float(values[s]) for s in self.symbols], dtype=float)
+            v = np.asarray(self._quick(x), dtype=float).ravel()
+        except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+            return None
+        if v.size != 3 * n * n or not np.all(np.isfinite(v)):
+            return None
+        M, K, C = (v[k * n * n:(k + 1) * n * n].reshape(n, n) for k in range(3))
+        if not np.linalg.cond(M) <= 1e8:
+            return None
+        big = float(np.max(np.abs(np.linalg.solve(M, np.hstack([K, C])))))
+        return 1.0 + big if math.isfinite(big) else None
 
     def checked_period(self, values: dict):
         """The period at `values` (`period_at`), a declared one verified there, and every

@@ -23,14 +23,26 @@ thresholds; everywhere else it returns None and the 113-bit computation decides:
   a multiplier marginal only within marginal_within(resolution, scale) ≤ 100·√(1e-20 ·
   MAX_SCALE) ≈ 3e-7 < NEAR of ±1 (any resolution it accepts), and on the circle only
   within on_circle ≤ 1e-14 of it.
-- **stable**, one degree of freedom only: the trace's bound keeps tr² < 4 det by
+- **stable**, one degree of freedom: the trace's bound keeps tr² < 4 det by
   MARGIN, so the multipliers are a complex pair, |μ|² = det Φ exactly, and det Φ is 1
   exactly where tr M⁻¹C ≡ 0 (no damping, no velocity terms) or below 1 − MARGIN where the
   Liouville exponent says so; the pair stays NEAR clear of ±1. The 113-bit verdict there
   is stable: its |μ| − 1 is half its determinant's mismatch, below its on_circle where
   Φ's entries are at most MAX_STABLE_SCALE (κ(Φ) ≤ 4·scale² for a 2×2 of determinant 1).
-  Two or more degrees of freedom: a multiplier on the circle cannot be told from one 1e-20
-  off it in double precision without the system's symplectic structure: never decided.
+- **stable**, two or more degrees of freedom, only where the system has the structure
+  that keeps a multiplier on the circle (without it one on the circle cannot be told from
+  one 1e-20 off it in double precision: never decided): M q̈ + C q̇ + K q = 0 is Lagrange's
+  equation of a quadratic Lagrangian ½q̇ᵀMq̇ + qᵀNq̇ − ½qᵀK′q exactly where M is
+  symmetric, A = C − Ṁ antisymmetric and K − Kᵀ = Ȧ (`hamiltonian`, decided once by SymPy),
+  and then Φ is similar, by the periodic change to (q, p), to a symplectic matrix: with μ
+  its multipliers hold 1/μ̄. Each Bauer–Fike disc holds exactly one multiplier where the
+  discs are disjoint (they move continuously from Φ's eigenvalues as the error is turned
+  on); where the disc about λ, and its reflection in the circle (within r′ of λ), meet no
+  other disc, the multiplier in it is its own reflection: on the circle. So: stable where
+  every disc is so isolated and NEAR clear of ±1, with κ(V)·n ≤ KAPPA_N and Φ's entries at
+  most MAX_STABLE_SCALE. The 113-bit verdict there is stable: its multipliers lie within
+  κ·n·(resolution·scale) ≤ KAPPA_N·resolution·scale of the circle (Bauer–Fike about the
+  exact ones), below its on_circle (1e3 times that), and more than NEAR from ±1.
 
 The equations' constants are doubles here (a 1/3 is rounded, as a parameter is); where a
 constant multiplies a parameter its rounding is one of the moves measured, and where it
@@ -47,6 +59,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import sympy as sp
 
 from mechbook.errors import MechbookError
 from mechbook.numerics.floquet import Floquet
@@ -62,6 +75,7 @@ MAX_STABLE_SCALE = 500.0  # a stable verdict: the 113-bit |μ| − 1 stays withi
 MAX_BOUND = 1e-6  # an error bound above this: not screened (the integration is poor)
 WORTH_IT = 4  # 2 or more degrees of freedom: screened once this many were unstable
 NUDGE = 8  # ulps each parameter (and the period) is moved by to measure Φ's sensitivity
+KAPPA_N = 250.0  # a stable verdict with 2+ degrees of freedom: κ(V)·n at most this
 
 
 class Screen:
@@ -76,6 +90,7 @@ class Screen:
         self.decided = 0
         self.escalated = 0
         self.unstable_seen = 0  # 113-bit verdicts 'unstable' (`note`)
+        self._hamiltonian: bool | None = None  # Φ similar to a symplectic matrix
 
     def _build(self) -> bool:
         if self._tight is None and not self.broken:
@@ -108,7 +123,7 @@ class Screen:
         'stable', α = 1 (in the first tongue) 'unstable', α a relative 1e-13 from an edge
         None."""
         flo = self.floquet
-        useful = self.n2 == 2 or self.unstable_seen >= WORTH_IT
+        useful = self.n2 == 2 or self.unstable_seen >= WORTH_IT or self.symplectic
         if not (useful and self._build()):  # the 113-bit path raises what it raises
             self.escalated += 1
             return None
@@ -140,10 +155,17 @@ class Screen:
             ds += abs(float(c[-1] - a[-1]))
         return dphi, ds
 
+    @property
+    def symplectic(self) -> bool:
+        """Whether Φ is similar to a symplectic matrix (`hamiltonian`, decided once)."""
+        if self._hamiltonian is None:
+            self._hamiltonian = self.n2 > 2 and hamiltonian(self.floquet.lin)
+        return self._hamiltonian
+
     def note(self, verdict: str) -> None:
         """A 113-bit verdict taken where the screen gave none: with two or more degrees of
-        freedom the screen can only tell 'unstable', so it is built (two compiles) only
-        once WORTH_IT such verdicts have been met."""
+        freedom and no symplectic structure the screen can only tell 'unstable', so it is
+        built (two compiles) only once WORTH_IT such verdicts have been met."""
         if verdict == "unstable":
             self.unstable_seen += 1
 
@@ -181,7 +203,56 @@ class Screen:
             det_lo, det_hi = math.exp(-s - ds), math.exp(-s + ds)
         if n2 == 2:
             return _two_by_two(phi, bound, det_lo, det_hi, flo.traceless, scale)
-        return _unstable_by_discs(phi, bound)
+        got = _unstable_by_discs(phi, bound)
+        if got is None and self.symplectic and scale <= MAX_STABLE_SCALE:
+            return _stable_by_symmetry(phi, bound)
+        return got
+
+
+def hamiltonian(lin) -> bool:
+    """Whether M q̈ + C q̇ + K q = 0 is Lagrange's equation of a quadratic Lagrangian
+    ½q̇ᵀMq̇ + qᵀNq̇ − ½qᵀK′q (M, K′ symmetric): M symmetric, A = C − Ṁ antisymmetric and
+    K − Kᵀ = Ȧ (then N = −A/2, K′ = K − Ȧ/2), each entry's difference simplified to 0
+    by SymPy. The monodromy of such a system is similar to a symplectic one (its flow in
+    q and p = Mq̇ + Nᵀq, the change periodic), so its multipliers come with 1/μ̄. False
+    where SymPy does not reduce a difference to 0 (the screen then decides no stability).
+    Example: m q̈ + k(t) q = 0 is; m q̈ + c q̇ + k q = 0 with c ≠ 0 is not."""
+    t = lin.dyn.sys.t
+    M, C, K = lin.M, lin.C, lin.K
+    A = C - M.diff(t)
+    n = M.rows
+    try:
+        return all(sp.simplify(e) == 0 for i in range(n) for j in range(n) for e in
+                   (M[i, j] - M[j, i], A[i, j] + A[j, i],
+                    K[i, j] - K[j, i] - sp.diff(A[i, j], t)))
+    except (TypeError, ValueError, NotImplementedError, RecursionError):
+        return False
+
+
+def _stable_by_symmetry(phi: np.ndarray, bound: float) -> str | None:
+    """Two or more degrees of freedom, Φ similar to a symplectic matrix: 'stable' where
+    every Bauer–Fike disc (radius r about λ) and its reflection in the unit circle (within
+    r′ = r/((|λ| − r)|λ|) + ||λ|² − 1|/|λ| of λ) meet no other disc and stay NEAR clear of
+    ±1, with κ(V)·n ≤ KAPPA_N (module docstring); else None."""
+    n = phi.shape[0]
+    try:
+        lam, V = np.linalg.eig(phi)
+        kappa = float(np.linalg.cond(V))
+    except np.linalg.LinAlgError:
+        return None
+    if not (math.isfinite(kappa) and kappa * n <= KAPPA_N):
+        return None
+    r = kappa * (n * bound + 100 * n * EPS * float(np.linalg.norm(phi, 2)))
+    for k in range(n):
+        size = abs(lam[k])
+        if size <= 2 * r:
+            return None
+        reach = max(r, r / ((size - r) * size) + abs(size * size - 1) / size)
+        if min(abs(lam[k] - 1), abs(lam[k] + 1)) - reach <= NEAR:
+            return None
+        if any(abs(lam[k] - lam[j]) <= reach + r for j in range(n) if j != k):
+            return None
+    return "stable"
 
 
 def _two_by_two(phi: np.ndarray, bound: float, det_lo: float, det_hi: float,

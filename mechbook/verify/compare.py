@@ -45,13 +45,14 @@ class Verdict:
 def _derived_value(expr: sp.Basic, point: dict) -> tuple:
     """(real part, imaginary part) of a derived symbol's expression at `point`: compiled
     once and run in mpmath at 15 digits beyond DIGITS (the walk toward a limit asks for it
-    at thousands of points: SymPy's subs and N cost 4 ms each there), SymPy's own
-    evaluation where the compiled program has no number for a part; (None, None) where
+    at thousands of points: SymPy's subs and N cost 4 ms each there), as mpmath numbers
+    (the checks on them are mpmath's comparisons, not SymPy's: a tenth of the time), SymPy's
+    own evaluation where the compiled program has no number for a part; (None, None) where
     the value is not a number."""
     try:
         with mpmath.workdps(DIGITS + 15):
             v = evaluate_mp(expr, point, DIGITS + 15)
-            return sp.Float(mpmath.re(v), DIGITS + 15), sp.Float(mpmath.im(v), DIGITS + 15)
+            return mpmath.re(v), mpmath.im(v)
     except NotNumeric:
         v = sp.N(expr.subs(point), DIGITS)
         re, im = v.as_real_imag()
@@ -107,7 +108,8 @@ class Sampler:
                 return None
             if sym.is_positive and re <= 0:
                 return None
-            point[sym] = sp.Float(re, DIGITS)
+            point[sym] = sp.Float(re, DIGITS)  # an mpf of 45 digits rounded to 30, as the
+            # 45-digit Float it was once made into first
         return point
 
     def draw(self, variables: Iterable[sp.Symbol] = (), spread: float | None = None,
