@@ -56,6 +56,18 @@ def exported(ref: str, into: Path):
     yield path
 
 
+def expand(args: list[str]) -> list[str]:
+    """Problem ids, a book's name (no '-') replaced by its problems' ids (0834a76's check
+    knows ids only, not books)."""
+    out = []
+    for arg in args:
+        if "-" in arg:
+            out.append(arg)
+        else:
+            out += [f"{arg}-{p.stem}" for p in sorted((ROOT / "problems" / arg).glob("*.yaml"))]
+    return out
+
+
 def run(tree: Path, ids: list[str]) -> tuple[float, float, dict]:
     """(CPU seconds, wall seconds, {(problem, part or cross-check): what must not change})."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
@@ -105,6 +117,7 @@ def main() -> None:
     ap.add_argument("--main", default="main", help="the commit the outcomes are compared with")
     ap.add_argument("--repeat", type=int, default=1)
     opts = ap.parse_args()
+    ids = expand(opts.ids)
     with tempfile.TemporaryDirectory(prefix="mechbook-cold-") as tmp, ExitStack() as stack:
         trees = {"ref": stack.enter_context(exported(opts.ref, Path(tmp)))}
         if opts.main != opts.ref:
@@ -115,14 +128,14 @@ def main() -> None:
         found: dict[str, dict] = {}
         for round_ in range(opts.repeat):
             for name, tree in trees.items():
-                c, w, found[name] = run(tree, opts.ids)
+                c, w, found[name] = run(tree, ids)
                 cpu[name].append(c)
                 wall[name].append(w)
                 print(f"round {round_ + 1}, {name}: {c:.2f} s CPU, {w:.2f} s wall",
                       file=sys.stderr)
     med = {name: (statistics.median(cpu[name]), statistics.median(wall[name])) for name in trees}
-    print(f"checked: {' '.join(opts.ids)} (--fresh --no-store --serial), {opts.repeat} round(s), "
-          f"load {os.getloadavg()[0]:.1f} at the end")
+    print(f"checked: {' '.join(opts.ids)}, {len(ids)} problems (--fresh --no-store --serial), "
+          f"{opts.repeat} round(s), load {os.getloadavg()[0]:.1f} at the end")
     for name, ref in (("ref", opts.ref), ("main", opts.main), ("this", "this tree")):
         if name in med:
             print(f"  {name:4} {ref:>10}: {med[name][0]:7.2f} s CPU  {med[name][1]:7.2f} s wall")
