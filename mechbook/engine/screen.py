@@ -143,31 +143,10 @@ def _newton(entries, n: int, X: np.ndarray) -> np.ndarray:
             step = finite & ~small
             if np.any(step):
                 k = idx[step]
-                X[k] -= _newton_steps(J[step], F[step])
+                X[k] -= np.einsum("kij,kj->ki", np.linalg.pinv(J[step]), F[step])
         F = entries(X)[:, :n]
     good = live & np.all(np.isfinite(X), axis=1) & (np.max(np.abs(F), axis=1) < 1e-10)
     return X[good]
-
-
-WELL_POSED = 1e-6  # |det J| / ‖J‖_F^n above this: cond J < 1e6, the pseudo-inverse is the inverse
-
-
-def _newton_steps(J: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """pinv(J)·F for each row: by LU solves where J is well conditioned (|det J| / ‖J‖_F^n
-    bounds σ_min/σ_max from below, so there cond J < 1e6 and the pseudo-inverse, which
-    drops only singular values below 1e-15 of the largest, is the inverse), the SVD's
-    pseudo-inverse only for the others. The same steps to rounding, an SVD per start
-    saved: the screen's Newton steps were 3 % of a cold check of both books."""
-    n = J.shape[1]
-    with np.errstate(all="ignore"):
-        ratio = np.abs(np.linalg.det(J)) / np.linalg.norm(J, axis=(1, 2)) ** n
-    easy = np.isfinite(ratio) & (ratio > WELL_POSED)
-    out = np.empty_like(F)
-    if np.any(easy):
-        out[easy] = np.linalg.solve(J[easy], F[easy][..., None])[..., 0]
-    if not np.all(easy):
-        out[~easy] = np.einsum("kij,kj->ki", np.linalg.pinv(J[~easy]), F[~easy])
-    return out
 
 
 def _distinct(entries, X: np.ndarray, n: int, flat: FlatRoots) -> list[np.ndarray]:
