@@ -6,15 +6,16 @@ a fresh process, with this interpreter and its packages, each tree importing its
 mechbook (PYTHONPATH, the editable install's finder dropped); the trees take turns (ref,
 main, this, ref, main, this, ...) so that the machine's load falls on all alike. For each:
 the CPU time of the child (user + system, `resource.getrusage`) and its wall time, the
-median of the rounds. The reference (default 0834a76, the commit issue 42 measures against)
-gives the ratio; main (default `main`) gives the outcomes: every part's status, method
-and power line and every cross-check's status must be the same in this tree as in main's,
-or the script lists the differences and exits 1 (details such as "worst relative 4.8e-32"
-may differ, as between two runs of one tree). Each reference tree is exported from git
-into a temporary directory (removed at the end) and byte-compiled first, as an installed
-tree is.
+median of the rounds. The reference (default 0834a76, the commit issue 42 measures
+against) gives the ratio; main (default: the merge base of HEAD and main, so that main's
+own later changes are not counted as this tree's) gives the outcomes: every part's status,
+method and power line and every cross-check's status must be the same in this tree as in
+main's, or the script lists the differences and exits 1 (details such as "worst relative
+4.8e-32" may differ, as between two runs of one tree). Each reference tree is exported
+from git into a temporary directory (removed at the end) and byte-compiled first, as an
+installed tree is.
 
-    python bench/cold_check.py [--ref 0834a76] [--main main] [--repeat 1] [BOOK_OR_ID ...]
+    python bench/cold_check.py [--ref 0834a76] [--main COMMIT] [--repeat 1] [BOOK_OR_ID ...]
 
 Never gates CI: timings depend on the machine and its load; run it niced, and take the
 ratio on a quiet machine.
@@ -114,9 +115,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("ids", nargs="*", default=["lim", "symon"])
     ap.add_argument("--ref", default=REFERENCE, help="the commit the ratio is to")
-    ap.add_argument("--main", default="main", help="the commit the outcomes are compared with")
+    ap.add_argument("--main", default=None,
+                    help="the commit the outcomes are compared with (default: the merge base "
+                         "of this tree's HEAD and main, so that main's own later changes are "
+                         "not counted as this tree's)")
     ap.add_argument("--repeat", type=int, default=1)
     opts = ap.parse_args()
+    if opts.main is None:
+        opts.main = subprocess.run(["git", "-C", str(ROOT), "merge-base", "HEAD", "main"],
+                                   capture_output=True, text=True, check=True).stdout.strip()[:12]
     ids = expand(opts.ids)
     with tempfile.TemporaryDirectory(prefix="mechbook-cold-") as tmp, ExitStack() as stack:
         trees = {"ref": stack.enter_context(exported(opts.ref, Path(tmp)))}
