@@ -92,14 +92,21 @@ def run(tree: Path, ids: list[str]) -> tuple[float, float, dict]:
 def outcomes(doc: dict) -> dict:
     """What the issue asks to stay the same: each part's status, method and power line,
     each cross-check's status, each problem's error."""
-    found = {}
+    found: dict = {}
+
+    def put(key: tuple, value) -> None:
+        n = 1
+        while (key[0], f"{key[1]} #{n}" if n > 1 else key[1]) in found:
+            n += 1  # a problem's two cross-checks of one name: both compared, in order
+        found[(key[0], f"{key[1]} #{n}" if n > 1 else key[1])] = value
+
     for prob in doc["problems"]:
-        found[(prob["id"], "error")] = prob.get("error")
+        put((prob["id"], "error"), prob.get("error"))
         for part in prob.get("parts", []):
-            found[(prob["id"], f"part {part['part']}")] = (
-                part["status"], part.get("method"), part.get("power"))
+            put((prob["id"], f"part {part['part']}"),
+                (part["status"], part.get("method"), part.get("power")))
         for x in prob.get("crosschecks", []):
-            found[(prob["id"], f"cross-check {x.get('name', '')}")] = x["status"]
+            put((prob["id"], f"cross-check {x.get('name', '')}"), x["status"])
     return found
 
 
