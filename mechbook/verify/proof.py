@@ -41,6 +41,9 @@ UNREACHABLE = (ESTIMATE, FLOATS, BOUNDARY, LIMIT, MEASURED, EXACT)
 
 CACHE_SIZE = 512  # proof results kept per process (the same difference met again: an erratum)
 _cache: dict = {}
+# the canonical forms' decisions, by expression: the first pass (canonical_only) and the
+# pass with simplify after it ask for the same one (11-05 (a): 6 s each, twice)
+_decisions: dict = {}
 
 
 @dataclass(frozen=True)
@@ -78,7 +81,7 @@ def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
     key = (expr, canonical_only)
     if key in _cache:
         return _cache[key]
-    decision = decide_zero(expr)
+    decision = _decide(expr)
     if decision.zero is True:
         return _keep(key, Proof(True))
     if decision.zero is False:
@@ -104,6 +107,16 @@ def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
     finally:
         budget.spent += time.process_time() - start
     return _keep(key, Proof(True) if ok else Proof(False, OPEN))
+
+
+def _decide(expr: sp.Basic):
+    """decide_zero(expr), once per process for each expression."""
+    decision = _decisions.get(expr)
+    if decision is None:
+        if len(_decisions) >= CACHE_SIZE:
+            _decisions.clear()
+        decision = _decisions[expr] = decide_zero(expr)
+    return decision
 
 
 def _keep(key, proof: Proof) -> Proof:
