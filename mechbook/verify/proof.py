@@ -35,6 +35,7 @@ BOUNDARY = "decided at a relation's boundary (crossings found numerically)"
 LIMIT = "a limit: the error's order is measured numerically"
 MEASURED = "measured by integration"
 NO_PATH = "no symbolic proof path for this quantity's check"
+NO_SIGN = "no sign proved for its conditions (positivity under the assumptions)"
 EXACT = "decided exactly, with no identity to prove (a count)"
 # the reasons no proof can remove: what is left is what a proof could reach ("expressible")
 UNREACHABLE = (ESTIMATE, FLOATS, BOUNDARY, LIMIT, MEASURED, EXACT)
@@ -119,6 +120,51 @@ def _decide(expr: sp.Basic):
     return decision
 
 
+def prove_sign(expr: sp.Basic, sampler, sign: int = 1) -> bool:
+    """Is `expr` proved > 0 (sign 1) or < 0 (sign −1) at every admissible point? Each
+    `restrict:` symbol replaced and each condition x > y turned into x = y + δ (δ > 0, the
+    later conditions rewritten with it: the domain is exactly the admissible one); then
+    over a common denominator numerator and denominator must each have a sign SymPy's
+    assumptions prove (as written, factored or expanded: a sum of positive terms of
+    positive symbols). Nothing numeric: a sign SymPy cannot show is not proved. Within the
+    part's proof budget.
+
+    Example: prove_sign(a**2 + a*b, sampler) is True for positive symbols a, b."""
+    if sampler.rtol > 1e-10 or sampler.fixed:
+        return False
+    expr = _on_admissible_points(expr, sampler, compose=True)
+    if expr.atoms(sp.Float) or expr.has(sp.nan, sp.zoo, sp.oo, -sp.oo, sp.I):
+        return False
+    budget = sampler.proof_budget()
+    seconds = min(budget.left(), sampler.policy.seconds)
+    if seconds <= 0:
+        return False
+    start = time.process_time()
+    try:
+        with time_limit(seconds):
+            num, den = sp.together(sign * expr).as_numer_denom()
+            n, d = _sign(num), _sign(den)
+            return n != 0 and n == d
+    except Timeout:
+        return False
+    except Exception:  # noqa: BLE001 - SymPy's odd failures: no sign proved
+        return False
+    finally:
+        budget.spent += time.process_time() - start
+
+
+def _sign(e: sp.Expr) -> int:
+    """1 or −1 where SymPy's assumptions prove e > 0 or e < 0 (as written, factored or
+    expanded), else 0."""
+    for form in (lambda x: x, sp.factor, sp.expand):
+        y = form(e)
+        if y.is_positive:
+            return 1
+        if y.is_negative:
+            return -1
+    return 0
+
+
 def _keep(key, proof: Proof) -> Proof:
     if len(_cache) >= CACHE_SIZE:
         _cache.clear()
@@ -126,26 +172,36 @@ def _keep(key, proof: Proof) -> Proof:
     return proof
 
 
-def _on_admissible_points(expr: sp.Basic, sampler) -> sp.Basic:
+def _on_admissible_points(expr: sp.Basic, sampler, compose: bool = False) -> sp.Basic:
     """expr with each `restrict:` symbol replaced by its expression (the latest first: it
     may use an earlier one), and each condition x > y (x < y) on a symbol x not in y by
-    x = y + δ (y − δ) with δ > 0: an identity there holds on every admissible point."""
+    x = y + δ (y − δ) with δ > 0: an identity there holds on every admissible point.
+    `compose` (a sign's proof, which needs the domain itself, not a larger one): each
+    substitution is made in the later conditions too (I1 < I3, I3 < I2: I3 = I1 + δ1,
+    I2 = I1 + δ1 + δ2), and c·x > y (c a positive rational) gives x = (y + δ)/c."""
     for sym in reversed(list(sampler.derived)):
         expr = expr.xreplace({sym: sampler.derived[sym]})
-    for cond in sampler.conditions:
-        sub = _shift(cond)
+    conditions = list(sampler.conditions)
+    for i, cond in enumerate(conditions):
+        sub = _shift(cond, compose)
         if sub is not None and expr.has(sub[0]):
             expr = expr.xreplace({sub[0]: sub[1]})
+        if sub is not None and compose:
+            conditions[i + 1:] = [c.xreplace({sub[0]: sub[1]}) for c in conditions[i + 1:]]
     return expr
 
 
-def _shift(cond: sp.Basic) -> tuple[sp.Symbol, sp.Expr] | None:
-    """(x, y + δ) for x > y or y < x, (x, y − δ) for x < y, with a fresh positive δ."""
+def _shift(cond: sp.Basic, scaled: bool = False) -> tuple[sp.Symbol, sp.Expr] | None:
+    """(x, y + δ) for x > y or y < x, (x, y − δ) for x < y, with a fresh positive δ;
+    `scaled`: also (x, (y + δ)/c) for c·x > y."""
     if not isinstance(cond, (sp.StrictGreaterThan, sp.StrictLessThan)):
         return None
     big, small = (cond.lhs, cond.rhs) if isinstance(cond, sp.StrictGreaterThan) \
         else (cond.rhs, cond.lhs)
     delta = sp.Dummy("delta", positive=True)
+    coeff, x = big.as_coeff_Mul()
+    if scaled and x.is_Symbol and coeff.is_Rational and coeff > 0 and not small.has(x):
+        return x, (small + delta) / coeff
     if big.is_Symbol and not small.has(big):
         return big, small + delta
     if small.is_Symbol and not big.has(small):
