@@ -203,7 +203,7 @@ def _shift(cond: sp.Basic, scaled: bool = False) -> tuple[sp.Symbol, sp.Expr] | 
         return None
     big, small = (cond.lhs, cond.rhs) if isinstance(cond, sp.StrictGreaterThan) \
         else (cond.rhs, cond.lhs)
-    delta = sp.Dummy("delta", positive=True)
+    delta = _delta(cond, scaled)
     coeff, x = big.as_coeff_Mul()
     if scaled and x.is_Symbol and coeff.is_Rational and coeff > 0 and not small.has(x):
         return x, (small + delta) / coeff
@@ -212,6 +212,22 @@ def _shift(cond: sp.Basic, scaled: bool = False) -> tuple[sp.Symbol, sp.Expr] | 
     if small.is_Symbol and not big.has(small):
         return small, big - delta
     return None
+
+
+_deltas: dict = {}
+
+
+def _delta(cond: sp.Basic, scaled: bool) -> sp.Dummy:
+    """The positive δ of a condition: the same one each time it is asked for, so that the
+    same difference on the same conditions is the same expression (the proof cache and the
+    decisions' cache are keyed by it: a fresh δ each time made every lookup miss, and
+    Symon 12-10's motion, checked twice, spent its budget twice)."""
+    key = (cond, scaled)
+    if key not in _deltas:
+        if len(_deltas) >= CACHE_SIZE:
+            _deltas.clear()
+        _deltas[key] = sp.Dummy("delta", positive=True)
+    return _deltas[key]
 
 
 def unproved_reason(method: str) -> str:
