@@ -46,7 +46,7 @@ from mechbook.core.rational import (
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.model.tensorfuncs import VARIABLE
 from mechbook.verify.compare import Sampler, Verdict, value_and_scale
-from mechbook.verify.proof import SIMPLIFY_SHARE
+from mechbook.verify.proof import SIMPLIFY_SHARE, too_large_to_simplify
 
 KINDS = ("scalar", "positive", "angle", "variable", "vector", "unit_vector", "tensor",
          "symmetric", "antisymmetric", "diagonal", "rotation", "orthogonal",
@@ -319,7 +319,10 @@ def _proved(st: Statement, sampler: Sampler) -> bool:
 
 def _simplified_zero(e: sp.Expr, seconds: float) -> bool:
     """simplify(e) == 0 within `seconds` (a share of the proof's time, as in
-    mechbook.verify.proof: the simplify calls that prove finish well within it)."""
+    mechbook.verify.proof: the simplify calls that prove finish well within it); none on
+    an expression larger than any simplify has proved."""
+    if too_large_to_simplify(e):
+        return False
     try:
         with time_limit(seconds):
             return sp.simplify(e) == 0

@@ -23,6 +23,11 @@ from mechbook.core.algebra_reach import within_exact_reach
 from mechbook.core.identity import decide_zero
 from mechbook.core.timeout import Timeout, time_limit
 
+# simplify is not tried on an expression of more operations (SymPy's count_ops) than this: the
+# calls that proved had at most 2164 (Symon 12-10), six of the seven that ran to the limit
+# 3362 to 48 533 (Symon 10-03, 11-03, 11-06 ×2, 11-08, 11-21; 12-06 had 1122)
+MAX_SIMPLIFY_OPS = 3000
+
 # why a passing part is not proved: one fixed phrase per reason (the method column's tail)
 ESTIMATE = "an estimate (compared within its stated tolerance)"
 FLOATS = "holds floating-point numbers (a numeric root or value)"
@@ -30,6 +35,8 @@ NOT_FREE = "not an identity in free symbols (holds where the conditions or const
 BRANCH = "holds on one branch of a root only (a sign SymPy cannot fix)"
 OPEN = "SymPy did not reduce it to 0 within the budget"
 BUDGET = "the part's proof budget was spent"
+TOO_LARGE = (f"too large for SymPy's simplify (over {MAX_SIMPLIFY_OPS} operations: none "
+             "that large was proved within the budget)")
 OUT_OF_REACH = "a rational exponent too large for exact algebra (decided numerically)"
 BOUNDARY = "decided at a relation's boundary (crossings found numerically)"
 LIMIT = "a limit: the error's order is measured numerically"
@@ -98,6 +105,8 @@ def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
         return Proof(False, OPEN)
     if not within_exact_reach(expr):  # simplify would abort the process in gmp
         return _keep(key, Proof(False, OUT_OF_REACH))
+    if too_large_to_simplify(expr):
+        return _keep(key, Proof(False, TOO_LARGE))
     budget = sampler.proof_budget()
     seconds = min(budget.left(), SIMPLIFY_SHARE * sampler.policy.seconds)
     if seconds <= 0:
@@ -123,6 +132,11 @@ def _decide(expr: sp.Basic):
             _decisions.clear()
         decision = _decisions[expr] = decide_zero(expr)
     return decision
+
+
+def too_large_to_simplify(expr: sp.Basic) -> bool:
+    """More operations than any expression `simplify` has proved 0 within the budget."""
+    return sp.count_ops(expr) > MAX_SIMPLIFY_OPS
 
 
 def prove_sign(expr: sp.Basic, sampler, sign: int = 1) -> bool:
