@@ -136,3 +136,18 @@ def test_symon_11_11_proved_and_its_wrong_verdict_fails(tmp_path):
     f.write_text(yaml.safe_dump(data))
     out = check_problem(Analysis(problem), load_answers(f), PROVE)
     assert {o.part: o.status for o in out}["intermediate"] == Status.FAIL
+
+
+def test_a_first_order_linearization_is_unproved_not_unsupported():
+    """The Chaplygin sleigh (a velocity constraint: a first-order linearization, no M, C,
+    K): its two verdicts pass under --prove as in a plain check and say why unproved (the
+    proof asked for M and made them unsupported)."""
+    an = Analysis(load_problem(ROOT / "problems" / "classic" / "chaplygin-sleigh.yaml"))
+    key = load_answers(ROOT / "answers" / "classic" / "chaplygin-sleigh.yaml")
+    proved = check_problem(an, key, PROVE)
+    plain = check_problem(Analysis(load_problem(
+        ROOT / "problems" / "classic" / "chaplygin-sleigh.yaml")), key)
+    assert [o.status for o in proved] == [o.status for o in plain]
+    verdicts = [o for o in proved if o.quantity == "stability"]
+    assert len(verdicts) == 2 and all(o.status == Status.PASS for o in verdicts)
+    assert all("first-order linearization" in o.method for o in verdicts)

@@ -31,6 +31,7 @@ import sympy as sp
 from mechbook.core.identity import decide_zero
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.engine.linear import LinearSystem, secular_determinant
+from mechbook.errors import MechbookError
 from mechbook.verify.proof import BUDGET, NO_PATH, NO_SIGN, Proof, prove_sign
 
 MAX_COORDINATES = 4  # Berkowitz's determinant of λ²M + λC + K beyond: no attempt
@@ -41,6 +42,7 @@ MAX_ENTRY = 2000  # characters of a matrix entry: larger (a root's closed form) 
 SHARE = 0.3
 NOT_SYMMETRIC = "M or K not shown symmetric (circulatory terms?)"
 TOO_LARGE = "the linearization's entries are too large for a sign's proof"
+FIRST_ORDER = "a first-order linearization (velocity constraints): no M, C, K to sign"
 
 
 def prove_stability(lin: LinearSystem, claim: str, sampler) -> Proof:
@@ -48,7 +50,10 @@ def prove_stability(lin: LinearSystem, claim: str, sampler) -> Proof:
     proved exactly? Proof(False, why) where not.
 
     Example: M = [[m]], C = [[0]], K = [[-k]] with m, k > 0: 'unstable' is proved."""
-    M, C, K = lin.M, lin.C, lin.K
+    try:
+        M, C, K = lin.M, lin.C, lin.K
+    except MechbookError:  # a first-order linearization (velocity constraints): no M, C, K
+        return Proof(False, FIRST_ORDER)
     if M.rows > MAX_COORDINATES or claim not in ("stable", "unstable"):
         return Proof(False, NO_PATH)
     if any(len(str(x)) > MAX_ENTRY for A in (M, C, K) for x in A):
@@ -63,6 +68,8 @@ def prove_stability(lin: LinearSystem, claim: str, sampler) -> Proof:
             return _prove(M, C, K, claim, sampler)
     except Timeout:
         return Proof(False, BUDGET)
+    except Exception:  # noqa: BLE001 - SymPy's odd failures: the numeric verdict stands
+        return Proof(False, NO_SIGN)
     finally:  # all of it charged once (the signs' own charges included in it)
         budget.spent = before + time.process_time() - start
 
