@@ -264,3 +264,29 @@ def test_a_float_inside_an_angle_is_never_rationalized():
     """sin(0.1·x) is not sin(x/10): the canonical form refuses the angle, never rounds it."""
     e = sp.Add(sp.sin(sp.Float(0.1) * x), -sp.sin(x / 10), evaluate=False)
     assert decide_zero(e).zero is None
+
+
+def test_integrations_and_estimates_are_named_as_such():
+    """A pass measured by integration (an event time, turning points off a level set, a
+    phase flow) or an estimate at the book's numbers says so, not "no proof path": those
+    are out of any proof's reach (bench/prove.py counts them apart)."""
+    for method in ("measured(3 points, rtol 1e-07)", "measured(1 point, rtol 0.02)",
+                   "numeric(3 points, flow DOP853 rtol 1e-12, rtol 1e-08)",
+                   "numeric(5 points, measured)"):
+        assert proof.unproved_reason(method) == proof.MEASURED, method
+    assert proof.unproved_reason("estimate(rtol 0.1)") == proof.ESTIMATE
+    assert proof.unproved_reason("numeric(6 points, polynomial roots)") == proof.NO_PATH
+    assert proof.unproved_reason("level set(6 points, rtol 1e-10)") == proof.NO_PATH
+
+
+def test_simplify_is_not_tried_beyond_the_size_any_proof_had():
+    """log(ab) = log a + log b for a, b > 0: the canonical forms leave it open (log a free
+    generator) and simplify proves it; the same identity times a product of 3000-odd
+    operations is refused at once with its reason (no simplify of that size ever proved one
+    within the budget)."""
+    small = sp.log(a * b) - sp.log(a) - sp.log(b)
+    assert decide_zero(small).zero is None
+    assert proof.prove_zero(small, _sampler()).ok
+    big = sp.Mul(*[sum(sp.Symbol(f"c{i}_{j}") * x**j for j in range(12)) for i in range(130)])
+    assert sp.count_ops(big) > proof.MAX_SIMPLIFY_OPS
+    assert proof.prove_zero(small * big, _sampler()) == proof.Proof(False, proof.TOO_LARGE)

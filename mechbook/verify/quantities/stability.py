@@ -17,6 +17,7 @@ from mechbook.verify.periodic import FloquetVerdicts, time_dependent
 from mechbook.verify.quantities.equilibria import check_stability_condition
 from mechbook.verify.quantities.steady import coordinate_map
 from mechbook.verify.registration import EXPR, LIMIT, POINT, REGION, Family
+from mechbook.verify.stability_proof import prove_stability
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
 quantity = FAMILY.quantity
@@ -31,7 +32,12 @@ quantity = FAMILY.quantity
                'needed. A marginal point (a zero frequency without gyroscopic terms) counts '
                'against `stable` and `unstable`; zero exponents of a symmetry are neutral. '
                'Coefficients periodic in t: Floquet multipliers (as `stability_condition`). A '
-               'relation is checked as `stability_condition`'),
+               'relation is checked as `stability_condition`. With `--prove`, `symbolic` '
+               'where the verdict follows from signs proved at every admissible point: '
+               'unstable from det M > 0 > det K; stable from M, K positive definite (C '
+               'gyroscopic or none) or, under gyroscopic terms, from the even characteristic '
+               'polynomial in s = λ² (degree ≤ 3) with positive coefficients and '
+               'discriminant'),
           literals=("stable", "unstable", "marginal"),
           keys={"limit": LIMIT, "period": EXPR},
           crosschecks=("modes",))
@@ -62,8 +68,17 @@ def check_stability(ctx: Context, val) -> Verdict:
                            f"engine finds it {got} at {{{shown}}}")
     power = (f"60 points drawn widely (factors to e²), all {val}: a claim of no boundary, "
              "checked away from one")
-    return Verdict(True, f"numeric(60 points, all {val})",
-                   power=power if floquet is None else f"{power}; {floquet.power()}")
+    numeric = Verdict(True, f"numeric(60 points, all {val})",
+                      power=power if floquet is None else f"{power}; {floquet.power()}")
+    if not ctx.policy.prove or floquet is not None:
+        return numeric
+    proof = prove_stability(lin, val, ctx.sampler)
+    if proof.ok:
+        return Verdict(True, "symbolic", power=f"proved {val} at every admissible point (the "
+                       "signs of the linearization's determinants and minors; "
+                       "mechbook.verify.stability_proof)")
+    numeric.unproved = proof.why
+    return numeric
 
 
 def _boxes(ctx: Context, pt: dict, unknowns: list) -> list[dict]:
