@@ -24,23 +24,18 @@ ratio on a quiet machine.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
+from classic_cost import check  # the one timed cold check of a tree (bench/ is on sys.path)
+
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = "0834a76"  # main when issue 42 was opened: its ratio is to this commit
-# the editable install's finder would serve a module missing from a tree from the checkout
-ONLY_THIS_TREE = ("import sys, runpy; sys.meta_path[:] = [f for f in sys.meta_path if "
-                  "'editable' not in str(getattr(f, '__module__', ''))]; "
-                  "sys.argv[0] = 'mechbook'; runpy.run_module('mechbook', run_name='__main__')")
 
 
 @contextmanager
@@ -70,22 +65,9 @@ def expand(args: list[str]) -> list[str]:
 
 
 def run(tree: Path, ids: list[str]) -> tuple[float, float, dict]:
-    """(CPU seconds, wall seconds, {(problem, part or cross-check): what must not change})."""
-    env = {**os.environ, "PYTHONPATH": str(tree)}
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", ONLY_THIS_TREE, "--root", str(tree), "check",
-                          *ids, "--fresh", "--no-store", "--serial", "--format", "json"],
-                         env=env, cwd=str(tree), capture_output=True, text=True)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    try:
-        doc = json.loads(out.stdout)
-    except json.JSONDecodeError:
-        sys.exit(f"{tree}: the check printed no JSON (exit {out.returncode}):\n"
-                 f"{out.stderr[-2000:]}")
+    """(CPU seconds, wall seconds, {(problem, part or cross-check): what must not change})
+    of one serial cold check of `ids` on `tree` (bench/classic_cost.py's `check`)."""
+    wall, cpu, doc = check(ids, None, tree)
     return cpu, wall, outcomes(doc)
 
 
