@@ -229,20 +229,31 @@ def hamiltonian(lin) -> bool:
         return False
 
 
-def _stable_by_symmetry(phi: np.ndarray, bound: float) -> str | None:
-    """Two or more degrees of freedom, Φ similar to a symplectic matrix: 'stable' where
-    every Bauer–Fike disc (radius r about λ) and its reflection in the unit circle (within
-    r′ = r/((|λ| − r)|λ|) + ||λ|² − 1|/|λ| of λ) meet no other disc and stay NEAR clear of
-    ±1, with κ(V)·n ≤ KAPPA_N (module docstring); else None."""
+def _discs(phi: np.ndarray, bound: float) -> tuple[np.ndarray, float, float] | None:
+    """Φ's eigenvalues, the Bauer–Fike radius about each that holds the exact Φ's
+    (‖ΔΦ‖₂ ≤ n·(entrywise bound), plus the eigensolver's own backward error, times κ(V)),
+    and κ(V); None where the eigenvectors are not computed or κ is not finite."""
     n = phi.shape[0]
     try:
         lam, V = np.linalg.eig(phi)
         kappa = float(np.linalg.cond(V))
     except np.linalg.LinAlgError:
         return None
-    if not (math.isfinite(kappa) and kappa * n <= KAPPA_N):
+    if not math.isfinite(kappa):
         return None
-    r = kappa * (n * bound + 100 * n * EPS * float(np.linalg.norm(phi, 2)))
+    return lam, kappa * (n * bound + 100 * n * EPS * float(np.linalg.norm(phi, 2))), kappa
+
+
+def _stable_by_symmetry(phi: np.ndarray, bound: float) -> str | None:
+    """Two or more degrees of freedom, Φ similar to a symplectic matrix: 'stable' where
+    every Bauer–Fike disc (radius r about λ) and its reflection in the unit circle (within
+    r′ = r/((|λ| − r)|λ|) + ||λ|² − 1|/|λ| of λ) meet no other disc and stay NEAR clear of
+    ±1, with κ(V)·n ≤ KAPPA_N (module docstring); else None."""
+    n = phi.shape[0]
+    discs = _discs(phi, bound)
+    if discs is None or discs[2] * n > KAPPA_N:
+        return None
+    lam, r, _ = discs
     for k in range(n):
         size = abs(lam[k])
         if size <= 2 * r:
@@ -280,15 +291,10 @@ def _unstable_by_discs(phi: np.ndarray, bound: float) -> str | None:
     discs lies wholly beyond |μ| = 1 + NEAR (it holds as many multipliers as eigenvalues
     of Φ), else None."""
     n = phi.shape[0]
-    try:
-        lam, V = np.linalg.eig(phi)
-        kappa = float(np.linalg.cond(V))
-    except np.linalg.LinAlgError:
+    discs = _discs(phi, bound)
+    if discs is None:
         return None
-    if not math.isfinite(kappa):
-        return None
-    # ‖ΔΦ‖₂ ≤ n·(entrywise bound), plus the eigensolver's own backward error
-    r = kappa * (n * bound + 100 * n * EPS * float(np.linalg.norm(phi, 2)))
+    lam, r, _ = discs
     groups = []  # connected components of the union of discs
     for k in range(n):
         joined = [g for g in groups if any(abs(lam[k] - lam[j]) <= 2 * r for j in g)]
