@@ -435,13 +435,7 @@ class Orbit:
                 try:
                     one = (1 - w) * (1 + w)
                     r = max(rs / one, rmin)
-                    try:
-                        k = E - fV(r, P, *params)
-                    except (ZeroDivisionError, ValueError):
-                        k = -1
-                    if not k > 0:
-                        raise UnsupportedError("scattering: the orbit leaves the allowed "
-                                               "region beyond its turning point")
+                    k = _room(fV, E, r, P, params, "scattering")
                     return (fu(r, P, *params) * mpmath.sqrt(fm(r, P, *params) / (2 * k))
                             * two_rs * w / (one * one))
                 finally:
@@ -480,13 +474,7 @@ class Orbit:
             ctx, inner = mpmath.mp, self.dps + 15
 
             def dt_dr(r):
-                try:
-                    k = E - fV(r, P, *params)
-                except (ZeroDivisionError, ValueError):
-                    k = -1
-                if not k > 0:
-                    raise UnsupportedError("time delay: the orbit leaves the allowed "
-                                           "region beyond its turning point")
+                k = _room(fV, E, r, P, params, "time delay")
                 return mpmath.sqrt(fm(r, P, *params) / (2 * k))
 
             t = self.turning  # r = rs + (X − rs)w² from the singular point, as for Θ
@@ -529,6 +517,19 @@ class Orbit:
             outside = mpmath.quad(beyond, [0, 1])
             free = mpmath.sqrt(X * X - b * b) / self.speed
             return 2 * (inside + outside - free)
+
+
+def _room(fV, E, r, P, params, what: str):
+    """E − V_eff(r) on an orbit's integration path, where it must be positive (beyond the
+    turning point): UnsupportedError naming `what` otherwise."""
+    try:
+        k = E - fV(r, P, *params)
+    except (ZeroDivisionError, ValueError):
+        k = -1
+    if not k > 0:
+        raise UnsupportedError(f"{what}: the orbit leaves the allowed region beyond its "
+                               "turning point")
+    return k
 
 
 class Captured(UnsupportedError):
