@@ -39,6 +39,23 @@ def load_analysis(tmp_path: Path, text: str, num: str) -> Analysis:
 
 # a harmonic oscillator, a double pendulum, and a bead on a hoop turning at a given rate
 # (explicitly time-dependent); their `id:` lines are rewritten by load_analysis
+# a particle in a plane about a fixed centre, its potential and name to fill in (the
+# scattering tests)
+PLANE = """\
+id: classic-{name}
+source: test
+title: a particle in a plane about a fixed centre
+parameters:
+  m: {{value: 1.3}}
+  k: {{value: 0.7, positive: true}}
+coordinates:
+  r: {{positive: true}}
+  theta: {{}}
+kinetic: m*(rdot**2 + r**2*thetadot**2)/2
+potential: {potential}
+"""
+
+
 DOUBLE = """\
 id: lim-9302
 source: test

@@ -30,6 +30,7 @@ import mpmath
 import pytest
 import sympy as sp
 from ruamel.yaml import YAML
+from systems import PLANE
 
 import mechbook.engine.scattering as engine
 from mechbook.engine.analysis import Analysis
@@ -39,19 +40,6 @@ from mechbook.verify.checker import check_problem
 from mechbook.verify.part import AnswerKey
 from mechbook.verify.wellformed import validate_key
 
-PLANE = """\
-id: classic-{name}
-source: test
-title: a particle in a plane about a fixed centre
-parameters:
-  m: {{value: 1.3}}
-  k: {{value: 0.7, positive: true}}
-coordinates:
-  r: {{positive: true}}
-  theta: {{}}
-kinetic: m*(rdot**2 + r**2*thetadot**2)/2
-potential: {potential}
-"""
 SYMBOLS = {"b": {"value": 0.8, "positive": True}, "E": {"value": 0.9, "positive": True}}
 
 

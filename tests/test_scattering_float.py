@@ -21,6 +21,7 @@ import math
 import mpmath
 import pytest
 import sympy as sp
+from systems import PLANE
 
 import mechbook.engine.scattering as engine
 import mechbook.engine.scattering_float as fl
@@ -29,19 +30,6 @@ from mechbook.engine.analysis import Analysis
 from mechbook.errors import UnsupportedError
 from mechbook.model.problem import load_problem
 
-PLANE = """\
-id: classic-{name}
-source: test
-title: a particle in a plane about a fixed centre
-parameters:
-  m: {{value: 1.3}}
-  k: {{value: 0.7, positive: true}}
-coordinates:
-  r: {{positive: true}}
-  theta: {{}}
-kinetic: m*(rdot**2 + r**2*thetadot**2)/2
-potential: {potential}
-"""
 K, M, E = 0.7, 1.3, 0.9
 
 
