@@ -233,3 +233,33 @@ def test_workers_start_with_the_imported_engine_frozen_out_of_the_collector(tmp_
     for frozen, thresholds in states:
         assert frozen > 50_000 and tuple(thresholds) == GC_THRESHOLDS
     assert (gc.get_freeze_count(), gc.get_threshold()) == before
+
+
+def _echo(value):
+    return value
+
+
+def test_a_killed_pool_ends_its_manager_thread_mid_message():
+    """A worker killed while it wrote a large result left a part of a message in the result
+    pipe: the pool's manager thread read the header and waited for the rest for ever (this
+    process holds the pipe's write end too, so no end of file came), and the interpreter's
+    exit joined that thread: a sweep interrupted in its last block hung after its
+    "interrupted" line (seen at Ctrl-C 3.5 s into tests/test_interrupts.py's sweep). The
+    half message is written here by hand; kill_pool must end the thread all the same."""
+    import struct
+    from concurrent.futures import ProcessPoolExecutor
+
+    from mechbook.app.running.batch import kill_pool
+
+    pool = ProcessPoolExecutor(1)
+    try:
+        assert pool.submit(_echo, 7).result(timeout=60) == 7
+        os.write(pool._result_queue._writer.fileno(), struct.pack("!i", 1000) + b"x" * 10)
+        time.sleep(0.5)  # the manager thread is reading the rest of the message now
+        manager = pool._executor_manager_thread
+        assert manager.is_alive()
+        kill_pool(pool)
+        manager.join(timeout=20)
+        assert not manager.is_alive(), "the pool's manager thread still waits on its pipe"
+    finally:
+        kill_pool(pool)

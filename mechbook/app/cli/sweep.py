@@ -4,6 +4,7 @@ mechbook.app.sweep's; here: the options checked before any work, the outputs wri
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 import click
@@ -100,8 +101,9 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
         spec = make_spec(problem_id, base, quantity, axes, system=system,
                          about=_pairs(about, "--about"), steady=_pairs(steady, "--steady"),
                          part=part, backend=backend)
-        result = run_sweep(spec, base, jobs=jobs, scheduler=address,
-                           timeout=timeout, memory_mb=memory_mb, samples=samples)
+        with _BlockProgress() as progress:
+            result = run_sweep(spec, base, jobs=jobs, scheduler=address, timeout=timeout,
+                               memory_mb=memory_mb, samples=samples, progress=progress)
     except (MechbookError, KeyError) as exc:
         out = failure(exc)  # no such problem: its own status (statuses.TABLE)
         out.message = message(exc)
@@ -115,6 +117,32 @@ def command(ctx: click.Context, problem_id: str, params: tuple[str, ...], quanti
         say(f"plot written to {plot_sweep(result, plot_path)}")
     if failed:
         sys.exit(1)
+
+
+class _BlockProgress:
+    """The blocks evaluated so far, on stderr: a bar on a terminal, otherwise a line per
+    block (`[7/14] blocks evaluated (2.1 s)`), for a CI log; nothing for a single block."""
+
+    def __enter__(self) -> _BlockProgress:
+        self.start, self.bar = time.monotonic(), None
+        return self
+
+    def __call__(self, done: int, total: int) -> None:
+        if total < 2:
+            return
+        if not sys.stderr.isatty():
+            click.echo(f"[{done}/{total}] blocks evaluated "
+                       f"({time.monotonic() - self.start:.1f} s)", err=True)
+            return
+        if self.bar is None:
+            self.bar = click.progressbar(length=total, label="blocks", file=sys.stderr,
+                                         show_eta=True, show_pos=True)
+            self.bar.__enter__()
+        self.bar.update(1)
+
+    def __exit__(self, *exc) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
 
 
 def _axes(params: tuple[str, ...], memory_mb: float, name: str | None) -> list:

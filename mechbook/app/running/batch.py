@@ -143,14 +143,27 @@ def pool_context():
 
 def kill_pool(pool) -> None:
     """Stop a concurrent.futures process pool at once: its workers killed, its queue dropped
-    (shutdown alone would wait for every task queued; its workers ignore Ctrl-C)."""
+    (shutdown alone would wait for every task queued; its workers ignore Ctrl-C).
+
+    A worker killed while it wrote a result leaves part of a message in the result pipe,
+    and the pool's manager thread would wait for the rest for ever: this process holds
+    the pipe's write end too, so no end of file comes, and the interpreter's exit joins
+    that thread (an interrupted sweep hung after its last line). Once the workers are
+    dead, this end is closed as well: the thread reads an end of file, finds the pool
+    broken and ends."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    writer = getattr(getattr(pool, "_result_queue", None), "_writer", None)  # shutdown drops it
     kill = getattr(pool, "kill_workers", None)  # Python 3.14
     if kill is not None:
         kill()
     else:
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
+        for process in processes:
             process.kill()
+    for process in processes:
+        process.join(timeout=5)  # SIGKILL: at once, unless the machine is stalled
     pool.shutdown(wait=False, cancel_futures=True)
+    if writer is not None and not writer.closed:
+        writer.close()
 
 
 def settle(preload: bool = False) -> None:
