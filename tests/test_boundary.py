@@ -74,3 +74,26 @@ def test_nothing_straddling_the_boundary_is_undecided():
 def test_a_disagreement_on_the_grid_is_still_a_fail():
     got = boundary.compare(k > -c, lambda pt, near: False, _sampler())
     assert not got.ok and got.outcome == "fail" and "the engine finds false" in got.detail
+
+
+def test_a_ray_point_is_sympy_float_bit_for_bit():
+    """A ray's points are built by `float_at_digits`, which must be SymPy's own
+    `Float(x, 30)` to the last bit: x = k/7·e^u at three working precisions (k and u from
+    a fixed grid, u over ±30), 1/3, and the special values."""
+    import mpmath
+
+    for dps in (15, 35, 50):
+        with mpmath.workdps(dps):
+            for k in range(-20, 21, 3):
+                for u in range(-30, 31, 7):
+                    x = mpmath.mpf(k) / 7 * mpmath.exp(mpmath.mpf(u) / 3)
+                    a, b = sp.Float(x, 30), boundary.float_at_digits(x)
+                    assert type(a) is type(b) and a == b, (dps, k, u)
+                    if isinstance(a, sp.Float):
+                        assert a._mpf_ == b._mpf_ and a._prec == b._prec, (dps, k, u)
+            third = mpmath.mpf(1) / 3
+            assert boundary.float_at_digits(third)._mpf_ == sp.Float(third, 30)._mpf_
+    assert boundary.float_at_digits(mpmath.mpf(0)) == sp.Float(mpmath.mpf(0), 30)
+    assert boundary.float_at_digits(mpmath.inf) == sp.oo
+    assert boundary.float_at_digits(-mpmath.inf) == -sp.oo
+    assert boundary.float_at_digits(mpmath.nan) is sp.nan
