@@ -56,8 +56,8 @@ def newton_residual(sys, symengine: bool = True, frames: dict | None = None) -> 
     """Σ J·(m r̈ − F) + rigid-body Euler terms + the Lagrange expressions of everything the
     file gives other than particles and bodies − Q: SymEngine expressions where SymEngine
     can do the calculus, SymPy's where it cannot or `symengine` is False. `frames`, a dict,
-    is filled with the bodies' frames computed on the way (`body_frames`: the check on the
-    constraint manifold uses the same ones)."""
+    is filled with the bodies' frames computed on the way ({body: (inertia, ω, R)}: the
+    check on the constraint manifold uses the same ones)."""
     spec = sys.spec
     if "approximation" in spec or "average" in spec:
         raise UnsupportedError("Newton cross-check: the Lagrangian is an approximation "
@@ -74,7 +74,8 @@ def newton_residual(sys, symengine: bool = True, frames: dict | None = None) -> 
     forces = _gravity(sys, spec, positions, masses, parse)
     rest = _springs(spec, positions, forces, parse) + _given_terms(spec, parse)
     frames = {} if frames is None else frames
-    frames.update(body_frames(sys))
+    frames.update({name: _body_frame(sys, name, b, masses[name], parse)
+                   for name, b in bodies.items()})
     pulls, attractor_q = _attractors(sys, spec, positions, masses, frames, parse)
     torque_q = _torques(sys, spec, frames, parse)
     friction_q = _friction(sys, spec, positions, frames, parse)
@@ -236,15 +237,6 @@ def _friction(sys, spec: dict, positions: dict, frames: dict, parse) -> list[sp.
     return out
 
 
-def body_frames(sys) -> dict:
-    """{body: (inertia, ω in body axes, R body -> space or None)} of the system's rigid
-    bodies, computed here (`_body_frame`): the Newton residual and the check on the
-    constraint manifold share them."""
-    bodies = dict(sys.spec.get("rigid_bodies") or {})
-    return {name: _body_frame(sys, name, b, sys.masses[name], sys.parse)
-            for name, b in bodies.items()}
-
-
 def _body_frame(sys, name: str, b: dict, m, parse):
     """(inertia, ω in body axes, R body -> space or None) of a body, computed here: ω from
     Rᵀ·dR/dt of the body's own rotation chain; for a planar body (moment, ω, None)."""
@@ -336,8 +328,7 @@ def _attractors(sys, spec, positions, masses, frames, parse) -> tuple[dict, list
 
 def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     dyn = analysis.dynamics(sys.name)
-    frames: dict = {}  # the bodies' frames, as the residual computed them
-    newton = newton_residual(sys, frames=frames)
+    newton = newton_residual(sys, frames=(frames := {}))  # the bodies' frames it computed
     engine = list(dyn.residuals)
     params = [p.symbol for p in sys.params.values()]
     free = [s for trio in sys.free_driven for s in trio]
