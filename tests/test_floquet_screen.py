@@ -515,3 +515,36 @@ def test_the_bound_covers_the_parameters_rounding_to_doubles(mathieu):
         want = sum(max(abs(x - y) for x, y in zip(phi(al, t), base, strict=True))
                    for al, t in ((alpha * nudge, mpmath.pi), (alpha, mpmath.pi * nudge)))
     assert abs(moved[0] / float(want) - 1) < 0.2, (moved, float(want))
+
+
+def test_the_early_escalation_never_drops_a_verdict(mathieu):
+    """The screen escalates before it measures the parameters' moves wherever the bounds
+    without them decide nothing (its verdicts are monotone in the bounds). Across both
+    edges of the first band (relative 1e-1 … 1e-14, Hill's edges): wherever the cheap
+    bounds give no verdict the full ones give none either, and every verdict the full
+    bounds give is the edge's side (stable inside a0 < α < b1)."""
+    flo, screen = mathieu
+    assert screen._build()
+    early = decided = 0
+    for kind in ("a0", "b1"):
+        edge = _hill(kind, "0.3")
+        for k in range(1, 15):
+            for side in (-1, 1):
+                with mpmath.workdps(40):
+                    alpha = edge + side * mpmath.mpf(10) ** -k * abs(edge)
+                inside = (kind == "a0") == (side > 0)
+                pars = np.array([float(alpha) if s.name == "alpha" else 0.3
+                                 for s in flo.symbols])
+                T = math.pi
+                a, b = screen._run(screen._tight, pars, T), screen._run(screen._loose, pars, T)
+                phi = a[:-1].reshape(2, 2).T
+                scale = float(np.max(np.abs(phi)))
+                cheap = screen._judge(phi, a, b, scale, (0.0, 0.0))
+                full = screen._judge(phi, a, b, scale, screen._rounding(pars, T, a))
+                if cheap is None:
+                    early += 1
+                    assert full is None, (kind, k, side, full)
+                if full is not None:
+                    decided += 1
+                    assert full == ("stable" if inside else "unstable"), (kind, k, side)
+    assert early >= 4 and decided >= 10, (early, decided)

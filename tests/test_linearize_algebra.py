@@ -66,3 +66,60 @@ def test_either_algebra_falls_back_to_sympy_and_lets_a_problem_fault_through():
 
     with pytest.raises(UnsupportedError):
         either(refused)
+
+
+KAPITZA = """\
+id: lim-9811
+source: test
+title: pendulum on a pivot driven up and down
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  a: {value: 0.1}
+  omega: {value: 45.0}
+  g: {value: 9.81}
+coordinates:
+  theta: {}
+driven:
+  y0: a*cos(omega*t)
+particles:
+  bob: {mass: m, position: [l*sin(theta), y0 - l*cos(theta)]}
+gravity: {}
+"""
+
+
+@pytest.mark.parametrize("at", ["0", "pi"])
+def test_the_first_order_expansion_is_the_closed_form(tmp_path, at):
+    """`Equilibria.expand` takes d/dε of the residuals in SymEngine (SymPy's where it
+    cannot). The pendulum on a pivot y0 = a cos ωt, by hand: T = m(l²θ̇² + ẏ0² + 2ẏ0 l
+    sinθ θ̇)/2, V = mg(y0 − l cosθ), so E = m l² θ̈ + m l (g + ÿ0) sinθ with ÿ0 = −aω²cos ωt;
+    about θ = 0 (sinθ ≈ δ) and θ = π (sinθ ≈ −δ): M = m l², C = 0, K = ±m l (g − aω²cos ωt),
+    no remainder. The engine's sign of E may be either: K/M is compared, and M, C, K the
+    same through SymPy's own diff."""
+    from systems import load_analysis
+
+    import mechbook.engine.equilibria as eqm
+
+    an = load_analysis(tmp_path, KAPITZA, "9811")
+    sys_ = an.system(None)
+    eq = an.equilibria(None)
+    theta = sys_.q[0]
+    point = {theta: sp.pi if at == "pi" else sp.S.Zero}
+    names = {p.symbol.name: p.symbol for p in sys_.params.values()}
+    m, ell, a, w, g = (names[k] for k in ("m", "l", "a", "omega", "g"))
+    t = sys_.t
+    zeroth, M, C, K, F = eq.expand(point)
+    sign = 1 if at == "0" else -1
+    assert all(sp.simplify(z) == 0 for z in zeroth)
+    assert sp.simplify(C[0, 0]) == 0 and all(sp.simplify(f) == 0 for f in F)
+    want = sign * (g - a * w**2 * sp.cos(w * t)) / ell
+    assert sp.simplify(K[0, 0] / M[0, 0] - want) == 0, (M, K)
+    assert sp.simplify(M[0, 0] ** 2 - (m * ell**2) ** 2) == 0  # M = ±m l²
+    slow = pytest.MonkeyPatch()
+    slow.setattr(eqm, "derivative", sp.diff)
+    try:
+        again = eq.expand(point)
+    finally:
+        slow.undo()
+    for x, y in zip((M, C, K, F), again[1:], strict=True):
+        assert all(sp.simplify(u - v) == 0 for u, v in zip(x, y, strict=True))

@@ -19,11 +19,12 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
+import symengine as se
 import sympy as sp
 
 from mechbook.core.backends import FEW_CALLS_BACKEND
 from mechbook.core.compile import compile_exprs
-from mechbook.core.secalc import derivative
+from mechbook.core.secalc import either, same
 from mechbook.engine.analysis import Analysis
 from mechbook.errors import MechbookError, UnsupportedError
 from mechbook.model.manifold import manifold_of
@@ -80,7 +81,8 @@ def _constraint_forces(sys, spec: dict, positions: dict, frames: dict, parse,
         k = parse(c["expr"], ("velocity_constraints", i, "expr"))
         mu = next(lam)
         out = [o + mu * sp.diff(k, v) for o, v in zip(out, sys.qd, strict=True)]
-    rows = []
+    rows: list = []
+    contacts = []  # (contact velocity, its tangents, their multipliers), SymPy objects
     for i, c in enumerate(spec.get("rolling") or []):
         sub = ("rolling", i)
         body = c["body"]
@@ -102,15 +104,33 @@ def _constraint_forces(sys, spec: dict, positions: dict, frames: dict, parse,
         if "velocity" in surface:
             v = v - sp.Matrix([parse(x, sub + ("surface", "velocity", j))
                                for j, x in enumerate(surface["velocity"])])
-        force = sp.zeros(r.rows, 1)
-        for t in _tangents(nv):
-            force += next(lam) * t
-            rows.append(v.dot(t))
-        # ∂v/∂q̇ entry by entry (SymEngine's calculus): SymPy's Matrix.diff goes through
-        # its array-derivative machinery, 10 times slower for the same derivatives
-        out = [o + force.dot(v.applyfunc(lambda e, qd=qd: derivative(e, qd)))
-               for o, qd in zip(out, sys.qd, strict=True)]
+        tangents = _tangents(nv)
+        contacts.append((list(v), [list(t) for t in tangents], [next(lam) for _ in tangents]))
+    if contacts:
+        # the friction's generalized forces and the tangential rows, in SymEngine's algebra
+        # where it can do the calculus (SymPy's otherwise): ∂v/∂q̇ and the dot products in
+        # SymPy were most of this cross-check's time (the compile layer takes either)
+        gen, rows = either(partial(_friction_terms, contacts, list(sys.qd)))
+        conv = se.sympify if isinstance(next(iter(gen), None), se.Basic) else same
+        out = [conv(o) + g for o, g in zip(out, gen, strict=True)]
     return out, rows
+
+
+def _friction_terms(contacts: list, qd: list, conv) -> tuple[list, list]:
+    """(Σ F·∂v/∂q̇_i over the contacts, each contact's tangential rows v·t), F = Σ λ_k t_k
+    the friction at the contact, in the algebra `conv` converts to (core.secalc.either)."""
+    gen = [conv(sp.S.Zero)] * len(qd)
+    rows = []
+    rates = [conv(x) for x in qd]
+    for v, tangents, lams in contacts:
+        vel = [conv(x) for x in v]
+        ts = [[conv(x) for x in t] for t in tangents]
+        force = [sum((conv(lam) * t[j] for lam, t in zip(lams, ts, strict=True)), conv(0))
+                 for j in range(len(vel))]
+        rows += [sum((a * b for a, b in zip(vel, t, strict=True)), conv(0)) for t in ts]
+        gen = [g + sum((f * e.diff(rate) for f, e in zip(force, vel, strict=True)), conv(0))
+               for g, rate in zip(gen, rates, strict=True)]
+    return gen, rows
 
 
 def on_manifold(analysis: Analysis, sys, newton: list, frames: dict,

@@ -52,10 +52,12 @@ def newton_crosscheck(analysis: Analysis, system_name: str | None = None,
     return out
 
 
-def newton_residual(sys, symengine: bool = True) -> list:
+def newton_residual(sys, symengine: bool = True, frames: dict | None = None) -> list:
     """Σ J·(m r̈ − F) + rigid-body Euler terms + the Lagrange expressions of everything the
     file gives other than particles and bodies − Q: SymEngine expressions where SymEngine
-    can do the calculus, SymPy's where it cannot or `symengine` is False."""
+    can do the calculus, SymPy's where it cannot or `symengine` is False. `frames`, a dict,
+    is filled with the bodies' frames computed on the way ({body: (inertia, ω, R)}: the
+    check on the constraint manifold uses the same ones)."""
     spec = sys.spec
     if "approximation" in spec or "average" in spec:
         raise UnsupportedError("Newton cross-check: the Lagrangian is an approximation "
@@ -71,7 +73,9 @@ def newton_residual(sys, symengine: bool = True) -> list:
     masses = {name: sys.masses[name] for name in positions}
     forces = _gravity(sys, spec, positions, masses, parse)
     rest = _springs(spec, positions, forces, parse) + _given_terms(spec, parse)
-    frames = {name: _body_frame(sys, name, b, masses[name], parse) for name, b in bodies.items()}
+    frames = {} if frames is None else frames
+    frames.update({name: _body_frame(sys, name, b, masses[name], parse)
+                   for name, b in bodies.items()})
     pulls, attractor_q = _attractors(sys, spec, positions, masses, frames, parse)
     torque_q = _torques(sys, spec, frames, parse)
     friction_q = _friction(sys, spec, positions, frames, parse)
@@ -324,7 +328,7 @@ def _attractors(sys, spec, positions, masses, frames, parse) -> tuple[dict, list
 
 def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     dyn = analysis.dynamics(sys.name)
-    newton = newton_residual(sys)
+    newton = newton_residual(sys, frames=(frames := {}))  # the bodies' frames it computed
     engine = list(dyn.residuals)
     params = [p.symbol for p in sys.params.values()]
     free = [s for trio in sys.free_driven for s in trio]
@@ -363,8 +367,6 @@ def _newton(analysis: Analysis, sys, out: CrossCheck, samples: int) -> None:
     out.status = Status.PASS if worst < NEWTON_TOL else Status.FAIL
     out.detail = _what_was_compared(sys.spec, used, worst)
     if sys.constraints or sys.velocity_constraints:
-        frames = {k: _body_frame(sys, k, b, sys.masses[k], sys.parse)
-                  for k, b in (sys.spec.get("rigid_bodies") or {}).items()}
         rows, force, states = on_manifold(analysis, sys, newton, frames, samples)
         out.error = max(worst, rows, force)
         if max(rows, force) >= NEWTON_TOL:

@@ -186,9 +186,23 @@ class Screen:
         scale = float(np.max(np.abs(phi)))
         if not scale <= MAX_SCALE:
             return None
+        # every verdict below is monotone in the bounds (a larger bound only widens the
+        # intervals and discs it is decided on), so where the bounds without the parameters'
+        # moves already decide nothing the full ones cannot either: escalated without the
+        # len(pars) + 1 runs that measure the moves (most points near a boundary)
+        if self._judge(phi, a, b, scale, (0.0, 0.0)) is None:
+            return None
         moved = self._rounding(pars, Tf, a)
         if moved is None:
             return None
+        return self._judge(phi, a, b, scale, moved)
+
+    def _judge(self, phi: np.ndarray, a: np.ndarray, b: np.ndarray, scale: float,
+               moved: tuple[float, float]) -> str | None:
+        """The verdict from the tight and loose runs `a`, `b` (Φ = `phi`, its largest entry
+        `scale`) and the moves of Φ and of Liouville's exponent under the parameters'
+        nudges (`moved`): 'stable', 'unstable' or None (module docstring)."""
+        flo = self.floquet
         bound = max(SAFETY * float(np.max(np.abs(a[:-1] - b[:-1]))), moved[0],
                     SAFETY * EPS * max(scale, 1.0))
         if bound > MAX_BOUND:
@@ -201,7 +215,7 @@ class Screen:
             return None
         else:
             det_lo, det_hi = math.exp(-s - ds), math.exp(-s + ds)
-        if n2 == 2:
+        if self.n2 == 2:
             return _two_by_two(phi, bound, det_lo, det_hi, flo.traceless, scale)
         got = _unstable_by_discs(phi, bound)
         if got is None and self.symplectic and scale <= MAX_STABLE_SCALE:

@@ -43,6 +43,7 @@ SPAN = 2.5  # a positive parameter moves by factors up to e^SPAN each way along 
 EPS = 1e-8  # relative offset of the points judged on either side of a crossing
 EPS_STEPS = (1e-8, 1e-6, 1e-4)  # coarser offsets where the engine has no verdict closer
 BISECT_TOL = 1e-13  # the Boolean bisection's bracket (in ray units, ~ relative change)
+BRACKET = 1e-6  # ... or this, where one atom's root in it is closed by the root finder
 TANGENT_RTOL = 1e-12  # an atom's minimum this small against its scale is a touching zero
 POINTS_KEPT = 4096  # points a ray keeps
 
@@ -113,17 +114,32 @@ class Ray:
             pt = dict(self.origin)
             for sym, d in zip(self.symbols, self.direction, strict=True):
                 x0 = mpmath.mpf(self.origin[sym]._mpf_)
+                d = float(d)  # a NumPy double: the same number, mpmath's fast path
                 if sym in self.scales:
                     x = x0 + t * d * mpmath.mpf(self.scales[sym])
                 elif sym.is_positive:
                     x = x0 * mpmath.exp(t * d)
                 else:
                     x = x0 + t * d * max(1, abs(x0))
-                pt[sym] = sp.Float(x, DIGITS)
+                pt[sym] = float_at_digits(x)
         pt = self.sampler.complete(pt)
         if pt is None or not all(holds(c, pt) for c in self.sampler.conditions):
             return None
         return pt
+
+
+_PREC = mpmath.libmp.dps_to_prec(DIGITS)
+
+
+def float_at_digits(x: mpmath.mpf) -> sp.Float:
+    """`sp.Float(x, DIGITS)`, the same number bit for bit (x rounded to nearest at DIGITS'
+    binary precision), without SymPy's inspection of its arguments (a third of a ray
+    point's cost: thousands of points a check). Zero, infinities and NaN: SymPy's own.
+    Example: float_at_digits(mpmath.mpf(1) / 3) == sp.Float(mpmath.mpf(1) / 3, 30)."""
+    m = x._mpf_
+    if not m[1]:
+        return sp.Float(x, DIGITS)
+    return sp.Float._new(mpmath.libmp.mpf_pos(m, _PREC, "n"), _PREC, zero=False)
 
 
 def atoms_of(cond: sp.Basic) -> list[sp.Expr]:
@@ -295,9 +311,10 @@ class _Judge:
         return book, (None if book is None else self.engine(pt, near)), pt
 
 
-def _bisect(fn: Callable, a: float, b: float, fa) -> tuple[float, float] | None:
-    """Shrink [a, b] (fn(a) = fa ≠ fn(b)) to BISECT_TOL; None if fn has no value inside."""
-    while b - a > BISECT_TOL:
+def _bisect(fn: Callable, a: float, b: float, fa,
+            tol: float = BISECT_TOL) -> tuple[float, float] | None:
+    """Shrink [a, b] (fn(a) = fa ≠ fn(b)) to `tol`; None if fn has no value inside."""
+    while b - a > tol:
         m = (a + b) / 2
         fm = fn(m)
         if fm is None:
@@ -307,6 +324,43 @@ def _bisect(fn: Callable, a: float, b: float, fa) -> tuple[float, float] | None:
         else:
             b = m
     return a, b
+
+
+def _crossing(atoms: list[sp.Expr], judge: _Judge, a: float, b: float,
+              fa: bool) -> tuple[mpmath.mpf, int] | None:
+    """Where the book's truth changes in the grid cell [a, b] (fa at a), to 30 digits, and
+    the index of the atom whose root it is: the Boolean bisection to BRACKET, then the
+    atom's root there (`refine`) where exactly one atom changes sign in that bracket and
+    its root lies inside; else, as everywhere before, the bisection on to BISECT_TOL and
+    the root refined from there. None where the relation has no truth value on the way.
+    The Boolean steps below BRACKET only narrowed what the root finder closes anyway."""
+    ray = judge.ray
+    coarse = _bisect(judge.book, a, b, fa, BRACKET)
+    if coarse is None:
+        return None
+    lo, hi = coarse
+    flips = _changing(atoms, ray, lo, hi)
+    if len(flips) == 1:
+        t = _root(atoms[flips[0]], ray, lo, hi)
+        if t is not None and lo <= t <= hi:
+            return t, flips[0]
+    fine = _bisect(judge.book, lo, hi, fa)
+    return None if fine is None else refine(atoms, ray, *fine)
+
+
+def _changing(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> list[int]:
+    """The atoms whose values at a and b have opposite signs ([] where one has none)."""
+    pa, pb = ray.point(a), ray.point(b)
+    if pa is None or pb is None:
+        return []
+    out = []
+    for i, f in enumerate(atoms):
+        va, vb = value_at(f, pa), value_at(f, pb)
+        if va is None or vb is None:
+            return []
+        if (va[0] > 0) != (vb[0] > 0):
+            out.append(i)
+    return out
 
 
 def refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> tuple[mpmath.mpf, int]:
@@ -319,14 +373,21 @@ def refine(atoms: list[sp.Expr], ray: Ray, a: float, b: float) -> tuple[mpmath.m
         if va is None or vb is None or (va[0] > 0) == (vb[0] > 0):
             continue
 
-        g = _along(f, ray)
-        try:
-            with mpmath.workdps(DIGITS):
-                return mpmath.findroot(g, (mpmath.mpf(a), mpmath.mpf(b)), solver="anderson",
-                                       tol=mpmath.mpf(10) ** (-2 * DIGITS + 10)), i
-        except (ValueError, ZeroDivisionError):
-            return mpmath.mpf((a + b) / 2), i
+        got = _root(f, ray, a, b)
+        return (mpmath.mpf((a + b) / 2) if got is None else got), i
     return mpmath.mpf((a + b) / 2), -1
+
+
+def _root(f: sp.Expr, ray: Ray, a: float, b: float) -> mpmath.mpf | None:
+    """The root of f along the ray from the bracket [a, b] (30 digits), None where the
+    root finder fails."""
+    g = _along(f, ray)
+    try:
+        with mpmath.workdps(DIGITS):
+            return mpmath.findroot(g, (mpmath.mpf(a), mpmath.mpf(b)), solver="anderson",
+                                   tol=mpmath.mpf(10) ** (-2 * DIGITS + 10))
+    except (ValueError, ZeroDivisionError):
+        return None
 
 
 def _along(f: sp.Expr, ray: Ray) -> Callable:
@@ -465,10 +526,10 @@ def compare(cond: sp.Basic, classify: Classifier, sampler: Sampler,
             b0, b1 = grid[k][0], grid[k + 1][0]
             if b0 is None or b1 is None or b0 == b1:
                 continue
-            bracket = _bisect(judge.book, float(ts[k]), float(ts[k + 1]), b0)
-            if bracket is None:
+            got = _crossing(atoms, judge, float(ts[k]), float(ts[k + 1]), b0)
+            if got is None:
                 continue
-            t_star, side = refine(atoms, ray, *bracket)
+            t_star, side = got
             crossed.add(side)
 
             bad = _judge_crossing(judge, t_star, res, words)
