@@ -26,7 +26,7 @@ report: $(STAMP)  ## check (reusing stored outcomes), then write results/report/
 $(AJV): .ci/ajv/package.json .ci/ajv/package-lock.json
 	if command -v npm >/dev/null 2>&1; then npm ci --silent --no-audit --no-fund --prefix .ci/ajv; fi
 
-test: $(STAMP) $(AJV)   ## the test suite, the mutation tests on a sample of six answer keys (~11 min on two cores)
+test: $(STAMP) $(AJV)   ## the test suite, the mutation tests on a sample of six answer keys (~8 min on two cores)
 	$(BIN)/python -m pytest -q -n auto -m 'not mutation'
 
 test-mutation: $(STAMP)  ## the mutation tests on every other answer key (~9 min on two cores; CI runs it)
