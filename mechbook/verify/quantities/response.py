@@ -19,6 +19,12 @@ from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
 from mechbook.verify.context import Context
 from mechbook.verify.registration import EXPR, Family
+from mechbook.verify.response_proof import (
+    prove_characteristic_polynomial,
+    prove_complex_modes,
+    prove_exponents,
+    prove_simultaneous_diagonalization,
+)
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
 quantity = FAMILY.quantity
@@ -142,8 +148,22 @@ def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
         ok, why = match_complex(mapped, engine, partial=False, rtol=1e-7)
         if not ok:
             return Verdict(False, f"numeric({plural(k + 1, 'point')})", why)
-    return Verdict(True, f"numeric({POINTS} points, 40 digits)",
-                   power=f"{POINTS} points: its roots are the exponents, to 1e-7, at 40 digits")
+    numeric = Verdict(True, f"numeric({POINTS} points, 40 digits)",
+                      power=f"{POINTS} points: its roots are the exponents, to 1e-7, at 40 "
+                            "digits")
+    if not ctx.policy.prove:
+        return numeric
+    return _proved(numeric, prove_characteristic_polynomial(lin, poly_expr, var, exponent,
+                                                            ctx.sampler),
+                   "proved symbolically: lc(P)·det(Mp² + Cp + K) = lc(D)·P, of degree 2n, "
+                   "with p the exponent map (a multiset of roots)")
+
+
+def _proved(numeric: Verdict, proof, power: str) -> Verdict:
+    """The numeric pass, or `symbolic` where the proof holds (its reason kept where not)."""
+    if proof.ok:
+        return Verdict(True, "symbolic", power=power)
+    return Verdict(True, numeric.method, numeric.detail, numeric.power, unproved=proof.why)
 
 
 def _book_list(ctx: Context, val) -> list[sp.Expr]:
@@ -160,7 +180,14 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
           complex_values=True,
           crosschecks=("modes",))
 def check_exponents(ctx: Context, val) -> Verdict:
-    return _multiset_at_points(ctx, val, lambda lin, pt: list(response.exponents(lin, pt)))
+    numeric = _multiset_at_points(ctx, val, lambda lin, pt: list(response.exponents(lin, pt)))
+    if not (numeric.ok and ctx.policy.prove):
+        return numeric
+    partial = bool(ctx.part.data.get("partial"))
+    return _proved(numeric, prove_exponents(ctx.linear(), _book_list(ctx, val), partial,
+                                            ctx.sampler),
+                   "proved symbolically: " + ("each a root of det(Mp² + Cp + K)" if partial
+                                              else "det M·∏(p − pᵢ) = det(Mp² + Cp + K)"))
 
 
 @quantity('decay_rates',
@@ -230,8 +257,14 @@ def check_complex_modes(ctx: Context, val) -> Verdict:
             if res > 1e-8:
                 return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"mode {i}: (Mp² + Cp + K)u relative residual {res:.3g}")
-    return Verdict(True, f"numeric({POINTS} points)",
-                   power=f"{POINTS} points: p an exponent to 1e-8, (Mp² + Cp + K)u to 1e-8")
+    numeric = Verdict(True, f"numeric({POINTS} points)",
+                      power=f"{POINTS} points: p an exponent to 1e-8, (Mp² + Cp + K)u to 1e-8")
+    if not ctx.policy.prove:
+        return numeric
+    return _proved(numeric, prove_complex_modes(lin, [(p, list(u)) for p, u in modes],
+                                                ctx.sampler),
+                   "proved symbolically: det(Mp² + Cp + K) = 0 and (Mp² + Cp + K)u = 0; "
+                   f"u nonzero at {POINTS} points")
 
 
 def _linear_forms(ctx: Context, keys: list[str], lin) -> dict[str, list]:
@@ -360,10 +393,14 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
         return Verdict(False, "numeric(6 points)", "diagonalizable at some parameter points "
                        f"only (residuals {', '.join(f'{r:.1e}' for r in residuals)})")
     ok = yes == val
-    return Verdict(ok, "numeric(6 points)",
-                   f"K M^-1 C - C M^-1 K relative residual up to {max(residuals):.1e}",
-                   power="6 points: the commutator below 1e-10 at every one (or above 1e-6 "
-                         "at every one)")
+    numeric = Verdict(ok, "numeric(6 points)",
+                      f"K M^-1 C - C M^-1 K relative residual up to {max(residuals):.1e}",
+                      power="6 points: the commutator below 1e-10 at every one (or above "
+                            "1e-6 at every one)")
+    if not (ok and ctx.policy.prove):
+        return numeric
+    return _proved(numeric, prove_simultaneous_diagonalization(lin, val, ctx.sampler),
+                   "proved symbolically: C = Cᵀ and K·adj(M)·C = C·adj(M)·K")
 
 
 
