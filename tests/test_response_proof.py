@@ -9,7 +9,10 @@ The linearizations are written out here from their Lagrangians and Rayleigh func
 - two masses in a chain of springs (wall–k1–m1–k2–m2), M = diag(m1, m2),
   K = [[k1 + k2, −k2], [−k2, k2]]: with friction C = b·M (proportional damping) one
   congruence diagonalizes all three (K M⁻¹ C = bK = C M⁻¹ K); with C = diag(b, 0) not
-  (K M⁻¹ C − C M⁻¹ K has the off-diagonal entry −k2·b/m1 ≠ 0).
+  (K M⁻¹ C − C M⁻¹ K has the off-diagonal entry −k2·b/m1 ≠ 0);
+- the driven damped oscillator, F = F0 cos ωt (or F0 sin ωt, a quarter period later):
+  x = Re(X e^{iωt}) with (k − mω² + ibω)X = F0, so the amplitude in phase with the force
+  is A = F0/(k − mω² + ibω) for either.
 """
 
 from __future__ import annotations
@@ -31,19 +34,21 @@ from mechbook.verify.response_proof import (
     prove_complex_modes,
     prove_exponents,
     prove_simultaneous_diagonalization,
+    prove_steady_amplitude,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
 PROVE = ProofPolicy(True, 5.0)
 WRONG = (1 + sp.Rational(1, 10**6), sp.Rational(101, 100))  # 1e-6 and 1 % off
 
-m, b, k, x = sp.symbols("m b k x", positive=True)
+m, b, k, x, F0, w = sp.symbols("m b k x F0 omega", positive=True)
+t = sp.Symbol("t", real=True)
 m1, m2, k1, k2 = sp.symbols("m1 m2 k1 k2", positive=True)
 IM = sp.I
 
 
 def _sampler():
-    base = {m: 1.0, b: 0.3, k: 2.0, m1: 1.0, m2: 2.0, k1: 3.0, k2: 1.5}
+    base = {m: 1.0, b: 0.3, k: 2.0, m1: 1.0, m2: 2.0, k1: 3.0, k2: 1.5, F0: 0.7, w: 1.1}
     return Sampler(base, [], policy=PROVE)
 
 
@@ -114,6 +119,26 @@ def test_proportional_friction_is_proved_separable_and_generic_friction_is_not()
         assert not prove_simultaneous_diagonalization(near, True, _sampler()).ok
     false = prove_simultaneous_diagonalization(_chain([[b, 0], [0, 0]]), False, _sampler())
     assert not false.ok and "points only" in false.why
+
+
+def _driven(force):
+    lin = _lin([[m]], [[b]], [[k]])
+    lin.F, lin.dyn = [force], SimpleNamespace(sys=SimpleNamespace(t=t))
+    return lin
+
+
+def test_a_driven_oscillators_amplitude_is_proved_and_one_off_is_not():
+    amplitude = F0 / (k - m * w**2 + IM * b * w)
+    for force in (F0 * sp.cos(w * t), F0 * sp.sin(w * t)):
+        lin = _driven(force)
+        assert prove_steady_amplitude(lin, {"x": amplitude}, {"x": [1]}, w, _sampler()).ok
+        for f in WRONG:
+            wrong = {"x": F0 / (k - m * w**2 * f + IM * b * w)}
+            assert not prove_steady_amplitude(lin, wrong, {"x": [1]}, w, _sampler()).ok
+    # a force at another frequency is not harmonic at ω: refused with the reason
+    other = prove_steady_amplitude(_driven(F0 * sp.cos(2 * w * t)), {"x": amplitude},
+                                   {"x": [1]}, w, _sampler())
+    assert not other.ok and "not proved harmonic" in other.why
 
 
 def _key(tmp_path, name: str, edit):

@@ -69,9 +69,15 @@ def _refusal(lin) -> str:
         return TOO_LARGE
     if any(len(str(x)) > MAX_ENTRY for A in (M, C, K) for x in A):
         return TOO_LARGE
-    if not (nonzero_determinant(M) or decide_zero(secular_determinant(M)).zero is False):
+    if not _nonsingular(M):
         return SINGULAR
     return ""
+
+
+def _nonsingular(A: sp.Matrix) -> bool:
+    """det A not identically 0, decided exactly: at a rational point, or (irrational
+    entries, such as √2 in a rotated form) its canonical form nonzero at an exact point."""
+    return nonzero_determinant(A) or decide_zero(secular_determinant(A)).zero is False
 
 
 def _char_poly(lin, p: sp.Symbol) -> sp.Expr:
@@ -156,3 +162,72 @@ def prove_simultaneous_diagonalization(lin, claim: bool, sampler) -> Proof:
     adj = M.adjugate(method="berkowitz")
     claims = list(C - C.T) + list(K * adj * C - C * adj * K)
     return proved_all([c for c in claims if c != 0], sampler)
+
+
+def prove_steady_amplitude(lin, book: dict, rows: dict, omega: sp.Expr, sampler) -> Proof:
+    """Are the book's steady amplitudes (every coordinate, or n independent linear forms of
+    them) the harmonic response, proved exactly? The force F(t) proved harmonic,
+    F(t) = F(0)cos ωt + F(π/2ω) sin ωt (so F̂ = F(0) − i·F(π/2ω)); the phase factor
+    e^{−iφ₀} of its first nonzero component a proved sign (a real or an imaginary
+    component); then with R the forms' rows (det R ≠ 0 exactly) and the book's values A,
+    (K − ω²M + iωC)·adj(R)·A = det R·e^{−iφ₀}·F̂, entry by entry: the book's response
+    solves the steady equations wherever they have one solution.
+
+    Example: M = [[m]], K = [[k]], F = F0 cos ωt: {x: F0/(k − mω²)} is proved."""
+    why = _refusal(lin)
+    if why:
+        return Proof(False, why)
+    n = lin.M.rows
+    if len(book) != n:
+        return Proof(False, NO_PATH + " (not every coordinate's amplitude: the rest of the "
+                     "response is not stated)")
+    R = sp.Matrix([rows[c] for c in book])
+    if not _nonsingular(R):
+        return Proof(False, NO_PATH + " (the forms are not shown independent)")
+    t = lin.dyn.sys.t
+    F = [sp.S(f) for f in lin.F]
+    at0 = [f.subs(t, 0) for f in F]
+    at4 = [f.subs(t, sp.pi / (2 * omega)) for f in F]
+    harmonic = proved_all([f - a * sp.cos(omega * t) - b * sp.sin(omega * t)
+                           for f, a, b in zip(F, at0, at4, strict=True)], sampler)
+    if not harmonic.ok:
+        return Proof(False, "the force is not proved harmonic at the driving frequency ("
+                     + harmonic.why + ")")
+    phase = _phase(at0, at4, sampler)
+    if phase is None:
+        return Proof(False, NO_SIGN_PHASE)
+    Fh = sp.Matrix([a - sp.I * b for a, b in zip(at0, at4, strict=True)])
+    H = lin.K - omega**2 * lin.M + sp.I * omega * lin.C
+    A = sp.Matrix(list(book.values()))
+    residual = H * R.adjugate(method="berkowitz") * A - R.det(method="berkowitz") * phase * Fh
+    return proved_all(list(residual), sampler)
+
+
+NO_SIGN_PHASE = "the force's phase is not a proved sign (its first component's sign)"
+
+
+def _phase(at0: list, at4: list, sampler) -> sp.Expr | None:
+    """e^{−iφ₀} for the first component of F̂ = F(0) − i·F(π/2ω) not identically 0: ±1
+    where it is real (F(π/2ω) = 0 there) of a proved sign, ±i where it is imaginary;
+    None otherwise."""
+    from mechbook.core.identity import decide_zero as zero
+    from mechbook.verify.proof import prove_sign
+
+    def vanishes(e) -> bool:
+        return e == 0 or zero(e).zero is True
+
+    for a, b in zip(at0, at4, strict=True):
+        if vanishes(a) and vanishes(b):
+            continue
+        if vanishes(b):  # F̂ = a real: e^{−iφ₀} = sign a
+            part, unit = a, sp.S.One
+        elif vanishes(a):  # F̂ = −i·b: e^{−iφ₀} = i·sign b
+            part, unit = b, sp.I
+        else:
+            return None
+        if prove_sign(part, sampler):
+            return unit
+        if prove_sign(part, sampler, -1):
+            return -unit
+        return None
+    return None

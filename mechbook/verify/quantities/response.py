@@ -24,6 +24,7 @@ from mechbook.verify.response_proof import (
     prove_complex_modes,
     prove_exponents,
     prove_simultaneous_diagonalization,
+    prove_steady_amplitude,
 )
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
@@ -325,8 +326,14 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
             if not abs(got - want) <= 1e-9 * max(abs(want), 1e-6 * scale):
                 return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"{c}: book {_c(got)}, engine {_c(want)} (ω = {w:.6g})")
-    return Verdict(True, f"numeric({POINTS} points, (K - w^2 M + i w C) X = F)",
-                   power=f"{POINTS} points: each amplitude to 1e-9")
+    numeric = Verdict(True, f"numeric({POINTS} points, (K - w^2 M + i w C) X = F)",
+                      power=f"{POINTS} points: each amplitude to 1e-9")
+    if not ctx.policy.prove:
+        return numeric
+    omega = ctx.parse(ctx.part.data["frequency"], ("frequency",))
+    return _proved(numeric, prove_steady_amplitude(lin, book, rows, omega, ctx.sampler),
+                   "proved symbolically: F harmonic, (K − ω²M + iωC)·X = e^{−iφ₀}F̂ for the "
+                   "book's amplitudes (wherever the steady response is unique)")
 
 
 
