@@ -12,7 +12,10 @@ The linearizations are written out here from their Lagrangians and Rayleigh func
   (K M⁻¹ C − C M⁻¹ K has the off-diagonal entry −k2·b/m1 ≠ 0);
 - the driven damped oscillator, F = F0 cos ωt (or F0 sin ωt, a quarter period later):
   x = Re(X e^{iωt}) with (k − mω² + ibω)X = F0, so the amplitude in phase with the force
-  is A = F0/(k − mω² + ibω) for either.
+  is A = F0/(k − mω² + ibω) for either;
+- equal masses m on springs k–k–k (wall to wall): M = m·1, K = [[2k, −k], [−k, 2k]],
+  normal coordinates x1 = (η1 + η2)/√(2m), x2 = (η1 − η2)/√(2m) with ω1² = k/m (in step)
+  and ω2² = 3k/m (opposed): AᵀMA = 1, AᵀKA = diag(k/m, 3k/m).
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from mechbook.verify.response_proof import (
     prove_characteristic_polynomial,
     prove_complex_modes,
     prove_exponents,
+    prove_normal_transformation,
     prove_simultaneous_diagonalization,
     prove_steady_amplitude,
 )
@@ -139,6 +143,16 @@ def test_a_driven_oscillators_amplitude_is_proved_and_one_off_is_not():
     other = prove_steady_amplitude(_driven(F0 * sp.cos(2 * w * t)), {"x": amplitude},
                                    {"x": [1]}, w, _sampler())
     assert not other.ok and "not proved harmonic" in other.why
+
+
+def test_a_normal_transformation_is_proved_and_one_off_is_not():
+    lin = _lin([[m, 0], [0, m]], [[0, 0], [0, 0]], [[2 * k, -k], [-k, 2 * k]])
+    A = sp.Matrix([[1, 1], [1, -1]]) / sp.sqrt(2 * m)
+    freqs = {0: sp.sqrt(k / m), 1: sp.sqrt(3 * k / m)}
+    assert prove_normal_transformation(lin, A, freqs, _sampler()).ok
+    for f in WRONG:
+        assert not prove_normal_transformation(lin, A * sp.diag(1, f), freqs, _sampler()).ok
+        assert not prove_normal_transformation(lin, A, {0: freqs[0] * f}, _sampler()).ok
 
 
 def _key(tmp_path, name: str, edit):

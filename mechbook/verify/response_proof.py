@@ -231,3 +231,21 @@ def _phase(at0: list, at4: list, sampler) -> sp.Expr | None:
             return -unit
         return None
     return None
+
+
+def prove_normal_transformation(lin, A: sp.Matrix, frequencies: dict, sampler) -> Proof:
+    """x = A·η: AᵀMA = 1 and AᵀKA diagonal (with `frequencies: {j: ω}` its diagonal
+    ω²), proved exactly entry by entry? `lin` must have no velocity terms (C = 0).
+
+    Example: M = [[m]], K = [[k]], A = [[1/√m]], {0: √(k/m)} is proved."""
+    if getattr(lin, "first_order", False):
+        return Proof(False, NO_PATH + " (a first-order linearization)")
+    M, K = lin.M, lin.K
+    if any(len(str(x)) > MAX_ENTRY for B in (M, K, A) for x in B):
+        return Proof(False, TOO_LARGE)
+    T, V = A.T * M * A, A.T * K * A
+    n = A.cols
+    claims = [T[i, j] - (1 if i == j else 0) for i in range(n) for j in range(n) if i <= j]
+    claims += [V[i, j] for i in range(n) for j in range(n) if i < j]
+    claims += [w**2 - V[j, j] for j, w in frequencies.items()]
+    return proved_all(claims, sampler)

@@ -23,6 +23,7 @@ from mechbook.verify.response_proof import (
     prove_characteristic_polynomial,
     prove_complex_modes,
     prove_exponents,
+    prove_normal_transformation,
     prove_simultaneous_diagonalization,
     prove_steady_amplitude,
 )
@@ -465,7 +466,14 @@ def check_normal_transformation(ctx: Context, val) -> Verdict:
             if abs(wv**2 - V[j, j]) > 1e-9 * scale:
                 return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"{etas[j]}: omega**2 = {_c(wv**2)}, engine {V[j, j]:.10g}")
-    return Verdict(True, f"numeric({POINTS} points)",
-                   power=f"{POINTS} points in double precision: AᵀMA = 1 and AᵀKA diagonal to "
-                         "1e-9, the offset exact")
+    numeric = Verdict(True, f"numeric({POINTS} points)",
+                      power=f"{POINTS} points in double precision: AᵀMA = 1 and AᵀKA diagonal "
+                            "to 1e-9, the offset exact")
+    if not ctx.policy.prove or (offset is not None and offset.method != "symbolic"):
+        return numeric if not ctx.policy.prove else Verdict(
+            True, numeric.method, numeric.detail, numeric.power,
+            unproved=offset.unproved or "the offset is checked numerically")
+    return _proved(numeric, prove_normal_transformation(lin, A, freqs, ctx.sampler),
+                   "proved symbolically: AᵀMA = 1 and AᵀKA diagonal"
+                   + (" with the stated ω²" if freqs else "") + ", entry by entry")
 
