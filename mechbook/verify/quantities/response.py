@@ -120,7 +120,10 @@ def _exponent_map(ctx: Context):
                'variable, one to one; default p itself), are the 2n exponents p of e^{pt} '
                'solutions of the linearized equations, with multiplicity (mpmath roots and '
                'eigenvalues at 40 digits, at 5 points); write a secular equation in ω as a '
-               'polynomial in ω with `exponent: sqrt(-1)*omega`'),
+               'polynomial in ω with `exponent: sqrt(-1)*omega`; with `--prove`, `symbolic` where '
+               'the exponent is linear in the variable, p = a·x + b, and lc(P)·D(a·x + b) = '
+               'lc(D)·P(x) is proved coefficient by coefficient, D(p) = det(Mp² + Cp + K), '
+               'both of degree 2n (the same roots with multiplicity), det M decided nonzero'),
           keys={"variable": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
                 "exponent": EXPR},
           names=lambda ctx: _exponent_map(ctx)[1],
@@ -177,7 +180,10 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
           how=('multiset equality with the 2n exponents p of e^{pt} solutions (roots of '
                'det(Mp² + Cp + K) = 0) at 5 points, each to 1e-8 of the largest |p| (a small '
                'real part beside a large frequency is resolved only to that); `partial: '
-               'true` for a subset'),
+               'true` for a subset; with `--prove`, `symbolic` where det M·∏(p − pᵢ) = '
+               'det(Mp² + Cp + K) is proved coefficient by coefficient in p (all 2n: the '
+               'same multiset), or each pᵢ a root (`partial`, distinct values), det M '
+               'decided nonzero'),
           keys={"partial": {"type": "boolean"}},
           complex_values=True,
           crosschecks=("modes",))
@@ -232,7 +238,9 @@ def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
           book='list of `{exponent: p, shape: {q: complex amplitude}}`',
           how=('p is an exponent of the linearized system and (Mp² + Cp + K)u = 0 for the '
                "book's shape u (relative residual 1e-8; any vector of a degenerate "
-               'eigenspace passes), at 5 points'),
+               'eigenspace passes), at 5 points; with `--prove`, `symbolic` where '
+               'det(Mp² + Cp + K) = 0 and (Mp² + Cp + K)u = 0 are proved entry by entry (u '
+               'nonzero at the points)'),
           complex_values=True,
           equivalent=("direction",),
           crosschecks=("modes",))
@@ -302,7 +310,11 @@ def _driving(ctx: Context, pt: dict) -> float:
                'phase of the force (its first nonzero '
                'generalized component as Re(F̂ e^{iωt})): A = X_q e^{−iφ₀} with '
                'X = (K − ω²M + iωC)⁻¹F̂, at 5 points (so a real A is the signed amplitude '
-               'in phase with the force)'),
+               'in phase with the force); with `--prove`, `symbolic` where every '
+               'coordinate is given (or n forms, their determinant decided nonzero), F is '
+               'proved harmonic at ω, the phase of its first nonzero component is a proved '
+               'sign, and (K − ω²M + iωC)·X = e^{−iφ₀}F̂ is proved entry by entry (the '
+               'unique response wherever there is one)'),
           keys={"frequency": EXPR},
           complex_values=True,
           crosschecks=("modes", "response"))
@@ -389,7 +401,10 @@ def check_resonances(ctx: Context, val) -> Verdict:
           book='true or false',
           how=('whether one linear change of coordinates diagonalizes M, C (friction) and K '
                'together: K M⁻¹C = C M⁻¹K (Caughey and O\'Kelly), decided at 6 points '
-               '(relative residual below 1e-10 at every one, or above 1e-6 at every one)'))
+               '(relative residual below 1e-10 at every one, or above 1e-6 at every one); '
+               'with `--prove`, `true` is `symbolic` where C = Cᵀ and K·adj(M)·C = '
+               'C·adj(M)·K are proved entry by entry, det M decided nonzero (`false` stays '
+               'decided at the points)'))
 def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
     if not isinstance(val, bool):
         raise ctx.part.error(("book",), "expected true or false")
@@ -416,7 +431,9 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
           book='`{q: linear form in normal coordinates}` (every coordinate)',
           how=('x = A·η (the normal coordinates η are answer symbols): AᵀMA = 1 and AᵀKA '
                'diagonal (T = Σ η̇²/2, V = Σ ω²η²/2), entrywise to 1e-9 at 5 points; '
-               '`frequencies: {η: ω}` also checks the diagonal'),
+               '`frequencies: {η: ω}` also checks the diagonal; with `--prove`, `symbolic` '
+               'where AᵀMA = 1, the off-diagonal AᵀKA and ω² − (AᵀKA)ⱼⱼ are proved 0 entry '
+               'by entry'),
           keys={"frequencies": {"type": "object", "additionalProperties": EXPR}},
           crosschecks=("modes",))
 def check_normal_transformation(ctx: Context, val) -> Verdict:
