@@ -29,7 +29,7 @@ import sympy as sp
 
 from mechbook.core.identity import decide_zero, nonzero_determinant
 from mechbook.engine.linear import secular_determinant
-from mechbook.verify.proof import NO_PATH, OPEN, Proof, prove_zero
+from mechbook.verify.proof import NO_PATH, OPEN, Proof, prove_sign, prove_zero
 
 MAX_COORDINATES = 6  # Berkowitz's determinant of Mp² + Cp + K beyond: no attempt
 MAX_ENTRY = 2000  # characters of a matrix entry: larger (a root's closed form) is not tried
@@ -210,11 +210,8 @@ def _phase(at0: list, at4: list, sampler) -> sp.Expr | None:
     """e^{−iφ₀} for the first component of F̂ = F(0) − i·F(π/2ω) not identically 0: ±1
     where it is real (F(π/2ω) = 0 there) of a proved sign, ±i where it is imaginary;
     None otherwise."""
-    from mechbook.core.identity import decide_zero as zero
-    from mechbook.verify.proof import prove_sign
-
     def vanishes(e) -> bool:
-        return e == 0 or zero(e).zero is True
+        return e == 0 or decide_zero(e).zero is True
 
     for a, b in zip(at0, at4, strict=True):
         if vanishes(a) and vanishes(b):
