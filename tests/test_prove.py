@@ -339,3 +339,17 @@ def test_a_rotations_eigenvalues_are_proved_by_eulers_formula(tmp_path):
         f.write_text(yaml.safe_dump(data, sort_keys=False))
         out = check_problem(Analysis(problem), load_answers(f), PROVE)
         assert [o.status for o in out] == [Status.FAIL] * 2
+
+
+def test_a_square_factor_of_known_sign_fixes_the_branch():
+    """(δ²sin²α + δ²cos²α)^(7/2) = δ⁷ for δ > 0: factored, SymPy takes δ⁷ out and the
+    rest's radicand reduces to the number 1, whose root is 1 (exact), so it is proved; with
+    δ of unknown sign it is not (|δ|⁷), and 1e-6 off it is never proved."""
+    d, s = sp.Symbol("d", positive=True), sp.Symbol("s", real=True)
+    inner = d**2 * sp.sin(x) ** 2 + d**2 * sp.cos(x) ** 2
+    assert proof.prove_zero(inner ** sp.Rational(7, 2) - d**7, _sampler()).ok
+    assert not proof.prove_zero(inner ** sp.Rational(7, 2) - d**7 * (1 + EPS), _sampler()).ok
+    unsigned = (s**2 * sp.sin(x) ** 2 + s**2 * sp.cos(x) ** 2) ** sp.Rational(7, 2) - s**7
+    assert not proof.prove_zero(unsigned, _sampler()).ok
+    assert decide_zero(sp.sqrt(4 * sp.sin(x) ** 2 + 4 * sp.cos(x) ** 2) - 2).zero is True
+    assert decide_zero(sp.sqrt(4 * sp.sin(x) ** 2 + 4 * sp.cos(x) ** 2) - 2 - EPS).zero is False

@@ -192,12 +192,27 @@ def _root(base: sp.Basic, q: int, form: _Form) -> se.Basic:
     value = _convert(base, form)
     num, den = value.as_numer_denom()
     num, den = (_reduce(_expand(x), form.relations) for x in (num, den))
+    exact = _rational_root(num, den, q)
+    if exact is not None:  # (sin² + cos²)^(1/2) = 1: the radicand is a number, its root too
+        return exact
     key = (str(num), str(den), q)
     if key not in form.roots:
         r = form.gen("r")
         form.roots[key] = r
         form.relations.append(_Relation(r, q, num / den))
     return form.roots[key]
+
+
+def _rational_root(num: se.Basic, den: se.Basic, q: int) -> se.Basic | None:
+    """(num/den)^(1/q) where the radicand reduced to a positive rational number whose
+    q-th root is rational (the principal root, exactly), else None."""
+    if not (isinstance(num, se.Rational) and isinstance(den, se.Rational)) or den == 0:
+        return None
+    value = sp.Rational(str(num)) / sp.Rational(str(den))
+    if value <= 0:
+        return None
+    root = value ** sp.Rational(1, q)
+    return se.Rational(int(root.p), int(root.q)) if root.is_Rational else None
 
 
 def _normal_radicand(base: sp.Basic, q: int) -> sp.Basic | None:
