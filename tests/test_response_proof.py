@@ -15,7 +15,10 @@ The linearizations are written out here from their Lagrangians and Rayleigh func
   is A = F0/(k − mω² + ibω) for either;
 - equal masses m on springs k–k–k (wall to wall): M = m·1, K = [[2k, −k], [−k, 2k]],
   normal coordinates x1 = (η1 + η2)/√(2m), x2 = (η1 − η2)/√(2m) with ω1² = k/m (in step)
-  and ω2² = 3k/m (opposed): AᵀMA = 1, AᵀKA = diag(k/m, 3k/m).
+  and ω2² = 3k/m (opposed): AᵀMA = 1, AᵀKA = diag(k/m, 3k/m);
+- the heavy symmetric top's uniform precession (Symon Eq. 11-171): at the tilt θ0 with
+  spin ω3 the torque balance is sin θ0·(I1 φ̇² cos θ0 − I3 ω3 φ̇ + mgl) = 0, so the book's
+  quadratic I1 φ̇² cos θ0 − I3 ω3 φ̇ + mgl = 0 has the same roots wherever sin θ0 ≠ 0.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from mechbook.verify.response_proof import (
     prove_complex_modes,
     prove_exponents,
     prove_normal_transformation,
+    prove_proportional,
     prove_simultaneous_diagonalization,
     prove_steady_amplitude,
 )
@@ -153,6 +157,38 @@ def test_a_normal_transformation_is_proved_and_one_off_is_not():
     for f in WRONG:
         assert not prove_normal_transformation(lin, A * sp.diag(1, f), freqs, _sampler()).ok
         assert not prove_normal_transformation(lin, A, {0: freqs[0] * f}, _sampler()).ok
+
+
+def test_proportional_polynomials_are_proved_and_a_coefficient_off_is_not():
+    th = sp.Symbol("theta0", real=True)
+    engine = sp.sin(th) * (m * x**2 * sp.cos(th) - k * b * x + F0)
+    book = m * x**2 * sp.cos(th) - k * b * x + F0
+    assert prove_proportional(book, engine, x, _sampler()).ok
+    assert prove_proportional(-2 * book, engine, x, _sampler()).ok
+    for f in WRONG:
+        wrong = m * x**2 * sp.cos(th) - k * b * x * f + F0
+        assert not prove_proportional(wrong, engine, x, _sampler()).ok
+    assert not prove_proportional(x * book, engine, x, _sampler()).ok  # a root 0 more
+
+
+def test_the_heavy_tops_precession_equation_is_proved_and_a_wrong_one_fails(tmp_path):
+    problem = load_problem(ROOT / "problems" / "symon" / "text-11-5-heavy-top.yaml")
+    part = "d-uniform-precession"
+
+    def keep(data):
+        data["parts"] = [p for p in data["parts"] if p["part"] == part]
+
+    out = check_problem(Analysis(problem), _key(tmp_path, "text-11-5-heavy-top", keep), PROVE)
+    assert [(o.status, o.method) for o in out] == [(Status.PASS, "symbolic")]
+    for factor in ("(1 + 1/10**6)", "(101/100)"):
+        def wrong(data, factor=factor):
+            keep(data)
+            data["parts"][0]["book"] = data["parts"][0]["book"].replace(
+                "m*g*l", f"m*g*l*{factor}")
+
+        out = check_problem(Analysis(problem), _key(tmp_path, "text-11-5-heavy-top", wrong),
+                            PROVE)
+        assert [o.status for o in out] == [Status.FAIL]
 
 
 def _key(tmp_path, name: str, edit):

@@ -100,9 +100,9 @@ def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
     if decision.zero is False:
         return _keep(key, Proof(False, NOT_FREE))
     if decision.why.startswith("a root's branch"):
-        alt = factored_radicands(expr)
-        if alt is not expr and _decide(alt).zero is True:
-            return _keep(key, Proof(True))
+        for alt in _rewritten(expr):
+            if _decide(alt).zero is True:
+                return _keep(key, Proof(True))
         return _keep(key, Proof(False, BRANCH))
     if canonical_only:
         return Proof(False, OPEN)
@@ -155,6 +155,20 @@ def factored_radicands(expr: sp.Basic) -> sp.Basic:
 
 
 MAX_RADICAND = 2000  # characters of a radicand factored for its square factors
+MAX_EXPAND = 5000  # characters of an expression SymPy expands for a branch's second try
+
+
+def _rewritten(expr: sp.Basic):
+    """The forms a one-branch remainder is tried again in (each exact): its radicands
+    factored; expanded by SymPy first, which joins √x·x into x^(3/2) and √x/√x before the
+    canonical forms merge roots (Symon 12-33's motion)."""
+    alt = factored_radicands(expr)
+    if alt is not expr:
+        yield alt
+    if len(str(expr)) <= MAX_EXPAND:
+        expanded = sp.expand(expr)
+        if expanded != expr:
+            yield factored_radicands(expanded)
 
 
 def too_large_to_simplify(expr: sp.Basic) -> bool:

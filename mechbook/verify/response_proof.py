@@ -246,3 +246,20 @@ def prove_normal_transformation(lin, A: sp.Matrix, frequencies: dict, sampler) -
     claims += [V[i, j] for i in range(n) for j in range(n) if i < j]
     claims += [w**2 - V[j, j] for j, w in frequencies.items()]
     return proved_all(claims, sampler)
+
+
+def prove_proportional(book: sp.Expr, engine: sp.Expr, x: sp.Symbol, sampler) -> Proof:
+    """Are two polynomials in x proportional by a factor free of x, proved exactly (the
+    same degree, lc(B)·E = lc(E)·B coefficient by coefficient)? Then they have the same
+    roots with multiplicity wherever their leading coefficients do not vanish (a steady
+    motion's equation in its rate and the engine's condition, which may differ by a
+    factor such as sin θ0).
+
+    Example: prove_proportional(2*x**2 - 2, sin(t)*(x**2 - 1), x, sampler).ok."""
+    try:
+        b, e = _coefficients(book, x), _coefficients(engine, x)
+    except sp.PolynomialError:
+        return Proof(False, NO_PATH + " (not a polynomial in the rate)")
+    if len(b) != len(e) or len(b) < 2:
+        return Proof(False, NO_PATH + " (the degrees differ)")
+    return proved_all([b[0] * ce - e[0] * cb for cb, ce in zip(b, e, strict=True)], sampler)
