@@ -75,6 +75,10 @@ def test_the_damped_oscillators_exponents_are_proved_and_wrong_ones_are_not():
         wrong = [ROOTS[0], ROOTS[1] * f]
         assert not prove_exponents(DAMPED, wrong, False, _sampler()).ok
         assert not prove_exponents(DAMPED, [ROOTS[0] * f], True, _sampler()).ok
+    # one root written twice (a double root it is not): refused as partial, failed as all
+    written_twice = [ROOTS[0], sp.expand(ROOTS[0])]
+    assert written_twice[0] != written_twice[1]  # two expressions, one value
+    assert not prove_exponents(DAMPED, written_twice, True, _sampler()).ok
     # both roots the same one: the sum and product do not match the coefficients
     assert not prove_exponents(DAMPED, [ROOTS[0], ROOTS[0]], False, _sampler()).ok
     # too few for the full multiset: refused, with the reason

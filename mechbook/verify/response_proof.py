@@ -29,6 +29,7 @@ import sympy as sp
 
 from mechbook.core.identity import decide_zero, nonzero_determinant
 from mechbook.engine.linear import secular_determinant
+from mechbook.verify.compare import value
 from mechbook.verify.proof import NO_PATH, OPEN, Proof, prove_sign, prove_zero
 
 MAX_COORDINATES = 6  # Berkowitz's determinant of Mp² + Cp + K beyond: no attempt
@@ -80,6 +81,15 @@ def _nonsingular(A: sp.Matrix) -> bool:
     return nonzero_determinant(A) or decide_zero(secular_determinant(A)).zero is False
 
 
+def _distinct(values: list[sp.Expr], sampler) -> bool:
+    """The values pairwise apart at a sampled point (a double root written two ways would
+    otherwise be proved a root once, not twice)."""
+    pt = sampler.draw()
+    nums = [value(v, pt) for v in values]
+    return all(abs(a - b) > 1e-12 * max(1.0, abs(a), abs(b))
+               for i, a in enumerate(nums) for b in nums[i + 1:])
+
+
 def _char_poly(lin, p: sp.Symbol) -> sp.Expr:
     return secular_determinant(p**2 * lin.M + p * lin.C + lin.K)
 
@@ -99,7 +109,7 @@ def prove_exponents(lin, book: list[sp.Expr], partial: bool, sampler) -> Proof:
     p = sp.Dummy("p")
     D = _char_poly(lin, p)
     if partial:
-        if len(set(book)) != len(book):
+        if not _distinct(book, sampler):  # a repeated root would need D'(p) = 0 as well
             return Proof(False, NO_PATH + " (a repeated value in a partial list)")
         return proved_all([D.subs(p, b) for b in book], sampler)
     if len(book) != 2 * lin.M.rows:
