@@ -290,3 +290,66 @@ def test_simplify_is_not_tried_beyond_the_size_any_proof_had():
     big = sp.Mul(*[sum(sp.Symbol(f"c{i}_{j}") * x**j for j in range(12)) for i in range(130)])
     assert sp.count_ops(big) > proof.MAX_SIMPLIFY_OPS
     assert proof.prove_zero(small * big, _sampler()) == proof.Proof(False, proof.TOO_LARGE)
+
+
+def test_one_branch_still_found_and_other_roots_screened_out():
+    """√(y(x + 1)²) = (x + 1)√y holds for x > −1 only: a root's branch (found exactly, the
+    float screen passing it on); √(z + 1)·y = z is no branch of anything: the screen
+    (R(r)·R(−r) far from 0 at a point of the variety) says so without the exact product."""
+    z, w = sp.Symbol("z"), sp.Symbol("w", positive=True)
+    branch = sp.sqrt(x**2 * w + 2 * x * w + w) - (x + 1) * sp.sqrt(w)
+    assert decide_zero(branch).why == "a root's branch"
+    assert decide_zero(branch + 2 * (x + 1) * sp.sqrt(w)).why == "a root's branch"  # −√ ...
+    assert decide_zero(sp.sqrt(z + 1) * w - z).why == "not reduced to 0 (roots)"
+    assert decide_zero(branch + EPS * sp.sqrt(w)).why == "not reduced to 0 (roots)"
+
+
+def test_no_simplify_once_a_canonical_form_refuses(monkeypatch):
+    """all_vanish of [log(ab) − log a − log b (open: simplify proves it), √(x²) − x (one
+    branch: x may be negative)]: the second refuses in the canonical pass, so the whole
+    cannot be proved and simplify is not run on the first; alone, the first is proved."""
+    calls = []
+    real = sp.simplify
+    monkeypatch.setattr(proof.sp, "simplify", lambda e, *k, **kw: calls.append(e) or real(e))
+    z = sp.Symbol("z", real=True)
+    u, v = sp.symbols("u v", positive=True)  # not met elsewhere: no cached proof
+    opened = sp.log(u * v) - sp.log(u) - sp.log(v)
+    branch = sp.sqrt(z**2 * a + 2 * z * a + a) - (z + 1) * sp.sqrt(a)
+    sampler = Sampler({a: 1.3, u: 0.8, v: 1.7}, [], policy=PROVE)
+    out = all_vanish([opened, branch], sampler)
+    assert out.ok and out.method != "symbolic" and proof.BRANCH in out.unproved and not calls
+    assert all_vanish([opened], sampler).method == "symbolic" and calls
+
+
+def test_a_rotations_eigenvalues_are_proved_by_eulers_formula(tmp_path):
+    """Symon 10-19: a rotation's eigenvalues 1, e^{±iα} with cos α = (tr A − 1)/2 (their
+    sum 1 + 2 cos α = tr A, pair products the same, product 1 = det A): with
+    e^{iα} = cos α + i sin α the generic statement's canonical form is 0, so symbolic; the
+    angle 1e-6 or 1 % off fails (at the instances, before any proof)."""
+    problem = load_problem(ROOT / "problems" / "symon" / "10-19.yaml")
+    data = yaml.safe_load((ROOT / "answers" / "symon" / "10-19.yaml").read_text())
+    data["parts"] = [p for p in data["parts"] if p["quantity"] == "eigenvalues"]
+    f = tmp_path / "10-19.yaml"
+    f.write_text(yaml.safe_dump(data, sort_keys=False))
+    out = check_problem(Analysis(problem), load_answers(f), PROVE)
+    assert [(o.status, o.method) for o in out] == [(Status.PASS, "symbolic")] * 2
+    for factor in ("(1 + 1/10**6)", "(101/100)"):
+        for p in data["parts"]:
+            p["book"][1] = f"expi(alpha*{factor})"
+        f.write_text(yaml.safe_dump(data, sort_keys=False))
+        out = check_problem(Analysis(problem), load_answers(f), PROVE)
+        assert [o.status for o in out] == [Status.FAIL] * 2
+
+
+def test_a_square_factor_of_known_sign_fixes_the_branch():
+    """(δ²sin²α + δ²cos²α)^(7/2) = δ⁷ for δ > 0: factored, SymPy takes δ⁷ out and the
+    rest's radicand reduces to the number 1, whose root is 1 (exact), so it is proved; with
+    δ of unknown sign it is not (|δ|⁷), and 1e-6 off it is never proved."""
+    d, s = sp.Symbol("d", positive=True), sp.Symbol("s", real=True)
+    inner = d**2 * sp.sin(x) ** 2 + d**2 * sp.cos(x) ** 2
+    assert proof.prove_zero(inner ** sp.Rational(7, 2) - d**7, _sampler()).ok
+    assert not proof.prove_zero(inner ** sp.Rational(7, 2) - d**7 * (1 + EPS), _sampler()).ok
+    unsigned = (s**2 * sp.sin(x) ** 2 + s**2 * sp.cos(x) ** 2) ** sp.Rational(7, 2) - s**7
+    assert not proof.prove_zero(unsigned, _sampler()).ok
+    assert decide_zero(sp.sqrt(4 * sp.sin(x) ** 2 + 4 * sp.cos(x) ** 2) - 2).zero is True
+    assert decide_zero(sp.sqrt(4 * sp.sin(x) ** 2 + 4 * sp.cos(x) ** 2) - 2 - EPS).zero is False

@@ -192,12 +192,27 @@ def _root(base: sp.Basic, q: int, form: _Form) -> se.Basic:
     value = _convert(base, form)
     num, den = value.as_numer_denom()
     num, den = (_reduce(_expand(x), form.relations) for x in (num, den))
+    exact = _rational_root(num, den, q)
+    if exact is not None:  # (sin² + cos²)^(1/2) = 1: the radicand is a number, its root too
+        return exact
     key = (str(num), str(den), q)
     if key not in form.roots:
         r = form.gen("r")
         form.roots[key] = r
         form.relations.append(_Relation(r, q, num / den))
     return form.roots[key]
+
+
+def _rational_root(num: se.Basic, den: se.Basic, q: int) -> se.Basic | None:
+    """(num/den)^(1/q) where the radicand reduced to a positive rational number whose
+    q-th root is rational (the principal root, exactly), else None."""
+    if not (isinstance(num, se.Rational) and isinstance(den, se.Rational)) or den == 0:
+        return None
+    value = sp.Rational(str(num)) / sp.Rational(str(den))
+    if value <= 0:
+        return None
+    root = value ** sp.Rational(1, q)
+    return se.Rational(int(root.p), int(root.q)) if root.is_Rational else None
 
 
 def _normal_radicand(base: sp.Basic, q: int) -> sp.Basic | None:
@@ -483,7 +498,10 @@ def _one_branch(reduced: se.Basic, form: _Form) -> bool:
     on one branch only (a sign the assumptions do not fix)?"""
     roots = set(form.roots.values())
     squares = [rel for rel in form.relations if rel.power == 2 and rel.gen in roots]
+    point = _float_point(form)
     for rel in squares[:3]:
+        if point is not None and _clearly_nonzero(reduced, rel.gen, point):
+            continue  # R(r)·R(−r) ≠ 0 at a point of the variety: its reduction cannot be 0
         flipped = reduced.subs({rel.gen: -rel.gen})
         try:
             norm = _reduce(_expand(reduced * flipped), form.relations)
@@ -492,6 +510,47 @@ def _one_branch(reduced: se.Basic, form: _Form) -> bool:
         if norm == 0:
             return True
     return False
+
+
+def _float_point(form: _Form, seed: int = 20261207) -> dict | None:
+    """A point of the generators' variety in complex doubles: each free generator a random
+    number in [0.6, 1.9] (a circle's cosine in (−0.9, 0.9)), each relation's generator a
+    root of its value (any root lies on the variety); None where a value does not
+    evaluate."""
+    rng = random.Random(seed)
+    bound = {rel.gen for rel in form.relations}
+    cosines = {c for _, c in form.circle}
+    gens = set(form.symbols.values()) | set(form.free_atoms.values()) | \
+        set(form.exps.values()) | cosines
+    point = {g: complex(rng.uniform(-0.9, 0.9) if g in cosines else rng.uniform(0.6, 1.9))
+             for g in gens if g not in bound}
+    try:
+        for rel in form.relations:
+            point[rel.gen] = _at(rel.value, point) ** (1.0 / rel.power)
+    except (RuntimeError, TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return None
+    return point
+
+
+def _at(e: se.Basic, point: dict) -> complex:
+    return complex(e.xreplace({g: se.sympify(v) for g, v in point.items()}))
+
+
+def _clearly_nonzero(reduced: se.Basic, gen: se.Symbol, point: dict) -> bool:
+    """R(r)·R(−r) far from 0 at a point of the variety (a million times double precision's
+    rounding of its terms): then no reduction of it is 0, and the exact product (its
+    expansion the square of R's size: Symon 12-10's motion, 6 s) is not needed."""
+    flipped = dict(point)
+    flipped[gen] = -point[gen]
+    try:
+        terms = reduced.args if isinstance(reduced, se.Add) else (reduced,)
+        a = [_at(t, point) for t in terms]
+        b = [_at(t, flipped) for t in terms]
+    except (RuntimeError, TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return False
+    scale = sum(abs(x) for x in a) * sum(abs(x) for x in b)
+    value = abs(sum(a) * sum(b))
+    return math.isfinite(scale) and value > 1e-6 * scale
 
 
 def nonzero_determinant(M: sp.Matrix, seed: int = 20261207) -> bool:

@@ -308,6 +308,7 @@ def _proved(st: Statement, sampler: Sampler) -> bool:
                 return all(e == 0 or _rational_zero(e) for e in exprs)
             if policy.prove:  # the exact canonical forms first, simplify for the rest
                 return all(e == 0 or decide_zero(e).zero is True
+                           or _trig_zero(e)
                            or _simplified_zero(e, SIMPLIFY_SHARE * policy.seconds)
                            for e in exprs)
     except Timeout:
@@ -315,6 +316,17 @@ def _proved(st: Statement, sampler: Sampler) -> bool:
     except Exception:  # noqa: BLE001 - SymPy's odd failures: the instances have decided
         return False
     return False
+
+
+def _trig_zero(e: sp.Expr) -> bool:
+    """e with each exp of an imaginary argument written cos x + i·sin x (Euler's formula,
+    exact) decided 0 by the canonical forms: SymPy's own evaluation then turns
+    cos(acos t) into t and sin(acos t) into √(1 − t²) (a rotation's eigenvalues e^{±iα},
+    α = acos((tr R − 1)/2), Symon 10-19)."""
+    if not any(a.args[0].has(sp.I) for a in e.atoms(sp.exp)):
+        return False
+    form = e.rewrite(sp.cos)
+    return form == 0 or decide_zero(form).zero is True
 
 
 def _simplified_zero(e: sp.Expr, seconds: float) -> bool:

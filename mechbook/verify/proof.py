@@ -100,6 +100,9 @@ def prove_zero(expr: sp.Basic, sampler, canonical_only: bool = False) -> Proof:
     if decision.zero is False:
         return _keep(key, Proof(False, NOT_FREE))
     if decision.why.startswith("a root's branch"):
+        for alt in _rewritten(expr):
+            if _decide(alt).zero is True:
+                return _keep(key, Proof(True))
         return _keep(key, Proof(False, BRANCH))
     if canonical_only:
         return Proof(False, OPEN)
@@ -132,6 +135,40 @@ def _decide(expr: sp.Basic):
             _decisions.clear()
         decision = _decisions[expr] = decide_zero(expr)
     return decision
+
+
+def factored_radicands(expr: sp.Basic) -> sp.Basic:
+    """expr with each root of a sum written as the root of its factored form, so that
+    SymPy's own rule takes out a square factor whose sign its assumptions know:
+    √(k·a·(l + 2a)²) = (l + 2a)·√(k·a) for positive a, l (exact; nothing where the sign is
+    unknown). Why: the canonical forms meet √(T²U) and T·√U as two roots tied only up to
+    sign (one branch), and a sign is exactly what the admissible domain, written with
+    positive δ, can give. `expr` itself where no radicand changes."""
+    reps = {}
+    for p in expr.atoms(sp.Pow):
+        if p.exp.is_Rational and not p.exp.is_Integer and p.base.is_Add \
+                and len(str(p.base)) <= MAX_RADICAND:
+            new = sp.Pow(sp.factor(p.base), p.exp)
+            if new != p:
+                reps[p] = new
+    return expr.xreplace(reps) if reps else expr
+
+
+MAX_RADICAND = 2000  # characters of a radicand factored for its square factors
+MAX_EXPAND = 5000  # characters of an expression SymPy expands for a branch's second try
+
+
+def _rewritten(expr: sp.Basic):
+    """The forms a one-branch remainder is tried again in (each exact): its radicands
+    factored; expanded by SymPy first, which joins √x·x into x^(3/2) and √x/√x before the
+    canonical forms merge roots (Symon 12-33's motion)."""
+    alt = factored_radicands(expr)
+    if alt is not expr:
+        yield alt
+    if len(str(expr)) <= MAX_EXPAND:
+        expanded = sp.expand(expr)
+        if expanded != expr:
+            yield factored_radicands(expanded)
 
 
 def too_large_to_simplify(expr: sp.Basic) -> bool:

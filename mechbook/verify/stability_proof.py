@@ -38,8 +38,9 @@ MAX_COORDINATES = 4  # Berkowitz's determinant of λ²M + λC + K beyond: no att
 MAX_ENTRY = 2000  # characters of a matrix entry: larger (a root's closed form) is not tried
 # (SymEngine's expansion of the determinant cannot be interrupted)
 # the proof's share of the part's budget: the six Symon verdicts it proves took at most
-# 0.34 s of CPU each; Symon 12-28 (b-outside), not proved, ran to the 10 s limit
-SHARE = 0.3
+# 0.34 s of CPU each; Symon 12-28 (b-inside, b-outside), not proved, spent 1.4 s and 3.3 s
+# (signs of 3105 and 11 394 operations): 1.5 s keeps every proof, with four times its time
+SHARE = 0.15
 NOT_SYMMETRIC = "M or K not shown symmetric (circulatory terms?)"
 TOO_LARGE = "the linearization's entries are too large for a sign's proof"
 FIRST_ORDER = "a first-order linearization (velocity constraints): no M, C, K to sign"

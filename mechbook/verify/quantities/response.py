@@ -19,6 +19,14 @@ from mechbook.errors import UnsupportedError
 from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
 from mechbook.verify.context import Context
 from mechbook.verify.registration import EXPR, Family
+from mechbook.verify.response_proof import (
+    prove_characteristic_polynomial,
+    prove_complex_modes,
+    prove_exponents,
+    prove_normal_transformation,
+    prove_simultaneous_diagonalization,
+    prove_steady_amplitude,
+)
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
 quantity = FAMILY.quantity
@@ -112,7 +120,10 @@ def _exponent_map(ctx: Context):
                'variable, one to one; default p itself), are the 2n exponents p of e^{pt} '
                'solutions of the linearized equations, with multiplicity (mpmath roots and '
                'eigenvalues at 40 digits, at 5 points); write a secular equation in ω as a '
-               'polynomial in ω with `exponent: sqrt(-1)*omega`'),
+               'polynomial in ω with `exponent: sqrt(-1)*omega`; with `--prove`, `symbolic` where '
+               'the exponent is linear in the variable, p = a·x + b, and lc(P)·D(a·x + b) = '
+               'lc(D)·P(x) is proved coefficient by coefficient, D(p) = det(Mp² + Cp + K), '
+               'both of degree 2n (the same roots with multiplicity), det M decided nonzero'),
           keys={"variable": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"},
                 "exponent": EXPR},
           names=lambda ctx: _exponent_map(ctx)[1],
@@ -142,8 +153,22 @@ def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
         ok, why = match_complex(mapped, engine, partial=False, rtol=1e-7)
         if not ok:
             return Verdict(False, f"numeric({plural(k + 1, 'point')})", why)
-    return Verdict(True, f"numeric({POINTS} points, 40 digits)",
-                   power=f"{POINTS} points: its roots are the exponents, to 1e-7, at 40 digits")
+    numeric = Verdict(True, f"numeric({POINTS} points, 40 digits)",
+                      power=f"{POINTS} points: its roots are the exponents, to 1e-7, at 40 "
+                            "digits")
+    if not ctx.policy.prove:
+        return numeric
+    return _proved(numeric, prove_characteristic_polynomial(lin, poly_expr, var, exponent,
+                                                            ctx.sampler),
+                   "proved symbolically: lc(P)·det(Mp² + Cp + K) = lc(D)·P, of degree 2n, "
+                   "with p the exponent map (a multiset of roots)")
+
+
+def _proved(numeric: Verdict, proof, power: str) -> Verdict:
+    """The numeric pass, or `symbolic` where the proof holds (its reason kept where not)."""
+    if proof.ok:
+        return Verdict(True, "symbolic", power=power)
+    return Verdict(True, numeric.method, numeric.detail, numeric.power, unproved=proof.why)
 
 
 def _book_list(ctx: Context, val) -> list[sp.Expr]:
@@ -155,12 +180,22 @@ def _book_list(ctx: Context, val) -> list[sp.Expr]:
           how=('multiset equality with the 2n exponents p of e^{pt} solutions (roots of '
                'det(Mp² + Cp + K) = 0) at 5 points, each to 1e-8 of the largest |p| (a small '
                'real part beside a large frequency is resolved only to that); `partial: '
-               'true` for a subset'),
+               'true` for a subset; with `--prove`, `symbolic` where det M·∏(p − pᵢ) = '
+               'det(Mp² + Cp + K) is proved coefficient by coefficient in p (all 2n: the '
+               'same multiset), or each pᵢ a root (`partial`, distinct values), det M '
+               'decided nonzero'),
           keys={"partial": {"type": "boolean"}},
           complex_values=True,
           crosschecks=("modes",))
 def check_exponents(ctx: Context, val) -> Verdict:
-    return _multiset_at_points(ctx, val, lambda lin, pt: list(response.exponents(lin, pt)))
+    numeric = _multiset_at_points(ctx, val, lambda lin, pt: list(response.exponents(lin, pt)))
+    if not (numeric.ok and ctx.policy.prove):
+        return numeric
+    partial = bool(ctx.part.data.get("partial"))
+    return _proved(numeric, prove_exponents(ctx.linear(), _book_list(ctx, val), partial,
+                                            ctx.sampler),
+                   "proved symbolically: " + ("each a root of det(Mp² + Cp + K)" if partial
+                                              else "det M·∏(p − pᵢ) = det(Mp² + Cp + K)"))
 
 
 @quantity('decay_rates',
@@ -203,7 +238,9 @@ def _residual(M, C, K, p: complex, u: np.ndarray) -> float:
           book='list of `{exponent: p, shape: {q: complex amplitude}}`',
           how=('p is an exponent of the linearized system and (Mp² + Cp + K)u = 0 for the '
                "book's shape u (relative residual 1e-8; any vector of a degenerate "
-               'eigenspace passes), at 5 points'),
+               'eigenspace passes), at 5 points; with `--prove`, `symbolic` where '
+               'det(Mp² + Cp + K) = 0 and (Mp² + Cp + K)u = 0 are proved entry by entry (u '
+               'nonzero at the points)'),
           complex_values=True,
           equivalent=("direction",),
           crosschecks=("modes",))
@@ -230,8 +267,14 @@ def check_complex_modes(ctx: Context, val) -> Verdict:
             if res > 1e-8:
                 return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"mode {i}: (Mp² + Cp + K)u relative residual {res:.3g}")
-    return Verdict(True, f"numeric({POINTS} points)",
-                   power=f"{POINTS} points: p an exponent to 1e-8, (Mp² + Cp + K)u to 1e-8")
+    numeric = Verdict(True, f"numeric({POINTS} points)",
+                      power=f"{POINTS} points: p an exponent to 1e-8, (Mp² + Cp + K)u to 1e-8")
+    if not ctx.policy.prove:
+        return numeric
+    return _proved(numeric, prove_complex_modes(lin, [(p, list(u)) for p, u in modes],
+                                                ctx.sampler),
+                   "proved symbolically: det(Mp² + Cp + K) = 0 and (Mp² + Cp + K)u = 0; "
+                   f"u nonzero at {POINTS} points")
 
 
 def _linear_forms(ctx: Context, keys: list[str], lin) -> dict[str, list]:
@@ -267,7 +310,11 @@ def _driving(ctx: Context, pt: dict) -> float:
                'phase of the force (its first nonzero '
                'generalized component as Re(F̂ e^{iωt})): A = X_q e^{−iφ₀} with '
                'X = (K − ω²M + iωC)⁻¹F̂, at 5 points (so a real A is the signed amplitude '
-               'in phase with the force)'),
+               'in phase with the force); with `--prove`, `symbolic` where every '
+               'coordinate is given (or n forms, their determinant decided nonzero), F is '
+               'proved harmonic at ω, the phase of its first nonzero component is a proved '
+               'sign, and (K − ω²M + iωC)·X = e^{−iφ₀}F̂ is proved entry by entry (the '
+               'unique response wherever there is one)'),
           keys={"frequency": EXPR},
           complex_values=True,
           crosschecks=("modes", "response"))
@@ -292,8 +339,14 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
             if not abs(got - want) <= 1e-9 * max(abs(want), 1e-6 * scale):
                 return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"{c}: book {_c(got)}, engine {_c(want)} (ω = {w:.6g})")
-    return Verdict(True, f"numeric({POINTS} points, (K - w^2 M + i w C) X = F)",
-                   power=f"{POINTS} points: each amplitude to 1e-9")
+    numeric = Verdict(True, f"numeric({POINTS} points, (K - w^2 M + i w C) X = F)",
+                      power=f"{POINTS} points: each amplitude to 1e-9")
+    if not ctx.policy.prove:
+        return numeric
+    omega = ctx.parse(ctx.part.data["frequency"], ("frequency",))
+    return _proved(numeric, prove_steady_amplitude(lin, book, rows, omega, ctx.sampler),
+                   "proved symbolically: F harmonic, (K − ω²M + iωC)·X = e^{−iφ₀}F̂ for the "
+                   "book's amplitudes (wherever the steady response is unique)")
 
 
 
@@ -348,7 +401,10 @@ def check_resonances(ctx: Context, val) -> Verdict:
           book='true or false',
           how=('whether one linear change of coordinates diagonalizes M, C (friction) and K '
                'together: K M⁻¹C = C M⁻¹K (Caughey and O\'Kelly), decided at 6 points '
-               '(relative residual below 1e-10 at every one, or above 1e-6 at every one)'))
+               '(relative residual below 1e-10 at every one, or above 1e-6 at every one); '
+               'with `--prove`, `true` is `symbolic` where C = Cᵀ and K·adj(M)·C = '
+               'C·adj(M)·K are proved entry by entry, det M decided nonzero (`false` stays '
+               'decided at the points)'))
 def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
     if not isinstance(val, bool):
         raise ctx.part.error(("book",), "expected true or false")
@@ -360,10 +416,14 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
         return Verdict(False, "numeric(6 points)", "diagonalizable at some parameter points "
                        f"only (residuals {', '.join(f'{r:.1e}' for r in residuals)})")
     ok = yes == val
-    return Verdict(ok, "numeric(6 points)",
-                   f"K M^-1 C - C M^-1 K relative residual up to {max(residuals):.1e}",
-                   power="6 points: the commutator below 1e-10 at every one (or above 1e-6 "
-                         "at every one)")
+    numeric = Verdict(ok, "numeric(6 points)",
+                      f"K M^-1 C - C M^-1 K relative residual up to {max(residuals):.1e}",
+                      power="6 points: the commutator below 1e-10 at every one (or above "
+                            "1e-6 at every one)")
+    if not (ok and ctx.policy.prove):
+        return numeric
+    return _proved(numeric, prove_simultaneous_diagonalization(lin, val, ctx.sampler),
+                   "proved symbolically: C = Cᵀ and K·adj(M)·C = C·adj(M)·K")
 
 
 
@@ -371,7 +431,9 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
           book='`{q: linear form in normal coordinates}` (every coordinate)',
           how=('x = A·η (the normal coordinates η are answer symbols): AᵀMA = 1 and AᵀKA '
                'diagonal (T = Σ η̇²/2, V = Σ ω²η²/2), entrywise to 1e-9 at 5 points; '
-               '`frequencies: {η: ω}` also checks the diagonal'),
+               '`frequencies: {η: ω}` also checks the diagonal; with `--prove`, `symbolic` '
+               'where AᵀMA = 1, the off-diagonal AᵀKA and ω² − (AᵀKA)ⱼⱼ are proved 0 entry '
+               'by entry'),
           keys={"frequencies": {"type": "object", "additionalProperties": EXPR}},
           crosschecks=("modes",))
 def check_normal_transformation(ctx: Context, val) -> Verdict:
@@ -421,7 +483,14 @@ def check_normal_transformation(ctx: Context, val) -> Verdict:
             if abs(wv**2 - V[j, j]) > 1e-9 * scale:
                 return Verdict(False, f"numeric({plural(k + 1, 'point')})",
                                f"{etas[j]}: omega**2 = {_c(wv**2)}, engine {V[j, j]:.10g}")
-    return Verdict(True, f"numeric({POINTS} points)",
-                   power=f"{POINTS} points in double precision: AᵀMA = 1 and AᵀKA diagonal to "
-                         "1e-9, the offset exact")
+    numeric = Verdict(True, f"numeric({POINTS} points)",
+                      power=f"{POINTS} points in double precision: AᵀMA = 1 and AᵀKA diagonal "
+                            "to 1e-9, the offset exact")
+    if not ctx.policy.prove or (offset is not None and offset.method != "symbolic"):
+        return numeric if not ctx.policy.prove else Verdict(
+            True, numeric.method, numeric.detail, numeric.power,
+            unproved=offset.unproved or "the offset is checked numerically")
+    return _proved(numeric, prove_normal_transformation(lin, A, freqs, ctx.sampler),
+                   "proved symbolically: AᵀMA = 1 and AᵀKA diagonal"
+                   + (" with the stated ω²" if freqs else "") + ", entry by entry")
 

@@ -14,6 +14,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from mechbook.core.identity import decide_zero
 from mechbook.core.numeval import NotNumeric, evaluate_resolved
 from mechbook.core.secalc import expand
 from mechbook.core.words import plural
@@ -24,7 +25,9 @@ from mechbook.verify import boundary
 from mechbook.verify.asymptotic import asymptotic
 from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
 from mechbook.verify.context import Context, numbers
+from mechbook.verify.proof import NO_PATH, Proof
 from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, Family
+from mechbook.verify.response_proof import prove_proportional
 
 FAMILY = Family()  # this module's quantities (mechbook.verify.registry lists it)
 quantity = FAMILY.quantity
@@ -94,7 +97,11 @@ def _rate_symbol(ctx: Context, fam: SteadyFamily) -> sp.Symbol:
                'them vanish and, unless `partial: true`, there are no other real ones; '
                'with `limit:` each book rate approaches an engine rate (decades, as for '
                'frequencies). `hold:` fixes the other cyclic rates; `estimate:` compares '
-               'at the book\'s numbers to its precision'),
+               'at the book\'s numbers to its precision; with `--prove`, an equation is '
+               '`symbolic` where it is polynomial in the rate and proved proportional to '
+               'the one condition not identically 0 (lc(B)·E = lc(E)·B, the same degree: '
+               'the same roots wherever the leading coefficients do not vanish, as sin θ0 '
+               'for a top)'),
           keys={**STEADY_KEYS, "partial": {"type": "boolean"}, "limit": LIMIT,
                 "estimate": ESTIMATE},
           crosschecks=("steady",))
@@ -173,8 +180,32 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
     if not seen:  # two equations without real roots agree without saying anything
         raise UndecidedError(f"no steady motion exists at any of {n} sampled points: the "
                              "check cannot discriminate (`assume:` a region where one does)")
-    return Verdict(True, f"numeric({plural(n, 'point')}, polynomial roots)",
-                   power=f"{plural(n, 'point')}: the real roots, all of them, to {ROOT_RTOL:g}")
+    numeric = Verdict(True, f"numeric({plural(n, 'point')}, polynomial roots)",
+                      power=f"{plural(n, 'point')}: the real roots, all of them, to "
+                            f"{ROOT_RTOL:g}")
+    if not ctx.policy.prove:
+        return numeric
+    proof = _proved_same_roots(fam, eq, ctx.sampler)
+    if proof.ok:
+        return Verdict(True, "symbolic", power="proved symbolically: the book's polynomial "
+                       "and the engine's condition proportional in the rate (the same roots "
+                       "wherever their leading coefficients do not vanish)")
+    return Verdict(True, numeric.method, numeric.detail, numeric.power, unproved=proof.why)
+
+
+def _proved_same_roots(fam: SteadyFamily, eq: sp.Expr, sampler) -> Proof:
+    """The one condition of the family not identically 0 proved proportional to the
+    book's polynomial in the rate; refused where there are several (common roots)."""
+    live = [c for c in fam.conditions if not (c == 0 or decide_zero(c).zero is True)]
+    if len(live) != 1:
+        return Proof(False, NO_PATH + " (several conditions: their common roots)")
+    num, den = sp.together(live[0]).as_numer_denom()
+    if den.has(fam.x):
+        return Proof(False, NO_PATH + " (the condition is not polynomial in the rate)")
+    bnum, bden = sp.together(eq).as_numer_denom()
+    if bden.has(fam.x):
+        return Proof(False, NO_PATH + " (the equation is not polynomial in the rate)")
+    return prove_proportional(bnum, num, fam.x, sampler)
 
 
 

@@ -273,7 +273,9 @@ def _tensor_subject(ctx: Context, names: dict) -> sp.Matrix:
                'det T, the coefficients of the secular equation (so the multiset matches, '
                'in any order, complex ones included, without solving it); fewer values '
                'with `partial: true`: each is a root, det(λ1 − T) = 0. `for_all:` '
-               'quantifies over generic tensors'),
+               'quantifies over generic tensors; with `--prove`, `symbolic` where the '
+               'generic statement is proved (exponentials of imaginary arguments written '
+               'cos x + i sin x: a rotation\'s e^{±iα} with α = acos((tr R − 1)/2))'),
           keys={"tensor": TENSOR, "for_all": FOR_ALL, "axes": AXES,
                 "partial": {"type": "boolean"}}, needs_system=False)
 def check_eigenvalues(ctx: Context, val) -> Verdict:
