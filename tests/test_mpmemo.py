@@ -67,3 +67,20 @@ def test_quadrature_through_the_namespace_has_the_closed_form():
             got = mpmath.quad(f, [0, mpmath.pi / 2, mpmath.pi])
             assert got == mpmath.quad(g, [0, mpmath.pi / 2, mpmath.pi])  # bit for bit
             assert abs(got - exact) < mpmath.mpf(10) ** -28 * exact
+
+
+def test_a_curves_quadrature_through_it_has_the_closed_form():
+    # the cycloid x = a(θ − sin θ), y = a(1 − cos θ) over one arch is 8a long; the second
+    # quadrature finds every node's sines and cosines remembered, the same number
+    from mechbook.engine.curve import Curve, integral
+
+    th, a = sp.Symbol("theta"), sp.Symbol("a", positive=True)
+    x, y = a * (th - sp.sin(th)), a * (1 - sp.cos(th))
+    curve = Curve(th, x, [y], (sp.Integer(0), 2 * sp.pi), [])
+    length = sp.sqrt(sp.diff(x, th) ** 2 + sp.diff(y, th) ** 2)
+    point = {a: sp.Float("0.7", 30)}
+    first, _ = integral(length, curve, point)
+    second, _ = integral(length, curve, point)
+    assert first == second
+    with mpmath.workdps(30):
+        assert abs(first - 8 * mpmath.mpf("0.7")) < mpmath.mpf(10) ** -27
