@@ -239,3 +239,25 @@ def test_a_quadrature_short_of_its_digits_is_unsupported(tmp_path, monkeypatch):
             "book": f"2*({OSC_J})"}   # even a wrong key: not a fail
     out = _outcome(tmp_path, "9813", well(2), part, {"E": {"value": 0.4}})
     assert out.status.value == "unsupported" and "quadrature reached only" in out.detail
+
+
+def test_each_orbit_is_built_once_per_point_and_precision(tmp_path, monkeypatch):
+    # H(J) = −mk²/2(J_r + J_φ)² (the closed form above) passes, and its actions, radial
+    # frequency, angular rate and energy at a point read one orbit at each precision:
+    # no level-set orbit is built twice with the same energy, momenta, start and digits
+    from mechbook.engine.levelset import LevelSet
+
+    built = []
+    orbit_at = LevelSet.orbit_at
+
+    def counted(self, energy, momenta, inside, values, dps):
+        built.append((str(self.c), mpmath.nstr(energy, 40), tuple(mpmath.nstr(p, 40)
+                      for p in momenta), mpmath.nstr(inside, 40), dps))
+        return orbit_at(self, energy, momenta, inside, values, dps)
+
+    monkeypatch.setattr(LevelSet, "orbit_at", counted)
+    part = {"quantity": "action_hamiltonian", "actions": {"Jr": "r", "Jphi": "phi"},
+            **KEPLER_MOTION, "book": "-m*k**2/(2*(Jr + Jphi)**2)"}
+    out = _outcome(tmp_path, "9808", KEPLER, part, {**KEPLER_SYMBOLS, "Jr": {}, "Jphi": {}})
+    assert out.status.value == "pass", out.detail
+    assert len(built) == len(set(built)) >= 12  # six points at two precisions at least

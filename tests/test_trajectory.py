@@ -16,6 +16,7 @@ from systems import pendulum
 
 from mechbook.engine.analysis import Analysis
 from mechbook.engine.levelset import LevelSet
+from mechbook.errors import UnsupportedError
 from mechbook.model.problem import load_problem
 from mechbook.numerics.measure import measure, signal_functions
 from mechbook.numerics.rhs import build_model
@@ -250,3 +251,24 @@ def test_an_exact_formula_is_exact_to_its_resolution(pend, tmp_path):
                            book="2*theta0")
     assert got == "pass", detail
     assert "resolution of its arithmetic" in detail
+
+
+def test_an_orbit_at_an_energy_is_kept_by_its_numbers(pend):
+    """orbit_at: the pendulum's orbit of energy E = −m g l cos θ0 through θ = 0 has the
+    closed-form period 4√(l/g) K(sin²(θ0/2)); asked again with the same numbers it is the
+    same orbit (its turning points and period computed once), at other digits or another
+    energy a new one, and an energy that cannot reach `inside` is refused each time."""
+    sys = pend.system()
+    th = sys.q[0]
+    level = LevelSet(pend.dynamics(), th)
+    values = pend.problem.values()
+    E = -M * G * L * math.cos(1.2)
+    one = level.orbit_at(E, [], 0, values, 40)
+    assert abs(float(one.period) / exact_period(1.2) - 1) < 1e-12
+    assert level.orbit_at(E, [], 0, values, 40) is one
+    assert level.orbit_at(E, [], 0, values, 50) is not one
+    other = level.orbit_at(-M * G * L * math.cos(0.3), [], 0, values, 40)
+    assert other is not one and abs(float(other.period) / exact_period(0.3) - 1) < 1e-12
+    for _ in range(2):
+        with pytest.raises(UnsupportedError):
+            level.orbit_at(-2 * M * G * L, [], 0, values, 40)  # below the well's bottom

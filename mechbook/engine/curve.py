@@ -19,6 +19,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from mechbook.core import mpmemo
 from mechbook.core.backends import FEW_CALLS_BACKEND
 from mechbook.core.compile import compile_exprs
 from mechbook.core.numeval import evaluate, evaluate_mp
@@ -73,12 +74,15 @@ def fast(expr: sp.Expr):
     """(f, symbols): expr as an mpmath function of its free symbols (SymPy's lambdify of
     an expression the safe parser and the engine built; cse), evaluated at the working
     precision: ten times faster than numeval's program, for the many evaluations of a
-    quadrature or an iteration (the verdicts' residuals keep numeval's scale)."""
+    quadrature or an iteration (the verdicts' residuals keep numeval's scale). Its
+    elementary functions remember their values (mechbook.core.mpmemo: the perturbed
+    curves' quadratures share their nodes), the same numbers bit for bit."""
     key = expr
     hit = _FAST.get(key)
     if hit is None:
         syms = sorted(expr.free_symbols, key=str)
-        hit = (sp.lambdify(syms, expr, modules="mpmath", cse=True), syms)
+        hit = (sp.lambdify(syms, expr, modules=[mpmemo.NAMESPACE, "mpmath"], cse=True),
+               syms)
         _FAST[key] = hit
     return hit
 

@@ -150,17 +150,26 @@ class LevelSet:
         """The orbit of energy `energy` and cyclic momenta `momenta` (in `self.cyclic`'s
         order) that passes through c = `inside` (a point of the allowed region, not a
         turning point): an action or a frequency asked at a given energy rather than from a
-        start. UnsupportedError if the motion cannot reach `inside` at that energy."""
+        start. UnsupportedError if the motion cannot reach `inside` at that energy. Kept as
+        `orbit`'s are, by the orbit's own numbers (the parts of one problem that ask at the
+        same energy, momenta and parameters: an action, H(J) and its frequencies)."""
         with mpmath.workdps(dps):
             def mp(v):
                 return mpmath.mpf(str(sp.N(v, dps)))
 
             params = [mp(values[p]) for p in self.params]
-            orbit = Orbit(self, [mp(x) for x in momenta], mp(energy), mp(inside),
-                          mpmath.mpf(1), params, dps)  # ċ0 ≠ 0: search both ways
+            P, E, c0 = [mp(x) for x in momenta], mp(energy), mp(inside)
+            key = ("at", tuple(P), E, c0, tuple(params), dps)
+            hit = self._orbits.get(key)
+            if hit is not None:
+                return hit
+            orbit = Orbit(self, P, E, c0, mpmath.mpf(1), params, dps)  # ċ0 ≠ 0: both ways
             if not orbit.kinetic(orbit.c0) > 0:
                 raise UnsupportedError(f"level set: at this energy the motion does not reach "
                                        f"{self.c} = {mpmath.nstr(orbit.c0, 8)}")
+            self._orbits[key] = orbit
+            if len(self._orbits) > ORBITS:
+                del self._orbits[next(iter(self._orbits))]
             return orbit
 
 

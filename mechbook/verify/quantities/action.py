@@ -56,6 +56,7 @@ class Actions:
 
     def __init__(self, ctx: Context, coordinates: list[str], where: tuple):
         self.ctx, sys, data = ctx, ctx.system, ctx.part.data
+        self._orbits: dict = {}  # (coordinate, digits, point): its Orbit
         self.coords = []
         for name in coordinates:
             if name is None:
@@ -101,6 +102,18 @@ class Actions:
         return out
 
     def orbit(self, c, pt: dict, dps: int) -> Orbit:
+        """The orbit of coordinate c at `pt`, computed once at each precision: a point's
+        action, its frequencies and its energy read the same orbit (its turning points and
+        quadratures are the orbit's cached properties, the same numbers whichever asks
+        first), where each built and searched it again (three times at each of six points
+        of an `action_hamiltonian`)."""
+        key = (c, dps, tuple(sorted(pt.items(), key=lambda kv: str(kv[0]))))
+        got = self._orbits.get(key)
+        if got is None:
+            got = self._orbits[key] = self._orbit(c, pt, dps)
+        return got
+
+    def _orbit(self, c, pt: dict, dps: int) -> Orbit:
         ctx, level = self.ctx, self.level(c)
         if self.start is not None:
             return level.orbit({k: v.subs(pt) for k, v in self.start.items()}, pt, dps)
