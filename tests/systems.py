@@ -37,8 +37,6 @@ def load_analysis(tmp_path: Path, text: str, num: str) -> Analysis:
     return Analysis(load_problem(d / f"{num}.yaml"))
 
 
-# a harmonic oscillator, a double pendulum, and a bead on a hoop turning at a given rate
-# (explicitly time-dependent); their `id:` lines are rewritten by load_analysis
 # a particle in a plane about a fixed centre, its potential and name to fill in (the
 # scattering tests)
 PLANE = """\
@@ -56,6 +54,29 @@ potential: {potential}
 """
 
 
+# a pendulum whose pivot is driven up and down (Kapitza): the driven and periodic tests
+KAPITZA = """\
+id: lim-9404
+source: test
+title: pendulum on a pivot driven up and down (Kapitza)
+parameters:
+  m: {value: 1.0}
+  l: {value: 1.0}
+  a: {value: 0.1}
+  omega: {value: 45.0}
+  g: {value: 9.81}
+coordinates:
+  theta: {}
+driven:
+  y0: a*cos(omega*t)
+particles:
+  bob: {mass: m, position: [l*sin(theta), y0 - l*cos(theta)]}
+gravity: {}
+"""
+
+
+# a harmonic oscillator, a double pendulum, and a bead on a hoop turning at a given rate
+# (explicitly time-dependent); their `id:` lines are rewritten by load_analysis
 DOUBLE = """\
 id: lim-9302
 source: test

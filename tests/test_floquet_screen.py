@@ -26,7 +26,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from systems import SADDLE, load_analysis
+from systems import KAPITZA, SADDLE, load_analysis
 
 from mechbook.errors import MechbookError
 from mechbook.numerics.floquet import Floquet
@@ -413,24 +413,6 @@ def test_the_expected_error_extrapolates_the_fall():
     assert boundary_limit.expected([math.inf]) == math.inf
 
 
-KAPITZA = """\
-id: lim-9804
-source: test
-title: pendulum on a pivot driven up and down
-parameters:
-  m: {value: 1.0}
-  l: {value: 1.0}
-  a: {value: 0.1}
-  omega: {value: 45.0}
-  g: {value: 9.81}
-coordinates:
-  theta: {}
-driven:
-  y0: a*cos(omega*t)
-particles:
-  bob: {mass: m, position: [l*sin(theta), y0 - l*cos(theta)]}
-gravity: {}
-"""
 
 
 def test_the_rate_guard_reads_the_coefficients_at_t0(tmp_path):

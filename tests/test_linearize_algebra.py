@@ -68,24 +68,6 @@ def test_either_algebra_falls_back_to_sympy_and_lets_a_problem_fault_through():
         either(refused)
 
 
-KAPITZA = """\
-id: lim-9811
-source: test
-title: pendulum on a pivot driven up and down
-parameters:
-  m: {value: 1.0}
-  l: {value: 1.0}
-  a: {value: 0.1}
-  omega: {value: 45.0}
-  g: {value: 9.81}
-coordinates:
-  theta: {}
-driven:
-  y0: a*cos(omega*t)
-particles:
-  bob: {mass: m, position: [l*sin(theta), y0 - l*cos(theta)]}
-gravity: {}
-"""
 
 
 @pytest.mark.parametrize("at", ["0", "pi"])
@@ -96,7 +78,7 @@ def test_the_first_order_expansion_is_the_closed_form(tmp_path, at):
     about θ = 0 (sinθ ≈ δ) and θ = π (sinθ ≈ −δ): M = m l², C = 0, K = ±m l (g − aω²cos ωt),
     no remainder. The engine's sign of E may be either: K/M is compared, and M, C, K the
     same through SymPy's own diff."""
-    from systems import load_analysis
+    from systems import KAPITZA, load_analysis
 
     import mechbook.engine.equilibria as eqm
 

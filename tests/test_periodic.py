@@ -26,7 +26,7 @@ import scipy.integrate
 import scipy.special
 import sympy as sp
 from ruamel.yaml import YAML
-from systems import SADDLE, load_analysis
+from systems import KAPITZA, SADDLE, load_analysis
 
 from mechbook.engine.periodic import period
 from mechbook.errors import UnsupportedError
@@ -234,24 +234,6 @@ def test_kapitza_threshold_at_finite_drive(tmp_path):
     assert out.status == "fail", out.detail
 
 
-KAPITZA = """\
-id: lim-9404
-source: test
-title: pendulum on a pivot driven up and down (Kapitza)
-parameters:
-  m: {value: 1.0}
-  l: {value: 1.0}
-  a: {value: 0.1}
-  omega: {value: 45.0}
-  g: {value: 9.81}
-coordinates:
-  theta: {}
-driven:
-  y0: a*cos(omega*t)
-particles:
-  bob: {mass: m, position: [l*sin(theta), y0 - l*cos(theta)]}
-gravity: {}
-"""
 KAPITZA_LIMIT = {"quantity": "stability_condition", "about": {"theta": "pi"},
                  "restrict": {"omega": "v/a"}, "limit": {"parameter": "a", "to": 0,
                                                            "order": 1}}
