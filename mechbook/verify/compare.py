@@ -42,6 +42,17 @@ class Verdict:
     unproved: str = ""
 
 
+def symbolic_or(numeric: Verdict, proof, power: str) -> Verdict:
+    """With --prove: `symbolic` with `power` where `proof` (a mechbook.verify.proof.Proof)
+    holds, else the numeric pass with the proof's reason for not holding.
+
+    Example: symbolic_or(Verdict(True, "numeric(5 points)"), Proof(True), "proved").method
+    == "symbolic"."""
+    if proof.ok:
+        return Verdict(True, "symbolic", power=power)
+    return Verdict(True, numeric.method, numeric.detail, numeric.power, unproved=proof.why)
+
+
 def _derived_value(expr: sp.Basic, point: dict) -> tuple:
     """(real part, imaginary part) of a derived symbol's expression at `point`: compiled
     once and run in mpmath at 15 digits beyond DIGITS (the walk toward a limit asks for it

@@ -16,7 +16,7 @@ import sympy as sp
 from mechbook.core.words import plural
 from mechbook.engine import response
 from mechbook.errors import UnsupportedError
-from mechbook.verify.compare import Verdict, all_vanish, combine, equal, value
+from mechbook.verify.compare import Verdict, all_vanish, combine, equal, symbolic_or, value
 from mechbook.verify.context import Context
 from mechbook.verify.registration import EXPR, Family
 from mechbook.verify.response_proof import (
@@ -158,17 +158,10 @@ def check_characteristic_polynomial(ctx: Context, val) -> Verdict:
                             "digits")
     if not ctx.policy.prove:
         return numeric
-    return _proved(numeric, prove_characteristic_polynomial(lin, poly_expr, var, exponent,
-                                                            ctx.sampler),
-                   "proved symbolically: lc(P)·det(Mp² + Cp + K) = lc(D)·P, of degree 2n, "
-                   "with p the exponent map (a multiset of roots)")
-
-
-def _proved(numeric: Verdict, proof, power: str) -> Verdict:
-    """The numeric pass, or `symbolic` where the proof holds (its reason kept where not)."""
-    if proof.ok:
-        return Verdict(True, "symbolic", power=power)
-    return Verdict(True, numeric.method, numeric.detail, numeric.power, unproved=proof.why)
+    return symbolic_or(numeric, prove_characteristic_polynomial(lin, poly_expr, var, exponent,
+                                                                 ctx.sampler),
+                        "proved symbolically: lc(P)·det(Mp² + Cp + K) = lc(D)·P, of degree 2n, "
+                        "with p the exponent map (a multiset of roots)")
 
 
 def _book_list(ctx: Context, val) -> list[sp.Expr]:
@@ -192,10 +185,10 @@ def check_exponents(ctx: Context, val) -> Verdict:
     if not (numeric.ok and ctx.policy.prove):
         return numeric
     partial = bool(ctx.part.data.get("partial"))
-    return _proved(numeric, prove_exponents(ctx.linear(), _book_list(ctx, val), partial,
-                                            ctx.sampler),
-                   "proved symbolically: " + ("each a root of det(Mp² + Cp + K)" if partial
-                                              else "det M·∏(p − pᵢ) = det(Mp² + Cp + K)"))
+    return symbolic_or(numeric, prove_exponents(ctx.linear(), _book_list(ctx, val), partial,
+                                                 ctx.sampler),
+                        "proved symbolically: " + ("each a root of det(Mp² + Cp + K)" if partial
+                                                   else "det M·∏(p − pᵢ) = det(Mp² + Cp + K)"))
 
 
 @quantity('decay_rates',
@@ -271,10 +264,10 @@ def check_complex_modes(ctx: Context, val) -> Verdict:
                       power=f"{POINTS} points: p an exponent to 1e-8, (Mp² + Cp + K)u to 1e-8")
     if not ctx.policy.prove:
         return numeric
-    return _proved(numeric, prove_complex_modes(lin, [(p, list(u)) for p, u in modes],
-                                                ctx.sampler),
-                   "proved symbolically: det(Mp² + Cp + K) = 0 and (Mp² + Cp + K)u = 0; "
-                   f"u nonzero at {POINTS} points")
+    return symbolic_or(numeric, prove_complex_modes(lin, [(p, list(u)) for p, u in modes],
+                                                     ctx.sampler),
+                        "proved symbolically: det(Mp² + Cp + K) = 0 and (Mp² + Cp + K)u = 0; "
+                        f"u nonzero at {POINTS} points")
 
 
 def _linear_forms(ctx: Context, keys: list[str], lin) -> dict[str, list]:
@@ -344,9 +337,9 @@ def check_steady_amplitude(ctx: Context, val) -> Verdict:
     if not ctx.policy.prove:
         return numeric
     omega = ctx.parse(ctx.part.data["frequency"], ("frequency",))
-    return _proved(numeric, prove_steady_amplitude(lin, book, rows, omega, ctx.sampler),
-                   "proved symbolically: F harmonic, (K − ω²M + iωC)·X = e^{−iφ₀}F̂ for the "
-                   "book's amplitudes (wherever the steady response is unique)")
+    return symbolic_or(numeric, prove_steady_amplitude(lin, book, rows, omega, ctx.sampler),
+                        "proved symbolically: F harmonic, (K − ω²M + iωC)·X = e^{−iφ₀}F̂ for the "
+                        "book's amplitudes (wherever the steady response is unique)")
 
 
 
@@ -422,8 +415,8 @@ def check_simultaneous_diagonalization(ctx: Context, val) -> Verdict:
                             "1e-6 at every one)")
     if not (ok and ctx.policy.prove):
         return numeric
-    return _proved(numeric, prove_simultaneous_diagonalization(lin, val, ctx.sampler),
-                   "proved symbolically: C = Cᵀ and K·adj(M)·C = C·adj(M)·K")
+    return symbolic_or(numeric, prove_simultaneous_diagonalization(lin, val, ctx.sampler),
+                        "proved symbolically: C = Cᵀ and K·adj(M)·C = C·adj(M)·K")
 
 
 
@@ -490,7 +483,7 @@ def check_normal_transformation(ctx: Context, val) -> Verdict:
         return numeric if not ctx.policy.prove else Verdict(
             True, numeric.method, numeric.detail, numeric.power,
             unproved=offset.unproved or "the offset is checked numerically")
-    return _proved(numeric, prove_normal_transformation(lin, A, freqs, ctx.sampler),
-                   "proved symbolically: AᵀMA = 1 and AᵀKA diagonal"
-                   + (" with the stated ω²" if freqs else "") + ", entry by entry")
+    return symbolic_or(numeric, prove_normal_transformation(lin, A, freqs, ctx.sampler),
+                        "proved symbolically: AᵀMA = 1 and AᵀKA diagonal"
+                        + (" with the stated ω²" if freqs else "") + ", entry by entry")
 

@@ -23,7 +23,14 @@ from mechbook.engine.steady import SteadyFamily, effective_potential, polynomial
 from mechbook.errors import UndecidedError, UnsupportedError
 from mechbook.verify import boundary
 from mechbook.verify.asymptotic import asymptotic
-from mechbook.verify.compare import DIGITS, Verdict, all_vanish, combine, value_and_scale
+from mechbook.verify.compare import (
+    DIGITS,
+    Verdict,
+    all_vanish,
+    combine,
+    symbolic_or,
+    value_and_scale,
+)
 from mechbook.verify.context import Context, numbers
 from mechbook.verify.proof import NO_PATH, Proof
 from mechbook.verify.registration import ESTIMATE, LIMIT, NAME, Family
@@ -185,12 +192,10 @@ def _same_roots(ctx: Context, fam: SteadyFamily, eq: sp.Expr) -> Verdict:
                             f"{ROOT_RTOL:g}")
     if not ctx.policy.prove:
         return numeric
-    proof = _proved_same_roots(fam, eq, ctx.sampler)
-    if proof.ok:
-        return Verdict(True, "symbolic", power="proved symbolically: the book's polynomial "
-                       "and the engine's condition proportional in the rate (the same roots "
-                       "wherever their leading coefficients do not vanish)")
-    return Verdict(True, numeric.method, numeric.detail, numeric.power, unproved=proof.why)
+    return symbolic_or(numeric, _proved_same_roots(fam, eq, ctx.sampler),
+                       "proved symbolically: the book's polynomial and the engine's condition "
+                       "proportional in the rate (the same roots wherever their leading "
+                       "coefficients do not vanish)")
 
 
 def _proved_same_roots(fam: SteadyFamily, eq: sp.Expr, sampler) -> Proof:
