@@ -179,3 +179,37 @@ def test_steady_motion_at_a_chart_singularity_says_so(tmp_path):
     th, ph, ps = sys.q
     with pytest.raises(UnsupportedError, match="singular point of the coordinates"):
         analysis.steady_linear(None, {ph: 0, ps: 3}, {th: 0})
+
+
+def test_the_mean_of_a_trigonometric_polynomial_by_symengine_is_sympys():
+    """The Fourier constant term by SymEngine (loads._laurent_constant) is the closed-form
+    mean and, term for term, the expression SymPy's exponential path gives (what a
+    problem's averaged Lagrangian was before); a wrong constant term would fail both."""
+    from mechbook.model import loads
+
+    x, a, b, th, ph = sp.symbols("x a b theta phi", real=True)
+    means = {  # each mean over a period worked out by hand
+        sp.cos(x) ** 2: sp.Rational(1, 2),
+        sp.sin(x) ** 2 * sp.cos(th): sp.cos(th) / 2,
+        (a * sp.cos(x) + b * sp.sin(x + th)) ** 2: (a**2 + b**2) / 2 + a * b * sp.sin(th),
+        sp.sin(3 * x) * sp.sin(3 * x - 1): sp.cos(1) / 2,
+        sp.cos(x) ** 4 * sp.sin(th) + sp.sin(2 * x) * sp.cos(x) ** 2: 3 * sp.sin(th) / 8,
+        sp.cos(x - th) * sp.cos(x) * a: a * sp.cos(th) / 2,
+        sp.cos(2 * x + ph) * sp.cos(x) ** 2: sp.cos(ph) / 4,
+        (sp.sin(th) ** 2 + sp.cos(th) ** 2) * sp.sin(x) ** 2: sp.Rational(1, 2),
+    }
+    for expr, mean in means.items():
+        fast = loads._laurent_constant(expr, x)
+        assert sp.simplify(fast - mean) == 0, expr
+        assert fast == _sympys_mean(loads, expr, x), expr
+    # a function other than sin and cos is left to SymPy's path
+    assert loads._laurent_constant(sp.sin(x) ** 2 * sp.tan(th), x) is None
+
+
+def _sympys_mean(loads, expr, x):
+    saved = loads._laurent_constant
+    loads._laurent_constant = lambda *args: None
+    try:
+        return loads._fourier_constant(expr, x)
+    finally:
+        loads._laurent_constant = saved

@@ -17,8 +17,10 @@
 
 from __future__ import annotations
 
+import symengine as se
 import sympy as sp
 
+from mechbook.core.secalc import to_sympy
 from mechbook.core.timeout import Timeout, time_limit
 from mechbook.model.attitude import rotation_matrix
 
@@ -132,6 +134,9 @@ def _fourier_constant(expr: sp.Expr, x: sp.Symbol) -> sp.Expr | None:
     stripped = expr.subs(dummies)
     if stripped.has(x) or not stripped.is_polynomial(*dummies.values()):
         return None  # e.g. 1/sqrt(a + b*cos(x)): expanding it would run for minutes
+    fast = _laurent_constant(expr, x)
+    if fast is not None:
+        return fast
     wave = sp.expand(expr.rewrite(sp.exp), power_exp=True, mul=True, multinomial=True)
     keep = sp.S.Zero
     for term in sp.Add.make_args(wave):
@@ -151,6 +156,40 @@ def _fourier_constant(expr: sp.Expr, x: sp.Symbol) -> sp.Expr | None:
         if freq == 0:
             keep += term.subs(x, 0)
     return sp.expand(keep.rewrite(sp.cos))
+
+
+def _laurent_constant(expr: sp.Expr, x: sp.Symbol) -> sp.Expr | None:
+    """The constant term in x of a trigonometric polynomial in x (its sines and cosines of
+    k·x + c, k an integer), by SymEngine. As on SymPy's path (_fourier_constant), every
+    sine and cosine is written in exponentials: with z = e^{ix}, cos(kx + c) is
+    (z^k e^{ic} + z^-k e^{-ic})/2 (sin: the same with a minus, over 2i), and those of other
+    arguments u as (e^{iu} ± e^{-iu})/2(i), so that sin²u + cos²u cancels as it does there;
+    the whole is expanded as a Laurent polynomial in z, its terms free of z kept, and
+    written back in cosines as SymPy's path writes them: the same expression, in C++ (0.56 s
+    to 0.02 s for a rigid body's averaged attraction, Symon 11-18). None where expr holds a
+    function other than sines and cosines, or SymEngine cannot: SymPy's path does it."""
+    if any(not isinstance(f, (sp.sin, sp.cos)) for f in expr.atoms(sp.Function)):
+        return None  # tan, exp, …: SymPy's path writes them in exponentials as well
+    try:
+        z = se.Dummy("z")
+        stand = {f: sp.Dummy() for f in expr.atoms(sp.sin, sp.cos)}
+        waves = {}
+        for f, d in stand.items():
+            arg = sp.expand(f.args[0])
+            k = arg.coeff(x) if arg.has(x) else sp.S.Zero
+            phase = se.exp(se.I * se.sympify(arg - k * x))
+            up, down = z**int(k) * phase, z**int(-k) / phase
+            waves[se.sympify(d)] = (up + down) / 2 if isinstance(f, sp.cos) else \
+                (up - down) / (2 * se.I)
+        wave = se.expand(se.sympify(expr.xreplace(stand)).xreplace(waves))
+        terms = wave.args if isinstance(wave, se.Add) else (wave,)
+        keep = se.Add(*[t for t in terms if z not in t.free_symbols])
+        out = to_sympy(keep, expr.free_symbols)
+    except Exception:  # noqa: BLE001 - SymEngine's conversion or expansion failed
+        return None
+    if out.has(x, *stand.values()):
+        return None
+    return sp.expand(sp.expand(out, power_exp=True).rewrite(sp.cos))
 
 
 def _pythagoras_in_roots(expr: sp.Expr, x: sp.Symbol) -> sp.Expr:
