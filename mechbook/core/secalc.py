@@ -27,15 +27,41 @@ class SymEngineCannot(Exception):
     """SymEngine cannot do this one (an unknown function, a derivative left unevaluated)."""
 
 
+class _Carrier(se.Symbol):
+    """A SymEngine symbol that converts back to the SymPy symbol it stands for (its
+    assumptions kept), so that a result comes back with the caller's symbols in one pass
+    instead of a second pass of SymPy's xreplace over the whole tree (half the time of
+    the conversion of a rigid body's derivatives). SymEngine takes it as equal to the plain
+    symbol of its name."""
+
+    def __init__(self, sym: sp.Symbol):
+        super().__init__(sym.name)
+        self.sym = sym
+
+    def _sympy_(self) -> sp.Symbol:
+        return self.sym
+
+
+_CARRIERS: dict[sp.Symbol, _Carrier] = {}  # one for each symbol (a subclass of Symbol is
+# kept alive by SymEngine's reference to it: made once, it is not made again)
+
+
+def _carrier(sym: sp.Symbol) -> _Carrier:
+    found = _CARRIERS.get(sym)
+    if found is None:
+        found = _CARRIERS[sym] = _Carrier(sym)
+    return found
+
+
 def to_sympy(e, symbols: Iterable[sp.Symbol]) -> sp.Basic:
     """A SymEngine result as SymPy, its symbols replaced by those of `symbols` (by name)."""
-    out = e._sympy_()
+    by_name = {s.name: s for s in symbols if type(s) is not sp.Dummy}
+    carry = {s: _carrier(by_name[s.name]) for s in e.free_symbols
+             if type(s) is se.Symbol and s.name in by_name}
+    out = (e.xreplace(carry) if carry else e)._sympy_()
     if out.has(sp.Derivative, sp.Subs):
         raise SymEngineCannot("a derivative left unevaluated")
-    by_name = {s.name: s for s in symbols}
-    back = {s: by_name[s.name] for s in out.free_symbols
-            if s.name in by_name and by_name[s.name] is not s}
-    return out.xreplace(back) if back else out
+    return out  # a Dummy comes back equal to itself (SymEngine keeps its index)
 
 
 def derivative(expr: sp.Basic, s: sp.Symbol) -> sp.Basic:
