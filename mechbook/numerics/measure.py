@@ -77,7 +77,7 @@ def signal_functions(system, dyn, values: dict, of: sp.Expr):
     """Compiled (signal, its time derivative on the motion) in (t, q, q̇)."""
     sub = {k: sp.Float(float(v), 17) for k, v in values.items()}
     acc = dict(zip(dyn.qdd, dyn.accelerations, strict=True))
-    rate = system.dt(of).subs(acc)
+    rate = system.dt(of).xreplace(acc)
     args = [system.t, *system.q, *system.qd]
     exprs = [of.xreplace(sub), rate.xreplace(sub)]
     fn, _ = compile_exprs(args, exprs)

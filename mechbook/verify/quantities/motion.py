@@ -71,13 +71,13 @@ def _residual_of_motion(ctx: Context, lin: LinearSystem, funcs: dict) -> Verdict
             subs.update({q: f, qd: sp.diff(f, t), qdd: sp.diff(f, t, 2)})
     checked = []
     for e in lin.equations():
-        r = e.subs(subs)
+        r = e.xreplace(subs)  # symbols only: SymPy's subs, without its pattern search
         if r.free_symbols & set(lin.q + lin.qd + lin.qdd):
             continue
         checked.append(r)
     for q, moved in lin.dependent.items():  # on a constraint manifold: as the others make it
         if q in coords:
-            r = (coords[q] - lin.point.get(q, 0) - moved).subs(subs)
+            r = (coords[q] - lin.point.get(q, 0) - moved).xreplace(subs)
             if not r.free_symbols & set(lin.q):
                 checked.append(r)
     if not checked:

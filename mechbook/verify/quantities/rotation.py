@@ -40,7 +40,7 @@ def _body(ctx: Context) -> str:
 def on_shell(ctx: Context, expr: sp.Expr) -> sp.Expr:
     """Accelerations replaced by the engine's (needed only if expr has any)."""
     if expr.free_symbols & set(ctx.dyn.qdd):
-        return expr.subs(dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True)))
+        return expr.xreplace(dict(zip(ctx.dyn.qdd, ctx.dyn.accelerations, strict=True)))
     return expr
 
 
