@@ -192,6 +192,12 @@ def main() -> None:
         print(f"  {sec:6.2f}  {pid}")
     print(f"outcomes: books the same in both configurations: {'yes' if same else 'NO'}; "
           f"not passing: {len(bad)}")
+    for a, b in zip(docs["books"], docs["all"], strict=True):
+        books, both = outcomes(a), outcomes(b)
+        for k in sorted(set(books) | {k for k in both if not k[0].startswith("classic-")},
+                        key=str):
+            if books.get(k) != both.get(k):
+                print(f"  differs: {k}: books {books.get(k)!r}; + classic {both.get(k)!r}")
     for line in bad:
         print(f"  {line}")
     if bad or not same:

@@ -31,11 +31,15 @@ class _Carrier(se.Symbol):
     """A SymEngine symbol that converts back to the SymPy symbol it stands for (its
     assumptions kept), so that a result comes back with the caller's symbols in one pass
     instead of a second pass of SymPy's xreplace over the whole tree (half the time of
-    the conversion of a rigid body's derivatives). SymEngine takes it as equal to the plain
-    symbol of its name."""
+    the conversion of a rigid body's derivatives).
 
-    def __init__(self, sym: sp.Symbol):
-        super().__init__(sym.name)
+    Its SymEngine name is its own ("r#3"), not the symbol's: SymEngine compares symbols by
+    name, and SymPy's cache keys a conversion (`Mul(*args)` of SymEngine arguments) by
+    them, so a carrier named plain "r" would be taken for the carrier of another problem's
+    r (real here, positive there) and come back as that r."""
+
+    def __init__(self, sym: sp.Symbol, index: int):
+        super().__init__(f"{sym.name}#{index}")
         self.sym = sym
 
     def _sympy_(self) -> sp.Symbol:
@@ -49,7 +53,7 @@ _CARRIERS: dict[sp.Symbol, _Carrier] = {}  # one for each symbol (a subclass of 
 def _carrier(sym: sp.Symbol) -> _Carrier:
     found = _CARRIERS.get(sym)
     if found is None:
-        found = _CARRIERS[sym] = _Carrier(sym)
+        found = _CARRIERS[sym] = _Carrier(sym, len(_CARRIERS))
     return found
 
 
