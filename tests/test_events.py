@@ -183,7 +183,9 @@ def test_without_the_compiled_loop_it_is_solve_ivp(tmp_path):
 def test_vector_atol_is_solve_ivps(tmp_path):
     """One atol per component, as solve_ivp takes it: the same steps (their number and the
     evaluations; the step points to rounding, which the first steps' error estimates,
-    below rounding themselves, amplify to ~1e-8), and not the steps of either scalar."""
+    below rounding themselves, amplify: 9.6e-9 where OpenBLAS sums solve_ivp's stages with
+    its Haswell kernel, 3.2e-7 on the same machine with its AVX-512 one, as on an AVX-512
+    CPU by default), and not the steps of either scalar."""
     model = model_of(tmp_path, "driven")
     y0 = np.array([0.4, 0.3])
     evals = {}
@@ -192,7 +194,7 @@ def test_vector_atol_is_solve_ivps(tmp_path):
         ref = solve_ivp(model.rhs_python, (0, 3), y0, method="DOP853", rtol=1e-8, atol=atol)
         assert run.status == 0 and len(run.t) == len(ref.t)
         assert run.evaluations == ref.nfev
-        assert np.allclose(run.t, ref.t, rtol=1e-7, atol=1e-12)
+        assert np.allclose(run.t, ref.t, rtol=1e-6, atol=1e-12)
         assert np.max(np.abs(run.y[:, -1] - ref.y[:, -1])) < 1e-11
         evals[tuple(atol)] = run.evaluations
     for atol in (1e-10, 1e-7):

@@ -553,11 +553,13 @@ def test_an_average_that_is_not_a_trig_polynomial_is_refused_within_seconds(tmp_
     from mechbook.app.authoring.validate import validate_file
 
     path = _ringed_planet_off_its_circle(tmp_path)
-    start = time.process_time()
+    # this thread's CPU: the process's would count what threads left running by earlier
+    # tests in the same worker spend (CI's run measured 56 s of process time here)
+    start = time.thread_time()
     with pytest.raises(SpecError, match="could not average over alpha") as err:
         validate_file(path)
     assert err.value.file == str(path) and err.value.line is not None
-    assert time.process_time() - start < 15  # was 63 s before the polynomial test
+    assert time.thread_time() - start < 15  # was 63 s before the polynomial test
 
 
 @pytest.mark.slow

@@ -302,11 +302,25 @@ def test_an_unbounded_motion_is_an_error_with_its_line(tree, tmp_path):
 def test_the_standard_map_exponent_grows_like_log_k_over_2(tree, tmp_path):
     """For large K the standard map's exponent approaches ln(K/2) (Chirikov): at K = 6,
     1.1 within ±0.3 (the pulses' width adds ~0.1, the run's spread ~0.2) — a value claim
-    with its tolerance."""
+    with its tolerance.
+
+    Past a few dozen kicks a chaotic run is a sample of the sea that rounding picks: the
+    start (1, 0.3) passed on one machine and was unresolved (spread 0.62, a sticky stretch)
+    on another whose OpenBLAS kernel rounds solve_ivp's stage sums otherwise. So eight
+    starts: none may fail (the claim is true), and most pass (35 of 40 nearby starts did;
+    the rest are unresolved, `unsupported` with the run's figures, as the quantity
+    promises)."""
     an = load_analysis(tree, ROTOR, "9305")
-    got = check(an, tmp_path, initial={"theta": 1.0, "thetadot": 0.3}, time=400,
-                max_step=0.005, book="log(3)", tolerance="0.3")
-    assert got[0] == "pass", got
+    outcomes = []
+    for k in range(8):
+        (tmp_path / str(k)).mkdir()
+        got = check(an, tmp_path / str(k), initial={"theta": 1.0, "thetadot": 0.3 + 0.1 * k},
+                    time=400, max_step=0.005, book="log(3)", tolerance="0.3")
+        assert got[0] in ("pass", "unsupported"), got
+        assert got[0] == "pass" or "neither lies within nor outside" in got[1] \
+            or "integration failed" in got[1], got
+        outcomes.append(got[0])
+    assert outcomes.count("pass") >= 4, outcomes
     assert math.log(3) == pytest.approx(1.0986, abs=1e-4)
 
 

@@ -21,7 +21,7 @@ import symengine as se
 import sympy as sp
 
 from mechbook.core.secalc import to_sympy
-from mechbook.core.timeout import Timeout, time_limit
+from mechbook.core.timeout import Timeout, hard_time_limit
 from mechbook.model.attitude import rotation_matrix
 
 
@@ -110,8 +110,8 @@ def _average(expr: sp.Expr, x: sp.Symbol, lo: sp.Expr, hi: sp.Expr) -> sp.Expr |
         out = _fourier_constant(expr, x)
         if out is not None:
             return out
-    try:
-        with time_limit(INTEGRAL_SECONDS):
+    try:  # a repeating alarm: one that SymPy swallows (a finalizer, a C callback) recurs
+        with hard_time_limit(INTEGRAL_SECONDS):
             out = sp.integrate(expr, (x, lo, hi)) / (hi - lo)
     except Timeout:
         return None
