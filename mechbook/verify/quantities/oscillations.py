@@ -11,7 +11,7 @@ from mechbook.core.identity import nonzero_determinant
 from mechbook.core.numeval import NotNumeric, evaluate_mp
 from mechbook.core.words import plural
 from mechbook.engine import perturbation
-from mechbook.engine.linear import LinearSystem, mp_matrix, secular_determinant
+from mechbook.engine.linear import LinearSystem, secular_determinant
 from mechbook.errors import MechbookError, UnsupportedError, WrongAnswerError
 from mechbook.model.manifold import Freedoms
 from mechbook.verify.asymptotic import asymptotic
@@ -419,7 +419,7 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
                                "coordinate: the velocity terms C couple it to the others")
             if "frequency" in item:
                 w = numbers([ctx.parse(item["frequency"], ("book", i, "frequency"))], pt)[0]
-                engine = _mode_frequency(lin, c, pt)
+                engine = lin.mode_frequency(c, pt)
                 if abs(engine - w) > 1e-8 * max(1, w):
                     return Verdict(False, "numeric", f"{item['coordinate']}: frequency "
                                    f"{w:.10g}, engine {engine:.10g}")
@@ -429,20 +429,6 @@ def check_normal_coordinates(ctx: Context, val) -> Verdict:
                       power="5 points: M⁻¹c an eigenvector to 1e-8 (a form up to a factor), "
                       "ω to 1e-8")
     return _proved_normal_coordinates(ctx, items, lin, numeric) if ctx.policy.prove else numeric
-
-
-def _mode_frequency(lin: LinearSystem, c: sp.Matrix, pt: dict) -> float:
-    """ω of the mode u = M⁻¹c from its Rayleigh quotient u·K·u / u·M·u at 50 digits. In
-    double precision a zero mode's quotient is rounding, ~1e-16 of K, and its square root
-    1e-8 (lim-2047's rigid rotation came out 1.41e-8 on an AVX-512 machine, against the
-    comparison's 1e-8); at 50 digits it is ~1e-25."""
-    import mpmath
-
-    with mpmath.workdps(50):
-        M, K, cv = (mp_matrix(X, pt, 50) for X in (lin.M, lin.K, c))
-        u = mpmath.lu_solve(M, cv)
-        w2 = (u.T * K * u)[0] / (u.T * M * u)[0]
-        return float(mpmath.sqrt(max(mpmath.re(w2), 0)))
 
 
 def _proved_normal_coordinates(ctx: Context, items: list, lin: LinearSystem,
