@@ -17,7 +17,12 @@ frequency is now taken from the quotient at 50 digits.
 
 from __future__ import annotations
 
+import math
+import random
+
+import numpy as np
 import pytest
+import sympy as sp
 from ruamel.yaml import YAML
 from systems import load_analysis
 
@@ -86,12 +91,6 @@ def test_the_zero_modes_frequency_is_free_of_rounding(tmp_path):
     """At 60 points of the ring, the rigid rotation's ω from the 50-digit quotient is below
     1e-20; the same quotient in double precision has a root past the comparison's 1e-8 at
     some of them (where its rounding comes out positive), as lim-2047's did."""
-    import math
-    import random
-
-    import numpy as np
-    import sympy as sp
-
     analysis = load_analysis(tmp_path, RING, "9711")
     system = analysis.system(None)
     lin = analysis.linear(None, {q: 0 for q in system.q})
